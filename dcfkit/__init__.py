@@ -1,0 +1,18 @@
+"""dcfkit: discriminative correlation filter trackers assembled from registered components."""
+from __future__ import annotations
+
+__version__ = "0.1.0"
+
+__all__ = ["__version__", "load_tracker", "load_config", "Tracker"]
+
+
+def __getattr__(name):  # lazy: importing dcfkit does no work
+    if name in ("load_tracker", "Tracker"):
+        from . import tracker
+
+        return getattr(tracker, name)
+    if name == "load_config":
+        from .config import load_config
+
+        return load_config
+    raise AttributeError(f"module 'dcfkit' has no attribute {name!r}")

@@ -1,0 +1,247 @@
+"""Tracker configs: YAML files with inheritance, dotted overrides and validation.
+
+A config names one component per slot (``features`` is a list) plus the tracker's geometry::
+
+    name: dr2track
+    base: strcf.yaml            # optional: inherit, then override (mappings merge, lists replace)
+    tracker: {search_area_scale: 5, cell_size: 4, ...}
+    features: [{name: gray}, {name: fhog}, {name: colornames}]
+    label: {name: distractor_repressed, top_n: 30, mu: 0.25}
+    regularizers: {spatial: {name: box}, temporal: {name: temporal, theta: 12}}
+    solver: {name: admm_strcf, iterations: 4}
+    search: {name: motion_aware}
+    scale: {name: dsst}
+
+Overrides are dotted keys (``label.mu=0.3``, ``features.0.name=gray``); a value ``null``
+removes an optional slot (``regularizers.temporal=null``).
+"""
+from __future__ import annotations
+
+import copy
+import dataclasses
+import hashlib
+import json
+from pathlib import Path
+from typing import Any, Mapping
+
+import yaml
+
+from .errors import ConfigError
+from .params import closest, param, parse_params
+
+SLOTS = ("features", "label", "regularizers", "solver", "search", "scale")
+TOP_LEVEL = ("name", "description", "base", "tracker") + SLOTS
+REGULARIZER_ROLES = ("spatial", "temporal")
+
+
+def shipped_config_dir() -> Path:
+    """Where the shipped configs are: the installed ``dcfkit.configs``, or ``configs/`` of a checkout."""
+    checkout = Path(__file__).resolve().parent.parent / "configs"
+    if checkout.is_dir():
+        return checkout
+    import importlib.resources
+
+    return Path(str(importlib.resources.files("dcfkit.configs")))
+
+
+@dataclasses.dataclass(frozen=True)
+class TrackerParams:
+    """Geometry of the search area and of the label (STRCF's init_size)."""
+
+    search_area_scale: float = param(5.0, "search area side / sqrt(target area) ('square') or per axis")
+    search_area_shape: str = param("square", "'square' (5√(WH) square) or 'proportional' (5W x 5H)",
+                                   choices=("square", "proportional"))
+    min_image_sample_size: float = param(150.0**2, "smallest area (px²) of the resampled search patch")
+    max_image_sample_size: float = param(200.0**2, "largest area (px²) of the resampled search patch")
+    cell_size: int = param(4, "feature cell size in pixels")
+    output_sigma_factor: float = param(1 / 16, "label σ as a fraction of sqrt(target area in cells)")
+    fft_backend: str = param("scipy", "FFT implementation", choices=("scipy", "pyfftw"))
+
+    def validate(self):
+        if self.search_area_scale < 1:
+            return "search_area_scale must be >= 1"
+        if not 0 < self.min_image_sample_size <= self.max_image_sample_size:
+            return "need 0 < min_image_sample_size <= max_image_sample_size"
+        if self.cell_size < 1:
+            return "cell_size must be >= 1"
+        if self.output_sigma_factor <= 0:
+            return "output_sigma_factor must be > 0"
+
+
+def _read_yaml(path: Path) -> dict:
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise ConfigError(f"cannot read config {path}: {exc.strerror}") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise ConfigError(f"{where}: YAML syntax error: {problem}") from None
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"{path}: a config must be a mapping, got {type(data).__name__}")
+    return data
+
+
+def merge(base: Mapping, override: Mapping) -> dict:
+    """Deep merge: mappings merge key by key, anything else (lists included) is replaced."""
+    out = copy.deepcopy(dict(base))
+    for key, value in override.items():
+        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = merge(out[key], value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+def _load_file(path: Path, chain: tuple[Path, ...] = ()) -> dict:
+    path = path.resolve()
+    if path in chain:
+        raise ConfigError(f"{path}: circular 'base' chain: {' -> '.join(map(str, chain + (path,)))}")
+    data = _read_yaml(path)
+    base = data.pop("base", None)
+    if base is None:
+        return data
+    if not isinstance(base, str):
+        raise ConfigError(f"{path}: 'base' must be a file name, got {base!r}")
+    base_path = (path.parent / base)
+    if not base_path.is_file():
+        raise ConfigError(f"{path}: base config '{base}' not found (looked for {base_path})")
+    return merge(_load_file(base_path, chain + (path,)), data)
+
+
+def parse_value(text: str) -> Any:
+    """A CLI override value: YAML scalars/lists ('0.3', 'true', '[1, 2]', 'null')."""
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError:
+        return text
+
+
+def set_dotted(config: dict, key: str, value: Any) -> None:
+    """Set ``a.b.0.c`` in nested dicts/lists; list indices are integers."""
+    parts = key.split(".")
+    node: Any = config
+    for i, part in enumerate(parts[:-1]):
+        where = ".".join(parts[: i + 1])
+        if isinstance(node, list):
+            node = node[_index(node, part, where)]
+        elif isinstance(node, dict):
+            if not isinstance(node.get(part), (dict, list)):
+                node[part] = {}
+            node = node[part]
+        else:
+            raise ConfigError(f"override '{key}': '{where}' is not a mapping")
+    last = parts[-1]
+    if isinstance(node, list):
+        node[_index(node, last, key)] = value
+    else:
+        node[last] = value
+
+
+def _index(items: list, part: str, where: str) -> int:
+    try:
+        i = int(part)
+    except ValueError:
+        raise ConfigError(f"override '{where}': this is a list; use an index 0..{len(items) - 1}") from None
+    if not -len(items) <= i < len(items):
+        raise ConfigError(f"override '{where}': index {i} out of range 0..{len(items) - 1}")
+    return i
+
+
+def load_config(source: str | Path | Mapping, overrides: Mapping[str, Any] | None = None) -> dict:
+    """Read a config (path, or a dict), apply dotted overrides, validate, fill in defaults.
+
+    A bare name such as 'dr2track' finds ``configs/dr2track.yaml``. Returns the fully
+    resolved config: every component with all its parameters.
+    """
+    if isinstance(source, Mapping):
+        data, origin = copy.deepcopy(dict(source)), "<config dict>"
+        base = data.pop("base", None)
+        if base is not None:
+            data = merge(_load_file(_find(base)), data)
+    else:
+        path = _find(source)
+        data, origin = _load_file(path), str(path)
+    for key, value in (overrides or {}).items():
+        set_dotted(data, key, value)
+    return resolve(data, origin)
+
+
+def _find(source: str | Path) -> Path:
+    path = Path(source)
+    if path.is_file():
+        return path
+    folder = shipped_config_dir()
+    for candidate in (folder / path, folder / f"{path}.yaml"):
+        if candidate.is_file():
+            return candidate
+    shipped = sorted(p.stem for p in folder.glob("*.yaml")) if folder.is_dir() else []
+    raise ConfigError(f"config not found: {source}" + (f"; shipped configs: {', '.join(shipped)}" if shipped else ""))
+
+
+def _component(registry, kind: str, spec: Any, where: str) -> dict:
+    instance = registry.build(kind, spec, where)
+    return {"name": type(instance).name, **dataclasses.asdict(instance.params)}
+
+
+def resolve(data: Mapping, origin: str) -> dict:
+    """Validate every key of ``data`` and return it with all defaults filled in."""
+    from .registry import get_registry
+
+    registry = get_registry()
+    unknown = [k for k in data if k not in TOP_LEVEL]
+    if unknown:
+        raise ConfigError(f"{origin}: unknown key '{unknown[0]}'{closest(unknown[0], TOP_LEVEL)}; "
+                          f"valid keys: {', '.join(TOP_LEVEL)}")
+    missing = [k for k in ("features", "label", "solver") if k not in data]
+    if missing:
+        raise ConfigError(f"{origin}: missing required key '{missing[0]}'")
+    out: dict[str, Any] = {"name": str(data.get("name") or Path(origin).stem)}
+    if data.get("description"):
+        out["description"] = str(data["description"])
+    tracker = parse_params(TrackerParams, data.get("tracker"), f"{origin}: tracker")
+    out["tracker"] = dataclasses.asdict(tracker)
+    features = data["features"]
+    if not isinstance(features, list) or not features:
+        raise ConfigError(f"{origin}: features must be a non-empty list, e.g. [{{name: fhog}}]")
+    out["features"] = [_component(registry, "feature", f, f"{origin}: features[{i}]") for i, f in enumerate(features)]
+    out["label"] = _component(registry, "label", data["label"], f"{origin}: label")
+    regs = data.get("regularizers") or {}
+    if not isinstance(regs, Mapping):
+        raise ConfigError(f"{origin}: regularizers must be a mapping with keys {', '.join(REGULARIZER_ROLES)}")
+    out["regularizers"] = {}
+    for role in regs:
+        if role not in REGULARIZER_ROLES:
+            raise ConfigError(f"{origin}: regularizers.{role}: unknown role{closest(role, REGULARIZER_ROLES)}; "
+                              f"valid: {', '.join(REGULARIZER_ROLES)}")
+    for role in REGULARIZER_ROLES:
+        spec = regs.get(role)
+        if spec is None:
+            out["regularizers"][role] = None
+            continue
+        where = f"{origin}: regularizers.{role}"
+        resolved = _component(registry, "regularizer", spec, where)
+        cls = registry.entry("regularizer", resolved["name"]).cls
+        if getattr(cls, "role", None) != role:
+            valid = [n for n in registry.names("regularizer")
+                     if getattr(registry.entry("regularizer", n).cls, "role", None) == role]
+            raise ConfigError(f"{where}: '{resolved['name']}' is a {getattr(cls, 'role', '?')} regularizer; "
+                              f"{role} ones: {', '.join(valid)}")
+        out["regularizers"][role] = resolved
+    out["solver"] = _component(registry, "solver", data["solver"], f"{origin}: solver")
+    out["search"] = _component(registry, "search", data.get("search", "fixed"), f"{origin}: search")
+    out["scale"] = _component(registry, "scale", data.get("scale", "pyramid"), f"{origin}: scale")
+    return out
+
+
+def config_hash(config: Mapping) -> str:
+    """Stable hash of a resolved config and the dcfkit version (for result keys)."""
+    from . import __version__
+
+    text = json.dumps({"config": config, "dcfkit": __version__}, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]

@@ -1,0 +1,571 @@
+"""One-pass evaluation (OPE) runner, result files, and OpenCV baseline trackers.
+
+A tracker is any object with ``init(image, box)`` and ``update(image) -> box``; images
+are ``(H, W, 3) uint8`` **BGR** (as ``cv2.imread`` returns them) and boxes are
+``(x, y, w, h)`` floats, **0-based**. Trackers come from a factory
+``make_tracker(config) -> tracker``, called once per sequence; the default is
+:func:`dcfkit.load_tracker`.
+
+Output layout of :func:`run_one_pass` (``OUT/<tracker name>/``):
+
+``<sequence>.txt``
+    one ``x,y,w,h`` line per frame, ``%.3f``, **1-based** (1 is added to x and y), so the
+    MATLAB OTB/UAV123 toolkit and pysot read it unchanged. Frame 0 holds the initial
+    ground-truth box. A lost target is written as ``nan,nan,nan,nan``.
+``<sequence>.json``
+    sidecar: per-frame tracker time in seconds (``init`` for frame 0, ``update`` after;
+    image decoding excluded), ``fps`` = frames / total tracker time, the config, its hash
+    and the dcfkit version. Written last, so it marks the sequence as done.
+``<sequence>.error.json``
+    written instead when the tracker raised: frame, error and traceback.
+
+Every file is written to a temporary file in the same folder and moved into place with
+``os.replace``, so an interrupted run never leaves a half-written file. On rerun a
+sequence is skipped when its sidecar has the same config hash and its ``.txt`` has one
+line per frame; failed sequences are retried.
+"""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import dataclasses
+import hashlib
+import json
+import logging
+import math
+import multiprocessing
+import os
+import tempfile
+import time
+import traceback
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any, Callable, Iterable, Mapping, Sequence as Seq
+
+import numpy as np
+
+from .datasets import DatasetError, Sequence, read_boxes
+from .errors import DcfkitError
+
+__all__ = [
+    "OpenCVTracker",
+    "OpenCVUnavailable",
+    "SequenceResult",
+    "add_eval_arguments",
+    "available_opencv_trackers",
+    "cmd_eval",
+    "config_hash",
+    "dcfkit_version",
+    "import_results",
+    "load_results",
+    "opencv_tracker",
+    "run_one_pass",
+]
+
+log = logging.getLogger(__name__)
+
+_THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+                "NUMEXPR_NUM_THREADS", "VECLIB_MAXIMUM_THREADS")
+
+
+# --------------------------------------------------------------------------- identity
+
+
+def dcfkit_version() -> str:
+    """``dcfkit.__version__``, else the installed distribution's version, else ``"unknown"``."""
+    import dcfkit
+
+    version = getattr(dcfkit, "__version__", None)
+    if version:
+        return str(version)
+    try:
+        import importlib.metadata
+
+        return importlib.metadata.version("dcfkit")
+    except Exception:
+        return "unknown"
+
+
+def _json_default(obj):
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return dataclasses.asdict(obj)
+    if isinstance(obj, (set, frozenset)):
+        return sorted(obj)
+    return str(obj)
+
+
+def config_hash(config: Mapping, version: str | None = None) -> str:
+    """16 hex digits of SHA-256 over the canonical JSON (sorted keys) of config + dcfkit version."""
+    payload = {"config": config, "dcfkit": version if version is not None else dcfkit_version()}
+    text = json.dumps(payload, sort_keys=True, separators=(",", ":"), default=_json_default)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _tracker_name(config: Mapping) -> str:
+    name = config.get("name") if isinstance(config, Mapping) else None
+    if not isinstance(name, str) or not name.strip():
+        raise ValueError("config has no top-level 'name' (the tracker name used for the output folder)")
+    if name in (".", "..") or any(c in name for c in "/\\:"):
+        raise ValueError(f"config 'name' {name!r} must be usable as a folder name (no / \\ :)")
+    return name
+
+
+# --------------------------------------------------------------------------- files
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` via a temporary file in the same folder + ``os.replace``."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+
+
+def _format_boxes(boxes: np.ndarray) -> str:
+    one_based = boxes + np.array([1.0, 1.0, 0.0, 0.0])
+    return "".join("%.3f,%.3f,%.3f,%.3f\n" % tuple(b) for b in one_based)
+
+
+def _count_lines(path: Path) -> int:
+    with open(path, "rb") as f:
+        return sum(1 for line in f if line.strip())
+
+
+def _paths(tracker_dir: Path, name: str) -> tuple[Path, Path, Path]:
+    return (tracker_dir / f"{name}.txt", tracker_dir / f"{name}.json",
+            tracker_dir / f"{name}.error.json")
+
+
+def _read_json(path: Path) -> dict | None:
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+
+
+def _is_done(tracker_dir: Path, seq: Sequence, chash: str) -> bool:
+    txt, side, _ = _paths(tracker_dir, seq.name)
+    meta = _read_json(side)
+    return (meta is not None and meta.get("config_hash") == chash
+            and txt.is_file() and _count_lines(txt) == len(seq))
+
+
+# --------------------------------------------------------------------------- tracking one sequence
+
+
+class _TrackerFailure(Exception):
+    def __init__(self, frame: int, message: str):
+        super().__init__(message)
+        self.frame = frame
+
+
+def _as_box(value, frame: int, seq: Sequence, method: str) -> np.ndarray:
+    try:
+        box = np.asarray(value, dtype=np.float64).reshape(4)
+    except (TypeError, ValueError):
+        raise _TrackerFailure(
+            frame, f"sequence {seq.name!r}, frame {frame} ({seq.frames[frame].name}): "
+                   f"{method} returned {value!r}, expected 4 numbers (x, y, w, h)") from None
+    return box
+
+
+def _default_factory(config):
+    from dcfkit import load_tracker  # lazy: the core is not needed to score results
+
+    return load_tracker(config)
+
+
+def _track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_tracker,
+                    chash: str, version: str, on_frame: Callable[[], None] | None = None) -> dict:
+    """Run one sequence and write its files; returns ``{"sequence", "status", ...}``."""
+    txt, side, err_file = _paths(tracker_dir, seq.name)
+    factory = make_tracker or _default_factory
+    boxes = np.full((len(seq), 4), np.nan)
+    times = np.zeros(len(seq))
+    frame = -1
+    try:
+        tracker = factory(dict(config))
+        for frame in range(len(seq)):
+            image = seq.frame(frame)  # decoding is not timed
+            t0 = time.perf_counter()
+            try:
+                if frame == 0:
+                    tracker.init(image, seq.init_box)
+                else:
+                    out = tracker.update(image)
+            except Exception as exc:
+                raise _TrackerFailure(
+                    frame, f"sequence {seq.name!r}, frame {frame} ({seq.frames[frame].name}): "
+                           f"{'init' if frame == 0 else 'update'} raised "
+                           f"{type(exc).__name__}: {exc}") from exc
+            times[frame] = time.perf_counter() - t0
+            boxes[frame] = seq.init_box if frame == 0 else _as_box(out, frame, seq, "update()")
+            if on_frame is not None:
+                on_frame()
+    except Exception as exc:
+        frame_no = exc.frame if isinstance(exc, _TrackerFailure) else frame
+        if isinstance(exc, (_TrackerFailure, DcfkitError)):
+            message = str(exc)
+        elif frame_no < 0:
+            message = f"sequence {seq.name!r}: creating the tracker raised {type(exc).__name__}: {exc}"
+        else:
+            message = f"sequence {seq.name!r}, frame {frame_no}: {type(exc).__name__}: {exc}"
+        cause = exc.__cause__ if isinstance(exc, _TrackerFailure) and exc.__cause__ else exc
+        record = {
+            "sequence": seq.name, "dataset": seq.dataset, "tracker": config.get("name"),
+            "frame": frame_no, "frame_file": str(seq.frames[frame_no]) if frame_no >= 0 else None,
+            "error": message, "type": type(cause).__name__,
+            "traceback": "".join(traceback.format_exception(cause)),
+            "config_hash": chash, "dcfkit_version": version,
+            "time": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        }
+        for stale in (side, txt):  # results of another config must not be mixed in
+            with contextlib.suppress(FileNotFoundError):
+                stale.unlink()
+        _atomic_write(err_file, json.dumps(record, indent=1, default=_json_default) + "\n")
+        return {"sequence": seq.name, "status": "failed", "error": message, "frames": len(seq)}
+
+    total = float(times.sum())
+    meta = {
+        "sequence": seq.name, "dataset": seq.dataset, "tracker": config["name"],
+        "frames": len(seq), "fps": len(seq) / total if total > 0 else None,
+        "total_time": total, "config_hash": chash, "dcfkit_version": version,
+        "time": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "config": config, "times": times.tolist(),
+    }
+    _atomic_write(txt, _format_boxes(boxes))
+    _atomic_write(side, json.dumps(meta, indent=1, default=_json_default) + "\n")  # marks done
+    with contextlib.suppress(FileNotFoundError):
+        err_file.unlink()
+    return {"sequence": seq.name, "status": "done", "fps": meta["fps"], "frames": len(seq)}
+
+
+# --------------------------------------------------------------------------- runner
+
+
+@contextlib.contextmanager
+def _single_threaded_env():
+    """Set the BLAS/OpenMP thread variables to 1 (inherited by spawned workers), then restore."""
+    saved = {k: os.environ.get(k) for k in _THREAD_VARS}
+    os.environ.update({k: "1" for k in _THREAD_VARS})
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def _worker_init():
+    os.environ.update({k: "1" for k in _THREAD_VARS})
+    with contextlib.suppress(Exception):
+        import cv2
+
+        cv2.setNumThreads(1)
+
+
+def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_tracker=None,
+                 jobs: int = 1, progress: bool = True) -> dict:
+    """One-pass evaluation of the tracker described by ``config`` on ``sequences``.
+
+    Each sequence starts from a fresh tracker (``make_tracker(config)``, default
+    :func:`dcfkit.load_tracker`) initialised on frame 0's ground truth. Results go to
+    ``out_dir/<config['name']>/`` (see the module docstring). Sequences already done with
+    the same config hash are skipped. A tracker exception fails only its sequence.
+    ``jobs > 1`` runs sequences in a spawned process pool with one BLAS/OpenMP thread per
+    worker; ``make_tracker`` must then be picklable (a module-level function or class).
+
+    Returns a plain dict: ``tracker``, ``dir``, ``config_hash``, ``done`` (computed now),
+    ``skipped`` (already done), ``failed`` (sequence -> message).
+    """
+    name = _tracker_name(config)
+    config = dict(config)
+    sequences = list(sequences)
+    bad = [s.name for s in sequences
+           if not (np.isfinite(s.ground_truth[0]).all() and (s.ground_truth[0, 2:] > 0).all())]
+    if bad:
+        raise DatasetError(
+            f"one-pass evaluation initialises on frame 0's ground truth, which is NaN or "
+            f"empty in sequence(s): {', '.join(bad)}")
+    version = dcfkit_version()
+    chash = config_hash(config, version)
+    tracker_dir = Path(out_dir) / name
+    tracker_dir.mkdir(parents=True, exist_ok=True)
+
+    todo = [s for s in sequences if not _is_done(tracker_dir, s, chash)]
+    summary = {"tracker": name, "dir": tracker_dir, "config_hash": chash,
+               "done": [], "skipped": [s.name for s in sequences if s not in todo], "failed": {}}
+
+    def record(result):
+        if result["status"] == "done":
+            summary["done"].append(result["sequence"])
+        else:
+            summary["failed"][result["sequence"]] = result["error"]
+            log.warning("%s: %s", name, result["error"])
+
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=sum(len(s) for s in todo), unit="frame", desc=name,
+               disable=not progress or not todo, dynamic_ncols=True)
+    try:
+        if jobs <= 1 or len(todo) <= 1:
+            for seq in todo:
+                bar.set_postfix_str(seq.name, refresh=False)
+                start = bar.n
+                record(_track_sequence(config, seq, tracker_dir, make_tracker, chash, version,
+                                       on_frame=lambda: bar.update(1)))
+                bar.update(start + len(seq) - bar.n)  # a failed sequence skips its rest
+        else:
+            with _single_threaded_env():
+                pool = ProcessPoolExecutor(max_workers=min(jobs, len(todo)),
+                                           mp_context=multiprocessing.get_context("spawn"),
+                                           initializer=_worker_init)
+                try:
+                    futures = {pool.submit(_track_sequence, config, seq, tracker_dir,
+                                           make_tracker, chash, version): seq for seq in todo}
+                    for future in as_completed(futures):
+                        result = future.result()
+                        record(result)
+                        bar.set_postfix_str(result["sequence"], refresh=False)
+                        bar.update(result["frames"])
+                finally:
+                    pool.shutdown(wait=True, cancel_futures=True)
+    finally:
+        bar.close()
+    order = {s.name: i for i, s in enumerate(sequences)}
+    summary["done"].sort(key=order.get)
+    return summary
+
+
+# --------------------------------------------------------------------------- reading results
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class SequenceResult:
+    """A tracker's result on one sequence: ``boxes`` ``(N, 4) float64`` 0-based;
+    ``times`` ``(N,) float64`` seconds per frame and ``fps`` when known (None for imports)."""
+
+    boxes: np.ndarray
+    times: np.ndarray | None = None
+    fps: float | None = None
+    config_hash: str | None = None
+
+
+def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]) -> dict[str, SequenceResult]:
+    """Completed results of ``tracker_name`` under ``out_dir`` for ``sequences``.
+
+    A sequence counts as completed when it has both ``.txt`` and ``.json`` sidecar;
+    others (not run, failed, interrupted) are left out of the returned dict. Raises
+    :class:`ValueError` if the completed sequences come from different configs, and
+    :class:`DatasetError` if a file has the wrong number of lines.
+    """
+    tracker_dir = Path(out_dir) / tracker_name
+    if not tracker_dir.is_dir():
+        raise DatasetError(f"no results folder for tracker {tracker_name!r}: {tracker_dir}")
+    results, hashes = {}, {}
+    for seq in sequences:
+        name = seq if isinstance(seq, str) else seq.name
+        txt, side, _ = _paths(tracker_dir, name)
+        meta = _read_json(side)
+        if meta is None or not txt.is_file():
+            continue
+        boxes = read_boxes(txt)
+        if not isinstance(seq, str) and len(boxes) != len(seq):
+            raise DatasetError(f"{txt}: {len(boxes)} lines but sequence {name!r} has {len(seq)} frames")
+        times = np.asarray(meta.get("times", []), dtype=np.float64)
+        fps = meta.get("fps")
+        results[name] = SequenceResult(boxes, times if times.size else None,
+                                       float(fps) if fps is not None else None, meta.get("config_hash"))
+        hashes.setdefault(meta.get("config_hash"), []).append(name)
+    if len(hashes) > 1:
+        detail = "; ".join(f"{h}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}" for h, v in hashes.items())
+        raise ValueError(
+            f"results in {tracker_dir} mix {len(hashes)} configurations ({detail}); rerun "
+            f"`dcfkit eval` with one config, or give the other config a different 'name'")
+    return results
+
+
+def import_results(folder) -> dict[str, SequenceResult]:
+    """Per-sequence result files of another tracker: ``folder/<sequence>.txt``, 1-based
+    ``x,y,w,h`` separated by commas, tabs or spaces. Returns 0-based boxes, no timings.
+    Files ending in ``_time.txt`` (timings written by some toolkits) are ignored."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise DatasetError(f"results folder not found: {folder}")
+    return {p.stem: SequenceResult(read_boxes(p))
+            for p in sorted(folder.glob("*.txt")) if not p.stem.endswith("_time")}
+
+
+# --------------------------------------------------------------------------- OpenCV baselines
+
+# Preferred constructor first: legacy trackers take and return float boxes (Rect2d).
+_OPENCV_CONSTRUCTORS = {
+    "CSRT": ("legacy.TrackerCSRT_create", "TrackerCSRT_create"),
+    "KCF": ("legacy.TrackerKCF_create", "TrackerKCF_create"),
+    "MOSSE": ("legacy.TrackerMOSSE_create",),
+}
+
+
+class OpenCVUnavailable(DcfkitError, LookupError):
+    """The requested OpenCV tracker is not in this OpenCV build."""
+
+
+def _opencv_constructor(name: str):
+    import cv2
+
+    for dotted in _OPENCV_CONSTRUCTORS[name]:
+        obj = cv2
+        for part in dotted.split("."):
+            obj = getattr(obj, part, None)
+            if obj is None:
+                break
+        if obj is not None:
+            return obj, dotted.startswith("legacy.")
+    return None, False
+
+
+def available_opencv_trackers() -> list[str]:
+    """Names of the OpenCV baselines this OpenCV build provides (subset of CSRT, KCF, MOSSE)."""
+    try:
+        return [n for n in _OPENCV_CONSTRUCTORS if _opencv_constructor(n)[0] is not None]
+    except ImportError:
+        return []
+
+
+class OpenCVTracker:
+    """An OpenCV tracker behind the dcfkit protocol (float ``(x, y, w, h)`` 0-based boxes).
+
+    When OpenCV reports a failure (``ok`` false) the previous box is returned, as the
+    tracker keeps no other estimate.
+    """
+
+    def __init__(self, name: str):
+        self.name = name
+        self._tracker = None
+        self._box = None
+
+    def init(self, image: np.ndarray, box) -> None:
+        create, legacy = _opencv_constructor(self.name)
+        self._tracker = create()
+        box = np.asarray(box, dtype=np.float64)
+        rect = tuple(float(v) for v in box) if legacy else (
+            int(round(box[0])), int(round(box[1])), max(1, int(round(box[2]))), max(1, int(round(box[3]))))
+        self._tracker.init(image, rect)
+        self._box = box.copy()
+
+    def update(self, image: np.ndarray) -> np.ndarray:
+        ok, rect = self._tracker.update(image)
+        rect = np.asarray(rect, dtype=np.float64)
+        if ok and np.isfinite(rect).all() and rect[2] > 0 and rect[3] > 0:
+            self._box = rect
+        return self._box.copy()
+
+
+class _OpenCVFactory:
+    """Picklable ``make_tracker`` for :func:`run_one_pass` (``jobs > 1``)."""
+
+    def __init__(self, name: str):
+        self.name = name
+
+    def __call__(self, config=None) -> OpenCVTracker:
+        return OpenCVTracker(self.name)
+
+    def __repr__(self):
+        return f"opencv_tracker({self.name!r})"
+
+
+def opencv_tracker(name: str) -> Callable[[Any], OpenCVTracker]:
+    """``make_tracker`` factory for OpenCV's CSRT, KCF or MOSSE (case-insensitive).
+
+    Raises :class:`OpenCVUnavailable` naming the available ones if this build lacks it.
+    Use with a config such as ``{"name": "opencv-kcf"}``.
+    """
+    key = str(name).upper()
+    if key not in _OPENCV_CONSTRUCTORS:
+        raise OpenCVUnavailable(f"unknown OpenCV tracker {name!r}; choose from {', '.join(_OPENCV_CONSTRUCTORS)}")
+    if key not in available_opencv_trackers():
+        raise OpenCVUnavailable(
+            f"OpenCV tracker {key} is not in this OpenCV build (available: "
+            f"{', '.join(available_opencv_trackers()) or 'none'}); install opencv-contrib-python-headless")
+    return _OpenCVFactory(key)
+
+
+# --------------------------------------------------------------------------- CLI
+
+
+def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
+    """``["a.b=3", "name=x"]`` -> ``{"a.b": 3, "name": "x"}`` (values parsed as YAML scalars)."""
+    out = {}
+    for item in items or ():
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise ValueError(f"--set expects KEY=VALUE, got {item!r}")
+        try:
+            import yaml
+
+            parsed = yaml.safe_load(value) if value.strip() else ""
+        except Exception:
+            parsed = value
+        out[key.strip()] = parsed
+    return out
+
+
+def add_eval_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """Arguments of ``dcfkit eval``."""
+    parser.add_argument("configs", nargs="+", metavar="CONFIG",
+                        help="tracker config YAML file(s); 'opencv:CSRT', 'opencv:KCF' or "
+                             "'opencv:MOSSE' runs an OpenCV baseline")
+    parser.add_argument("--dataset", default="auto",
+                        help="uav123, uav123_10fps, uav123_20l, dtb70, uavdt, otb (default: detect)")
+    parser.add_argument("--root", required=True, type=Path, help="benchmark root folder")
+    parser.add_argument("--out", required=True, type=Path, help="results folder (OUT/<tracker>/)")
+    parser.add_argument("--sequences", default=None, help="comma-separated sequence names (default: all)")
+    parser.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                        help="override a config value (repeatable), e.g. --set solver.iterations=3")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    return parser
+
+
+def _resolve_config(spec: str, overrides: Mapping[str, Any]) -> tuple[dict, Callable | None]:
+    """(config, make_tracker) for a CONFIG argument of ``dcfkit eval``."""
+    if spec.lower().startswith("opencv:"):
+        kind = spec.split(":", 1)[1]
+        factory = opencv_tracker(kind)
+        return {"name": f"opencv-{factory.name.lower()}", "opencv": factory.name, **overrides}, factory
+    from dcfkit.config import load_config  # lazy: only needed to run dcfkit trackers
+
+    return dict(load_config(spec, overrides)), None
+
+
+def cmd_eval(args: argparse.Namespace) -> int:
+    """``dcfkit eval``: run each config on the dataset; exit status 1 if any sequence failed."""
+    from .datasets import load_dataset
+
+    sequences = load_dataset(args.dataset, args.root, args.sequences)
+    overrides = parse_overrides(args.overrides)
+    status = 0
+    for spec in args.configs:
+        config, factory = _resolve_config(spec, overrides)
+        summary = run_one_pass(config, sequences, args.out, make_tracker=factory,
+                               jobs=args.jobs, progress=not args.no_progress)
+        print(f"{summary['tracker']}: {len(summary['done'])} run, {len(summary['skipped'])} "
+              f"already done, {len(summary['failed'])} failed -> {summary['dir']}")
+        for seq, message in summary["failed"].items():
+            print(f"  FAILED {message}")
+        status = status or (1 if summary["failed"] else 0)
+    return status

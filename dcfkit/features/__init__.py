@@ -1,0 +1,104 @@
+"""Feature components: each maps an image patch to a (C, H/cell, W/cell) float32 map.
+
+A feature has ``channels(...)`` and ``extract(patch, cell_size)``; the patch is an
+(H, W, 3) uint8 BGR array whose sides are multiples of ``cell_size``. The tracker stacks
+the maps of the configured features along the channel axis (the paper uses gray + fHOG + CN,
+1 + 31 + 10 = 42 channels at cell size 4).
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import cv2
+import numpy as np
+
+from ..params import param
+from ..registry import Component
+from .colornames import load_table, table_index
+from .fhog import fhog
+
+
+def cell_average(x: np.ndarray, cell_size: int) -> np.ndarray:
+    """Average (H, W[, C]) over non-overlapping cells -> (h, w[, C]) float32."""
+    if cell_size == 1:
+        return x.astype(np.float32, copy=False)
+    h, w = x.shape[0] // cell_size, x.shape[1] // cell_size
+    return cv2.resize(x.astype(np.float32, copy=False), (w, h), interpolation=cv2.INTER_AREA)
+
+
+class Feature(Component):
+    kind = "feature"
+
+    def channels(self) -> int:
+        raise NotImplementedError
+
+    def extract(self, patch: np.ndarray, cell_size: int) -> np.ndarray:
+        """(H, W, 3) uint8 BGR -> (C, H/cell, W/cell) float32."""
+        raise NotImplementedError
+
+
+class Gray(Feature):
+    """Gray level in [-0.5, 0.5], averaged over each cell."""
+
+    name = "gray"
+
+    def channels(self) -> int:
+        return 1
+
+    def extract(self, patch, cell_size):
+        gray = cv2.cvtColor(patch, cv2.COLOR_BGR2GRAY).astype(np.float32)
+        gray *= 1.0 / 255.0
+        gray -= 0.5
+        return cell_average(gray, cell_size)[None]
+
+
+class FHOG(Feature):
+    """Felzenszwalb HOG: 18 signed + 9 unsigned orientation bins + 4 texture channels."""
+
+    name = "fhog"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        n_orients: int = param(9, "unsigned orientation bins (signed ones: twice as many)")
+        clip: float = param(0.2, "truncation of the normalised histograms")
+
+        def validate(self):
+            if self.n_orients < 2:
+                return "n_orients must be at least 2"
+            if not 0 < self.clip <= 1:
+                return "clip must be in (0, 1]"
+
+    def channels(self) -> int:
+        return 3 * self.params.n_orients + 4
+
+    def extract(self, patch, cell_size):
+        return fhog(patch, cell_size=cell_size, n_orients=self.params.n_orients, clip=self.params.clip)
+
+
+class ColorNames(Feature):
+    """The 10-D normalised Color Names (van de Weijer et al. 2009), averaged over each cell."""
+
+    name = "colornames"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        table_path: str = param("", "a .npy/.mat CN table; empty: read it from the installed OpenCV")
+
+    def channels(self) -> int:
+        return 10
+
+    def extract(self, patch, cell_size):
+        table = load_table(self.params.table_path)
+        values = table[table_index(patch)]  # (H, W, 10)
+        return np.ascontiguousarray(cell_average(values, cell_size).transpose(2, 0, 1))
+
+
+BUILTIN = (Gray, FHOG, ColorNames)
+
+
+def extract_stack(features, patch: np.ndarray, cell_size: int) -> np.ndarray:
+    """Concatenate every feature's map of ``patch`` (gray patches are treated as BGR)."""
+    if patch.ndim == 2:
+        patch = cv2.cvtColor(patch, cv2.COLOR_GRAY2BGR)
+    maps = [f.extract(patch, cell_size) for f in features]
+    return maps[0] if len(maps) == 1 else np.concatenate(maps, axis=0)

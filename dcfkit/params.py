@@ -1,0 +1,120 @@
+"""Typed parameter schemas for components: frozen dataclasses built from YAML mappings.
+
+A component declares ``Params``, a frozen dataclass whose fields use :func:`param`
+(default + one-line description). :func:`parse_params` turns a YAML mapping into an
+instance, rejecting unknown keys (with the closest valid name) and wrong types.
+"""
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import typing
+from typing import Any, Mapping
+
+from .errors import ConfigError
+
+
+def param(default: Any, help: str, choices: tuple | None = None) -> Any:
+    """A dataclass field with a default, a one-line description and optional choices."""
+    meta = {"help": help}
+    if choices is not None:
+        meta["choices"] = tuple(choices)
+    if isinstance(default, (list, dict)):
+        raise TypeError("use tuples for sequence defaults")
+    return dataclasses.field(default=default, metadata=meta)
+
+
+@dataclasses.dataclass(frozen=True)
+class NoParams:
+    """A component without parameters."""
+
+
+def closest(name: str, options) -> str:
+    """' (did you mean X?)' for the closest option, or ''."""
+    match = difflib.get_close_matches(str(name), [str(o) for o in options], n=1)
+    return f" (did you mean '{match[0]}'?)" if match else ""
+
+
+def _coerce(value: Any, kind: Any, where: str) -> Any:
+    origin = typing.get_origin(kind)
+    if kind is Any:
+        return value
+    if origin is typing.Union:
+        args = [a for a in typing.get_args(kind) if a is not type(None)]
+        if value is None:
+            return None
+        return _coerce(value, args[0], where)
+    if origin in (tuple, list):
+        if not isinstance(value, (list, tuple)):
+            raise ConfigError(f"{where}: expected a list, got {value!r}")
+        (item,) = typing.get_args(kind)[:1] or (Any,)
+        return tuple(_coerce(v, item, f"{where}[{i}]") for i, v in enumerate(value))
+    if kind is bool:
+        if isinstance(value, bool):
+            return value
+        raise ConfigError(f"{where}: expected true or false, got {value!r}")
+    if kind is int:
+        if isinstance(value, int) and not isinstance(value, bool):
+            return value
+        if isinstance(value, float) and value.is_integer():
+            return int(value)
+        raise ConfigError(f"{where}: expected an integer, got {value!r}")
+    if kind is float:
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            return float(value)
+        if isinstance(value, str):  # YAML 1.1 reads '1e-3' as a string
+            try:
+                return float(value)
+            except ValueError:
+                pass
+        raise ConfigError(f"{where}: expected a number, got {value!r}")
+    if kind is str:
+        if isinstance(value, str):
+            return value
+        raise ConfigError(f"{where}: expected a string, got {value!r}")
+    return value
+
+
+def fields(schema: type) -> list[dict]:
+    """Describe a schema: name, type, default, help and choices of each field."""
+    hints = typing.get_type_hints(schema)
+    out = []
+    for f in dataclasses.fields(schema):
+        out.append({
+            "name": f.name,
+            "type": getattr(hints[f.name], "__name__", str(hints[f.name])),
+            "default": f.default,
+            "help": f.metadata.get("help", ""),
+            "choices": f.metadata.get("choices"),
+        })
+    return out
+
+
+def parse_params(schema: type, values: Mapping[str, Any] | None, where: str) -> Any:
+    """Build ``schema`` from ``values``; ``where`` (e.g. 'dr2track.yaml: label') prefixes errors."""
+    values = dict(values or {})
+    hints = typing.get_type_hints(schema)
+    known = {f.name: f for f in dataclasses.fields(schema)}
+    unknown = [k for k in values if k not in known]
+    if unknown:
+        k = unknown[0]
+        valid = ", ".join(known) or "none"
+        raise ConfigError(f"{where}: unknown parameter '{k}'{closest(k, known)}; valid parameters: {valid}")
+    kwargs = {}
+    for name, value in values.items():
+        key = f"{where}.{name}"
+        kwargs[name] = _coerce(value, hints[name], key)
+        choices = known[name].metadata.get("choices")
+        if choices is not None and kwargs[name] not in choices:
+            raise ConfigError(f"{key}: {kwargs[name]!r} is not one of {', '.join(map(str, choices))}"
+                              f"{closest(kwargs[name], choices)}")
+    try:
+        instance = schema(**kwargs)
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f"{where}: {exc}") from None
+    check = getattr(instance, "validate", None)
+    if check is not None:
+        problem = check()
+        if problem:
+            raise ConfigError(f"{where}: {problem}")
+    return instance

@@ -1,0 +1,48 @@
+"""Image patches: crop a region around a centre (edges replicated) and resize it.
+
+Coordinates are 0-based pixel indices, (y, x) order for centres and (h, w) for sizes; a box
+(x, y, w, h) covering pixels x..x+w-1 has its centre at x + (w - 1) / 2.
+"""
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+
+def box_to_centre_size(box) -> tuple[np.ndarray, np.ndarray]:
+    """(x, y, w, h) -> centre (y, x) and size (h, w), float64."""
+    x, y, w, h = (float(v) for v in box)
+    return np.array([y + (h - 1) / 2, x + (w - 1) / 2]), np.array([h, w])
+
+
+def centre_size_to_box(centre, size) -> tuple[float, float, float, float]:
+    """Inverse of :func:`box_to_centre_size`."""
+    (cy, cx), (h, w) = centre, size
+    return (float(cx - (w - 1) / 2), float(cy - (h - 1) / 2), float(w), float(h))
+
+
+def crop(image: np.ndarray, centre, region) -> np.ndarray:
+    """The ``region`` (h, w) pixels around ``centre`` (y, x); outside pixels replicate the edge."""
+    rh, rw = max(int(round(region[0])), 1), max(int(round(region[1])), 1)
+    y0 = int(np.floor(centre[0] - (rh - 1) / 2 + 0.5))
+    x0 = int(np.floor(centre[1] - (rw - 1) / 2 + 0.5))
+    height, width = image.shape[:2]
+    if y0 >= 0 and x0 >= 0 and y0 + rh <= height and x0 + rw <= width:
+        return image[y0:y0 + rh, x0:x0 + rw]
+    rows = np.clip(np.arange(y0, y0 + rh), 0, height - 1)
+    cols = np.clip(np.arange(x0, x0 + rw), 0, width - 1)
+    return image[rows[:, None], cols[None, :]]
+
+
+def resize(patch: np.ndarray, out) -> np.ndarray:
+    """Resize to ``out`` (h, w): area averaging when shrinking, bilinear when enlarging."""
+    oh, ow = int(out[0]), int(out[1])
+    if patch.shape[:2] == (oh, ow):
+        return np.ascontiguousarray(patch)
+    shrink = patch.shape[0] * patch.shape[1] > oh * ow
+    return cv2.resize(patch, (ow, oh), interpolation=cv2.INTER_AREA if shrink else cv2.INTER_LINEAR)
+
+
+def sample(image: np.ndarray, centre, region, out) -> np.ndarray:
+    """Crop ``region`` (h, w) around ``centre`` and resize it to ``out`` (h, w)."""
+    return resize(crop(image, centre, region), out)

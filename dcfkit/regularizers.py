@@ -1,0 +1,116 @@
+"""Regularizers of the filter: spatial (the window w of Eqs. 1, 2, 10) and temporal (θ).
+
+A spatial regularizer returns w² over the filter grid, (H, W) float32 in the centred layout
+of the image patch (the target in the middle). The solver's h-step (Eq. 10) uses it as
+h = γK (v + z) / (w² + γK); ``inf`` entries force h to zero there, which is BACF's
+cropping matrix P (h = P^T P h). The temporal regularizer contributes θ‖h - h_prev‖²
+(Eq. 1); its θ is 0 on the first frame (Remark 1).
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from .params import param
+from .registry import Component
+
+
+def _target_mask(shape: tuple[int, int], target_cells: tuple[float, float]) -> np.ndarray:
+    """Boolean (H, W): the target-sized box (its size in cells, floored) centred on the patch."""
+    mask = np.zeros(shape, dtype=bool)
+    spans = []
+    for size, extent in zip(shape, target_cells):
+        extent = int(min(max(np.floor(extent), 1), size))
+        start = (size - extent) // 2  # centred on the patch centre, (size - 1) / 2
+        spans.append(slice(start, start + extent))
+    mask[spans[0], spans[1]] = True
+    return mask
+
+
+class SpatialRegularizer(Component):
+    kind = "regularizer"
+    role = "spatial"
+
+    def weights_squared(self, shape: tuple[int, int], target_cells: tuple[float, float]) -> np.ndarray:
+        """w² over the (H, W) filter grid, centred layout."""
+        raise NotImplementedError
+
+
+class BoxWindow(SpatialRegularizer):
+    """STRCF/DR²Track window: ``inside`` on the target box, ``outside`` elsewhere."""
+
+    name = "box"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        inside: float = param(1e-3, "w inside the target box (reg_window_min)")
+        outside: float = param(1e5, "w outside the target box (reg_window_max)")
+
+        def validate(self):
+            if not 0 <= self.inside <= self.outside:
+                return "need 0 <= inside <= outside"
+
+    def weights_squared(self, shape, target_cells):
+        w = np.where(_target_mask(shape, target_cells), self.params.inside, self.params.outside)
+        return (w**2).astype(np.float32)
+
+
+class SmoothWindow(SpatialRegularizer):
+    """SRDCF's quadratic window: w = min + (edge - min)·((2y/h)² + (2x/w)²) — 'edge' at the box border."""
+
+    name = "smooth"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        minimum: float = param(0.1, "w at the target centre")
+        edge: float = param(3.0, "w at the border of the target box")
+        power: float = param(2.0, "exponent of the normalised distance")
+
+        def validate(self):
+            if not 0 <= self.minimum <= self.edge:
+                return "need 0 <= minimum <= edge"
+
+    def weights_squared(self, shape, target_cells):
+        ys = (np.arange(shape[0]) - (shape[0] - 1) / 2) / max(target_cells[0] / 2, 0.5)
+        xs = (np.arange(shape[1]) - (shape[1] - 1) / 2) / max(target_cells[1] / 2, 0.5)
+        p = self.params.power
+        w = self.params.minimum + (self.params.edge - self.params.minimum) * (
+            np.abs(ys)[:, None] ** p + np.abs(xs)[None, :] ** p)
+        return (w**2).astype(np.float32)
+
+
+class Crop(SpatialRegularizer):
+    """BACF: h is zero outside the target box (cropping matrix P) and λ‖h‖² inside."""
+
+    name = "crop"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        lam: float = param(0.01, "λ: ridge weight on the filter inside the box")
+
+        def validate(self):
+            if self.lam < 0:
+                return "lam must be >= 0"
+
+    def weights_squared(self, shape, target_cells):
+        return np.where(_target_mask(shape, target_cells), self.params.lam, np.inf).astype(np.float32)
+
+
+class Temporal(Component):
+    """θ/2 ‖h - h_prev‖² of Eq. (1) (STRCF's temporal regularization)."""
+
+    kind = "regularizer"
+    role = "temporal"
+    name = "temporal"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        theta: float = param(15.0, "θ: weight of the distance to the previous frame's filter")
+
+        def validate(self):
+            if self.theta < 0:
+                return "theta must be >= 0"
+
+
+BUILTIN = (BoxWindow, SmoothWindow, Crop, Temporal)

@@ -1,0 +1,133 @@
+"""Scale estimators.
+
+``pyramid`` (STRCF, BACF): the translation filter is evaluated on samples at a few relative
+scales and the best response picks the scale. ``dsst`` (DR²Track, after Danelljan et al.
+PAMI 2017): a separate 1-D correlation filter over a pyramid of target-sized fHOG samples.
+Both keep the scale within limits set at init (target at least ~5 px, at most the image).
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from .features.fhog import fhog
+from .params import param
+from .patches import sample
+from .registry import Component
+
+
+class ScaleEstimator(Component):
+    kind = "scale"
+
+    def init(self, image: np.ndarray, centre: np.ndarray, base_target: np.ndarray, scale: float,
+             limits: tuple[float, float]) -> None:
+        """First frame: target centre (y, x), size at scale 1 (h, w), current scale, (min, max) scale."""
+        self.base_target = np.asarray(base_target, dtype=float)
+        self.limits = limits
+
+    def search_factors(self) -> np.ndarray:
+        """Relative scales at which the translation filter is evaluated."""
+        return np.ones(1)
+
+    def update(self, image: np.ndarray, centre: np.ndarray, scale: float) -> float:
+        """After translation: the new scale (``scale`` already includes the chosen search factor)."""
+        return float(np.clip(scale, *self.limits))
+
+
+def _factors(n: int, step: float) -> np.ndarray:
+    return step ** (np.arange(n) - (n - 1) / 2)
+
+
+class Pyramid(ScaleEstimator):
+    """Evaluate the translation filter at ``n_scales`` scales ``step`` apart."""
+
+    name = "pyramid"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        n_scales: int = param(5, "number of scales searched")
+        step: float = param(1.01, "ratio between neighbouring scales")
+
+        def validate(self):
+            if self.n_scales < 1:
+                return "n_scales must be >= 1"
+            if self.step <= 1:
+                return "step must be > 1"
+
+    def search_factors(self):
+        return _factors(self.params.n_scales, self.params.step)
+
+
+class DSST(ScaleEstimator):
+    """Discriminative scale filter: fHOG of S target-sized samples, a 1-D filter over scale."""
+
+    name = "dsst"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        n_scales: int = param(33, "number of scales in the scale filter")
+        step: float = param(1.03, "ratio between neighbouring scales")
+        sigma_factor: float = param(0.25, "label width: σ = n_scales / √33 · sigma_factor")
+        lam: float = param(0.01, "regularization of the scale filter")
+        learning_rate: float = param(0.025, "interpolation rate of the scale model")
+        model_max_area: int = param(512, "largest area (pixels) of a scale sample")
+        cell_size: int = param(4, "fHOG cell size of the scale samples")
+
+        def validate(self):
+            if self.n_scales < 3:
+                return "n_scales must be >= 3"
+            if self.step <= 1:
+                return "step must be > 1"
+            if not 0 < self.learning_rate <= 1:
+                return "learning_rate must be in (0, 1]"
+
+    def init(self, image, centre, base_target, scale, limits):
+        super().init(image, centre, base_target, scale, limits)
+        p = self.params
+        n = p.n_scales
+        self.factors = _factors(n, p.step)
+        offsets = np.arange(n) - (n - 1) // 2
+        sigma = n / np.sqrt(33) * p.sigma_factor
+        self.label_f = np.fft.fft(np.exp(-0.5 * offsets**2 / sigma**2))
+        self.window = np.hanning(n + 2)[1:-1]
+        area = float(np.prod(self.base_target))
+        shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
+        self.model_size = np.maximum(np.round(self.base_target * shrink), 2 * p.cell_size).astype(int)
+        self.num = self.den = None
+        self._learn(image, centre, scale)
+
+    def _samples(self, image, centre, scale) -> np.ndarray:
+        """(D, S) windowed fHOG of the S scale samples around ``centre``."""
+        patches = np.stack([sample(image, centre, self.base_target * scale * f, self.model_size)
+                            for f in self.factors])
+        feats = fhog(patches, cell_size=self.params.cell_size, batch=True)
+        return feats.reshape(len(self.factors), -1).T * self.window[None, :]
+
+    def _learn(self, image, centre, scale):
+        xsf = np.fft.fft(self._samples(image, centre, scale), axis=1)
+        num = self.label_f[None, :] * xsf.conj()
+        den = np.einsum("ds,ds->s", xsf, xsf.conj()).real
+        if self.num is None:
+            self.num, self.den = num, den
+        else:
+            lr = self.params.learning_rate
+            self.num = (1 - lr) * self.num + lr * num
+            self.den = (1 - lr) * self.den + lr * den
+
+    def update(self, image, centre, scale):
+        xsf = np.fft.fft(self._samples(image, centre, scale), axis=1)
+        resp = np.fft.ifft(np.einsum("ds,ds->s", self.num, xsf) / (self.den + self.params.lam)).real
+        scale = float(np.clip(scale * self.factors[int(np.argmax(resp))], *self.limits))
+        self._learn(image, centre, scale)
+        return scale
+
+
+def scale_limits(base_target: np.ndarray, base_region: np.ndarray, image_shape, min_pixels: float = 5.0) -> tuple[float, float]:
+    """(min, max) scale: the search region keeps ≥ ``min_pixels`` px; the target fits in the image."""
+    lo = np.max(min_pixels / np.asarray(base_region, dtype=float))
+    hi = np.min(np.asarray(image_shape[:2], dtype=float) / np.asarray(base_target, dtype=float))
+    return float(lo), float(max(hi, lo))
+
+
+BUILTIN = (Pyramid, DSST)

@@ -1,0 +1,149 @@
+"""Filter solvers: ADMM for the spatially and temporally regularized objective (Eqs. 4–11).
+
+Objective solved each frame (Eq. 2, with λ = 1 on the spatial term as in Eq. 10):
+
+    E(h) = ½‖ŷ - Σ_c conj(ĥ_c) m̂_c‖² + θ/2 Σ_c‖ĥ_c - v̂ˡ_c‖² + ½ Σ_c‖w ⊙ h_c‖²,
+
+the first two terms in the (unnormalised) Fourier domain, i.e. K times their spatial
+value. ADMM splits h = v and alternates (per frame, from h = u = 0, Remark 1):
+
+* v-step (Eqs. 6–9): per frequency, (a aᴴ + (θ+γ) I) v = a conj(ŷ) + θ v̂ˡ + γ ĥ - û, with
+  a = m̂ at that frequency, solved by Sherman–Morrison;
+* h-step (Eq. 10): h = γK (v + u/γ) / (w² + γK) in the spatial domain;
+* multiplier (Eq. 11): û ← û + γ (v̂ - ĥ), then γ ← min(γ_max, β γ).
+
+The multiplier is kept unscaled (u = γ z of the paper), the standard form when γ changes
+between iterations; with a fixed γ the two forms are identical. Spectra are half spectra
+(rfft2) of real maps, shape (C, H, W//2+1) complex64; every equation above is per
+frequency, so solving on the half spectrum is exact.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from .params import param
+from .registry import Component
+
+
+def sherman_morrison_solve(a: np.ndarray, b: np.ndarray, c: float | np.ndarray,
+                           aa: np.ndarray | None = None) -> np.ndarray:
+    """Solve (a aᴴ + c I) x = b independently per pixel (Eq. 9).
+
+    a, b: (C, ...) complex; c > 0 scalar or (...); aa: precomputed Σ|a|² (...). Returns (C, ...).
+    """
+    if aa is None:
+        aa = np.einsum("c...,c...->...", a.conj(), a).real
+    ahb = np.einsum("c...,c...->...", a.conj(), b)
+    return (b - a * (ahb / (c + aa))) / c
+
+
+@dataclasses.dataclass(frozen=True)
+class ADMMParams:
+    iterations: int = param(4, "E: ADMM iterations per frame")
+    gamma0: float = param(1.0, "γ⁰: initial penalty")
+    beta: float = param(10.0, "β: penalty growth per iteration")
+    gamma_max: float = param(10000.0, "γ_max: largest penalty")
+
+    def validate(self):
+        if self.iterations < 1:
+            return "iterations must be >= 1"
+        if self.gamma0 <= 0 or self.gamma_max <= 0 or self.beta <= 0:
+            return "gamma0, beta and gamma_max must be > 0"
+
+
+def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: np.ndarray | None,
+         p: ADMMParams, fft) -> tuple[np.ndarray, np.ndarray]:
+    """Run E iterations of Eqs. (9)-(11).
+
+    xf: (C, H, Wr) complex64 training sample; yf: (H, Wr) label spectrum; w2: (H, W) float32 w²
+    in the patch layout, target centred, like h itself (may hold inf); theta: temporal weight (ignored when v_prev is None);
+    v_prev: (C, H, Wr) last frame's filter. Returns (v̂, ĥ), each (C, H, Wr) complex64.
+    """
+    shape = w2.shape
+    K = float(shape[0] * shape[1])
+    if v_prev is None:
+        theta = 0.0
+    aa = np.einsum("chw,chw->hw", xf.conj(), xf).real
+    rhs0 = xf * yf.conj()[None]
+    if theta > 0:
+        rhs0 = rhs0 + theta * v_prev
+    hf = np.zeros_like(xf)
+    uf = np.zeros_like(xf)
+    gamma = p.gamma0
+    for _ in range(p.iterations):
+        c = theta + gamma
+        vf = sherman_morrison_solve(xf, rhs0 + gamma * hf - uf, c, aa)
+        shrink = (gamma * K) / (w2 + gamma * K)
+        h = shrink * fft.irfft2(vf + uf / gamma, shape)
+        hf = fft.rfft2(h.astype(np.float32, copy=False)).astype(np.complex64, copy=False)
+        uf = uf + gamma * (vf - hf)
+        gamma = min(p.gamma_max, p.beta * gamma)
+    return vf.astype(np.complex64, copy=False), hf
+
+
+class Solver(Component):
+    """Trains the filter of one frame. State between frames lives in the solver instance."""
+
+    kind = "solver"
+    Params = ADMMParams
+
+    def __init__(self, params=None):
+        super().__init__(params)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget everything learnt (called by the tracker's init)."""
+        raise NotImplementedError
+
+    def train(self, xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, fft) -> np.ndarray:
+        """One frame: sample (C, H, Wr), label spectrum (H, Wr), w² (H, W), θ -> filter (C, H, Wr)."""
+        raise NotImplementedError
+
+
+class ADMMStrcf(Solver):
+    """STRCF/DR²Track: current sample, temporal term towards the previous filter (Eqs. 4–11)."""
+
+    name = "admm_strcf"
+
+    def reset(self):
+        self.v_prev = None
+
+    def train(self, xf, yf, w2, theta, fft):
+        vf, _ = admm(xf, yf, w2, theta, self.v_prev, self.params, fft)
+        self.v_prev = vf
+        return vf
+
+
+@dataclasses.dataclass(frozen=True)
+class BACFParams(ADMMParams):
+    iterations: int = param(2, "E: ADMM iterations per frame")
+    learning_rate: float = param(0.013, "η: weight of the new sample in the running sample model")
+
+    def validate(self):
+        return super().validate() or (None if 0 < self.learning_rate <= 1 else "learning_rate must be in (0, 1]")
+
+
+class ADMMBacf(Solver):
+    """BACF: ADMM on a running average of the samples, x̂ ← (1-η) x̂ + η m̂; with the
+    ``crop`` regularizer the h-step is BACF's h = P^T P ifft(...) with λ (Kiani Galoogahi 2017)."""
+
+    name = "admm_bacf"
+    Params = BACFParams
+
+    def reset(self):
+        self.model = None
+        self.v_prev = None
+
+    def train(self, xf, yf, w2, theta, fft):
+        if self.model is None:
+            self.model = xf.copy()
+        else:
+            self.model = (1 - self.params.learning_rate) * self.model + self.params.learning_rate * xf
+        vf, _ = admm(self.model, yf, w2, theta, self.v_prev, self.params, fft)
+        self.v_prev = vf
+        return vf
+
+
+BUILTIN = (ADMMStrcf, ADMMBacf)

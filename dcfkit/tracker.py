@@ -1,0 +1,199 @@
+"""The DCF tracking loop: Algorithm 1 of DR²Track, with every step a configured component.
+
+Frame 1 (``init``): extract the sample m¹ at the ground truth, train h¹ (θ = 0), V¹ = 0.
+Frame t (``update``): centre the search area (Eq. 14), compute the response (Eq. 12) at each
+search scale, take the peak as p^t, update the scale, extract m^t at p^t, build the label
+(Eq. 3 for the repressed label), train h^t (Eqs. 9–11), and update the velocity (Eq. 13).
+
+Images are (H, W, 3) uint8 BGR or (H, W) uint8 gray; boxes are (x, y, w, h) floats,
+0-based pixels. The tracker is deterministic.
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Mapping
+
+import numpy as np
+
+from .config import TrackerParams, load_config
+from .errors import InputError, TrackingError
+from .features import extract_stack
+from .fft import make_fft
+from .labels import Detection, gaussian_label
+from .patches import box_to_centre_size, centre_size_to_box, sample
+from .registry import get_registry
+from .response import response, subpixel_peak
+from .scale import scale_limits
+
+
+def check_image(image: Any, frame: int) -> np.ndarray:
+    """Reject anything but a non-empty (H, W) or (H, W, 3) uint8 array, naming the frame."""
+    if not isinstance(image, np.ndarray):
+        raise InputError(f"frame {frame}: expected a numpy image, got {type(image).__name__}")
+    if image.dtype != np.uint8:
+        raise InputError(f"frame {frame}: expected a uint8 image, got dtype {image.dtype}")
+    if image.ndim == 3 and image.shape[2] == 1:
+        image = image[:, :, 0]
+    if not (image.ndim == 2 or (image.ndim == 3 and image.shape[2] == 3)):
+        raise InputError(f"frame {frame}: expected an HxW or HxWx3 image, got shape {image.shape}")
+    if image.shape[0] < 1 or image.shape[1] < 1:
+        raise InputError(f"frame {frame}: the image is empty (shape {image.shape})")
+    return image
+
+
+def check_box(box: Any, image_shape: tuple[int, ...]) -> np.ndarray:
+    """A finite (x, y, w, h) with positive size that overlaps the image."""
+    try:
+        b = np.asarray(box, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError(f"initial box must be 4 numbers (x, y, w, h), got {box!r}") from None
+    if b.size != 4 or not np.all(np.isfinite(b)):
+        raise InputError(f"initial box must be 4 finite numbers (x, y, w, h), got {box!r}")
+    x, y, w, h = b
+    if w <= 0 or h <= 0:
+        raise InputError(f"initial box {tuple(b)} has non-positive size (w={w}, h={h})")
+    height, width = image_shape[:2]
+    if x + w <= 0 or y + h <= 0 or x >= width or y >= height:
+        raise InputError(f"initial box {tuple(b)} lies outside the {width}x{height} image")
+    return b
+
+
+def hann2d(shape: tuple[int, int]) -> np.ndarray:
+    """Cosine window without zero borders (hann(n + 2) trimmed), (H, W) float32."""
+    return np.outer(np.hanning(shape[0] + 2)[1:-1], np.hanning(shape[1] + 2)[1:-1]).astype(np.float32)
+
+
+@dataclasses.dataclass
+class Geometry:
+    """Sizes fixed at init, in pixels at scale 1 unless stated (see STRCF's init_size)."""
+
+    base_target: np.ndarray      # (h, w) target
+    sample_size: np.ndarray      # (h, w) resampled search patch, a multiple of the cell size
+    filter_size: tuple[int, int]  # (H, W) in cells
+    target_cells: tuple[float, float]
+
+
+class Tracker:
+    """A DCF tracker assembled from components (see :func:`dcfkit.load_tracker`)."""
+
+    def __init__(self, config: Mapping[str, Any]):
+        registry = get_registry()
+        self.config = dict(config)
+        self.name = config["name"]
+        self.params = TrackerParams(**config["tracker"])
+        build = lambda kind, spec, where: registry.build(kind, spec, f"{self.name}: {where}")  # noqa: E731
+        self.features = [build("feature", f, f"features[{i}]") for i, f in enumerate(config["features"])]
+        self.label = build("label", config["label"], "label")
+        regs = config["regularizers"]
+        self.spatial = build("regularizer", regs["spatial"], "regularizers.spatial") if regs.get("spatial") else None
+        self.temporal = build("regularizer", regs["temporal"], "regularizers.temporal") if regs.get("temporal") else None
+        self.solver = build("solver", config["solver"], "solver")
+        self.search = build("search", config["search"], "search")
+        self.scale_estimator = build("scale", config["scale"], "scale")
+        self.fft = make_fft(self.params.fft_backend)
+        self.frame = 0
+        self.last_response: np.ndarray | None = None
+        self.last_distractors = np.zeros((0, 2))
+
+    # -- geometry ---------------------------------------------------------------------------
+    def _geometry(self, target: np.ndarray) -> tuple[Geometry, float]:
+        p = self.params
+        region = (np.full(2, p.search_area_scale * np.sqrt(np.prod(target))) if p.search_area_shape == "square"
+                  else target * p.search_area_scale)
+        area = float(np.prod(region))
+        scale = 1.0
+        if area > p.max_image_sample_size:
+            scale = np.sqrt(area / p.max_image_sample_size)
+        elif area < p.min_image_sample_size:
+            scale = np.sqrt(area / p.min_image_sample_size)
+        cells = np.maximum(np.round(region / scale / p.cell_size), 4).astype(int)
+        base_target = target / scale
+        target_cells = tuple(float(v) for v in base_target / p.cell_size)
+        geom = Geometry(base_target, cells * p.cell_size, (int(cells[0]), int(cells[1])), target_cells)
+        return geom, float(scale)
+
+    def _sample(self, image: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
+        """(C, H, Wr) complex64 spectrum of the windowed features of the patch at ``centre``."""
+        g = self.geometry
+        patch = sample(image, centre, g.sample_size * scale, g.sample_size)
+        x = extract_stack(self.features, patch, self.params.cell_size)
+        return self.fft.rfft2(x * self.window).astype(np.complex64, copy=False)
+
+    # -- Algorithm 1 ------------------------------------------------------------------------
+    def init(self, image: np.ndarray, box) -> None:
+        """Frame 1: learn the first filter at ``box`` (x, y, w, h)."""
+        self.frame = 1
+        image = check_image(image, self.frame)
+        box = check_box(box, image.shape)
+        centre, target = box_to_centre_size(box)
+        self.geometry, self.scale = self._geometry(target)
+        g = self.geometry
+        self.window = hann2d(g.filter_size)
+        sigma = np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * self.params.output_sigma_factor
+        self.base_label = gaussian_label(g.filter_size, sigma)
+        self.w2 = (self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
+                   else np.zeros(g.filter_size, np.float32))
+        self.limits = scale_limits(g.base_target, g.sample_size, image.shape)
+        self.scale = float(np.clip(self.scale, *self.limits))
+        self.solver.reset()
+        self.search.reset(centre)
+        self.scale_estimator.init(image, centre, g.base_target, self.scale, self.limits)
+        self.position = centre
+        self.last_response = None
+        self.last_distractors = np.zeros((0, 2))
+        self._train(image, None)
+
+    def update(self, image: np.ndarray) -> tuple[float, float, float, float]:
+        """Frame t > 1: locate the target, return its box (x, y, w, h), and learn from it."""
+        if self.frame == 0:
+            raise TrackingError("update() called before init()")
+        self.frame += 1
+        image = check_image(image, self.frame)
+        g = self.geometry
+        centre = self._clamp(self.search.centre(), image.shape)  # Eq. (14)
+        factors = self.scale_estimator.search_factors()
+        samples = np.stack([self._sample(image, centre, self.scale * f) for f in factors])
+        maps = response(self.hf, samples, g.filter_size, self.fft)  # Eq. (12)
+        if not np.all(np.isfinite(maps)):
+            raise TrackingError(f"frame {self.frame}: the response map is not finite")
+        best = int(np.argmax(maps.reshape(len(factors), -1).max(axis=1)))
+        dy, dx, _ = subpixel_peak(maps[best])
+        step = self.params.cell_size * self.scale * factors[best]
+        self.position = self._clamp(centre + np.array([dy, dx]) * step, image.shape)
+        self.scale = self.scale_estimator.update(image, self.position, self.scale * factors[best])
+        self.search.observe(self.position)  # Eq. (13)
+        peak = np.unravel_index(int(np.argmax(maps[best])), g.filter_size)
+        self.last_response = np.fft.fftshift(maps[best])
+        self._train(image, Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells))
+        return self.box
+
+    def _train(self, image: np.ndarray, detection: Detection | None) -> None:
+        xf = self._sample(image, self.position, self.scale)  # m^t at p^t
+        y, offsets = self.label.make(self.base_label, detection)  # Eq. (3)
+        yf = self.fft.rfft2(y).astype(np.complex64, copy=False)
+        theta = self.temporal.params.theta if self.temporal is not None else 0.0
+        self.hf = self.solver.train(xf, yf, self.w2, theta, self.fft)  # Eqs. (9)-(11)
+        step = self.params.cell_size * self.scale
+        self.last_distractors = (self.position[None, ::-1] + offsets[:, ::-1] * step) if len(offsets) else \
+            np.zeros((0, 2))
+
+    @staticmethod
+    def _clamp(centre: np.ndarray, shape) -> np.ndarray:
+        """Keep the centre on the image so a target leaving it never yields a NaN box."""
+        return np.clip(centre, 0, np.array(shape[:2], dtype=float) - 1)
+
+    @property
+    def box(self) -> tuple[float, float, float, float]:
+        """Current (x, y, w, h), 0-based pixels."""
+        return centre_size_to_box(self.position, self.geometry.base_target * self.scale)
+
+
+def load_tracker(config: str | Mapping[str, Any], **overrides: Any) -> Tracker:
+    """Build a tracker from a config path, shipped name ('dr2track') or dict, with dotted overrides.
+
+    Overrides use ``__`` for dots in keyword form (``label__mu=0.3``) or pass a mapping via
+    ``overrides={'label.mu': 0.3}``.
+    """
+    extra = dict(overrides.pop("overrides", None) or {})
+    extra.update({k.replace("__", "."): v for k, v in overrides.items()})
+    return Tracker(load_config(config, extra))

@@ -1,0 +1,92 @@
+"""Reading frames (video file or image folder) and writing annotated videos."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Iterator
+
+import cv2
+import numpy as np
+
+from .errors import InputError
+
+IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff")
+COLOURS = ((0, 0, 255), (0, 200, 0), (255, 128, 0), (0, 200, 255), (255, 0, 255))
+
+
+def frame_files(folder: str | Path) -> list[Path]:
+    """Image files of a folder in name order; an error when there are none."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise InputError(f"--frames: {folder} is not a folder")
+    files = sorted(p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
+    if not files:
+        raise InputError(f"--frames: no images ({', '.join(IMAGE_SUFFIXES)}) in {folder}")
+    return files
+
+
+def read_image(path: str | Path, frame: int) -> np.ndarray:
+    image = cv2.imread(str(path), cv2.IMREAD_COLOR)
+    if image is None or image.size == 0:
+        raise InputError(f"frame {frame}: cannot read image {path}")
+    return image
+
+
+def iter_frames(video: str | None = None, frames: str | None = None) -> Iterator[np.ndarray]:
+    """Yield BGR frames from a video file or an image folder."""
+    if frames is not None:
+        for i, path in enumerate(frame_files(frames), start=1):
+            yield read_image(path, i)
+        return
+    if not Path(video).is_file():
+        raise InputError(f"--video: file not found: {video}")
+    cap = cv2.VideoCapture(str(video))
+    if not cap.isOpened():
+        raise InputError(f"--video: OpenCV cannot open {video}")
+    count = 0
+    try:
+        while True:
+            ok, image = cap.read()
+            if not ok:
+                break
+            count += 1
+            yield image
+    finally:
+        cap.release()
+    if count == 0:
+        raise InputError(f"--video: {video} has no readable frames")
+
+
+class VideoWriter:
+    """Writes frames with boxes drawn on them (.mp4: mp4v, .avi: MJPG)."""
+
+    def __init__(self, path: str | Path, fps: float = 10.0):
+        self.path = Path(path)
+        self.fps = fps
+        self._writer = None
+
+    def write(self, frame: np.ndarray, boxes: dict[str, tuple] | None = None, text: str = "") -> None:
+        if frame.ndim == 2:
+            frame = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR)
+        frame = frame.copy()
+        for i, (name, box) in enumerate((boxes or {}).items()):
+            if box is None or not np.all(np.isfinite(box)):
+                continue
+            x, y, w, h = (int(round(v)) for v in box)
+            colour = COLOURS[i % len(COLOURS)]
+            cv2.rectangle(frame, (x, y), (x + w - 1, y + h - 1), colour, 2)
+            cv2.putText(frame, name, (10, 20 + 18 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv2.LINE_AA)
+        if text:
+            cv2.putText(frame, text, (10, frame.shape[0] - 10), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1,
+                        cv2.LINE_AA)
+        if self._writer is None:
+            fourcc = cv2.VideoWriter_fourcc(*("MJPG" if self.path.suffix.lower() == ".avi" else "mp4v"))
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self._writer = cv2.VideoWriter(str(self.path), fourcc, self.fps, (frame.shape[1], frame.shape[0]))
+            if not self._writer.isOpened():
+                raise InputError(f"cannot write video {self.path} (try a .avi or .mp4 name)")
+        self._writer.write(frame)
+
+    def close(self) -> None:
+        if self._writer is not None:
+            self._writer.release()
+            self._writer = None

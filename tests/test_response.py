@@ -1,0 +1,59 @@
+"""Detection (Eq. 12), peak and local maxima against brute force."""
+import itertools
+
+import numpy as np
+import pytest
+
+from dcfkit.fft import make_fft
+from dcfkit.response import local_maxima, response, subpixel_peak, wrap
+
+
+@pytest.mark.parametrize("backend", ["scipy", "pyfftw"])
+def test_response_is_circular_cross_correlation(backend):
+    rng = np.random.default_rng(0)
+    fft = make_fft(backend)
+    C, H, W = 3, 7, 6
+    h = rng.standard_normal((C, H, W)).astype(np.float32)
+    s = rng.standard_normal((2, C, H, W)).astype(np.float32)  # two search scales
+    got = response(fft.rfft2(h), fft.rfft2(s), (H, W), fft)
+    for k in range(2):
+        for ty, tx in itertools.product(range(H), range(W)):
+            brute = sum(h[c, y, x] * s[k, c, (y + ty) % H, (x + tx) % W]
+                        for c in range(C) for y in range(H) for x in range(W))
+            assert got[k, ty, tx] == pytest.approx(brute, abs=1e-4)
+
+
+def test_local_maxima_match_brute_force():
+    rng = np.random.default_rng(1)
+    r = rng.standard_normal((9, 11)).astype(np.float32)
+    rows, cols = local_maxima(r)
+    H, W = r.shape
+    brute = []
+    for y, x in itertools.product(range(H), range(W)):
+        neigh = [r[(y + dy) % H, (x + dx) % W] for dy in (-1, 0, 1) for dx in (-1, 0, 1) if dy or dx]
+        if r[y, x] >= max(neigh):
+            brute.append((y, x))
+    assert sorted(zip(rows.tolist(), cols.tolist())) == sorted(brute)
+    values = r[rows, cols]
+    assert np.all(np.diff(values) <= 0)  # highest first
+
+
+def test_flat_map_has_no_local_maxima():
+    rows, _ = local_maxima(np.ones((5, 5), np.float32))
+    assert rows.size == 0
+
+
+@pytest.mark.parametrize("true_dy,true_dx", [(0.3, -0.2), (-2.4, 3.1), (5.45, -5.0)])
+def test_subpixel_peak_recovers_a_quadratic_peak(true_dy, true_dx):
+    H, W = 16, 15
+    dy = wrap(np.arange(H), H)[:, None].astype(float)
+    dx = wrap(np.arange(W), W)[None, :].astype(float)
+    r = 10 - (dy - true_dy) ** 2 - 2 * (dx - true_dx) ** 2
+    y, x, _ = subpixel_peak(r.astype(np.float32))
+    assert y == pytest.approx(true_dy, abs=1e-4)
+    assert x == pytest.approx(true_dx, abs=1e-4)
+
+
+def test_wrap_gives_signed_offsets():
+    assert wrap(np.arange(6), 6).tolist() == [0, 1, 2, -3, -2, -1]
+    assert wrap(np.arange(5), 5).tolist() == [0, 1, 2, -2, -1]
