@@ -13,7 +13,9 @@ A config names one component per slot (``features`` is a list) plus the tracker'
     scale: {name: dsst}
 
 Overrides are dotted keys (``label.mu=0.3``, ``features.0.name=gray``); a value ``null``
-removes an optional slot (``regularizers.temporal=null``).
+removes an optional slot (``regularizers.temporal=null``). Naming another component
+(``label.name=gaussian``, or ``label: {name: gaussian}`` in a child file) drops the old
+component's parameters.
 """
 from __future__ import annotations
 
@@ -88,10 +90,14 @@ def _read_yaml(path: Path) -> dict:
 
 
 def merge(base: Mapping, override: Mapping) -> dict:
-    """Deep merge: mappings merge key by key, anything else (lists included) is replaced."""
+    """Deep merge: mappings merge key by key, anything else (lists included) is replaced.
+
+    A component mapping that names a different component replaces the old one whole (its
+    parameters would not fit the new component)."""
     out = copy.deepcopy(dict(base))
     for key, value in override.items():
-        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping) and \
+                value.get("name", out[key].get("name")) == out[key].get("name"):
             out[key] = merge(out[key], value)
         else:
             out[key] = copy.deepcopy(value)
@@ -140,6 +146,8 @@ def set_dotted(config: dict, key: str, value: Any) -> None:
     if isinstance(node, list):
         node[_index(node, last, key)] = value
     else:
+        if last == "name" and node.get("name") not in (None, value):
+            node.clear()  # another component: the old one's parameters do not apply
         node[last] = value
 
 

@@ -32,7 +32,6 @@ import dataclasses
 import hashlib
 import json
 import logging
-import math
 import multiprocessing
 import os
 import tempfile
@@ -41,12 +40,12 @@ import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping, Sequence as Seq
+from typing import Any, Callable, Iterable, Mapping
 
 import numpy as np
 
 from .datasets import DatasetError, Sequence, read_boxes
-from .errors import DcfkitError
+from .errors import ConfigError, DcfkitError
 
 __all__ = [
     "OpenCVTracker",
@@ -109,9 +108,9 @@ def config_hash(config: Mapping, version: str | None = None) -> str:
 def _tracker_name(config: Mapping) -> str:
     name = config.get("name") if isinstance(config, Mapping) else None
     if not isinstance(name, str) or not name.strip():
-        raise ValueError("config has no top-level 'name' (the tracker name used for the output folder)")
+        raise ConfigError("config has no top-level 'name' (the tracker name used for the output folder)")
     if name in (".", "..") or any(c in name for c in "/\\:"):
-        raise ValueError(f"config 'name' {name!r} must be usable as a folder name (no / \\ :)")
+        raise ConfigError(f"config 'name' {name!r} must be usable as a folder name (no / \\ :)")
     return name
 
 
@@ -370,8 +369,8 @@ def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]
 
     A sequence counts as completed when it has both ``.txt`` and ``.json`` sidecar;
     others (not run, failed, interrupted) are left out of the returned dict. Raises
-    :class:`ValueError` if the completed sequences come from different configs, and
-    :class:`DatasetError` if a file has the wrong number of lines.
+    :class:`DatasetError` if the completed sequences come from different configs or a
+    file has the wrong number of lines.
     """
     tracker_dir = Path(out_dir) / tracker_name
     if not tracker_dir.is_dir():
@@ -393,7 +392,7 @@ def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]
         hashes.setdefault(meta.get("config_hash"), []).append(name)
     if len(hashes) > 1:
         detail = "; ".join(f"{h}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}" for h, v in hashes.items())
-        raise ValueError(
+        raise DatasetError(
             f"results in {tracker_dir} mix {len(hashes)} configurations ({detail}); rerun "
             f"`dcfkit eval` with one config, or give the other config a different 'name'")
     return results
@@ -513,7 +512,7 @@ def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
     for item in items or ():
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
-            raise ValueError(f"--set expects KEY=VALUE, got {item!r}")
+            raise ConfigError(f"--set expects KEY=VALUE, got {item!r}")
         try:
             import yaml
 

@@ -274,19 +274,19 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
     Folders written by :func:`dcfkit.evaluation.run_one_pass` (with ``.json`` sidecars)
     are read with ``load_results`` (completed sequences only, timings included); other
     folders are imported as plain 1-based ``x,y,w,h`` text files. ``None`` takes every
-    sub-folder of ``out_dir`` that holds ``.txt`` files.
+    sub-folder of ``out_dir`` holding a ``<sequence>.txt`` of one of ``sequences``.
     """
     from .evaluation import import_results, load_results
 
     out_dir = Path(out_dir)
     exclude = {Path(p).resolve() for p in exclude}
+    names = {s.name for s in sequences}
     if trackers is None:
         if not out_dir.is_dir():
             raise DatasetError(f"results folder not found: {out_dir}")
         trackers = [p.name for p in sorted(out_dir.iterdir())
                     if p.is_dir() and not p.name.startswith(".") and p.resolve() not in exclude
-                    and any(p.glob("*.txt"))]
-    names = {s.name for s in sequences}
+                    and any((p / f"{n}.txt").is_file() for n in names)]
     results = {}
     for tracker in trackers:
         folder = out_dir / tracker if (out_dir / tracker).is_dir() else Path(tracker)

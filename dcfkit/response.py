@@ -21,19 +21,38 @@ def wrap(index, size: int):
     return (np.asarray(index) + size // 2) % size - size // 2
 
 
-def subpixel_peak(r: np.ndarray) -> tuple[float, float, float]:
-    """Peak of a circular (H, W) map: (dy, dx) signed offset refined by a 1-D parabola per axis, and value."""
+def subpixel_peak(r: np.ndarray, iterations: int = 5) -> tuple[float, float, float]:
+    """Peak of a circular (H, W) map as a signed (dy, dx) offset, and its value.
+
+    Starts at the grid maximum and takes Newton steps on the map's trigonometric (Fourier)
+    interpolant, as STRCF/SRDCF do, which avoids the bias of per-axis parabolas towards whole
+    cells. A step that leaves the cell around the grid maximum or lowers the value is dropped.
+    """
     h, w = r.shape
     i, j = np.unravel_index(int(np.argmax(r)), r.shape)
-    peak = float(r[i, j])
-
-    def refine(left: float, centre: float, right: float) -> float:
-        denom = left - 2.0 * centre + right
-        return 0.0 if denom >= 0 else float(np.clip(0.5 * (left - right) / denom, -0.5, 0.5))
-
-    dy = refine(r[(i - 1) % h, j], peak, r[(i + 1) % h, j]) if h > 2 else 0.0
-    dx = refine(r[i, (j - 1) % w], peak, r[i, (j + 1) % w]) if w > 2 else 0.0
-    return float(wrap(i, h)) + dy, float(wrap(j, w)) + dx, peak
+    y0, x0, best = float(wrap(i, h)), float(wrap(j, w)), float(r[i, j])
+    if iterations <= 0 or h < 3 or w < 3:
+        return y0, x0, best
+    spectrum = np.fft.fft2(r.astype(np.float64)) / (h * w)
+    ky = 2j * np.pi * np.fft.fftfreq(h)  # d/dy of exp(2πi ky y / H), per unit of y
+    kx = 2j * np.pi * np.fft.fftfreq(w)
+    y, x = y0, x0
+    for _ in range(iterations):
+        ey, ex = np.exp(ky * y), np.exp(kx * x)
+        gy = ((ky * ey) @ spectrum @ ex).real
+        gx = (ey @ spectrum @ (kx * ex)).real
+        hyy = ((ky * ky * ey) @ spectrum @ ex).real
+        hxx = (ey @ spectrum @ (kx * kx * ex)).real
+        hxy = ((ky * ey) @ spectrum @ (kx * ex)).real
+        det = hyy * hxx - hxy * hxy
+        if not (det > 0 and hyy < 0):  # not a local maximum of the interpolant: stop
+            break
+        y -= (hxx * gy - hxy * gx) / det
+        x -= (hyy * gx - hxy * gy) / det
+    if abs(y - y0) > 1 or abs(x - x0) > 1:
+        return y0, x0, best
+    value = float((np.exp(ky * y) @ spectrum @ np.exp(kx * x)).real)
+    return (y, x, value) if value >= best else (y0, x0, best)
 
 
 def local_maxima(r: np.ndarray, size: int = 3) -> tuple[np.ndarray, np.ndarray]:

@@ -70,7 +70,7 @@ def test_admm_first_frame_and_crop_match_dense_solution():
     w2 = np.full(shape, np.inf, np.float32)
     w2[2:5, 2:4] = 0.5
     expected = dense_minimiser(m, y, w2, 0.0, None)
-    p = ADMMParams(iterations=1000, gamma0=0.05, beta=1.0, gamma_max=0.05)
+    p = ADMMParams(iterations=2000, gamma0=3.0, beta=1.0, gamma_max=3.0)
     _, hf = admm(fft.rfft2(m).astype(np.complex64), fft.rfft2(y).astype(np.complex64), w2, 5.0, None, p, fft)
     h = fft.irfft2(hf, shape)
     assert np.abs(h[:, w2 == np.inf]).max() < 1e-6

@@ -1,0 +1,92 @@
+"""Configs: inheritance, overrides, validation and clear errors."""
+from pathlib import Path
+
+import pytest
+
+from dcfkit.config import load_config, shipped_config_dir
+from dcfkit.errors import ConfigError, RegistryError
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+
+
+@pytest.mark.parametrize("name", ["strcf", "bacf", "dr2track"])
+def test_shipped_configs_resolve(name):
+    cfg = load_config(CONFIGS / f"{name}.yaml")
+    assert cfg["name"] == name
+    assert load_config(name) == cfg  # a bare name finds the shipped file
+
+
+def test_dr2track_has_the_papers_parameters():
+    cfg = load_config("dr2track")
+    assert cfg["label"] == {"name": "distractor_repressed", "top_n": 30, "mu": 0.25, "variant": "subtractive",
+                            "neighbourhood": 3, "exclusion": 1.0}
+    assert cfg["regularizers"]["temporal"]["theta"] == 12
+    assert cfg["solver"]["iterations"] == 4 and cfg["solver"]["gamma0"] == 1
+    assert cfg["solver"]["beta"] == 10 and cfg["solver"]["gamma_max"] == 10000
+    assert cfg["search"]["name"] == "motion_aware"
+    assert cfg["scale"]["name"] == "dsst" and cfg["scale"]["n_scales"] == 33 and cfg["scale"]["step"] == 1.03
+    assert cfg["tracker"]["search_area_scale"] == 5 and cfg["tracker"]["cell_size"] == 4
+    assert [f["name"] for f in cfg["features"]] == ["gray", "fhog", "colornames"]
+
+
+def test_ablations_differ_from_dr2track_only_where_they_say():
+    full = load_config("dr2track")
+    no_dr = load_config(CONFIGS / "ablations" / "dr2track_no_dr.yaml")
+    no_ma = load_config(CONFIGS / "ablations" / "dr2track_no_ma.yaml")
+    assert {k for k in full if full[k] != no_dr[k]} == {"name", "label"}
+    assert no_dr["label"]["name"] == "gaussian"
+    assert {k for k in full if full[k] != no_ma[k]} == {"name", "search"}
+    assert no_ma["search"]["name"] == "fixed"
+
+
+def test_dotted_overrides():
+    cfg = load_config("dr2track", {"label.mu": 0.3, "features.0.name": "fhog", "regularizers.temporal": None})
+    assert cfg["label"]["mu"] == 0.3
+    assert cfg["features"][0]["name"] == "fhog"
+    assert cfg["regularizers"]["temporal"] is None
+
+
+def test_unknown_parameter_names_valid_ones_and_suggests(tmp_path):
+    with pytest.raises(ConfigError, match=r"label.*unknown parameter 'mue'.*did you mean 'mu'.*top_n"):
+        load_config("dr2track", {"label.mue": 0.3})
+
+
+def test_unknown_component_lists_registered_ones():
+    with pytest.raises(RegistryError, match=r"unknown label 'gausian'.*did you mean 'gaussian'"):
+        load_config("strcf", {"label.name": "gausian"})
+
+
+def test_wrong_type_is_reported_with_key():
+    with pytest.raises(ConfigError, match=r"solver.*iterations: expected an integer"):
+        load_config("strcf", {"solver.iterations": "four"})
+    with pytest.raises(ConfigError, match=r"mu must be >= 0"):
+        load_config("dr2track", {"label.mu": -1})
+
+
+def test_yaml_syntax_error_names_file_and_line(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: x\nlabel: {name: gaussian\nsolver: admm_strcf\n")
+    with pytest.raises(ConfigError, match=r"bad.yaml:\d+:\d+: YAML syntax error"):
+        load_config(bad)
+
+
+def test_unknown_top_level_key_and_wrong_regularizer_role(tmp_path):
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(f"base: {CONFIGS / 'strcf.yaml'}\nsolvr: {{name: admm_strcf}}\n")
+    with pytest.raises(ConfigError, match=r"unknown key 'solvr'.*did you mean 'solver'"):
+        load_config(cfg)
+    with pytest.raises(ConfigError, match=r"regularizers.spatial: 'temporal' is a temporal regularizer"):
+        load_config("strcf", {"regularizers.spatial": {"name": "temporal"}})
+
+
+def test_circular_base_is_an_error(tmp_path):
+    (tmp_path / "a.yaml").write_text("base: b.yaml\n")
+    (tmp_path / "b.yaml").write_text("base: a.yaml\n")
+    with pytest.raises(ConfigError, match="circular"):
+        load_config(tmp_path / "a.yaml")
+
+
+def test_missing_config_lists_shipped_ones():
+    with pytest.raises(ConfigError, match=r"config not found: nope.*dr2track"):
+        load_config("nope")
+    assert (shipped_config_dir() / "dr2track.yaml").is_file()

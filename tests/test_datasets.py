@@ -1,0 +1,293 @@
+"""Loaders on small fixture folders (every layout and variant, error cases) and on the
+real development data in ../shared/data (skipped when absent)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from dcfkit import datasets
+from dcfkit.datasets import DatasetError, Sequence, detect_dataset, load_dataset, read_boxes
+
+REAL = Path(__file__).resolve().parents[2] / "shared" / "data"
+needs_real = pytest.mark.skipif(not REAL.is_dir(), reason=f"real benchmark data not found at {REAL}")
+
+
+# --------------------------------------------------------------------------- fixture builders
+
+
+def write_jpg(path: Path, value: int = 0) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    assert cv2.imwrite(str(path), np.full((8, 8, 3), value, np.uint8))
+
+
+def touch_frames(folder: Path, pattern: str, first: int, last: int, real: int = 2) -> None:
+    """Empty placeholder frames (the loaders only check existence) plus ``real`` real jpgs."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for k in range(first, last + 1):
+        if k < first + real:
+            write_jpg(folder / (pattern % k), value=k)
+        else:
+            (folder / (pattern % k)).touch()
+
+
+def write_anno(path: Path, n: int, sep: str = ",", nan_rows=()) -> np.ndarray:
+    """n 1-based boxes; returns them 0-based."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    rows = np.array([[10 + k, 20 + 2 * k, 30, 40] for k in range(n)], dtype=float)
+    lines = [sep.join(f"{v:g}" for v in r) for r in rows]
+    for i in nan_rows:
+        lines[i] = sep.join(["NaN"] * 4)
+        rows[i] = np.nan
+    path.write_text("\n".join(lines) + "\n")
+    return rows - [1, 1, 0, 0]
+
+
+def uav_root(tmp_path: Path, subset="UAV123_10fps", nested=True, seqs=("wakeboard7",),
+             anno_subset=None, data_subset=None) -> Path:
+    """A UAV123-family root holding ``seqs`` with the frame ranges of the official table."""
+    root = tmp_path / subset
+    table = datasets._uav_table()[subset]
+    anno = root / "anno" / (anno_subset or subset) if nested else root / "anno"
+    data = root / "data_seq" / (data_subset or subset) if nested else root / "data_seq"
+    for name in seqs:
+        folder, first, last = table[name]
+        write_anno(anno / f"{name}.txt", last - first + 1)
+        touch_frames(data / folder, "%06d.jpg", first, last)
+    return root
+
+
+# --------------------------------------------------------------------------- annotation parsing
+
+
+def test_read_boxes_separators_nan_and_one_based(tmp_path):
+    p = tmp_path / "gt.txt"
+    p.write_text("1,2,3,4\n5\t6\t7\t8\n9 10  11 12\nNaN,NaN,NaN,NaN\r\n13, 14, 15, 16\n\n\n")
+    boxes = read_boxes(p)
+    assert boxes.dtype == np.float64 and boxes.shape == (5, 4)
+    np.testing.assert_array_equal(boxes[0], [0, 1, 3, 4])
+    np.testing.assert_array_equal(boxes[2], [8, 9, 11, 12])
+    assert np.isnan(boxes[3]).all()
+    np.testing.assert_array_equal(read_boxes(p, one_based=False)[4], [13, 14, 15, 16])
+
+
+@pytest.mark.parametrize("bad", ["1,2,3", "1,2,3,x", "", "1,2,3,4,5"])
+def test_read_boxes_malformed_line_names_file_and_line(tmp_path, bad):
+    p = tmp_path / "gt.txt"
+    p.write_text(f"1,2,3,4\n{bad}\n5,6,7,8\n")
+    with pytest.raises(DatasetError, match=r"gt\.txt, line 2"):
+        read_boxes(p)
+
+
+# --------------------------------------------------------------------------- UAV123 family
+
+
+def test_uav123_10fps_nested_layout(tmp_path):
+    root = uav_root(tmp_path, seqs=("wakeboard7", "truck4_1", "truck4_2"))
+    seqs = load_dataset("UAV123@10fps", root)
+    assert [s.name for s in seqs] == ["truck4_1", "truck4_2", "wakeboard7"]  # table order
+    t1, t2, wb = seqs
+    assert len(t1) == 193 and len(t2) == 229 and len(wb) == 67
+    # truck4_2 uses frames 193..421 of folder truck4
+    assert t2.frames[0].name == "000193.jpg" and t2.frames[-1].name == "000421.jpg"
+    assert t2.frames[0].parent.name == "truck4"
+    assert wb.dataset == "uav123_10fps"
+    np.testing.assert_array_equal(wb.ground_truth[0], [9, 19, 30, 40])
+    # attributes come from the packaged table when there is no att file
+    assert wb.attributes["SV"] and wb.attributes["ARC"] and not wb.attributes["FOC"]
+    assert list(wb.attributes) == list(datasets.ATTRIBUTE_NAMES)
+    assert wb.frame(0).shape == (8, 8, 3)
+
+
+def test_uav_att_file_takes_precedence(tmp_path):
+    root = uav_root(tmp_path)
+    att = root / "anno" / "UAV123_10fps" / "att" / "wakeboard7.txt"
+    att.parent.mkdir()
+    att.write_text("0,0,0,0,1,0,0,0,0,0,0,1\n")
+    (seq,) = load_dataset("uav123_10fps", root)
+    assert {k for k, v in seq.attributes.items() if v} == {"FOC", "SOB"}
+    att.write_text("0,1,0\n")
+    with pytest.raises(DatasetError, match="wakeboard7.txt"):
+        load_dataset("uav123_10fps", root)
+
+
+def test_uav123_flat_variant(tmp_path):
+    root = uav_root(tmp_path, nested=False, seqs=("wakeboard7",))
+    assert (root / "anno" / "wakeboard7.txt").is_file()
+    (seq,) = load_dataset("uav123_10fps", root)
+    assert len(seq) == 67 and seq.frames[0].parent == root / "data_seq" / "wakeboard7"
+    assert detect_dataset(root) == "uav123_10fps"  # decided by the annotation length
+
+
+def test_uav123_30fps_subset(tmp_path):
+    root = uav_root(tmp_path, subset="UAV123", seqs=("wakeboard7",))
+    (seq,) = load_dataset("uav123", root)
+    assert len(seq) == 199 and seq.dataset == "uav123"
+    assert detect_dataset(root) == "uav123"
+
+
+def test_uav20l_official_layout_and_attributes(tmp_path):
+    # official release: anno/UAV20L/<seq>.txt with the images of data_seq/UAV123/
+    root = uav_root(tmp_path, subset="UAV123_20L", seqs=("bike1", "car1"),
+                    anno_subset="UAV20L", data_subset="UAV123")
+    bike1, car1 = load_dataset("uav20l", root)
+    assert len(bike1) == 3085 and len(car1) == 2629
+    assert bike1.attributes and bike1.attributes["SV"]  # same frames as UAV123 bike1
+    assert car1.attributes == {}  # UAV123 has car1_1..3, not car1: no packaged attributes
+    assert detect_dataset(root) == "uav123_20l"
+
+
+def test_uav_listing_only_present_sequences_and_not_found(tmp_path):
+    root = uav_root(tmp_path, seqs=("wakeboard7", "truck4_1"))
+    with pytest.raises(DatasetError) as e:
+        load_dataset("uav123_10fps", root, ["wakeboard"])
+    msg = str(e.value)
+    assert "'wakeboard'" in msg and "Did you mean 'wakeboard7'" in msg and "truck4_1" in msg
+    assert [s.name for s in load_dataset("uav123_10fps", root, "WAKEBOARD7")] == ["wakeboard7"]
+
+
+def test_uav_missing_folder_missing_frames_and_count(tmp_path):
+    root = uav_root(tmp_path)
+    frames = root / "data_seq" / "UAV123_10fps" / "wakeboard7"
+    (frames / "000033.jpg").unlink()
+    with pytest.raises(DatasetError, match=r"missing .*000033\.jpg"):
+        load_dataset("uav123_10fps", root)
+    for f in frames.iterdir():
+        f.unlink()
+    frames.rmdir()
+    with pytest.raises(DatasetError, match="image folder not found.*wakeboard7"):
+        load_dataset("uav123_10fps", root)
+    root = uav_root(tmp_path / "b")
+    anno = root / "anno" / "UAV123_10fps" / "wakeboard7.txt"
+    anno.write_text(anno.read_text() + "1,1,1,1\n")
+    with pytest.raises(DatasetError, match=r"wakeboard7\.txt: 68 annotation lines but 67 frames"):
+        load_dataset("uav123_10fps", root)
+    with pytest.raises(DatasetError, match="folder not found"):
+        load_dataset("uav123", tmp_path / "nowhere")
+
+
+# --------------------------------------------------------------------------- DTB70, UAVDT, OTB
+
+
+def dtb_root(tmp_path, n=5, nan_rows=()):
+    root = tmp_path / "DTB70"
+    gt = write_anno(root / "Gull1" / "groundtruth_rect.txt", n, nan_rows=nan_rows)
+    touch_frames(root / "Gull1" / "img", "%05d.jpg", 1, n, real=n)
+    write_anno(root / "Car2" / "groundtruth_rect.txt", 3)
+    touch_frames(root / "Car2" / "img", "%05d.jpg", 1, 3)
+    return root, gt
+
+
+def test_dtb70(tmp_path):
+    root, gt = dtb_root(tmp_path, nan_rows=(2,))
+    seqs = load_dataset("DTB70", root)
+    assert [s.name for s in seqs] == ["Car2", "Gull1"]
+    gull = seqs[1]
+    assert isinstance(gull, Sequence) and len(gull) == 5 and gull.attributes == {}
+    np.testing.assert_array_equal(gull.ground_truth, gt)  # NaN row kept
+    assert np.isnan(gull.ground_truth[2]).all()
+    assert not gull.ground_truth.flags.writeable
+    assert gull.frame(4)[0, 0, 0] in (4, 5, 6)  # jpeg of value 5
+    assert detect_dataset(root) == "dtb70"
+    (root / "Gull1" / "img" / "00006.jpg").touch()
+    with pytest.raises(DatasetError, match="5 annotation lines but 6 frames"):
+        load_dataset("dtb70", root, ["Gull1"])
+
+
+def test_unreadable_frame_names_the_file(tmp_path):
+    root, _ = dtb_root(tmp_path)
+    (root / "Car2" / "img" / "00003.jpg").write_bytes(b"not a jpeg")
+    (seq,) = load_dataset("dtb70", root, ["Car2"])
+    with pytest.raises(DatasetError, match=r"frame 2 of sequence 'Car2'.*00003\.jpg"):
+        seq.frame(2)
+
+
+def test_uavdt(tmp_path):
+    root = tmp_path / "UAVDT"
+    gt = write_anno(root / "anno" / "S0601_gt.txt", 4)
+    touch_frames(root / "data_seq" / "S0601", "img%06d.jpg", 1, 4)
+    (root / "anno" / "S0601_att.txt").write_text("1,0,0,1,0,0,0,0\n")  # not a sequence
+    (seq,) = load_dataset("uavdt", root)
+    assert seq.name == "S0601" and seq.frames[-1].name == "img000004.jpg"
+    np.testing.assert_array_equal(seq.ground_truth, gt)
+    assert detect_dataset(root) == "uavdt"
+    (root / "data_seq" / "S0601" / "img000004.jpg").unlink()
+    with pytest.raises(DatasetError, match="img000004.jpg"):
+        load_dataset("uavdt", root)
+
+
+def test_otb_separators_multi_target_and_frame_ranges(tmp_path):
+    root = tmp_path / "OTB100"
+    gt = write_anno(root / "Basketball" / "groundtruth_rect.txt", 4, sep="\t")
+    touch_frames(root / "Basketball" / "img", "%04d.jpg", 1, 4)
+    write_anno(root / "Jogging" / "groundtruth_rect.1.txt", 3, sep=" ")
+    write_anno(root / "Jogging" / "groundtruth_rect.2.txt", 3, sep=",")
+    touch_frames(root / "Jogging" / "img", "%04d.jpg", 1, 3)
+    (root / "Human4").mkdir()
+    (root / "Human4" / "groundtruth_rect.1.txt").write_text("")  # empty as in OTB-100
+    write_anno(root / "Human4" / "groundtruth_rect.2.txt", 2)
+    touch_frames(root / "Human4" / "img", "%04d.jpg", 1, 2)
+    write_anno(root / "David" / "groundtruth_rect.txt", 471)  # frames 300..770 of 770
+    touch_frames(root / "David" / "img", "%04d.jpg", 1, 770)
+    seqs = {s.name: s for s in load_dataset("otb", root)}
+    assert sorted(seqs) == ["Basketball", "David", "Human4", "Jogging-1", "Jogging-2"]
+    np.testing.assert_array_equal(seqs["Basketball"].ground_truth, gt)
+    assert seqs["David"].frames[0].name == "0300.jpg" and len(seqs["David"]) == 471
+    assert detect_dataset(root) == "otb"
+    write_anno(root / "Basketball" / "groundtruth_rect.txt", 3)
+    with pytest.raises(DatasetError, match="3 annotation lines but 4 frames"):
+        load_dataset("otb", root, ["Basketball"])
+
+
+def test_dataset_names_and_detection_errors(tmp_path):
+    with pytest.raises(DatasetError, match="valid names: uav123, uav123_10fps, uav123_20l, dtb70, uavdt, otb"):
+        load_dataset("vot2018", tmp_path)
+    assert datasets.canonical_name("UAV123_10FPS") == "uav123_10fps"
+    assert datasets.canonical_name("uav123-20l") == "uav123_20l"
+    with pytest.raises(DatasetError, match="no known benchmark layout"):
+        detect_dataset(tmp_path)
+    root = uav_root(tmp_path, seqs=("wakeboard7",))
+    (root / "anno" / "UAV123").mkdir()
+    with pytest.raises(DatasetError, match="cannot tell which UAV123 subset"):
+        detect_dataset(root)
+    amb = tmp_path / "bench"
+    write_anno(amb / "A" / "groundtruth_rect.txt", 1)
+    touch_frames(amb / "A" / "img", "%04d.jpg", 1, 1)
+    write_anno(amb / "B" / "groundtruth_rect.txt", 1)
+    touch_frames(amb / "B" / "img", "%05d.jpg", 1, 1)
+    with pytest.raises(DatasetError, match="dtb70 or otb"):
+        detect_dataset(amb)
+
+
+# --------------------------------------------------------------------------- real data
+
+
+@needs_real
+def test_real_uav123_10fps():
+    root = REAL / "UAV123_10fps"
+    assert detect_dataset(root) == "uav123_10fps"
+    seqs = {s.name: s for s in load_dataset(None, root)}
+    expected = {"boat1": 301, "building4": 263, "truck4_1": 193, "truck4_2": 229,
+                "wakeboard7": 67, "wakeboard10": 157}
+    assert {n: len(s) for n, s in seqs.items()} == expected
+    boat1 = seqs["boat1"]
+    first = np.loadtxt(root / "anno" / "UAV123_10fps" / "boat1.txt", delimiter=",")[0]
+    np.testing.assert_array_equal(boat1.ground_truth[0], first - [1, 1, 0, 0])
+    np.testing.assert_array_equal(boat1.ground_truth[0], [392, 327, 155, 319])
+    assert boat1.frame(0).shape == (720, 1280, 3)
+    assert seqs["truck4_2"].frames[0].name == "000193.jpg"
+    att = (root / "anno" / "UAV123_10fps" / "att" / "boat1.txt").read_text().strip().split(",")
+    assert [int(v) for v in boat1.attributes.values()] == [int(v) for v in att]
+
+
+@needs_real
+def test_real_dtb70_and_uavdt():
+    (gull,) = load_dataset(detect_dataset(REAL / "DTB70"), REAL / "DTB70")
+    assert gull.name == "Gull1" and len(gull) == 120
+    np.testing.assert_array_equal(gull.ground_truth[0], [164, 639, 77, 55])
+    (s0601,) = load_dataset(detect_dataset(REAL / "UAVDT"), REAL / "UAVDT")
+    assert s0601.name == "S0601" and len(s0601) == 82
+    np.testing.assert_array_equal(s0601.ground_truth[0], [561, 125, 20, 23])
+    assert s0601.frame(81).shape == (540, 1024, 3)

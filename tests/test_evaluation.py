@@ -1,0 +1,384 @@
+"""Runner (files, resume, atomicity, failure isolation, process pool), OpenCV baselines,
+result import and reports — with fake trackers, independent of the dcfkit core."""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from dcfkit import evaluation, report
+from dcfkit.datasets import DatasetError, Sequence, load_dataset
+from dcfkit.evaluation import (config_hash, import_results, load_results, opencv_tracker,
+                               run_one_pass)
+
+REAL = Path(__file__).resolve().parents[2] / "shared" / "data"
+
+N_FRAMES = 6
+
+
+class Crash(BaseException):
+    """Stands for the process dying (not caught by the runner, like KeyboardInterrupt)."""
+
+
+class DriftTracker:
+    """Returns the initial box moved ``drift`` px right per frame; optionally fails."""
+
+    def __init__(self, config, fail_at=None, error=ValueError):
+        self.drift = float(config.get("drift", 1.0))
+        self.fail_at, self.error = fail_at, error
+
+    def init(self, image, box):
+        assert image.dtype == np.uint8 and image.ndim == 3
+        self.box, self.k = np.asarray(box, dtype=float), 0
+
+    def update(self, image):
+        self.k += 1
+        if self.k == self.fail_at:
+            raise self.error("boom")
+        return self.box + [self.drift * self.k, 0, 0, 0]
+
+
+def make_drift(config):
+    """Module-level (picklable) factory for jobs > 1."""
+    return DriftTracker(config)
+
+
+class Counter:
+    """A factory counting the trackers it makes; ``plan`` maps the n-th tracker to a failure."""
+
+    def __init__(self, plan=None):
+        self.made, self.plan = 0, plan or {}
+
+    def __call__(self, config):
+        self.made += 1
+        fail_at, error = self.plan.get(self.made, (None, ValueError))
+        return DriftTracker(config, fail_at, error)
+
+
+def gt_boxes(n=N_FRAMES, x0=2.0):
+    return np.array([[x0 + k, 3, 5, 6] for k in range(n)], dtype=float)
+
+
+@pytest.fixture
+def seqs(tmp_path):
+    out = []
+    for i, name in enumerate("abc"):
+        folder = tmp_path / "data" / name
+        folder.mkdir(parents=True)
+        frames = []
+        for k in range(N_FRAMES):
+            f = folder / f"{k + 1:05d}.jpg"
+            cv2.imwrite(str(f), np.full((16, 16, 3), 10 * i + k, np.uint8))
+            frames.append(f)
+        out.append(Sequence(name, tuple(frames), gt_boxes(), {"SV": i != 1, "FM": i == 2}, "fake"))
+    return out
+
+
+CONFIG = {"name": "drift", "drift": 1.0}
+
+
+def files(folder: Path) -> set[str]:
+    return {p.name for p in folder.iterdir()}
+
+
+# --------------------------------------------------------------------------- output files
+
+
+def test_result_files_are_one_based_with_sidecar(tmp_path, seqs):
+    summary = run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
+    assert summary["done"] == ["a", "b", "c"] and not summary["failed"] and not summary["skipped"]
+    d = tmp_path / "out" / "drift"
+    assert files(d) == {"a.txt", "a.json", "b.txt", "b.json", "c.txt", "c.json"}
+    lines = (d / "a.txt").read_text().splitlines()
+    assert lines[0] == "3.000,4.000,5.000,6.000"  # 0-based (2, 3) written 1-based
+    assert lines[5] == "8.000,4.000,5.000,6.000"
+    meta = json.loads((d / "a.json").read_text())
+    assert meta["config_hash"] == config_hash(CONFIG) == summary["config_hash"]
+    assert meta["dcfkit_version"] == evaluation.dcfkit_version()
+    assert len(meta["times"]) == N_FRAMES and meta["fps"] > 0 and meta["config"] == CONFIG
+    res = load_results(tmp_path / "out", "drift", seqs)
+    np.testing.assert_allclose(res["b"].boxes, gt_boxes())
+    assert res["b"].times.shape == (N_FRAMES,) and res["b"].fps > 0
+
+
+def test_config_hash_is_canonical():
+    assert config_hash({"a": 1, "b": {"c": 2, "d": 3}}) == config_hash({"b": {"d": 3, "c": 2}, "a": 1})
+    assert config_hash({"a": 1}) != config_hash({"a": 2})
+    assert config_hash({"a": 1}, "1.0") != config_hash({"a": 1}, "1.1")
+    assert config_hash({"a": (1, 2)}) == config_hash({"a": [1, 2]})
+
+
+def test_nan_first_box_and_bad_name_are_errors(tmp_path, seqs):
+    gt = gt_boxes()
+    gt[0] = np.nan
+    bad = dataclasses.replace(seqs[1], ground_truth=gt)
+    with pytest.raises(DatasetError, match="sequence.*: b"):
+        run_one_pass(CONFIG, [seqs[0], bad], tmp_path, make_tracker=Counter(), progress=False)
+    with pytest.raises(ValueError, match="'name'"):
+        run_one_pass({"drift": 1}, seqs, tmp_path, make_tracker=Counter(), progress=False)
+
+
+# --------------------------------------------------------------------------- resume and atomicity
+
+
+def test_resume_recomputes_nothing(tmp_path, seqs):
+    first = Counter()
+    run_one_pass(CONFIG, seqs, tmp_path, make_tracker=first, progress=False)
+    assert first.made == 3
+    again = Counter()
+    summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=again, progress=False)
+    assert again.made == 0 and summary["skipped"] == ["a", "b", "c"] and summary["done"] == []
+    # a truncated result file is not done, even with its sidecar present
+    txt = tmp_path / "drift" / "b.txt"
+    txt.write_text("".join(txt.read_text().splitlines(keepends=True)[:3]))
+    third = Counter()
+    assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=third, progress=False)["done"] == ["b"]
+    assert third.made == 1
+    # another config (same name) is recomputed
+    fourth = Counter()
+    run_one_pass({**CONFIG, "drift": 2.0}, seqs, tmp_path, make_tracker=fourth, progress=False)
+    assert fourth.made == 3
+
+
+def test_crash_mid_sequence_leaves_no_partial_result(tmp_path, seqs):
+    with pytest.raises(Crash):
+        run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter({2: (3, Crash)}), progress=False)
+    d = tmp_path / "drift"
+    assert files(d) == {"a.txt", "a.json"}  # no half file, no temp file
+    rerun = Counter()
+    summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=rerun, progress=False)
+    assert rerun.made == 2 and summary["done"] == ["b", "c"] and summary["skipped"] == ["a"]
+
+
+def test_crash_between_result_and_sidecar_is_not_done(tmp_path, seqs, monkeypatch):
+    real_write = evaluation._atomic_write
+
+    def dying_write(path, text):
+        if path.name == "b.json":
+            raise Crash
+        real_write(path, text)
+
+    monkeypatch.setattr(evaluation, "_atomic_write", dying_write)
+    with pytest.raises(Crash):
+        run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    monkeypatch.undo()
+    assert (tmp_path / "drift" / "b.txt").is_file() and not (tmp_path / "drift" / "b.json").exists()
+    assert set(load_results(tmp_path, "drift", seqs)) == {"a"}
+    rerun = Counter()
+    assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=rerun, progress=False)["done"] == ["b", "c"]
+
+
+def test_atomic_write_interrupted_keeps_old_file(tmp_path, monkeypatch):
+    target = tmp_path / "x.txt"
+    target.write_text("old\n")
+
+    def boom(*a):
+        raise Crash
+
+    monkeypatch.setattr(evaluation.os, "replace", boom)
+    with pytest.raises(Crash):
+        evaluation._atomic_write(target, "new\n")
+    assert target.read_text() == "old\n" and files(tmp_path) == {"x.txt"}
+
+
+# --------------------------------------------------------------------------- failures
+
+
+def test_tracker_failure_is_isolated_and_retried(tmp_path, seqs, caplog):
+    summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter({2: (2, ValueError)}),
+                           progress=False)
+    assert summary["done"] == ["a", "c"] and list(summary["failed"]) == ["b"]
+    message = summary["failed"]["b"]
+    assert "'b'" in message and "frame 2" in message and "00003.jpg" in message and "boom" in message
+    assert "frame 2" in caplog.text
+    d = tmp_path / "drift"
+    record = json.loads((d / "b.error.json").read_text())
+    assert record["frame"] == 2 and record["type"] == "ValueError" and "boom" in record["traceback"]
+    assert not (d / "b.txt").exists() and set(load_results(tmp_path, "drift", seqs)) == {"a", "c"}
+    rerun = Counter()
+    summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=rerun, progress=False)
+    assert rerun.made == 1 and summary["done"] == ["b"] and not (d / "b.error.json").exists()
+
+
+def test_bad_box_and_factory_errors_are_failures(tmp_path, seqs):
+    class NoneTracker(DriftTracker):
+        def update(self, image):
+            return None
+
+    summary = run_one_pass(CONFIG, seqs[:1], tmp_path, make_tracker=NoneTracker, progress=False)
+    assert "frame 1" in summary["failed"]["a"] and "expected 4 numbers" in summary["failed"]["a"]
+
+    def broken(config):
+        raise KeyError("features")
+
+    summary = run_one_pass(CONFIG, seqs[:1], tmp_path, make_tracker=broken, progress=False)
+    assert "creating the tracker raised KeyError" in summary["failed"]["a"]
+
+
+def test_process_pool_matches_serial(tmp_path, seqs):
+    run_one_pass(CONFIG, seqs, tmp_path / "serial", make_tracker=make_drift, progress=False)
+    summary = run_one_pass(CONFIG, seqs, tmp_path / "pool", make_tracker=make_drift, jobs=2,
+                           progress=False)
+    assert sorted(summary["done"]) == ["a", "b", "c"]
+    for s in "abc":
+        assert ((tmp_path / "serial" / "drift" / f"{s}.txt").read_text()
+                == (tmp_path / "pool" / "drift" / f"{s}.txt").read_text())
+
+
+def test_mixed_configs_refused_by_load_results(tmp_path, seqs):
+    run_one_pass(CONFIG, seqs[:1], tmp_path, make_tracker=Counter(), progress=False)
+    run_one_pass({**CONFIG, "drift": 3.0}, seqs[1:2], tmp_path, make_tracker=Counter(), progress=False)
+    with pytest.raises(ValueError, match="mix 2 configurations"):
+        load_results(tmp_path, "drift", seqs)
+
+
+# --------------------------------------------------------------------------- OpenCV baselines
+
+
+def synthetic_sequence(tmp_path, n=8):
+    rng = np.random.default_rng(0)
+    background = rng.integers(0, 80, (160, 160, 3), dtype=np.uint8)
+    patch = rng.integers(100, 255, (48, 48, 3), dtype=np.uint8)  # MOSSE needs texture
+    frames, gt = [], []
+    for k in range(n):
+        img = background.copy()
+        x, y = 40 + 2 * k, 45 + 2 * k
+        img[y:y + 48, x:x + 48] = patch
+        f = tmp_path / "syn" / f"{k:03d}.png"
+        f.parent.mkdir(exist_ok=True)
+        cv2.imwrite(str(f), img)
+        frames.append(f)
+        gt.append([x, y, 48, 48])
+    return Sequence("syn", tuple(frames), np.array(gt, float), {}, "synthetic")
+
+
+@pytest.mark.parametrize("name", ["CSRT", "KCF", "MOSSE"])
+def test_opencv_baselines(tmp_path, name):
+    if name not in evaluation.available_opencv_trackers():
+        pytest.skip(f"OpenCV {name} is not in this OpenCV build")
+    seq = synthetic_sequence(tmp_path)
+    factory = opencv_tracker(name.lower())
+    tracker = factory({})
+    tracker.init(seq.frame(0), seq.init_box)
+    box = tracker.update(seq.frame(1))
+    assert box.dtype == np.float64 and box.shape == (4,)
+    summary = run_one_pass({"name": f"opencv-{name}"}, [seq], tmp_path / "out", make_tracker=factory,
+                           progress=False)
+    assert summary["done"] == ["syn"]
+    res = load_results(tmp_path / "out", f"opencv-{name}", [seq])["syn"]
+    assert np.abs(res.boxes[-1] - seq.ground_truth[-1]).max() < 6
+
+
+def test_opencv_unknown_name():
+    with pytest.raises(evaluation.OpenCVUnavailable, match="CSRT, KCF, MOSSE"):
+        opencv_tracker("medianflow")
+
+
+# --------------------------------------------------------------------------- import and report
+
+
+def test_import_results(tmp_path):
+    d = tmp_path / "other"
+    d.mkdir()
+    (d / "a.txt").write_text("3,4,5,6\n4,4,5,6\n")
+    (d / "b.txt").write_text("3\t4\t5\t6\nNaN\tNaN\tNaN\tNaN\n")
+    (d / "b_time.txt").write_text("0.01\n0.02\n")
+    res = import_results(d)
+    assert sorted(res) == ["a", "b"] and res["a"].fps is None
+    np.testing.assert_array_equal(res["a"].boxes[0], [2, 3, 5, 6])
+    assert np.isnan(res["b"].boxes[1]).all()
+
+
+def test_evaluate_scores_and_sorting(seqs):
+    perfect = {s.name: gt_boxes() for s in seqs}
+    shifted = {s.name: gt_boxes(x0=32.0) for s in seqs[:2]}  # far off; "c" missing
+    ev = report.evaluate({"shifted": shifted, "perfect": perfect}, seqs)
+    top, low = ev["overall"]
+    assert top["tracker"] == "perfect" and top["auc"] == pytest.approx(20 / 21) and top["precision"] == 1
+    assert low["tracker"] == "shifted" and low["missing"] == 1 and low["precision"] == 0
+    assert top["fps"] is None  # plain arrays carry no timing
+    assert len(ev["per_sequence"]) == 6
+    sv = [r for r in ev["per_attribute"] if r["attribute"] == "SV"]
+    assert [r["sequences"] for r in sv] == [2, 2] and ev["attributes"] == {"SV": 2, "FM": 1}
+    np.testing.assert_allclose(ev["curves"]["perfect"]["precision"], 1.0)
+    md = report.format_rows(ev["overall"], "markdown", report.OVERALL_COLUMNS)
+    assert md.splitlines()[0] == "| tracker | auc | precision | norm_precision | fps | sequences | missing |"
+    assert "| perfect | 0.952 | 1.000 | 1.000 | - | 3 | 0 |" in md
+    csv_text = report.format_rows(ev["overall"], "csv", report.OVERALL_COLUMNS)
+    assert csv_text.splitlines()[1].startswith("perfect,0.952380952")
+    assert "perfect" in report.format_rows(ev["overall"], "table")
+
+
+def test_write_report_files(tmp_path, seqs):
+    out = tmp_path / "out"
+    run_one_pass(CONFIG, seqs, out, make_tracker=Counter(), progress=False)
+    run_one_pass({"name": "slow", "drift": 2.0}, seqs, out, make_tracker=Counter(), progress=False)
+    other = tmp_path / "imported"
+    other.mkdir()
+    for s in seqs:
+        (other / f"{s.name}.txt").write_text(evaluation._format_boxes(gt_boxes()))
+    paths = report.write_report(out, seqs, trackers=["drift", "slow", str(other)])
+    names = {p.name for p in paths}
+    for stem in ("precision", "success", "success_SV", "success_FM"):
+        assert {f"{stem}.png", f"{stem}.svg"} <= names
+    for stem in ("overall", "per_sequence", "per_attribute"):
+        assert {f"{stem}.txt", f"{stem}.md", f"{stem}.csv"} <= names
+    assert all(p.parent == out / "report" and p.stat().st_size > 0 for p in paths)
+    data = json.loads((out / "report" / "report.json").read_text())
+    rows = {r["tracker"]: r for r in data["overall"]}
+    assert set(rows) == {"drift", "slow", "imported"} and rows["drift"]["fps"] > 0
+    assert rows["imported"]["fps"] is None
+    assert "drift [0.952]" in (out / "report" / "success.svg").read_text()
+    # default trackers: the folders of OUT holding sequence results (not OUT/report)
+    assert sorted(report.gather_results(out, seqs)) == ["drift", "slow"]
+
+
+def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
+    root = tmp_path / "DTB70"
+    for s in seqs:
+        (root / s.name / "img").mkdir(parents=True)
+        for k, f in enumerate(s.frames):
+            (root / s.name / "img" / f"{k + 1:05d}.jpg").write_bytes(f.read_bytes())
+        (root / s.name / "groundtruth_rect.txt").write_text(evaluation._format_boxes(s.ground_truth))
+    seen = {}
+
+    def fake_resolve(spec, overrides):
+        seen["overrides"] = overrides
+        return {"name": Path(spec).stem, **overrides}, make_drift
+
+    monkeypatch.setattr(evaluation, "_resolve_config", fake_resolve)
+    parser = argparse.ArgumentParser()
+    evaluation.add_eval_arguments(parser)
+    args = parser.parse_args(["fast.yaml", "--root", str(root), "--out", str(tmp_path / "out"),
+                              "--sequences", "a,c", "--set", "drift=0.5", "--no-progress"])
+    assert evaluation.cmd_eval(args) == 0
+    assert seen["overrides"] == {"drift": 0.5}
+    assert files(tmp_path / "out" / "fast") == {"a.txt", "a.json", "c.txt", "c.json"}
+    assert "fast: 2 run, 0 already done, 0 failed" in capsys.readouterr().out
+
+    parser = argparse.ArgumentParser()
+    report.add_report_arguments(parser)
+    args = parser.parse_args([str(tmp_path / "out"), "--root", str(root), "--dataset", "dtb70",
+                              "--sequences", "a,c", "--format", "markdown"])
+    assert report.cmd_report(args) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("| tracker | auc |") and "| fast |" in out
+    assert (tmp_path / "out" / "report" / "success.png").is_file()
+
+
+@pytest.mark.skipif(not (REAL / "UAV123_10fps").is_dir(), reason=f"real data not found at {REAL}")
+def test_real_sequence_with_opencv_kcf(tmp_path):
+    if "KCF" not in evaluation.available_opencv_trackers():
+        pytest.skip("OpenCV KCF is not in this OpenCV build")
+    (boat1,) = load_dataset("uav123_10fps", REAL / "UAV123_10fps", ["boat1"])
+    short = dataclasses.replace(boat1, frames=boat1.frames[:12], ground_truth=boat1.ground_truth[:12])
+    run_one_pass({"name": "kcf"}, [short], tmp_path, make_tracker=opencv_tracker("KCF"), progress=False)
+    first = (tmp_path / "kcf" / "boat1.txt").read_text().splitlines()[0]
+    assert first == "393.000,328.000,155.000,319.000"  # the annotation file's first line
+    ev = report.evaluate({"kcf": load_results(tmp_path, "kcf", [short])}, [short])
+    assert ev["overall"][0]["auc"] > 0.5 and ev["overall"][0]["fps"] > 0

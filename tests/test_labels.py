@@ -1,0 +1,56 @@
+"""Label generators: Eq. (1)'s Gaussian and Eq. (3)'s distractor repression."""
+import numpy as np
+import pytest
+
+from dcfkit.labels import Detection, DistractorRepressed, Gaussian, gaussian_label
+
+
+def test_gaussian_label_peaks_at_origin_and_is_symmetric():
+    g = gaussian_label((10, 9), sigma=1.5)
+    assert g[0, 0] == pytest.approx(1.0)
+    assert g.argmax() == 0
+    assert g[1, 0] == pytest.approx(np.exp(-0.5 / 1.5**2))
+    assert g[1, 0] == pytest.approx(g[-1, 0]) and g[0, 2] == pytest.approx(g[0, -2])
+
+
+def response_with_peaks(shape, peaks):
+    r = np.zeros(shape, np.float32)
+    for (y, x), v in peaks.items():
+        r[y, x] = v
+    return r
+
+
+def test_repressed_label_hand_computed_subtractive():
+    # target peak at (10, 12) of a 20x24 map, distractors at offsets (+6, 0), (0, -8), one inside the target area
+    r = response_with_peaks((20, 24), {(10, 12): 2.0, (16, 12): 1.0, (10, 4): 0.5, (11, 13): 1.5})
+    det = Detection(r, (10, 12), target_cells=(4.0, 4.0))
+    g = gaussian_label((20, 24), 2.0)
+    label = DistractorRepressed(DistractorRepressed.Params(top_n=30, mu=0.25, variant="subtractive"))
+    y, offsets = label.make(g, det)
+    assert sorted(map(tuple, offsets.tolist())) == [(0, -8), (6, 0)]
+    expected = g.copy()
+    expected[6, 0] -= 0.25 * 1.0 / 2.0       # the [η] shift puts the offset (6, 0) at label index (6, 0)
+    expected[0, -8] -= 0.25 * 0.5 / 2.0
+    np.testing.assert_allclose(y, expected, atol=1e-7)
+
+
+def test_repressed_label_multiplicative_and_top_n():
+    r = response_with_peaks((20, 20), {(0, 0): 1.0, (7, 0): 0.9, (0, 7): 0.6, (-7 % 20, -7 % 20): 0.3})
+    det = Detection(r, (0, 0), target_cells=(3.0, 3.0))
+    g = gaussian_label((20, 20), 4.0)
+    label = DistractorRepressed(DistractorRepressed.Params(top_n=2, mu=0.5, variant="multiplicative"))
+    y, offsets = label.make(g, det)
+    assert offsets.tolist() == [[7, 0], [0, 7]]  # the two strongest, strongest first
+    expected = g.copy()
+    expected[7, 0] *= 1 - 0.5 * 0.9
+    expected[0, 7] *= 1 - 0.5 * 0.6
+    np.testing.assert_allclose(y, expected, atol=1e-7)
+
+
+def test_without_detection_or_with_flat_response_the_label_is_the_gaussian():
+    g = gaussian_label((8, 8), 1.0)
+    label = DistractorRepressed()
+    assert np.array_equal(label.make(g, None)[0], g)
+    flat = Detection(np.zeros((8, 8), np.float32), (0, 0), (2.0, 2.0))
+    assert np.array_equal(label.make(g, flat)[0], g)
+    assert np.array_equal(Gaussian().make(g, flat)[0], g)

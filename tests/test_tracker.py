@@ -1,0 +1,104 @@
+"""Whole trackers: every shipped config on a generated sequence, bad input, determinism."""
+import numpy as np
+import pytest
+
+import dcfkit
+from dcfkit.errors import InputError, TrackingError
+from dcfkit.metrics import score_sequence
+from dcfkit.synthetic import make_sequence
+
+CONFIGS = ["strcf", "bacf", "dr2track", "configs/ablations/dr2track_no_dr.yaml",
+           "configs/ablations/dr2track_no_ma.yaml"]
+
+
+@pytest.fixture(scope="module")
+def sequence():
+    return make_sequence(n_frames=60, seed=3)
+
+
+def run(tracker, frames, box):
+    tracker.init(frames[0], box)
+    return [tuple(box)] + [tracker.update(f) for f in frames[1:]]
+
+
+@pytest.mark.parametrize("config", CONFIGS)
+def test_shipped_config_tracks_the_synthetic_sequence(config, sequence, request):
+    path = request.config.rootpath / config if config.endswith(".yaml") else config
+    boxes = run(dcfkit.load_tracker(path), sequence.frames, sequence.ground_truth[0])
+    scores = score_sequence(boxes, sequence.ground_truth)
+    assert scores["precision"] >= 0.95
+    assert scores["auc"] >= 0.6
+
+
+def test_tracking_is_deterministic_and_exposes_diagnostics(sequence):
+    a = run(dcfkit.load_tracker("dr2track"), sequence.frames[:15], sequence.ground_truth[0])
+    tracker = dcfkit.load_tracker("dr2track")
+    b = run(tracker, sequence.frames[:15], sequence.ground_truth[0])
+    assert a == b
+    assert tracker.last_response.shape == tracker.geometry.filter_size
+    peak = np.unravel_index(tracker.last_response.argmax(), tracker.last_response.shape)
+    centre = np.array(tracker.geometry.filter_size) // 2  # centred layout: offset 0 in the middle
+    assert np.abs(np.array(peak) - centre).max() <= 4  # (not near a corner, as the raw layout would be)
+    assert tracker.last_distractors.ndim == 2 and tracker.last_distractors.shape[1] == 2
+    assert 0 < len(tracker.last_distractors) <= 30
+
+
+def test_overrides_reach_the_components():
+    tracker = dcfkit.load_tracker("dr2track", label__mu=0.4, overrides={"solver.iterations": 2})
+    assert tracker.label.params.mu == 0.4 and tracker.solver.params.iterations == 2
+
+
+def test_grayscale_frames_are_tracked(sequence):
+    import cv2
+
+    gray = [cv2.cvtColor(f, cv2.COLOR_BGR2GRAY) for f in sequence.frames[:20]]
+    boxes = run(dcfkit.load_tracker("dr2track"), gray, sequence.ground_truth[0])
+    scores = score_sequence(boxes, sequence.ground_truth[:20])
+    assert scores["precision"] >= 0.9
+
+
+@pytest.mark.parametrize("box,match", [
+    ((10, 10, 0, 20), "non-positive size"),
+    ((10, 10, 20, -3), "non-positive size"),
+    ((900, 10, 20, 20), "outside the 480x360 image"),
+    ((1, 2, 3), "4 finite numbers"),
+    ((np.nan, 2, 3, 4), "4 finite numbers"),
+])
+def test_bad_initial_box_is_a_clear_error(box, match, sequence):
+    with pytest.raises(InputError, match=match):
+        dcfkit.load_tracker("strcf").init(sequence.frames[0], box)
+
+
+def test_bad_frames_are_clear_errors_naming_the_frame(sequence):
+    tracker = dcfkit.load_tracker("strcf")
+    with pytest.raises(TrackingError, match="before init"):
+        tracker.update(sequence.frames[0])
+    with pytest.raises(InputError, match="frame 1: expected a uint8 image"):
+        tracker.init(sequence.frames[0].astype(np.float32), (10, 10, 20, 20))
+    tracker.init(sequence.frames[0], sequence.ground_truth[0])
+    with pytest.raises(InputError, match="frame 2: the image is empty"):
+        tracker.update(np.zeros((0, 0, 3), np.uint8))
+    with pytest.raises(InputError, match=r"frame 3: expected an HxW or HxWx3 image, got shape \(10, 10, 4\)"):
+        tracker.update(np.zeros((10, 10, 4), np.uint8))
+    with pytest.raises(InputError, match="frame 4: expected a numpy image"):
+        tracker.update(None)
+
+
+@pytest.mark.parametrize("config", ["strcf", "bacf", "dr2track"])
+@pytest.mark.parametrize("box", [(200, 150, 5, 4), (0, 0, 480, 360), (470, 350, 30, 30)],
+                         ids=["tiny", "whole-image", "partly-outside"])
+def test_extreme_boxes_give_finite_boxes(config, box, sequence):
+    boxes = run(dcfkit.load_tracker(config), sequence.frames[:8], box)
+    assert np.all(np.isfinite(boxes))
+    assert all(b[2] > 0 and b[3] > 0 for b in boxes)
+
+
+def test_target_leaving_the_image_keeps_boxes_finite():
+    frames = make_sequence(n_frames=40, seed=1).frames
+    import cv2
+
+    # the content slides out to the left; the image edge is replicated
+    shifted = [cv2.warpAffine(f, np.float32([[1, 0, -12 * k], [0, 1, 0]]), f.shape[1::-1],
+                              borderMode=cv2.BORDER_REPLICATE) for k, f in enumerate(frames)]
+    boxes = run(dcfkit.load_tracker("dr2track"), shifted, (20, 150, 30, 20))
+    assert np.all(np.isfinite(boxes))
