@@ -21,8 +21,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import hashlib
-import json
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -245,11 +243,3 @@ def resolve(data: Mapping, origin: str) -> dict:
     out["search"] = _component(registry, "search", data.get("search", "fixed"), f"{origin}: search")
     out["scale"] = _component(registry, "scale", data.get("scale", "pyramid"), f"{origin}: scale")
     return out
-
-
-def config_hash(config: Mapping) -> str:
-    """Stable hash of a resolved config and the dcfkit version (for result keys)."""
-    from . import __version__
-
-    text = json.dumps({"config": config, "dcfkit": __version__}, sort_keys=True, default=str)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]

@@ -29,9 +29,17 @@ def crop(image: np.ndarray, centre, region) -> np.ndarray:
     height, width = image.shape[:2]
     if y0 >= 0 and x0 >= 0 and y0 + rh <= height and x0 + rw <= width:
         return image[y0:y0 + rh, x0:x0 + rw]
-    rows = np.clip(np.arange(y0, y0 + rh), 0, height - 1)
-    cols = np.clip(np.arange(x0, x0 + rw), 0, width - 1)
-    return image[rows[:, None], cols[None, :]]
+    # the part inside the image (at least its nearest edge pixel), then replicate its borders
+    ya, xa = min(max(y0, 0), height - 1), min(max(x0, 0), width - 1)
+    yb, xb = max(min(y0 + rh, height), ya + 1), max(min(x0 + rw, width), xa + 1)
+    inside = image[ya:yb, xa:xb]
+    top, left = max(ya - y0, 0), max(xa - x0, 0)
+    bottom, right = rh - top - inside.shape[0], rw - left - inside.shape[1]
+    if min(top, bottom, left, right) < 0:  # region entirely beyond one edge: rows/cols replicate it
+        rows = np.clip(np.arange(y0, y0 + rh), 0, height - 1)
+        cols = np.clip(np.arange(x0, x0 + rw), 0, width - 1)
+        return image[rows[:, None], cols[None, :]]
+    return cv2.copyMakeBorder(inside, top, bottom, left, right, cv2.BORDER_REPLICATE)
 
 
 def resize(patch: np.ndarray, out) -> np.ndarray:

@@ -98,8 +98,15 @@ class DSST(ScaleEstimator):
         self._learn(image, centre, scale)
 
     def _samples(self, image, centre, scale) -> np.ndarray:
-        """(D, S) windowed fHOG of the S scale samples around ``centre``."""
-        patches = np.stack([sample(image, centre, self.base_target * scale * f, self.model_size)
+        """(D, S) windowed fHOG of the S scale samples around ``centre``.
+
+        The largest region is cut from the image and resampled once to a small working
+        patch (fine enough for the smallest scale); every scale sample is resized from it."""
+        span = self.factors[-1] / self.factors[0]
+        work_size = np.ceil(self.model_size * span).astype(int)
+        work = sample(image, centre, self.base_target * scale * self.factors[-1], work_size)
+        middle = (work_size - 1) / 2
+        patches = np.stack([sample(work, middle, work_size * (f / self.factors[-1]), self.model_size)
                             for f in self.factors])
         feats = fhog(patches, cell_size=self.params.cell_size, batch=True)
         return feats.reshape(len(self.factors), -1).T * self.window[None, :]

@@ -93,7 +93,10 @@ def fhog(
     """
     _check_params(cell_size, n_orients, clip)
     imgs = _as_stack(image, batch, cell_size)
-    hist = _cell_histograms(imgs, cell_size, 2 * n_orients, soft_orientation)
+    if imgs.shape[0] == 0:
+        hb, wb = imgs.shape[1] // cell_size, imgs.shape[2] // cell_size
+        return np.zeros((0, fhog_channels(n_orients), hb, wb), np.float32)
+    hist = _histograms(imgs, cell_size, 2 * n_orients, soft_orientation)
     out = _normalise(hist, n_orients, clip, cell_size)
     return out if batch else out[0]
 
@@ -158,8 +161,9 @@ def _workspace(key) -> dict:
 
 
 def _buf(ws: dict, name: str, shape, dtype=np.float32) -> np.ndarray:
+    """The scratch array ``name`` of ``ws``, (re)allocated to ``shape``/``dtype``."""
     a = ws.get(name)
-    if a is None:
+    if a is None or a.shape != (shape if isinstance(shape, tuple) else (shape,)) or a.dtype != dtype:
         a = ws[name] = np.empty(shape, dtype)
     return a
 
@@ -170,70 +174,81 @@ def _buf(ws: dict, name: str, shape, dtype=np.float32) -> np.ndarray:
 def _gradients(imgs: np.ndarray, rows: int, cols: int, ws: dict) -> tuple[np.ndarray, np.ndarray]:
     """Gradient magnitude and direction over the top-left ``rows x cols`` pixels.
 
+    The images are placed side by side (cv2 filters pay per image row, and batch
+    images are narrow), so results are laid out ``(row, image, column)``.
+
     Args:
         imgs: ``(N, H, W)`` or ``(N, H, W, 3)`` uint8/float32, ``H >= rows``,
             ``W >= cols``.
         ws: scratch buffers (the results live there).
 
     Returns:
-        ``mag, theta``: ``(N * rows, cols)`` float32; ``theta`` in ``[0, 2pi]``
-        is the angle of ``(gx, gy)``, x to the right and y downwards.  Colour
-        images use, per pixel, the channel of largest magnitude (the first on
-        ties).
+        ``mag, theta``: ``(rows, N, cols)`` float32, C-contiguous; ``theta`` in
+        ``[0, 2pi]`` is the angle of ``(gx, gy)``, x to the right and y
+        downwards.  Colour images use, per pixel, the channel of largest
+        magnitude (the first one on ties).
     """
     n = imgs.shape[0]
     # One row/column beyond the cells keeps centred differences at their edge.
     imgs = imgs[:, : rows + 1, : cols + 1]
     h, w = imgs.shape[1:3]
     if n == 1 and imgs[0, 0].flags.c_contiguous:
-        tall = imgs[0]  # cv2 takes row-strided views
+        wide = imgs[0]  # cv2 takes row-strided views
     else:
-        tall = np.ascontiguousarray(imgs).reshape((n * h, w) + imgs.shape[3:])
-    if tall.ndim == 3:
-        planes = cv2.split(tall, [_buf(ws, f"plane{c}", (n * h, w), tall.dtype) for c in range(3)])
+        wide = np.ascontiguousarray(imgs.swapaxes(0, 1)).reshape((h, n * w) + imgs.shape[3:])
+    if wide.ndim == 3:
+        planes = cv2.split(wide, [_buf(ws, f"plane{c}", (h, n * w), wide.dtype) for c in range(3)])
     else:
-        planes = [tall]
+        planes = [wide]
 
+    # The differences are taken with the opposite sign, so that arctan2 of them
+    # plus pi is the gradient direction in [0, 2pi].
     mags, gxs, gys = [], [], []
     for c, plane in enumerate(planes):
-        gx = _buf(ws, f"gx{c}", (n * h, w))
-        gy = _buf(ws, f"gy{c}", (n * h, w))
-        _central_differences(plane, gx, gy, n)
-        mags.append(cv2.magnitude(gx, gy, magnitude=_buf(ws, f"mag{c}", (n * h, w))))
+        gx = _buf(ws, f"gx{c}", (h, n * w))
+        gy = _buf(ws, f"gy{c}", (h, n * w))
+        _negated_differences(plane, gx, gy, n)
+        mags.append(cv2.magnitude(gx, gy, magnitude=_buf(ws, f"mag{c}", (h, n * w))))
         gxs.append(gx)
         gys.append(gy)
     mag, gx, gy = mags[0], gxs[0], gys[0]
     if len(planes) > 1:
-        better = _buf(ws, "better", (n * h, w), np.uint8)
+        better = _buf(ws, "better", (h, n * w), np.uint8)
         for c in (1, 2):
             cv2.compare(mags[c], mag, cv2.CMP_GT, dst=better)
             cv2.copyTo(gxs[c], better, gx)
             cv2.copyTo(gys[c], better, gy)
             cv2.max(mag, mags[c], dst=mag)
-    theta = cv2.phase(gx, gy, angle=_buf(ws, "theta", (n * h, w)))
+    theta = np.arctan2(gy, gx, out=_buf(ws, "theta", (h, n * w)))  # cv2.phase is 1e-4 rad off
+    theta += np.float32(np.pi)
+    mag, theta = mag.reshape(h, n, w), theta.reshape(h, n, w)
     if h != rows or w != cols:
-        mag = np.ascontiguousarray(mag.reshape(n, h, w)[:, :rows, :cols]).reshape(n * rows, cols)
-        theta = np.ascontiguousarray(theta.reshape(n, h, w)[:, :rows, :cols]).reshape(n * rows, cols)
+        mag = np.ascontiguousarray(mag[:rows, :, :cols])
+        theta = np.ascontiguousarray(theta[:rows, :, :cols])
     return mag, theta
 
 
-def _central_differences(plane: np.ndarray, gx: np.ndarray, gy: np.ndarray, n: int) -> None:
-    """``[-1, 0, 1] / 2`` derivatives of ``n`` images stacked as ``(n * h, w)``.
+def _negated_differences(plane: np.ndarray, gx: np.ndarray, gy: np.ndarray, n: int) -> None:
+    """Minus the ``[-1, 0, 1] / 2`` derivatives of ``n`` images side by side.
 
-    Interior pixels get ``(I[p+1] - I[p-1]) / 2``, border pixels ``I[1] - I[0]``
-    and ``I[-1] - I[-2]`` (Piotr's ``grad1``); results go to ``gx``, ``gy``.
+    ``plane`` is ``(h, n * w)``.  Interior pixels get ``-(I[p+1] - I[p-1]) / 2``,
+    border pixels ``-(I[1] - I[0])`` and ``-(I[-1] - I[-2])`` (Piotr's ``grad1``,
+    negated); results go to ``gx``, ``gy`` (float32, same shape).
     """
-    kw = dict(ksize=1, scale=0.5, borderType=cv2.BORDER_REPLICATE)
+    kw = dict(ksize=1, scale=-0.5, borderType=cv2.BORDER_REPLICATE)
     cv2.Sobel(plane, cv2.CV_32F, 1, 0, dst=gx, **kw)
     cv2.Sobel(plane, cv2.CV_32F, 0, 1, dst=gy, **kw)
     # Replicated borders give half the one-sided difference.
-    gx[:, 0] *= 2
-    gx[:, -1] *= 2
-    # In a stack the rows next to each seam saw the neighbouring image.
-    p = plane.reshape(n, -1, plane.shape[1])
-    g = gy.reshape(n, -1, gy.shape[1])
-    np.subtract(p[:, 1], p[:, 0], out=g[:, 0], dtype=np.float32)
-    np.subtract(p[:, -1], p[:, -2], out=g[:, -1], dtype=np.float32)
+    gy[0] *= 2
+    gy[-1] *= 2
+    if n == 1:
+        gx[:, 0] *= 2
+        gx[:, -1] *= 2
+    else:  # the columns at each seam saw the neighbouring image
+        p = plane.reshape(plane.shape[0], n, -1)
+        g = gx.reshape(gx.shape[0], n, -1)
+        np.subtract(p[:, :, 0], p[:, :, 1], out=g[:, :, 0], dtype=np.float32)
+        np.subtract(p[:, :, -2], p[:, :, -1], out=g[:, :, -1], dtype=np.float32)
 
 
 # ----------------------------------------------------------------------- histograms
@@ -257,38 +272,45 @@ def _cell_axis(length: int, cell_size: int) -> tuple[np.ndarray, np.ndarray]:
 
 @lru_cache(maxsize=8)
 def _scatter_plan(n: int, rows: int, cols: int, cell_size: int, slots: int):
-    """Tables for scattering pixels into ``(n * rows, cols // cell_size + 2, slots)``.
+    """Tables for the scatter of pixels into per-row cell histograms (cached).
 
-    Pixel rows stay separate in the scatter (they are pooled densely after it);
-    columns go bilinearly to padded cells; ``slots`` orientation slots.
+    Pixels come in the order (row, image, column) of ``_gradients``.  The
+    scatter target is ``(rows + 2 * cell_size, n, cols // cell_size + 2,
+    slots)``: pixel rows stay separate (they are pooled densely afterwards; a
+    cell of zero rows above and below lets every cell row see two neighbours),
+    columns go bilinearly to cells padded by one on each side.
 
     Returns:
-        ``base``: ``(4, n * rows * cols)`` intp, flat target of each pixel for
-        (lower cell, bin o0), (lower, o0 + 1), (upper, o0), (upper, o0 + 1),
-        less ``o0``.  ``wx``: ``(2, 1, n * rows * cols)`` float64, weights of the
-        lower and upper cell.  ``wy``: ``(3, cell_size)`` float64, weight of a
-        pixel at row ``r`` of a cell to the cell above (0), its own (1) and the
-        one below (2).
+        ``base``: ``(n * rows * cols,)`` intp, flat index of each pixel's left
+        cell, orientation slot 0.  ``wx``: ``(2, 1, n * rows * cols)`` float64,
+        weights of the left and right cell.  ``wy``: ``(1, 3 * cell_size)``
+        float64, weights of the rows of the cells above, at and below a cell.
+        ``scale``: ``(rows // cell_size, cols // cell_size)`` float32,
+        ``1 / cell_size**2`` times ``8/7`` per image border the cell touches.
     """
+    hb, wb = rows // cell_size, cols // cell_size
     lower, d = _cell_axis(cols, cell_size)
-    wbp = cols // cell_size + 2
-    row_start = np.arange(n * rows, dtype=np.intp)[:, None] * wbp
-    base = ((row_start + lower[None, :]) * slots).ravel()
-    offsets = np.array([0, 1, slots, slots + 1], dtype=np.intp)
-    base4 = base[None, :] + offsets[:, None]
+    row = np.arange(rows)[:, None] + cell_size  # in the padded rows
+    row_start = (row * n + np.arange(n)[None, :])[:, :, None] * (wb + 2)  # (rows, n, 1)
+    base = ((row_start + lower) * slots).ravel()
     wx = np.empty((2, 1, n * rows * cols))
     wx[0, 0] = np.tile(1.0 - d, n * rows)
     wx[1, 0] = np.tile(d, n * rows)
 
-    lower_r, d_r = _cell_axis(cell_size, cell_size)  # rows of one cell
-    wy = np.zeros((3, cell_size))
-    for r in range(cell_size):
-        k = int(lower_r[r])  # 0: shares with the cell above, 1: with the one below
-        wy[k, r] += 1.0 - d_r[r]
-        wy[k + 1, r] += d_r[r]
-    for a in (base4, wx, wy):
+    # Row r of a cell sits at cell coordinate t = (r + 0.5) / cell_size - 0.5
+    # relative to it and feeds the cell floor(t) with 1 - frac(t) and the next
+    # one with frac(t): the window weights of a cell are the ramp 1 - |t|.
+    t = (np.arange(3 * cell_size) + 0.5) / cell_size - 1.5
+    wy = np.maximum(0.0, 1.0 - np.abs(t))[None]
+
+    edge_r = np.ones(hb)
+    edge_r[[0, -1]] = 8.0 / 7.0
+    edge_c = np.ones(wb)
+    edge_c[[0, -1]] = 8.0 / 7.0
+    scale = (np.outer(edge_r, edge_c) / cell_size**2).astype(np.float32)
+    for a in (base, wx, wy, scale):
         a.setflags(write=False)
-    return base4, wx, wy
+    return base, wx, wy, scale
 
 
 def _cell_histograms(
@@ -313,58 +335,58 @@ def _cell_histograms(
     Returns:
         ``(N, n_bins, H // cell_size, W // cell_size)`` float32.
     """
+    return _histograms(imgs, cell_size, n_bins, soft_orientation).transpose(1, 0, 2, 3)
+
+
+def _histograms(imgs: np.ndarray, cell_size: int, n_bins: int, soft_orientation: bool) -> np.ndarray:
+    """``_cell_histograms`` laid out ``(n_bins, N, hb, wb)`` (C-contiguous)."""
     n = imgs.shape[0]
     hb, wb = imgs.shape[1] // cell_size, imgs.shape[2] // cell_size
     rows, cols = hb * cell_size, wb * cell_size
-    ws = _workspace((imgs.shape, imgs.dtype.char, cell_size, n_bins, soft_orientation))
+    ws = _workspace((imgs.shape, imgs.dtype.char, cell_size, n_bins))
     mag, theta = _gradients(imgs, rows, cols, ws)
 
-    # Orientation: bins o0 and o0 + 1; slot n_bins is bin 0 again.
-    slots, npix = n_bins + 1, n * rows * cols
+    # Orientation bins o0 and o0 + 1 in [0, n_bins + 1]; slots n_bins and
+    # n_bins + 1 are bins 0 and 1 again (theta may be 2pi).
+    slots, npix = n_bins + 2, n * rows * cols
+    base, wx, wy, scale = _scatter_plan(n, rows, cols, cell_size, slots)
     o = theta.reshape(npix)
     o *= np.float32(n_bins / (2 * np.pi))
     mag = mag.reshape(npix)
-    o0 = _buf(ws, "o0", npix, np.intp)
-    base4, wx, wy = _scatter_plan(n, rows, cols, cell_size, slots)
-    if soft_orientation:
-        np.copyto(o0, o, casting="unsafe")  # floor, as o >= 0
-        np.minimum(o0, n_bins - 1, out=o0)  # theta rounded up to 2pi
-        frac = _buf(ws, "frac", npix)
-        np.copyto(frac, o0, casting="unsafe")
-        np.subtract(o, frac, out=frac)
-        mo = _buf(ws, "mo", (1, 2, npix), np.float64)  # weights of o0, o0 + 1
+    if not soft_orientation:
+        o += np.float32(0.5)
+    lo = np.floor(o, out=_buf(ws, "lo", npix))
+    o0 = _buf(ws, "o0", npix, np.int32)
+    np.copyto(o0, lo, casting="unsafe")
+    idx0 = np.add(base, o0, out=_buf(ws, "idx0", npix, np.intp))
+    if soft_orientation:  # (left, o0), (left, o0 + 1), (right, o0), (right, o0 + 1)
+        frac = np.subtract(o, lo, out=lo)  # weight of bin o0 + 1
+        mo = _buf(ws, "mo", (1, 2, npix), np.float64)
         np.multiply(mag, frac, out=frac)
         np.copyto(mo[0, 1], frac)
-        np.subtract(mag, frac, out=mag)
-        np.copyto(mo[0, 0], mag)
-        idx = np.add(base4, o0, out=_buf(ws, "idx", base4.shape, np.intp))
-        weights = np.multiply(wx, mo, out=_buf(ws, "weights", (2, 2, npix), np.float64))
-    else:
-        o += np.float32(0.5)
-        np.copyto(o0, o, casting="unsafe")  # round; bin n_bins lands in slot n_bins
-        idx = np.add(base4[::2], o0, out=_buf(ws, "idx", (2, npix), np.intp))
-        weights = np.multiply(wx[:, 0], mag, out=_buf(ws, "weights", (2, npix), np.float64))
-    wbp = wb + 2
-    t = np.bincount(idx.reshape(-1), weights.reshape(-1), minlength=n * rows * wbp * slots)
+        np.subtract(mag, frac, out=frac)
+        np.copyto(mo[0, 0], frac)
+        weights = np.multiply(wx, mo, out=_buf(ws, "weights4", (2, 2, npix), np.float64))
+        offsets = np.array([[0], [1], [slots], [slots + 1]], np.intp)
+    else:  # (left, o0), (right, o0)
+        weights = np.multiply(wx[:, 0], mag, out=_buf(ws, "weights2", (2, npix), np.float64))
+        offsets = np.array([[0], [slots]], np.intp)
+    idx = np.add(idx0, offsets, out=_buf(ws, f"idx{len(offsets)}", (len(offsets), npix), np.intp))
+    prows, row_len = rows + 2 * cell_size, n * (wb + 2) * slots
+    t = np.bincount(idx.reshape(-1), weights.reshape(-1), minlength=prows * row_len)
 
-    # Rows: a pixel at row r of cell c feeds cells c-1, c and c+1 with wy[:, r].
-    t = t.reshape(n, hb, cell_size, wbp * slots)
-    y = np.matmul(wy, t, out=_buf(ws, "y", (n, hb, 3, wbp * slots), np.float64))
-    h = _buf(ws, "h", (n, hb, wbp * slots), np.float64)
-    np.copyto(h, y[:, :, 1])
-    h[:, 1:] += y[:, :-1, 2]
-    h[:, :-1] += y[:, 1:, 0]
+    # Rows: cell c sums the rows of cells c-1, c, c+1 weighted by wy (a strided
+    # window view, no copy).
+    step = t.itemsize * row_len
+    windows = np.ndarray((hb, 3 * cell_size, row_len), t.dtype, t, 0, (cell_size * step, step, t.itemsize))
+    h = np.matmul(wy, windows, out=_buf(ws, "h", (hb, 1, row_len), np.float64))
 
-    h = h.reshape(n, hb, wbp, slots)[:, :, 1 : wb + 1]
-    h[..., 0] += h[..., n_bins]
-    hist = np.empty((n, n_bins, hb, wb), np.float32)
-    np.copyto(hist, h[..., :n_bins].transpose(0, 3, 1, 2), casting="same_kind")
-    hist *= np.float32(1.0 / cell_size**2)
-    edge = np.float32(8.0 / 7.0)
-    hist[:, :, 0] *= edge
-    hist[:, :, -1] *= edge
-    hist[:, :, :, 0] *= edge
-    hist[:, :, :, -1] *= edge
+    # Drop the padding cells, fold slots n_bins, n_bins + 1 into bins 0, 1.
+    h = h.reshape(hb, n, wb + 2, slots)[:, :, 1 : wb + 1].transpose(3, 1, 0, 2)
+    hist = np.empty((n_bins, n, hb, wb), np.float32)
+    np.copyto(hist, h[:n_bins], casting="same_kind")
+    hist[:2] += h[n_bins:]
+    hist *= scale
     return hist
 
 
@@ -375,24 +397,25 @@ def _normalise(hist: np.ndarray, n_orients: int, clip: float, cell_size: int) ->
     """Block-normalise, clip and project cell histograms into fhog channels.
 
     Args:
-        hist: ``(N, 2 * n_orients, hb, wb)`` float32 (``_cell_histograms``),
+        hist: ``(2 * n_orients, N, hb, wb)`` float32 (``_histograms``),
             ``hb, wb >= 2``.
 
     Returns:
         ``(N, 3 * n_orients + 4, hb, wb)`` float32, C-contiguous.
     """
-    n, _, hb, wb = hist.shape
+    _, n, hb, wb = hist.shape
     no = 3 * n_orients  # orientation channels
+    cells = n * hb * wb
     # Orientation features: contrast-sensitive then -insensitive histograms.
-    feats = np.empty((n, no, hb * wb), np.float32)
-    flat = hist.reshape(n, 2 * n_orients, hb * wb)
-    feats[:, : 2 * n_orients] = flat
-    insens = feats[:, 2 * n_orients :]
-    np.add(flat[:, :n_orients], flat[:, n_orients:], out=insens)
+    feats = np.empty((no, cells), np.float32)
+    flat = hist.reshape(2 * n_orients, cells)
+    feats[: 2 * n_orients] = flat
+    insens = feats[2 * n_orients :]
+    np.add(flat[:n_orients], flat[n_orients:], out=insens)
 
     # 1 / sqrt(energy of each 2x2 block + eps), edge-padded to (hb + 1, wb + 1)
     # so that every cell has 4 blocks.
-    energy = np.einsum("nok,nok->nk", insens, insens).reshape(n, hb, wb)
+    energy = np.einsum("ok,ok->k", insens, insens).reshape(n, hb, wb)
     blocks = energy[:, :-1, :-1] + energy[:, 1:, :-1]
     blocks += energy[:, :-1, 1:]
     blocks += energy[:, 1:, 1:]
@@ -406,17 +429,18 @@ def _normalise(hist: np.ndarray, n_orients: int, clip: float, cell_size: int) ->
     inv[:, :, 0] = inv[:, :, 1]
     inv[:, :, wb] = inv[:, :, wb - 1]
 
-    out = np.zeros((n, no + 4, hb * wb), np.float32)
-    orient = out[:, :no]
+    out = np.zeros((no + 4, cells), np.float32)
+    orient = out[:no]
     tmp = np.empty_like(feats)
-    norm = np.empty((n, 1, hb, wb), np.float32)
+    norm = np.empty((n, hb, wb), np.float32)
     clip = np.float32(clip)
     for k, (dr, dc) in enumerate(_BLOCK_OFFSETS):
-        np.copyto(norm[:, 0], inv[:, dr : dr + hb, dc : dc + wb])
-        np.multiply(feats, norm.reshape(n, 1, hb * wb), out=tmp)
+        np.copyto(norm, inv[:, dr : dr + hb, dc : dc + wb])
+        np.multiply(feats, norm.reshape(1, cells), out=tmp)
         np.minimum(tmp, clip, out=tmp)
         orient += tmp
-        np.sum(tmp[:, : 2 * n_orients], axis=1, out=out[:, no + k])
+        np.sum(tmp[: 2 * n_orients], axis=0, out=out[no + k])
     orient *= np.float32(0.5)
-    out[:, no:] *= np.float32(_TEXTURE_SCALE)
-    return out.reshape(n, no + 4, hb, wb)
+    out[no:] *= np.float32(_TEXTURE_SCALE)
+    out = out.reshape(no + 4, n, hb, wb)
+    return out[:, 0][None] if n == 1 else np.ascontiguousarray(out.transpose(1, 0, 2, 3))

@@ -1,0 +1,72 @@
+"""Tracker speed on real or synthetic frames: fps per config, image decoding excluded.
+
+    python benchmarks/speed.py [--root ../shared/data/UAV123_10fps] [--configs strcf,bacf,dr2track]
+        [--json speed.json]
+
+Run single-threaded (the script sets OMP/OPENBLAS/MKL threads to 1 before numpy loads).
+Frames are decoded before timing; only init/update are timed. Prints per-sequence fps,
+the median over sequences per config, and peak RSS of this process.
+"""
+import os
+
+for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[var] = "1"
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import resource  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+import dcfkit  # noqa: E402
+from dcfkit.synthetic import make_sequence  # noqa: E402
+
+
+def sequences(root):
+    if root and Path(root).is_dir():
+        from dcfkit.datasets import load_dataset
+
+        for seq in load_dataset("uav123_10fps", root):
+            yield seq.name, [seq.frame(i) for i in range(len(seq))], seq.init_box
+    else:
+        print(f"no real data at {root!r}: synthetic 1280x720 frames")
+        seq = make_sequence(n_frames=100, size=(720, 1280), target=(40, 70))
+        yield "synthetic_720p", seq.frames, seq.ground_truth[0]
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--root", default=str(Path(__file__).resolve().parents[2] / "shared/data/UAV123_10fps"))
+    parser.add_argument("--configs", default="strcf,bacf,dr2track")
+    parser.add_argument("--json", help="also write the table here")
+    args = parser.parse_args()
+    configs = args.configs.split(",")
+    rows = []
+    for name, frames, box in sequences(args.root):
+        for config in configs:
+            tracker = dcfkit.load_tracker(config)
+            start = time.perf_counter()
+            tracker.init(frames[0], box)
+            first = time.perf_counter() - start
+            start = time.perf_counter()
+            for frame in frames[1:]:
+                tracker.update(frame)
+            fps = (len(frames) - 1) / (time.perf_counter() - start)
+            rows.append({"sequence": name, "config": config, "fps": fps, "first_frame_s": first})
+            print(f"{name:<14} {config:<10} {fps:7.1f} fps   first frame {first * 1000:6.1f} ms", flush=True)
+    print("\nmedian over sequences:")
+    summary = {}
+    for config in configs:
+        fps = [r["fps"] for r in rows if r["config"] == config]
+        summary[config] = float(np.median(fps))
+        print(f"  {config:<10} {summary[config]:7.1f} fps")
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"peak RSS {rss:.0f} MB")
+    if args.json:
+        Path(args.json).write_text(json.dumps({"rows": rows, "median_fps": summary, "peak_rss_mb": rss}, indent=2))
+
+
+if __name__ == "__main__":
+    main()

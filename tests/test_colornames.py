@@ -1,0 +1,58 @@
+"""The Color Names table and feature."""
+import hashlib
+
+import numpy as np
+import pytest
+
+from dcfkit.errors import ConfigError
+from dcfkit.features import ColorNames, Gray, cell_average
+from dcfkit.features import colornames as cn
+
+
+def test_table_is_found_and_verified():
+    table = cn.load_table()
+    assert table.shape == (32768, 10) and table.dtype == np.float32
+    assert hashlib.sha256(table.tobytes()).hexdigest() == cn.SHA256
+    # the published first row of the normalised CN table
+    np.testing.assert_allclose(table[0, :4], [0.45975, 0.014802, 0.044289, -0.028193], rtol=1e-6)
+
+
+def test_table_index_is_r_plus_32g_plus_1024b():
+    bgr = np.array([[[0, 0, 255], [0, 255, 0], [255, 0, 0], [17, 130, 9]]], np.uint8)
+    assert cn.table_index(bgr).tolist() == [[31, 31 * 32, 31 * 1024, 9 // 8 + 32 * (130 // 8) + 1024 * (17 // 8)]]
+
+
+def test_feature_is_the_cell_mean_of_table_rows():
+    rng = np.random.default_rng(0)
+    patch = rng.integers(0, 256, (8, 12, 3), dtype=np.uint8)
+    got = ColorNames().extract(patch, 4)
+    table = cn.load_table()
+    assert got.shape == (10, 2, 3)
+    for cy in range(2):
+        for cx in range(3):
+            block = patch[4 * cy:4 * cy + 4, 4 * cx:4 * cx + 4]
+            np.testing.assert_allclose(got[:, cy, cx], table[cn.table_index(block)].reshape(-1, 10).mean(0), atol=1e-6)
+
+
+def test_table_from_file_and_bad_files(tmp_path):
+    good = tmp_path / "cn.npy"
+    np.save(good, cn.load_table())
+    assert np.array_equal(cn.load_table(str(good)), cn.load_table())
+    bad = tmp_path / "bad.npy"
+    np.save(bad, np.zeros((32768, 10), np.float32))
+    with pytest.raises(ConfigError, match="failed its checksum"):
+        cn.load_table(str(bad))
+    np.save(bad, np.zeros((10, 10), np.float32))
+    with pytest.raises(ConfigError, match=r"shape \(10, 10\), expected \(32768, 10\)"):
+        cn.load_table(str(bad))
+    with pytest.raises(ConfigError, match="file not found"):
+        cn.load_table(str(tmp_path / "missing.npy"))
+
+
+def test_gray_feature_is_centred_cell_mean():
+    patch = np.full((8, 8, 3), 255, np.uint8)
+    patch[:4, :4] = 0
+    got = Gray().extract(patch, 4)
+    np.testing.assert_allclose(got[0], [[-0.5, 0.5], [0.5, 0.5]], atol=1e-6)
+    np.testing.assert_allclose(cell_average(np.arange(16, dtype=np.float32).reshape(4, 4), 2),
+                               [[2.5, 4.5], [10.5, 12.5]])
