@@ -160,17 +160,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--format", choices=("table", "markdown", "json"), default="table")
     p.set_defaults(func=cmd_components)
 
-    try:
-        from .evaluation import add_eval_arguments, cmd_eval
-        from .report import add_report_arguments, cmd_report
-    except ImportError:  # pragma: no cover - present in every install
-        return parser
+    from .evaluation import add_eval_arguments, cmd_eval
+    from .report import add_report_arguments, cmd_report
+
     p = sub.add_parser("eval", help="one-pass evaluation of configs on a benchmark")
     add_eval_arguments(p)
     p.set_defaults(func=cmd_eval)
     p = sub.add_parser("report", help="tables and precision/success plots of evaluation results")
     add_report_arguments(p)
     p.set_defaults(func=cmd_report)
+    try:
+        from .ablation import add_ablate_arguments, cmd_ablate
+    except ImportError:
+        return parser
+    p = sub.add_parser("ablate", help="run an ablation spec: variants x parameter grids x sequences")
+    add_ablate_arguments(p)
+    p.set_defaults(func=cmd_ablate)
     return parser
 
 

@@ -36,6 +36,7 @@ from __future__ import annotations
 import threading
 from collections import OrderedDict
 from functools import lru_cache
+from typing import NamedTuple
 
 import cv2
 import numpy as np
@@ -270,38 +271,62 @@ def _cell_axis(length: int, cell_size: int) -> tuple[np.ndarray, np.ndarray]:
     return (lower + 1).astype(np.intp), t - lower
 
 
-@lru_cache(maxsize=8)
-def _scatter_plan(n: int, rows: int, cols: int, cell_size: int, slots: int):
-    """Tables for the scatter of pixels into per-row cell histograms (cached).
+_SCATTER_BYTES = 1 << 19  # target size of one chunk's float64 scatter output (L2)
 
-    Pixels come in the order (row, image, column) of ``_gradients``.  The
-    scatter target is ``(rows + 2 * cell_size, n, cols // cell_size + 2,
-    slots)``: pixel rows stay separate (they are pooled densely afterwards; a
-    cell of zero rows above and below lets every cell row see two neighbours),
-    columns go bilinearly to cells padded by one on each side.
+
+class _Plan(NamedTuple):
+    """Geometry of the chunked scatter (see ``_scatter_plan``)."""
+
+    cells: int  # cell rows per chunk
+    prows: int  # rows of a full chunk's scatter output
+    base: np.ndarray  # (4, chunk pixels) intp
+    wx: np.ndarray  # (2, 1, chunk pixels) float64
+    wy: np.ndarray  # (1, L) float64
+    scale: np.ndarray  # (hb, wb) float32
+
+
+@lru_cache(maxsize=8)
+def _scatter_plan(n: int, rows: int, cols: int, cell_size: int, slots: int) -> _Plan:
+    """Tables for scattering pixels into per-row cell histograms (cached).
+
+    The pixels ``(rows, n, cols)`` of ``_gradients`` are scattered one chunk of
+    ``cells`` cell rows at a time into ``(prows, n, cols // cell_size + 2,
+    slots)`` float64: pixel rows stay separate (they are pooled densely
+    afterwards), columns go bilinearly to cells padded by one on each side.
+    Zero rows above and below the chunk's pixels make the row window of local
+    cell ``j`` (``-1 .. cells``) start at row ``(j + 1) * cell_size``.
 
     Returns:
-        ``base``: ``(n * rows * cols,)`` intp, flat index of each pixel's left
-        cell, orientation slot 0.  ``wx``: ``(2, 1, n * rows * cols)`` float64,
-        weights of the left and right cell.  ``wy``: ``(1, 3 * cell_size)``
-        float64, weights of the rows of the cells above, at and below a cell.
-        ``scale``: ``(rows // cell_size, cols // cell_size)`` float32,
+        ``_Plan`` with ``base``: flat target of each pixel of a chunk for
+        (left cell, orientation slot 0), (left, 1), (right, 0), (right, 1);
+        ``wx``: weights of the left and right cell; ``wy``: row weights of a
+        cell over its ``L`` (about ``2 * cell_size``) window rows; ``scale``:
         ``1 / cell_size**2`` times ``8/7`` per image border the cell touches.
     """
     hb, wb = rows // cell_size, cols // cell_size
-    lower, d = _cell_axis(cols, cell_size)
-    row = np.arange(rows)[:, None] + cell_size  # in the padded rows
-    row_start = (row * n + np.arange(n)[None, :])[:, :, None] * (wb + 2)  # (rows, n, 1)
-    base = ((row_start + lower) * slots).ravel()
-    wx = np.empty((2, 1, n * rows * cols))
-    wx[0, 0] = np.tile(1.0 - d, n * rows)
-    wx[1, 0] = np.tile(d, n * rows)
-
     # Row r of a cell sits at cell coordinate t = (r + 0.5) / cell_size - 0.5
     # relative to it and feeds the cell floor(t) with 1 - frac(t) and the next
-    # one with frac(t): the window weights of a cell are the ramp 1 - |t|.
+    # one with frac(t): over the rows of the cells above, at and below, a
+    # cell's weights are the ramp 1 - |t|; keep its non-zero part.
     t = (np.arange(3 * cell_size) + 0.5) / cell_size - 1.5
-    wy = np.maximum(0.0, 1.0 - np.abs(t))[None]
+    wy = np.maximum(0.0, 1.0 - np.abs(t))
+    first, last = np.flatnonzero(wy)[[0, -1]]
+    wy = wy[first : last + 1][None]
+    pad = 2 * cell_size - first  # zero rows above a chunk's pixels
+    pad_below = first + wy.shape[1] - cell_size
+    row_len = n * (wb + 2) * slots
+    cells = (_SCATTER_BYTES // (8 * row_len) - pad - pad_below) // cell_size
+    cells = min(hb, max(cells, 4))
+    cells = -(-hb // -(-hb // cells))  # same number of chunks, equal sizes
+
+    lower, d = _cell_axis(cols, cell_size)
+    row = np.arange(cells * cell_size)[:, None] + pad
+    row_start = (row * n + np.arange(n)[None, :])[:, :, None] * (wb + 2)  # (rows, n, 1)
+    base = ((row_start + lower) * slots).reshape(1, -1)
+    base = base + np.array([[0], [1], [slots], [slots + 1]], np.intp)
+    wx = np.empty((2, 1, base.shape[1]))
+    wx[0, 0] = np.tile(1.0 - d, n * cells * cell_size)
+    wx[1, 0] = np.tile(d, n * cells * cell_size)
 
     edge_r = np.ones(hb)
     edge_r[[0, -1]] = 8.0 / 7.0
@@ -310,7 +335,7 @@ def _scatter_plan(n: int, rows: int, cols: int, cell_size: int, slots: int):
     scale = (np.outer(edge_r, edge_c) / cell_size**2).astype(np.float32)
     for a in (base, wx, wy, scale):
         a.setflags(write=False)
-    return base, wx, wy, scale
+    return _Plan(cells, pad + cells * cell_size + pad_below, base, wx, wy, scale)
 
 
 def _cell_histograms(
@@ -346,10 +371,10 @@ def _histograms(imgs: np.ndarray, cell_size: int, n_bins: int, soft_orientation:
     ws = _workspace((imgs.shape, imgs.dtype.char, cell_size, n_bins))
     mag, theta = _gradients(imgs, rows, cols, ws)
 
-    # Orientation bins o0 and o0 + 1 in [0, n_bins + 1]; slots n_bins and
-    # n_bins + 1 are bins 0 and 1 again (theta may be 2pi).
+    # Orientation bins o0 and o0 + 1 in [0, n_bins + 1] with weights m0, m1;
+    # slots n_bins and n_bins + 1 are bins 0 and 1 again (theta may be 2pi).
     slots, npix = n_bins + 2, n * rows * cols
-    base, wx, wy, scale = _scatter_plan(n, rows, cols, cell_size, slots)
+    plan = _scatter_plan(n, rows, cols, cell_size, slots)
     o = theta.reshape(npix)
     o *= np.float32(n_bins / (2 * np.pi))
     mag = mag.reshape(npix)
@@ -358,35 +383,46 @@ def _histograms(imgs: np.ndarray, cell_size: int, n_bins: int, soft_orientation:
     lo = np.floor(o, out=_buf(ws, "lo", npix))
     o0 = _buf(ws, "o0", npix, np.int32)
     np.copyto(o0, lo, casting="unsafe")
-    idx0 = np.add(base, o0, out=_buf(ws, "idx0", npix, np.intp))
-    if soft_orientation:  # (left, o0), (left, o0 + 1), (right, o0), (right, o0 + 1)
-        frac = np.subtract(o, lo, out=lo)  # weight of bin o0 + 1
-        mo = _buf(ws, "mo", (1, 2, npix), np.float64)
+    mo = _buf(ws, "mo", (1, 2, npix), np.float64)
+    if soft_orientation:
+        frac = np.subtract(o, lo, out=lo)
         np.multiply(mag, frac, out=frac)
         np.copyto(mo[0, 1], frac)
         np.subtract(mag, frac, out=frac)
         np.copyto(mo[0, 0], frac)
-        weights = np.multiply(wx, mo, out=_buf(ws, "weights4", (2, 2, npix), np.float64))
-        offsets = np.array([[0], [1], [slots], [slots + 1]], np.intp)
-    else:  # (left, o0), (right, o0)
-        weights = np.multiply(wx[:, 0], mag, out=_buf(ws, "weights2", (2, npix), np.float64))
-        offsets = np.array([[0], [slots]], np.intp)
-    idx = np.add(idx0, offsets, out=_buf(ws, f"idx{len(offsets)}", (len(offsets), npix), np.intp))
-    prows, row_len = rows + 2 * cell_size, n * (wb + 2) * slots
-    t = np.bincount(idx.reshape(-1), weights.reshape(-1), minlength=prows * row_len)
+    else:
+        np.copyto(mo[0, 0], mag)
+        mo[0, 1] = 0.0
 
-    # Rows: cell c sums the rows of cells c-1, c, c+1 weighted by wy (a strided
-    # window view, no copy).
-    step = t.itemsize * row_len
-    windows = np.ndarray((hb, 3 * cell_size, row_len), t.dtype, t, 0, (cell_size * step, step, t.itemsize))
-    h = np.matmul(wy, windows, out=_buf(ws, "h", (hb, 1, row_len), np.float64))
+    # Scatter chunk by chunk (small outputs stay in cache) and pool rows: cell c
+    # sums rows of the cells c-1, c, c+1 weighted by wy, taken as a strided
+    # window view of the scatter output.
+    row_len = n * (wb + 2) * slots
+    chunk_pix = plan.base.shape[1]
+    idx_buf = _buf(ws, "idx", 4 * chunk_pix, np.intp)
+    w_buf = _buf(ws, "weights", 4 * chunk_pix, np.float64)
+    h = _buf(ws, "h", (hb + 2, 1, row_len), np.float64)  # a cell row of padding each side
+    h.fill(0.0)
+    for c0 in range(0, hb, plan.cells):
+        c1 = min(c0 + plan.cells, hb)
+        p0, p1 = c0 * cell_size * n * cols, c1 * cell_size * n * cols
+        m = p1 - p0
+        idx = np.add(plan.base[:, :m], o0[p0:p1], out=idx_buf[: 4 * m].reshape(4, m))
+        weights = np.multiply(plan.wx[:, :, :m], mo[:, :, p0:p1], out=w_buf[: 4 * m].reshape(2, 2, m))
+        prows = plan.prows - (plan.cells - (c1 - c0)) * cell_size
+        t = np.bincount(idx.reshape(-1), weights.reshape(-1), minlength=prows * row_len)
+        step = t.itemsize * row_len
+        windows = np.ndarray(
+            (c1 - c0 + 2, plan.wy.shape[1], row_len), t.dtype, t, 0, (cell_size * step, step, t.itemsize)
+        )
+        h[c0 : c1 + 2] += np.matmul(plan.wy, windows)
 
     # Drop the padding cells, fold slots n_bins, n_bins + 1 into bins 0, 1.
-    h = h.reshape(hb, n, wb + 2, slots)[:, :, 1 : wb + 1].transpose(3, 1, 0, 2)
+    h = h[1 : hb + 1].reshape(hb, n, wb + 2, slots)[:, :, 1 : wb + 1].transpose(3, 1, 0, 2)
     hist = np.empty((n_bins, n, hb, wb), np.float32)
     np.copyto(hist, h[:n_bins], casting="same_kind")
     hist[:2] += h[n_bins:]
-    hist *= scale
+    hist *= plan.scale
     return hist
 
 
