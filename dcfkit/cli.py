@@ -11,18 +11,6 @@ from . import __version__
 from .errors import DcfkitError
 
 
-def _overrides(pairs: list[str] | None) -> dict:
-    from .config import parse_value
-
-    out = {}
-    for pair in pairs or []:
-        key, sep, value = pair.partition("=")
-        if not sep or not key:
-            raise DcfkitError(f"--set expects key=value (e.g. label.mu=0.3), got {pair!r}")
-        out[key.strip()] = parse_value(value)
-    return out
-
-
 def _parse_box(text: str) -> tuple[float, ...]:
     try:
         box = tuple(float(v) for v in text.replace(" ", "").split(","))
@@ -34,10 +22,11 @@ def _parse_box(text: str) -> tuple[float, ...]:
 
 
 def cmd_track(args) -> int:
+    from .config import parse_overrides
     from .tracker import load_tracker
     from .video import VideoWriter, iter_frames
 
-    tracker = load_tracker(args.config, overrides=_overrides(args.set))
+    tracker = load_tracker(args.config, overrides=parse_overrides(args.set))
     offset = 1.0 if args.one_based else 0.0
     box = _parse_box(args.box)
     box = (box[0] - offset, box[1] - offset, box[2], box[3])
@@ -189,6 +178,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"dcfkit {args.command}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # e.g. piped into head
+        sys.stderr.close()
+        return 0
 
 
 if __name__ == "__main__":

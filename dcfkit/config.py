@@ -126,6 +126,17 @@ def parse_value(text: str) -> Any:
         return text
 
 
+def parse_overrides(items) -> dict:
+    """``["label.mu=0.3", "name=x"]`` -> ``{"label.mu": 0.3, "name": "x"}`` (CLI ``--set`` values)."""
+    out = {}
+    for item in items or ():
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise ConfigError(f"--set expects KEY=VALUE (e.g. label.mu=0.3), got {item!r}")
+        out[key.strip()] = parse_value(value) if value.strip() else ""
+    return out
+
+
 def set_dotted(config: dict, key: str, value: Any) -> None:
     """Set ``a.b.0.c`` in nested dicts/lists; list indices are integers."""
     parts = key.split(".")

@@ -506,23 +506,6 @@ def opencv_tracker(name: str) -> Callable[[Any], OpenCVTracker]:
 # --------------------------------------------------------------------------- CLI
 
 
-def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
-    """``["a.b=3", "name=x"]`` -> ``{"a.b": 3, "name": "x"}`` (values parsed as YAML scalars)."""
-    out = {}
-    for item in items or ():
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise ConfigError(f"--set expects KEY=VALUE, got {item!r}")
-        try:
-            import yaml
-
-            parsed = yaml.safe_load(value) if value.strip() else ""
-        except Exception:
-            parsed = value
-        out[key.strip()] = parsed
-    return out
-
-
 def add_eval_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
     """Arguments of ``dcfkit eval``."""
     parser.add_argument("configs", nargs="+", metavar="CONFIG",
@@ -556,6 +539,8 @@ def cmd_eval(args: argparse.Namespace) -> int:
     from .datasets import load_dataset
 
     sequences = load_dataset(args.dataset, args.root, args.sequences)
+    from .config import parse_overrides
+
     overrides = parse_overrides(args.overrides)
     status = 0
     for spec in args.configs:

