@@ -27,16 +27,22 @@ from .params import param
 from .registry import Component
 
 
-def sherman_morrison_solve(a: np.ndarray, b: np.ndarray, c: float | np.ndarray,
+def sherman_morrison_solve(a: np.ndarray, b: np.ndarray, c: float, a_conj: np.ndarray | None = None,
                            aa: np.ndarray | None = None) -> np.ndarray:
-    """Solve (a aᴴ + c I) x = b independently per pixel (Eq. 9).
+    """Solve (a aᴴ + c I) x = b independently per pixel (Eq. 9): x = (b - a (aᴴb) / (c + aᴴa)) / c.
 
-    a, b: (C, ...) complex; c > 0 scalar or (...); aa: precomputed Σ|a|² (...). Returns (C, ...).
+    a, b: (C, ...) complex; c > 0; a_conj, aa: conj(a) and Σ|a|², when precomputed. Returns (C, ...).
     """
+    if a_conj is None:
+        a_conj = a.conj()
     if aa is None:
-        aa = np.einsum("c...,c...->...", a.conj(), a).real
-    ahb = np.einsum("c...,c...->...", a.conj(), b)
-    return (b - a * (ahb / (c + aa))) / c
+        aa = np.einsum("c...,c...->...", a_conj, a).real
+    t = np.einsum("c...,c...->...", a_conj, b)
+    t /= c + aa
+    x = a * t[None]
+    np.subtract(b, x, out=x)
+    x *= 1.0 / c
+    return x
 
 
 @dataclasses.dataclass(frozen=True)
@@ -54,33 +60,42 @@ class ADMMParams:
 
 
 def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: np.ndarray | None,
-         p: ADMMParams, fft) -> tuple[np.ndarray, np.ndarray]:
+         p: ADMMParams, fft, need_h: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
     """Run E iterations of Eqs. (9)-(11).
 
     xf: (C, H, Wr) complex64 training sample; yf: (H, Wr) label spectrum; w2: (H, W) float32 w²
-    in the patch layout, target centred, like h itself (may hold inf); theta: temporal weight (ignored when v_prev is None);
-    v_prev: (C, H, Wr) last frame's filter. Returns (v̂, ĥ), each (C, H, Wr) complex64.
+    in the patch layout, target centred like h itself (may hold inf); theta: temporal weight
+    (ignored when v_prev is None); v_prev: (C, H, Wr) last frame's filter.
+    Returns (v̂, ĥ), each (C, H, Wr) complex64. The trackers use v̂ only, so the last h-step
+    and multiplier update, which cannot change it, run only when ``need_h``.
     """
     shape = w2.shape
     K = float(shape[0] * shape[1])
     if v_prev is None:
         theta = 0.0
-    aa = np.einsum("chw,chw->hw", xf.conj(), xf).real
+    xc = xf.conj()
+    aa = np.einsum("chw,chw->hw", xc, xf).real
     rhs0 = xf * yf.conj()[None]
     if theta > 0:
-        rhs0 = rhs0 + theta * v_prev
-    hf = np.zeros_like(xf)
-    uf = np.zeros_like(xf)
+        rhs0 += theta * v_prev
+    hf = uf = None  # zero at the start of every frame (Remark 1)
     gamma = p.gamma0
-    for _ in range(p.iterations):
+    for e in range(p.iterations):
         c = theta + gamma
-        vf = sherman_morrison_solve(xf, rhs0 + gamma * hf - uf, c, aa)
-        shrink = (gamma * K) / (w2 + gamma * K)
-        h = shrink * fft.irfft2(vf + uf / gamma, shape)
+        # v-step (Eq. 9): Sherman-Morrison per frequency, b = a conj(ŷ) + θ v̂ˡ + γ ĥ - û
+        b = rhs0 if hf is None else rhs0 + gamma * hf - uf
+        vf = sherman_morrison_solve(xf, b, c, xc, aa)
+        if e == p.iterations - 1 and not need_h:
+            return vf, None
+        # h-step (Eq. 10) in the spatial domain
+        h = fft.irfft2(vf if uf is None else vf + uf * (1.0 / gamma), shape)
+        h *= (gamma * K) / (w2 + gamma * K)
         hf = fft.rfft2(h.astype(np.float32, copy=False)).astype(np.complex64, copy=False)
-        uf = uf + gamma * (vf - hf)
+        # multiplier (Eq. 11) and penalty schedule
+        step = gamma * (vf - hf)
+        uf = step if uf is None else uf + step
         gamma = min(p.gamma_max, p.beta * gamma)
-    return vf.astype(np.complex64, copy=False), hf
+    return vf, hf
 
 
 class Solver(Component):
