@@ -61,6 +61,8 @@ class FHOG(Feature):
     class Params:
         n_orients: int = param(9, "unsigned orientation bins (signed ones: twice as many)")
         clip: float = param(0.2, "truncation of the normalised histograms")
+        soft_orientation: bool = param(False, "split each gradient between the two nearest orientation bins "
+                                              "(false: nearest bin only, as Piotr's fhog used by STRCF/BACF)")
 
         def validate(self):
             if self.n_orients < 2:
@@ -72,7 +74,8 @@ class FHOG(Feature):
         return 3 * self.params.n_orients + 4
 
     def extract(self, patch, cell_size):
-        return fhog(patch, cell_size=cell_size, n_orients=self.params.n_orients, clip=self.params.clip)
+        p = self.params
+        return fhog(patch, cell_size=cell_size, n_orients=p.n_orients, clip=p.clip, soft_orientation=p.soft_orientation)
 
 
 class ColorNames(Feature):
