@@ -92,7 +92,7 @@ class ColorNames(Feature):
 
     def extract(self, patch, cell_size):
         table = load_table(self.params.table_path)
-        values = table[table_index(patch)]  # (H, W, 10)
+        values = np.take(table, table_index(patch), axis=0)  # (H, W, 10); take: ~4x faster than table[...]
         return np.ascontiguousarray(cell_average(values, cell_size).transpose(2, 0, 1))
 
 

@@ -26,8 +26,8 @@ _FIRST_ROW = np.array([0.45975, 0.014802, 0.044289, -0.028193, 0.001151], np.flo
 
 def table_index(bgr: np.ndarray) -> np.ndarray:
     """Row of the table for each pixel of an (H, W, 3) uint8 BGR image: R/8 + 32 G/8 + 1024 B/8."""
-    q = (bgr >> 3).astype(np.intp)
-    return q[..., 2] + 32 * q[..., 1] + 1024 * q[..., 0]
+    q = bgr >> 3
+    return q[..., 2].astype(np.int32) | (q[..., 1].astype(np.int32) << 5) | (q[..., 0].astype(np.int32) << 10)
 
 
 def _cache_dir() -> Path:

@@ -1,0 +1,94 @@
+"""Per-stage time of one tracker per frame (patch extraction, each feature, FFTs, detection,
+label, solver, scale), by wrapping the tracker's components with timers — the tracker code
+itself carries no instrumentation.
+
+    python benchmarks/stages.py [--config dr2track] [--root ../shared/data/UAV123_10fps]
+        [--sequence boat1] [--frames 100] [--json stages.json]
+
+Single-threaded; frames are decoded before timing. Synthetic 1280x720 frames when the real
+data is absent. Prints ms per frame per stage and its share of the total.
+"""
+import os
+
+for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[var] = "1"
+
+import argparse  # noqa: E402
+import collections  # noqa: E402
+import functools  # noqa: E402
+import json  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import cv2  # noqa: E402
+
+import dcfkit  # noqa: E402
+import dcfkit.tracker as tracker_module  # noqa: E402
+from dcfkit.synthetic import make_sequence  # noqa: E402
+
+cv2.setNumThreads(1)
+TOTALS = collections.defaultdict(float)
+
+
+def timed(stage, fn):
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        start = time.perf_counter()
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            TOTALS[stage] += time.perf_counter() - start
+    return wrapper
+
+
+def instrument(tracker):
+    """Wrap the stages; nested stages (features inside 'scale') are counted in both."""
+    tracker_module.sample = timed("patch extraction", tracker_module.sample)
+    tracker_module.response = timed("detection (response)", tracker_module.response)
+    tracker_module.subpixel_peak = timed("detection (peak)", tracker_module.subpixel_peak)
+    for f in tracker.features:
+        f.extract = timed(f"feature {f.name}", f.extract)
+    tracker.fft.rfft2 = timed("fft", tracker.fft.rfft2)
+    tracker.fft.irfft2 = timed("fft", tracker.fft.irfft2)
+    tracker.label.make = timed(f"label {tracker.label.name}", tracker.label.make)
+    tracker.solver.train = timed(f"solver {tracker.solver.name} (incl. its FFTs)", tracker.solver.train)
+    tracker.scale_estimator.update = timed(f"scale {tracker.scale_estimator.name}", tracker.scale_estimator.update)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--config", default="dr2track")
+    parser.add_argument("--root", default=str(Path(__file__).resolve().parents[2] / "shared/data/UAV123_10fps"))
+    parser.add_argument("--sequence", default="boat1")
+    parser.add_argument("--frames", type=int, default=100)
+    parser.add_argument("--json")
+    args = parser.parse_args()
+    if Path(args.root).is_dir():
+        from dcfkit.datasets import load_dataset
+
+        (seq,) = load_dataset("uav123_10fps", args.root, [args.sequence])
+        n = min(args.frames, len(seq))
+        frames, box = [seq.frame(i) for i in range(n)], seq.init_box
+    else:
+        syn = make_sequence(n_frames=args.frames, size=(720, 1280), target=(40, 70))
+        frames, box = syn.frames, syn.ground_truth[0]
+    tracker = dcfkit.load_tracker(args.config)
+    instrument(tracker)
+    tracker.init(frames[0], box)
+    TOTALS.clear()
+    start = time.perf_counter()
+    for frame in frames[1:]:
+        tracker.update(frame)
+    total = time.perf_counter() - start
+    n = len(frames) - 1
+    print(f"{args.config} on {args.sequence}: {n / total:.1f} fps, {1000 * total / n:.2f} ms/frame")
+    rows = sorted(TOTALS.items(), key=lambda kv: -kv[1])
+    for stage, seconds in rows:
+        print(f"  {stage:<40} {1000 * seconds / n:7.2f} ms  {100 * seconds / total:5.1f} %")
+    if args.json:
+        Path(args.json).write_text(json.dumps({"fps": n / total, "ms_per_frame": {k: 1000 * v / n for k, v in rows}},
+                                              indent=2))
+
+
+if __name__ == "__main__":
+    main()
