@@ -56,6 +56,9 @@ class TrackerParams:
     cell_size: int = param(4, "feature cell size in pixels")
     output_sigma_factor: float = param(1 / 16, "label σ as a fraction of sqrt(target area in cells)")
     fft_backend: str = param("scipy", "FFT implementation", choices=("scipy", "pyfftw"))
+    training_sample: str = param("extract", "'extract' m^t at p^t (Algorithm 1) or 'shift' the detection sample "
+                                 "to p^t in the Fourier domain (the reference codes; one extraction less)",
+                                 choices=("extract", "shift"))
 
     def validate(self):
         if self.search_area_scale < 1:

@@ -64,3 +64,12 @@ def local_maxima(r: np.ndarray, size: int = 3) -> tuple[np.ndarray, np.ndarray]:
     rows, cols = np.nonzero((r == filtered) & (r > lowest))
     order = np.argsort(-r[rows, cols], kind="stable")
     return rows[order], cols[order]
+
+
+def shift_spectrum(xf: np.ndarray, dy: float, dx: float, shape: tuple[int, int]) -> np.ndarray:
+    """Half spectra (..., H, W//2+1) of maps translated so that x'(p) = x(p + (dy, dx)), circularly
+    (sub-cell shifts interpolate in the Fourier domain)."""
+    ky = np.fft.fftfreq(shape[0])[:, None]
+    kx = np.fft.rfftfreq(shape[1])[None, :]
+    phase = np.exp(2j * np.pi * (ky * dy + kx * dx)).astype(np.complex64)
+    return xf * phase

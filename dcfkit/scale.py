@@ -95,7 +95,7 @@ class DSST(ScaleEstimator):
         shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
         self.model_size = np.maximum(np.round(self.base_target * shrink), 2 * p.cell_size).astype(int)
         self.num = self.den = None
-        self._learn(image, centre, scale)
+        self._learn(np.fft.fft(self._samples(image, centre, scale), axis=1))
 
     def _samples(self, image, centre, scale) -> np.ndarray:
         """(D, S) windowed fHOG of the S scale samples around ``centre``.
@@ -111,8 +111,8 @@ class DSST(ScaleEstimator):
         feats = fhog(patches, cell_size=self.params.cell_size, batch=True)
         return feats.reshape(len(self.factors), -1).T * self.window[None, :]
 
-    def _learn(self, image, centre, scale):
-        xsf = np.fft.fft(self._samples(image, centre, scale), axis=1)
+    def _learn(self, xsf: np.ndarray) -> None:
+        """Update the scale model with the (D, S) spectrum of the scale samples."""
         num = self.label_f[None, :] * xsf.conj()
         den = np.einsum("ds,ds->s", xsf, xsf.conj()).real
         if self.num is None:
@@ -125,9 +125,11 @@ class DSST(ScaleEstimator):
     def update(self, image, centre, scale):
         xsf = np.fft.fft(self._samples(image, centre, scale), axis=1)
         resp = np.fft.ifft(np.einsum("ds,ds->s", self.num, xsf) / (self.den + self.params.lam)).real
-        scale = float(np.clip(scale * self.factors[int(np.argmax(resp))], *self.limits))
-        self._learn(image, centre, scale)
-        return scale
+        new_scale = float(np.clip(scale * self.factors[int(np.argmax(resp))], *self.limits))
+        if new_scale != scale:  # learn from samples at the new scale; unchanged: the same samples
+            xsf = np.fft.fft(self._samples(image, centre, new_scale), axis=1)
+        self._learn(xsf)
+        return new_scale
 
 
 def scale_limits(base_target: np.ndarray, base_region: np.ndarray, image_shape, min_pixels: float = 5.0) -> tuple[float, float]:

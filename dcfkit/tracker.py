@@ -22,7 +22,7 @@ from .fft import make_fft
 from .labels import Detection, gaussian_label
 from .patches import box_to_centre_size, centre_size_to_box, sample
 from .registry import get_registry
-from .response import response, subpixel_peak
+from .response import response, shift_spectrum, subpixel_peak
 from .scale import scale_limits
 
 
@@ -164,11 +164,16 @@ class Tracker:
         self.search.observe(self.position)  # Eq. (13)
         peak = np.unravel_index(int(np.argmax(maps[best])), g.filter_size)
         self.last_response = np.fft.fftshift(maps[best])
-        self._train(image, Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells))
+        xf = None
+        if self.params.training_sample == "shift":  # the detection sample, moved to p^t
+            dy, dx = (self.position - centre) / step
+            xf = shift_spectrum(samples[best], dy, dx, g.filter_size)
+        self._train(image, Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells), xf)
         return self.box
 
-    def _train(self, image: np.ndarray, detection: Detection | None) -> None:
-        xf = self._sample(image, self.position, self.scale)  # m^t at p^t
+    def _train(self, image: np.ndarray, detection: Detection | None, xf: np.ndarray | None = None) -> None:
+        if xf is None:
+            xf = self._sample(image, self.position, self.scale)  # m^t at p^t
         y, offsets = self.label.make(self.base_label, detection)  # Eq. (3)
         yf = self.fft.rfft2(y).astype(np.complex64, copy=False)
         theta = self.temporal.params.theta if self.temporal is not None else 0.0

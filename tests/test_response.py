@@ -61,3 +61,12 @@ def test_subpixel_peak_recovers_the_peak_of_a_band_limited_map(true_dy, true_dx)
 def test_wrap_gives_signed_offsets():
     assert wrap(np.arange(6), 6).tolist() == [0, 1, 2, -3, -2, -1]
     assert wrap(np.arange(5), 5).tolist() == [0, 1, 2, -2, -1]
+
+
+def test_shift_spectrum_matches_roll_for_whole_cells():
+    from dcfkit.response import shift_spectrum
+
+    fft = make_fft("scipy")
+    x = np.random.default_rng(2).standard_normal((3, 8, 10)).astype(np.float32)
+    shifted = fft.irfft2(shift_spectrum(fft.rfft2(x), 2, -3, (8, 10)), (8, 10))
+    np.testing.assert_allclose(shifted, np.roll(x, (-2, 3), axis=(1, 2)), atol=1e-5)

@@ -1,0 +1,34 @@
+"""Scale estimators recover a known zoom."""
+import cv2
+import numpy as np
+import pytest
+
+from dcfkit.scale import DSST, Pyramid, scale_limits
+
+
+def zoomed(image, centre, factor):
+    """``image`` magnified by ``factor`` about ``centre`` (y, x)."""
+    cy, cx = centre
+    m = np.float32([[factor, 0, cx - factor * cx], [0, factor, cy - factor * cy]])
+    return cv2.warpAffine(image, m, image.shape[1::-1], flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT)
+
+
+@pytest.mark.parametrize("steps", [-3, -2, 0, 2, 4])
+def test_dsst_recovers_a_zoom(steps):
+    rng = np.random.default_rng(0)
+    noise = cv2.GaussianBlur(rng.random((240, 320, 3)).astype(np.float32), (0, 0), 1.5)
+    image = ((noise - noise.min()) / np.ptp(noise) * 255).astype(np.uint8)
+    centre, target = np.array([120.0, 160.0]), np.array([40.0, 56.0])
+    dsst = DSST()
+    dsst.init(image, centre, target, 1.0, (0.1, 10.0))
+    factor = dsst.params.step ** steps
+    assert dsst.update(zoomed(image, centre, factor), centre, 1.0) == pytest.approx(factor, rel=1e-9)
+
+
+def test_pyramid_factors_and_limits():
+    pyramid = Pyramid(Pyramid.Params(n_scales=5, step=1.02))
+    np.testing.assert_allclose(pyramid.search_factors(), 1.02 ** np.arange(-2, 3))
+    pyramid.init(None, np.zeros(2), np.array([10.0, 20.0]), 1.0, (0.5, 2.0))
+    assert pyramid.update(None, np.zeros(2), 3.0) == 2.0 and pyramid.update(None, np.zeros(2), 0.1) == 0.5
+    lo, hi = scale_limits(np.array([10.0, 20.0]), np.array([100.0, 100.0]), (360, 480))
+    assert lo == pytest.approx(0.05) and hi == pytest.approx(24.0)
