@@ -89,29 +89,17 @@ def cmd_demo(args) -> int:
 
 
 def cmd_components(args) -> int:
-    from .params import fields
-    from .registry import KINDS, get_registry
+    from .docs_gen import component_rows, components_markdown
+    from .registry import get_registry
 
     registry = get_registry()
-    rows = []
-    for kind in [args.kind] if args.kind else KINDS:
-        for name in registry.names(kind):
-            entry = registry.entry(kind, name)
-            rows.append({"kind": kind, "name": name, "provider": entry.provider,
-                         "doc": (entry.cls.__doc__ or "").strip().splitlines()[0] if entry.cls.__doc__ else "",
-                         "params": fields(entry.cls.Params)})
+    rows = component_rows(registry, [args.kind] if args.kind else None)
     if args.format == "json":
         print(json.dumps(rows, indent=2, default=str))
-        return 0
-    for row in rows:
-        if args.format == "markdown":
-            print(f"### {row['kind']} `{row['name']}`\n\n{row['doc']} (from {row['provider']})\n")
-            if row["params"]:
-                print("| parameter | type | default | description |\n|---|---|---|---|")
-                for f in row["params"]:
-                    print(f"| `{f['name']}` | {f['type']} | `{f['default']}` | {f['help']} |")
-                print()
-        else:
+    elif args.format == "markdown":
+        print(components_markdown(rows), end="")
+    else:
+        for row in rows:
             print(f"{row['kind']:<12} {row['name']:<22} {row['doc']}  [{row['provider']}]")
             for f in row["params"]:
                 print(f"{'':<14}{f['name']} ({f['type']}, default {f['default']}): {f['help']}")
@@ -149,6 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--format", choices=("table", "markdown", "json"), default="table")
     p.set_defaults(func=cmd_components)
 
+    from .ablation import add_ablate_arguments, cmd_ablate
     from .evaluation import add_eval_arguments, cmd_eval
     from .report import add_report_arguments, cmd_report
 
@@ -158,10 +147,6 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("report", help="tables and precision/success plots of evaluation results")
     add_report_arguments(p)
     p.set_defaults(func=cmd_report)
-    try:
-        from .ablation import add_ablate_arguments, cmd_ablate
-    except ImportError:
-        return parser
     p = sub.add_parser("ablate", help="run an ablation spec: variants x parameter grids x sequences")
     add_ablate_arguments(p)
     p.set_defaults(func=cmd_ablate)

@@ -34,6 +34,8 @@ import json
 import logging
 import multiprocessing
 import os
+import signal
+import sys
 import tempfile
 import time
 import traceback
@@ -269,12 +271,27 @@ def _single_threaded_env():
                 os.environ[k] = v
 
 
-def _worker_init():
+def _worker_init(parent_pid: int | None = None):
+    """A worker process: one BLAS/OpenMP/OpenCV thread; with ``parent_pid``, die with the parent."""
     os.environ.update({k: "1" for k in _THREAD_VARS})
     with contextlib.suppress(Exception):
         import cv2
 
         cv2.setNumThreads(1)
+    if parent_pid is not None:
+        _die_with_parent(parent_pid)
+
+
+def _die_with_parent(parent_pid: int) -> None:
+    """Linux: have the kernel kill this worker when the parent dies, even by SIGKILL
+    (a pool worker would otherwise wait forever on its task queue)."""
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(Exception):
+            import ctypes
+
+            ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
+    if os.getppid() != parent_pid:  # the parent died before prctl
+        os._exit(1)
 
 
 def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_tracker=None,
@@ -332,7 +349,7 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
             with _single_threaded_env():
                 pool = ProcessPoolExecutor(max_workers=min(jobs, len(todo)),
                                            mp_context=multiprocessing.get_context("spawn"),
-                                           initializer=_worker_init)
+                                           initializer=_worker_init, initargs=(os.getpid(),))
                 try:
                     futures = {pool.submit(_track_sequence, config, seq, tracker_dir,
                                            make_tracker, chash, version): seq for seq in todo}

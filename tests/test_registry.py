@@ -1,5 +1,4 @@
 """The component registry: built-ins, plugins, duplicates and broken plugins."""
-import dataclasses
 import importlib.metadata
 import sys
 import types
@@ -9,7 +8,6 @@ import pytest
 from dcfkit import registry as reg
 from dcfkit.errors import RegistryError
 from dcfkit.labels import Label
-from dcfkit.params import param
 
 
 class FakeEntryPoint:

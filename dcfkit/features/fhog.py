@@ -213,7 +213,11 @@ def _gradients(imgs: np.ndarray, rows: int, cols: int, ws: dict) -> tuple[np.nda
         gx = _buf(ws, f"gx{c}", (h, n * w))
         gy = _buf(ws, f"gy{c}", (h, n * w))
         _negated_differences(plane, gx, gy, n)
-        mags.append(cv2.magnitude(gx, gy, magnitude=_buf(ws, f"mag{c}", (h, n * w))))
+        # numpy, not cv2.magnitude: OpenCV's SIMD path rounds the last bit differently
+        # depending on buffer alignment, which made tracking non-deterministic
+        mag = np.multiply(gx, gx, out=_buf(ws, f"mag{c}", (h, n * w)))
+        mag += np.multiply(gy, gy, out=_buf(ws, "gy_squared", (h, n * w)))
+        mags.append(np.sqrt(mag, out=mag))
         gxs.append(gx)
         gys.append(gy)
     mag, gx, gy = mags[0], gxs[0], gys[0]
