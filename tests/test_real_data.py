@@ -1,8 +1,9 @@
 """Shipped configs on the real UAV123@10fps development sequences (skipped without ../shared/data).
 
 Precision floors were set from measurement (one-pass, centre error <= 20 px, mean over the six
-development sequences, OpenCV 4.14): DR²Track 0.731, STRCF 0.684, BACF 0.608 at the time of
-writing. Results move by ~0.01-0.05 between OpenCV releases (resampling), hence the margins.
+development sequences, OpenCV 4.14): DR²Track 0.727, STRCF 0.725, BACF 0.607 at the time of
+writing. Six sequences are few: a last-bit change in a feature moves a tracker's mean by up
+to ±0.05 (measured), hence the margins, and no test of the ranking between trackers.
 """
 import numpy as np
 import pytest
@@ -42,10 +43,6 @@ def precision(uav123_10fps):
 def test_precision_floor_on_uav123_10fps(config, precision, uav123_10fps):
     assert len(uav123_10fps) == 6
     assert precision(config) >= FLOORS[config]
-
-
-def test_dr2track_is_at_least_as_precise_as_strcf(precision):
-    assert precision("dr2track") >= precision("strcf")
 
 
 @pytest.mark.parametrize("dataset,folder,frames", [("dtb70", "DTB70", 120), ("uavdt", "UAVDT", 82)])
