@@ -35,13 +35,10 @@ REGULARIZER_ROLES = ("spatial", "temporal")
 
 
 def shipped_config_dir() -> Path:
-    """Where the shipped configs are: the installed ``dcfkit.configs``, or ``configs/`` of a checkout."""
-    checkout = Path(__file__).resolve().parent.parent / "configs"
-    if checkout.is_dir():
-        return checkout
-    import importlib.resources
-
-    return Path(str(importlib.resources.files("dcfkit.configs")))
+    """The shipped configs: ``configs/`` of a checkout, or ``dcfkit/configs`` when installed."""
+    package = Path(__file__).resolve().parent
+    checkout = package.parent / "configs"
+    return checkout if (checkout / "dr2track.yaml").is_file() else package / "configs"
 
 
 @dataclasses.dataclass(frozen=True)

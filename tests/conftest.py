@@ -1,4 +1,10 @@
+import importlib.metadata
+import importlib.util
 import os
+import re
+import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -17,3 +23,49 @@ def shared_data() -> Path:
 @pytest.fixture(autouse=True)
 def _no_external_plugins_unless_asked(monkeypatch):
     monkeypatch.setenv("OMP_NUM_THREADS", os.environ.get("OMP_NUM_THREADS", "1"))
+
+
+# pip could not get setuptools/wheel for an isolated build: offline without a local index
+OFFLINE = re.compile(r"No matching distribution|Could not find a version|NewConnectionError|"
+                     r"Temporary failure in name resolution|Network is unreachable")
+
+
+def local_build_backend() -> bool:
+    """Can setuptools build a wheel here without downloading anything?"""
+    try:
+        version = importlib.metadata.version("setuptools")  # importing setuptools here would patch distutils
+    except importlib.metadata.PackageNotFoundError:
+        return False
+    major, minor = (int(v) for v in re.findall(r"\d+", version)[:2])
+    return (major, minor) >= (70, 1) or importlib.util.find_spec("wheel") is not None  # bdist_wheel
+
+
+@pytest.fixture(scope="session")
+def pip_install_copy(tmp_path_factory):
+    """``install(source) -> site``: pip-install (no deps) a copy of a project folder into a fresh
+    folder, as a user's ``pip install`` would, and return that folder (for PYTHONPATH)."""
+
+    def install(project: Path) -> Path:
+        if importlib.util.find_spec("pip") is None:
+            pytest.skip("pip is not installed in this environment")
+        tmp = tmp_path_factory.mktemp(project.name)
+        source = tmp / "source"  # pip builds in the source tree: build a copy, leave the checkout clean
+        shutil.copytree(project, source, ignore=shutil.ignore_patterns(
+            "build", "*.egg-info", "__pycache__", ".git", ".ci-venv", "plugins", "tests", ".pytest_cache"))
+        target = tmp / "site"
+        isolated = not local_build_backend()  # then pip fetches setuptools + wheel (a local index or PyPI)
+        cmd = [sys.executable, "-m", "pip", "install", "--no-deps", "--no-input", "--disable-pip-version-check",
+               "--target", str(target), str(source)] + ([] if isolated else ["--no-build-isolation"])
+        try:
+            done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+        except subprocess.TimeoutExpired:
+            if not isolated:
+                raise
+            pytest.skip("pip timed out fetching a build backend (setuptools + wheel)")
+        if done.returncode != 0 and isolated and OFFLINE.search(done.stdout + done.stderr):
+            pytest.skip("setuptools cannot build a wheel here (no 'wheel' package, setuptools < 70.1) and pip "
+                        "could not download a build backend: " + (done.stderr.strip().splitlines() or ["?"])[-1])
+        assert done.returncode == 0, f"{' '.join(cmd)} failed:\n{done.stdout}\n{done.stderr}"
+        return target
+
+    return install

@@ -4,12 +4,9 @@ It is pip-installed (``--target`` a temporary folder, put on PYTHONPATH of a sub
 through its ``dcfkit`` entry point by ``dcfkit components``, used from YAML by ``dcfkit track``,
 and hidden by DCFKIT_DISABLE_PLUGINS=1. The tutorial docs/plugins.md quotes its source verbatim.
 """
-import importlib.metadata
-import importlib.util
 import json
 import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -25,43 +22,10 @@ PLUGIN = ROOT / "plugins" / "dcfkit-context-label"
 CONFIG = PLUGIN / "configs" / "strcf_context.yaml"
 TUTORIAL = ROOT / "docs" / "plugins.md"
 PROVIDER = "context (dcfkit_context_label)"  # entry-point name (module)
-# pip could not get setuptools/wheel for an isolated build: offline without a local index
-OFFLINE = re.compile(r"No matching distribution|Could not find a version|NewConnectionError|"
-                     r"Temporary failure in name resolution|Network is unreachable")
-
-
-def local_build_backend() -> bool:
-    """Can setuptools build a wheel here without downloading anything?"""
-    try:
-        version = importlib.metadata.version("setuptools")  # importing setuptools here would patch distutils
-    except importlib.metadata.PackageNotFoundError:
-        return False
-    major, minor = (int(v) for v in re.findall(r"\d+", version)[:2])
-    return (major, minor) >= (70, 1) or importlib.util.find_spec("wheel") is not None  # bdist_wheel
-
-
 @pytest.fixture(scope="module")
-def site(tmp_path_factory) -> Path:
+def site(pip_install_copy) -> Path:
     """The plugin pip-installed into a fresh folder; its dist-info carries the entry point."""
-    if importlib.util.find_spec("pip") is None:
-        pytest.skip("pip is not installed in this environment: cannot install the example plugin")
-    tmp = tmp_path_factory.mktemp("plugin")
-    source = tmp / "source"  # pip builds in the source tree: build a copy, leave the checkout clean
-    shutil.copytree(PLUGIN, source, ignore=shutil.ignore_patterns("build", "*.egg-info", "__pycache__"))
-    target = tmp / "site"
-    isolated = not local_build_backend()  # then pip fetches setuptools + wheel (a local index or PyPI)
-    cmd = [sys.executable, "-m", "pip", "install", "--no-deps", "--no-input", "--disable-pip-version-check",
-           "--target", str(target), str(source)] + ([] if isolated else ["--no-build-isolation"])
-    try:
-        done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
-    except subprocess.TimeoutExpired:
-        if not isolated:
-            raise
-        pytest.skip("pip timed out fetching a build backend (setuptools + wheel) for the example plugin")
-    if done.returncode != 0 and isolated and OFFLINE.search(done.stdout + done.stderr):
-        pytest.skip("setuptools cannot build a wheel here (no 'wheel' package, setuptools < 70.1) and pip "
-                    "could not download a build backend: " + (done.stderr.strip().splitlines() or ["?"])[-1])
-    assert done.returncode == 0, f"{' '.join(cmd)} failed:\n{done.stdout}\n{done.stderr}"
+    target = pip_install_copy(PLUGIN)
     (dist_info,) = target.glob("dcfkit_context_label-*.dist-info")
     assert "[dcfkit]\ncontext = dcfkit_context_label" in (dist_info / "entry_points.txt").read_text()
     return target
