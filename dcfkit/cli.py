@@ -32,26 +32,28 @@ def cmd_track(args) -> int:
     box = (box[0] - offset, box[1] - offset, box[2], box[3])
     writer = VideoWriter(args.save_video) if args.save_video else None
     boxes, seconds = [], 0.0
-    for i, image in enumerate(iter_frames(args.video, args.frames)):
-        start = time.perf_counter()
-        if i == 0:
-            tracker.init(image, box)
-            current = box
-        else:
-            current = tracker.update(image)
-        seconds += time.perf_counter() - start
-        boxes.append(current)
+    try:
+        for i, image in enumerate(iter_frames(args.video, args.frames)):
+            start = time.perf_counter()
+            if i == 0:
+                tracker.init(image, box)
+                current = box
+            else:
+                current = tracker.update(image)
+            seconds += time.perf_counter() - start
+            boxes.append(current)
+            if writer:
+                writer.write(image, {tracker.name: current}, f"frame {i + 1}")
+    finally:  # an error on frame k keeps the boxes of frames 1..k-1
         if writer:
-            writer.write(image, {tracker.name: current}, f"frame {i + 1}")
-    if writer:
-        writer.close()
-    lines = [",".join(f"{v + (offset if k < 2 else 0):.3f}" for k, v in enumerate(b)) for b in boxes]
-    if args.out:
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.out).write_text("\n".join(lines) + "\n")
-    else:
-        print("\n".join(lines))
-    print(f"{tracker.name}: {len(boxes)} frames, {len(boxes) / max(seconds, 1e-9):.1f} fps", file=sys.stderr)
+            writer.close()
+        lines = [",".join(f"{v + (offset if k < 2 else 0):.3f}" for k, v in enumerate(b)) for b in boxes]
+        if args.out and boxes:
+            Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+            Path(args.out).write_text("\n".join(lines) + "\n")
+        elif boxes:
+            print("\n".join(lines))
+        print(f"{tracker.name}: {len(boxes)} frames, {len(boxes) / max(seconds, 1e-9):.1f} fps", file=sys.stderr)
     return 0
 
 

@@ -1,0 +1,98 @@
+"""The command line: track (frames and video), errors, demo."""
+import cv2
+import numpy as np
+import pytest
+
+from dcfkit import cli
+from dcfkit.synthetic import make_sequence
+
+
+@pytest.fixture(scope="module")
+def clip(tmp_path_factory):
+    seq = make_sequence(n_frames=12, seed=4)
+    folder = tmp_path_factory.mktemp("clip")
+    frames = folder / "frames"
+    frames.mkdir()
+    for i, f in enumerate(seq.frames):
+        cv2.imwrite(str(frames / f"{i:05d}.png"), f)
+    return seq, frames
+
+
+def box_arg(box, offset=0.0):
+    return ",".join(f"{v + (offset if i < 2 else 0)}" for i, v in enumerate(box))
+
+
+def test_track_frames_writes_one_box_per_frame(clip, tmp_path, capsys):
+    seq, frames = clip
+    out = tmp_path / "boxes.txt"
+    assert cli.main(["track", "dr2track", "--frames", str(frames), "--box", box_arg(seq.ground_truth[0]),
+                     "--out", str(out), "--set", "label.mu=0.3"]) == 0
+    boxes = np.loadtxt(out, delimiter=",")
+    assert boxes.shape == (12, 4)
+    np.testing.assert_allclose(boxes[0], seq.ground_truth[0])
+    centre = lambda b: b[:, :2] + b[:, 2:] / 2  # noqa: E731
+    assert np.hypot(*(centre(boxes) - centre(seq.ground_truth)).T).max() < 10
+    assert "12 frames" in capsys.readouterr().err
+
+
+def test_one_based_boxes_round_trip(clip, tmp_path):
+    seq, frames = clip
+    out = tmp_path / "boxes.txt"
+    assert cli.main(["track", "strcf", "--frames", str(frames), "--box", box_arg(seq.ground_truth[0], 1.0),
+                     "--one-based", "--out", str(out)]) == 0
+    np.testing.assert_allclose(np.loadtxt(out, delimiter=",")[0], seq.ground_truth[0] + [1, 1, 0, 0])
+
+
+def test_track_video_and_annotated_output(clip, tmp_path):
+    seq, _ = clip
+    video = tmp_path / "in.avi"
+    writer = cv2.VideoWriter(str(video), cv2.VideoWriter_fourcc(*"MJPG"), 10, seq.frames[0].shape[1::-1])
+    for f in seq.frames:
+        writer.write(f)
+    writer.release()
+    out, annotated = tmp_path / "b.txt", tmp_path / "out.avi"
+    assert cli.main(["track", "bacf", "--video", str(video), "--box", box_arg(seq.ground_truth[0]),
+                     "--out", str(out), "--save-video", str(annotated)]) == 0
+    assert np.loadtxt(out, delimiter=",").shape == (12, 4)
+    cap = cv2.VideoCapture(str(annotated))
+    assert int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) == 12
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--box", "1,2,3"], "--box expects x,y,w,h"),
+    (["--box", "10,10,0,5"], "non-positive size"),
+    (["--box", "10,10,20,20", "--set", "label.mue=1"], "unknown parameter 'mue'"),
+    (["--box", "10,10,20,20", "--set", "labelmu"], "--set expects KEY=VALUE"),
+])
+def test_track_errors_are_one_line_messages(clip, args, message, capsys):
+    _, frames = clip
+    assert cli.main(["track", "dr2track", "--frames", str(frames), *args]) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+
+
+def test_unreadable_frame_names_the_frame(clip, tmp_path, capsys):
+    seq, frames = clip
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    for i in range(3):
+        cv2.imwrite(str(bad / f"{i}.png"), seq.frames[i])
+    (bad / "3.png").write_bytes(b"broken")
+    out = tmp_path / "partial.txt"
+    assert cli.main(["track", "strcf", "--frames", str(bad), "--box", box_arg(seq.ground_truth[0]),
+                     "--out", str(out)]) == 2
+    assert "frame 4: cannot read image" in capsys.readouterr().err
+    assert np.loadtxt(out, delimiter=",").shape == (3, 4)  # the frames before the error are kept
+
+
+def test_missing_inputs(tmp_path, capsys):
+    assert cli.main(["track", "strcf", "--frames", str(tmp_path), "--box", "1,1,5,5"]) == 2
+    assert "no images" in capsys.readouterr().err
+    assert cli.main(["track", "strcf", "--video", str(tmp_path / "none.mp4"), "--box", "1,1,5,5"]) == 2
+    assert "file not found" in capsys.readouterr().err
+
+
+def test_demo_prints_scores(tmp_path, capsys):
+    assert cli.main(["demo", "--frames", "10", "--save-video", str(tmp_path / "demo.avi")]) == 0
+    out = capsys.readouterr().out
+    assert "strcf" in out and "dr2track" in out and (tmp_path / "demo.avi").stat().st_size > 0
