@@ -155,7 +155,7 @@ def set_dotted(config: dict, key: str, value: Any) -> None:
     if isinstance(node, list):
         node[_index(node, last, key)] = value
     else:
-        if last == "name" and node.get("name") not in (None, value):
+        if last == "name" and len(parts) > 1 and node.get("name") not in (None, value):
             node.clear()  # another component: the old one's parameters do not apply
         node[last] = value
 

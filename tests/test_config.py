@@ -40,6 +40,10 @@ def test_ablations_differ_from_dr2track_only_where_they_say():
 
 
 def test_dotted_overrides():
+    renamed = load_config("dr2track", {"name": "dr2track_mu03", "label.mu": 0.3})
+    assert renamed["name"] == "dr2track_mu03" and renamed["scale"]["name"] == "dsst"  # the rest is kept
+    switched = load_config("dr2track", {"label.name": "gaussian"})
+    assert switched["label"] == {"name": "gaussian"}  # another component: old parameters dropped
     cfg = load_config("dr2track", {"label.mu": 0.3, "features.0.name": "fhog", "regularizers.temporal": None})
     assert cfg["label"]["mu"] == 0.3
     assert cfg["features"][0]["name"] == "fhog"
