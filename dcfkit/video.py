@@ -10,7 +10,7 @@ import numpy as np
 from .errors import InputError
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff")
-COLOURS = ((0, 0, 255), (0, 200, 0), (255, 128, 0), (0, 200, 255), (255, 0, 255))
+COLOURS = ((0, 0, 255), (0, 255, 255), (255, 160, 0), (255, 0, 255), (255, 255, 255))  # BGR
 
 
 def frame_files(folder: str | Path) -> list[Path]:
@@ -74,6 +74,7 @@ class VideoWriter:
             x, y, w, h = (int(round(v)) for v in box)
             colour = COLOURS[i % len(COLOURS)]
             cv2.rectangle(frame, (x, y), (x + w - 1, y + h - 1), colour, 2)
+            cv2.rectangle(frame, (6, 6 + 18 * i), (140, 24 + 18 * i), (0, 0, 0), -1)  # legend background
             cv2.putText(frame, name, (10, 20 + 18 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv2.LINE_AA)
         if text:
             cv2.putText(frame, text, (10, frame.shape[0] - 10), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1,
