@@ -12,7 +12,7 @@ import dcfkit
 from dcfkit.datasets import load_dataset
 from dcfkit.metrics import average, score_sequence
 
-FLOORS = {"dr2track": 0.70, "strcf": 0.62, "bacf": 0.55}
+FLOORS = {"dr2track": 0.65, "strcf": 0.65, "bacf": 0.53}  # measured minus ~0.075
 
 
 @pytest.fixture(scope="module")
