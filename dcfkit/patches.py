@@ -21,11 +21,15 @@ def centre_size_to_box(centre, size) -> tuple[float, float, float, float]:
     return (float(cx - (w - 1) / 2), float(cy - (h - 1) / 2), float(w), float(h))
 
 
+def _origin(centre: float, size: int) -> int:
+    """First pixel of ``size`` whole pixels centred on ``centre``."""
+    return int(np.floor(centre - (size - 1) / 2 + 0.5))
+
+
 def crop(image: np.ndarray, centre, region) -> np.ndarray:
     """The ``region`` (h, w) pixels around ``centre`` (y, x); outside pixels replicate the edge."""
     rh, rw = max(int(round(region[0])), 1), max(int(round(region[1])), 1)
-    y0 = int(np.floor(centre[0] - (rh - 1) / 2 + 0.5))
-    x0 = int(np.floor(centre[1] - (rw - 1) / 2 + 0.5))
+    y0, x0 = _origin(centre[0], rh), _origin(centre[1], rw)
     height, width = image.shape[:2]
     if y0 >= 0 and x0 >= 0 and y0 + rh <= height and x0 + rw <= width:
         return image[y0:y0 + rh, x0:x0 + rw]
@@ -52,5 +56,23 @@ def resize(patch: np.ndarray, out) -> np.ndarray:
 
 
 def sample(image: np.ndarray, centre, region, out) -> np.ndarray:
-    """Crop ``region`` (h, w) around ``centre`` and resize it to ``out`` (h, w)."""
-    return resize(crop(image, centre, region), out)
+    """Crop ``region`` (h, w) around ``centre`` and resample it to ``out`` (h, w).
+
+    A shrink by k >= 2 first averages k x k blocks (OpenCV's fast integer path; a non-integer
+    area resize of a ~1000 px region costs 2-3x more), then maps the exact region onto the
+    output grid bilinearly (the remaining factor is below 2)."""
+    oh, ow = int(out[0]), int(out[1])
+    k = int(min(region[0] / oh, region[1] / ow))
+    if k < 2:
+        return resize(crop(image, centre, region), out)
+    ch, cw = (int(np.ceil(region[0] / k)) + 2) * k, (int(np.ceil(region[1] / k)) + 2) * k
+    big = crop(image, centre, (ch, cw))
+    small = cv2.resize(big, (cw // k, ch // k), interpolation=cv2.INTER_AREA)
+    # output pixel u samples image row cy + (u - (oh - 1) / 2) * region_h / oh; small row i
+    # averages image rows y0 + k i .. y0 + k i + k - 1, centred at y0 + k i + (k - 1) / 2
+    sy, sx = region[0] / oh, region[1] / ow
+    ty = (centre[0] - (oh - 1) / 2 * sy - _origin(centre[0], ch) - (k - 1) / 2) / k
+    tx = (centre[1] - (ow - 1) / 2 * sx - _origin(centre[1], cw) - (k - 1) / 2) / k
+    warp = np.array([[sx / k, 0.0, tx], [0.0, sy / k, ty]])
+    return cv2.warpAffine(small, warp, (ow, oh), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+                          borderMode=cv2.BORDER_REPLICATE)
