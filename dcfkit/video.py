@@ -24,18 +24,13 @@ def frame_files(folder: str | Path) -> list[Path]:
     return files
 
 
-def read_image(path: str | Path, frame: int) -> np.ndarray:
-    image = cv2.imread(str(path), cv2.IMREAD_COLOR)
-    if image is None or image.size == 0:
-        raise InputError(f"frame {frame}: cannot read image {path}")
-    return image
-
-
 def iter_frames(video: str | None = None, frames: str | None = None) -> Iterator[np.ndarray]:
     """Yield BGR frames from a video file or an image folder."""
     if frames is not None:
+        from .datasets import read_frame
+
         for i, path in enumerate(frame_files(frames), start=1):
-            yield read_image(path, i)
+            yield read_frame(path, f"frame {i}")
         return
     if not Path(video).is_file():
         raise InputError(f"--video: file not found: {video}")

@@ -81,7 +81,7 @@ def test_unreadable_frame_names_the_frame(clip, tmp_path, capsys):
     out = tmp_path / "partial.txt"
     assert cli.main(["track", "strcf", "--frames", str(bad), "--box", box_arg(seq.ground_truth[0]),
                      "--out", str(out)]) == 2
-    assert "frame 4: cannot read image" in capsys.readouterr().err
+    assert "cannot read frame 4" in capsys.readouterr().err
     assert np.loadtxt(out, delimiter=",").shape == (3, 4)  # the frames before the error are kept
 
 
