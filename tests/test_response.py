@@ -23,14 +23,16 @@ def test_response_is_circular_cross_correlation(backend):
             assert got[k, ty, tx] == pytest.approx(brute, abs=1e-4)
 
 
-def test_local_maxima_match_brute_force():
+@pytest.mark.parametrize("size, dtype", [(3, np.float32), (3, np.float64), (5, np.float32), (7, np.float64)])
+def test_local_maxima_match_brute_force(size, dtype):
     rng = np.random.default_rng(1)
-    r = rng.standard_normal((9, 11)).astype(np.float32)
-    rows, cols = local_maxima(r)
+    r = rng.standard_normal((9, 11)).astype(dtype)
+    rows, cols = local_maxima(r, size)
     H, W = r.shape
     brute = []
+    offsets = range(-(size // 2), size // 2 + 1)
     for y, x in itertools.product(range(H), range(W)):
-        neigh = [r[(y + dy) % H, (x + dx) % W] for dy in (-1, 0, 1) for dx in (-1, 0, 1) if dy or dx]
+        neigh = [r[(y + dy) % H, (x + dx) % W] for dy in offsets for dx in offsets if dy or dx]
         if r[y, x] >= max(neigh):
             brute.append((y, x))
     assert sorted(zip(rows.tolist(), cols.tolist())) == sorted(brute)
