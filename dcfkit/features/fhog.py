@@ -41,16 +41,11 @@ import threading
 from collections import OrderedDict
 from functools import lru_cache
 
-import cv2
 import numpy as np
 
 __all__ = ["fhog", "fhog_channels"]
 
 _TEXTURE_SCALE = 0.2357  # Piotr's constant for the 4 texture channels
-# (row, col) offsets into the edge-padded grid of block normalisers, in the order
-# of Piotr's texture channels: the 2x2 block below-right of a cell, above-right,
-# below-left, above-left.
-_BLOCK_OFFSETS = ((1, 1), (0, 1), (1, 0), (0, 0))
 
 
 def fhog_channels(n_orients: int = 9) -> int:
@@ -250,46 +245,21 @@ def _normalise(hist: np.ndarray, n_orients: int, clip: float, cell_size: int, ws
     Returns:
         ``(N, 3 * n_orients + 4, hb, wb)`` float32, C-contiguous, a new array.
     """
+    from . import fhog_kernels
+
     _, n, hb, wb = hist.shape
     no = 3 * n_orients  # orientation channels
     cells = n * hb * wb
-    # Orientation features: contrast-sensitive then -insensitive histograms.
-    feats = _buf(ws, "feats", (no, cells))
-    flat = hist.reshape(2 * n_orients, cells)
-    feats[: 2 * n_orients] = flat
-    insens = feats[2 * n_orients :]
-    np.add(flat[:n_orients], flat[n_orients:], out=insens)
-
-    # 1 / sqrt(energy of each 2x2 block + eps), edge-padded to (hb + 1, wb + 1)
-    # so that every cell has 4 blocks.
-    energy = np.einsum("ok,ok->k", insens, insens).reshape(n, hb, wb)
-    blocks = energy[:, :-1, :-1] + energy[:, 1:, :-1]
-    blocks += energy[:, :-1, 1:]
-    blocks += energy[:, 1:, 1:]
-    blocks += np.float32(1e-4 / 4 / cell_size**4)  # Piotr's eps on this scale
-    inv = _buf(ws, "inv", (n, hb + 1, wb + 1))
-    core = inv[:, 1:hb, 1:wb]
-    np.sqrt(blocks, out=core)
-    np.divide(np.float32(1.0), core, out=core)
-    inv[:, 0, 1:wb] = core[:, 0]
-    inv[:, hb, 1:wb] = core[:, -1]
-    inv[:, :, 0] = inv[:, :, 1]
-    inv[:, :, wb] = inv[:, :, wb - 1]
-
     # One new array: the result (for a batch, channel-major scratch first).
     out = np.empty((no + 4, cells), np.float32) if n == 1 else _buf(ws, "out", (no + 4, cells))
-    orient = out[:no]
-    orient.fill(0.0)
-    tmp = _buf(ws, "tmp", (no, cells))
-    norm = _buf(ws, "norm", (n, hb, wb))
-    # the texture channel of a normalisation sums its clipped sensitive channels
+    clipped = _buf(ws, "clipped", (4, 2 * n_orients, cells))
+    eps = np.float32(1e-4 / 4 / cell_size**4)  # Piotr's eps on this scale
+    fhog_kernels.normalise(hist, clip, eps, out[:no].reshape(no, n, hb, wb),
+                           clipped.reshape(4, 2 * n_orients, n, hb, wb))
+    # the texture channel of a normalisation: 0.2357 times the sum of its clipped sensitive
+    # channels, by numpy's matmul as before (its summation order decides the last bit)
     texture_weights = np.full((1, 2 * n_orients), _TEXTURE_SCALE, np.float32)
-    for k, (dr, dc) in enumerate(_BLOCK_OFFSETS):
-        np.copyto(norm, inv[:, dr : dr + hb, dc : dc + wb])
-        np.multiply(feats, norm.reshape(1, cells), out=tmp)
-        cv2.min(tmp, float(clip), dst=tmp)  # np.minimum is 2x slower (NaN checks)
-        cv2.add(orient, tmp, dst=orient)
-        np.matmul(texture_weights, tmp[: 2 * n_orients], out=out[no + k : no + k + 1])
-    orient *= np.float32(0.5)
+    for k in range(4):
+        np.matmul(texture_weights, clipped[k], out=out[no + k : no + k + 1])
     out = out.reshape(no + 4, n, hb, wb)
     return out[:, 0][None] if n == 1 else np.ascontiguousarray(out.transpose(1, 0, 2, 3))

@@ -101,6 +101,66 @@ def cell_histograms(mag, theta, cell_size, n_bins, soft, scale, hist):  # pragma
 
 
 @numba.njit(cache=True, nogil=True)
+def normalise(hist, clip, eps, orient, clipped):  # pragma: no cover - compiled
+    """Block normalisation and clipping of fhog (see ``fhog._normalise``).
+
+    hist: (2n, N, hb, wb) float32 contrast-sensitive histograms. Per cell, the
+    contrast-insensitive histogram is the sum of opposite bins; ``1 / sqrt(energy + eps)`` of
+    each of the 4 2x2-cell blocks around the cell (edge-replicated at the borders) scales the
+    3n orientation channels, which are clipped at ``clip``. Writes orient: (3n, N, hb, wb)
+    float32, half the sum of the 4 clipped normalisations; clipped: (4, 2n, N, hb, wb) the
+    clipped sensitive channels per normalisation (the texture channels sum them).
+    """
+    n2, n, hb, wb = hist.shape
+    no = n2 // 2
+    clip32 = np.float32(clip)
+    half = np.float32(0.5)
+    energy = np.empty((hb, wb), np.float32)
+    inv = np.empty((hb + 1, wb + 1), np.float32)
+    feat = np.empty((hb, wb), np.float32)
+    acc = np.empty((hb, wb), np.float32)
+    for i in range(n):
+        for r in range(hb):
+            for c in range(wb):
+                e = np.float32(0.0)
+                for o in range(no):
+                    v = hist[o, i, r, c] + hist[o + no, i, r, c]
+                    e = e + v * v
+                energy[r, c] = e
+        for r in range(hb - 1):
+            for c in range(wb - 1):
+                b = energy[r, c] + energy[r + 1, c]
+                b = b + energy[r, c + 1]
+                b = b + energy[r + 1, c + 1]
+                b = b + eps
+                inv[r + 1, c + 1] = np.float32(1.0) / np.sqrt(b)
+        for c in range(1, wb):
+            inv[0, c] = inv[1, c]
+            inv[hb, c] = inv[hb - 1, c]
+        for r in range(hb + 1):
+            inv[r, 0] = inv[r, 1]
+            inv[r, wb] = inv[r, wb - 1]
+        for o in range(3 * no):  # channel by channel: contiguous, vectorised inner loops
+            for r in range(hb):
+                for c in range(wb):
+                    if o < n2:
+                        feat[r, c] = hist[o, i, r, c]
+                    else:
+                        feat[r, c] = hist[o - n2, i, r, c] + hist[o - no, i, r, c]
+            for k in range(4):  # blocks below-right, above-right, below-left, above-left
+                dr, dc = 1 - k % 2, 1 - k // 2
+                for r in range(hb):
+                    for c in range(wb):
+                        t = min(feat[r, c] * inv[r + dr, c + dc], clip32)
+                        acc[r, c] = t if k == 0 else acc[r, c] + t
+                        if o < n2:
+                            clipped[k, o, i, r, c] = t
+            for r in range(hb):
+                for c in range(wb):
+                    orient[o, i, r, c] = acc[r, c] * half
+
+
+@numba.njit(cache=True, nogil=True)
 def _cell_axis(length, cell_size, cells):  # pragma: no cover - compiled
     """Per pixel: the cell left of it (-1 before the first centre) and the two weights."""
     left = np.empty(length, np.int64)
