@@ -6,7 +6,8 @@
 Run single-threaded (the script sets OMP/OPENBLAS/MKL threads to 1 before numpy loads).
 Frames are decoded one at a time outside the timer; only init/update are timed. Runs the
 UAV123@10fps sequences and a synthetic sequence of the same 1280x720 frame size. Prints
-per-sequence fps, the median over the real sequences per config, and the process's peak RSS.
+per-sequence fps, the median over the real sequences per config, the process's peak RSS, and
+the first frame's cost in a fresh process (imports, numba's cached code, the CN table).
 """
 import os
 
@@ -16,6 +17,8 @@ for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import argparse  # noqa: E402
 import json  # noqa: E402
 import resource  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
@@ -31,8 +34,8 @@ SYNTHETIC = "synthetic_720p"
 
 
 def sequences(root):
-    """(name, frame getter, number of frames, initial box) per sequence; frames are decoded
-    one at a time, so the peak RSS is the tracker's plus one frame's."""
+    """(name, frame getter, number of frames, initial box) per real sequence; frames are
+    decoded one at a time, so the peak RSS is the trackers' plus one frame's."""
     if root and Path(root).is_dir():
         from dcfkit.datasets import load_dataset
 
@@ -40,8 +43,36 @@ def sequences(root):
             yield seq.name, seq.frame, len(seq), seq.init_box
     else:
         print(f"no real data at {root!r}: synthetic frames only")
-    seq = make_sequence(n_frames=200, size=(720, 1280), target=(40, 70))  # UAV123's frame size
+
+
+def synthetic():
+    """A generated sequence of UAV123's frame size (its frames are all held in memory)."""
+    seq = make_sequence(n_frames=200, size=(720, 1280), target=(40, 70))
     yield SYNTHETIC, seq.frames.__getitem__, len(seq.frames), seq.ground_truth[0]
+
+
+FRESH_PROCESS = """
+import sys, time
+import cv2, numpy
+cv2.setNumThreads(1)
+frame = cv2.imread(sys.argv[2]) if sys.argv[2] else numpy.full((720, 1280, 3), 128, numpy.uint8)
+box = [float(v) for v in sys.argv[3].split(",")]
+start = time.perf_counter()
+import dcfkit
+tracker = dcfkit.load_tracker(sys.argv[1])
+loaded = time.perf_counter()
+tracker.init(frame, box)
+tracker.update(frame)
+print(loaded - start, time.perf_counter() - loaded)
+"""
+
+
+def first_frame_fresh(config: str, image: str, box) -> tuple[float, float]:
+    """(import + load_tracker, init + first update) seconds in a new Python process: everything
+    a first frame costs (numba loading its cached machine code, the CN table) but decoding."""
+    out = subprocess.run([sys.executable, "-c", FRESH_PROCESS, config, image, ",".join(map(str, box))],
+                         check=True, capture_output=True, text=True).stdout.split()
+    return float(out[0]), float(out[1])
 
 
 def main():
@@ -52,7 +83,16 @@ def main():
     args = parser.parse_args()
     configs = args.configs.split(",")
     rows = []
-    for name, frame_at, n_frames, box in sequences(args.root):
+    rss = None
+
+    def all_sequences():
+        nonlocal rss
+        yield from sequences(args.root)
+        if rows:  # before the synthetic frames, which are all held in memory
+            rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+        yield from synthetic()
+
+    for name, frame_at, n_frames, box in all_sequences():
         for config in configs:
             tracker = dcfkit.load_tracker(config)
             frame = frame_at(0)
@@ -75,10 +115,27 @@ def main():
         fps = [r["fps"] for r in (real or rows) if r["config"] == config]
         summary[config] = float(np.median(fps))
         print(f"  {config:<10} {summary[config]:7.1f} fps")
-    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    print(f"peak RSS {rss:.0f} MB")
+    if rss is None:
+        rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"peak RSS {rss:.0f} MB (all trackers, one frame at a time)")
+
+    first = {}
+    image, box = "", (600, 320, 70, 40)
+    if Path(args.root).is_dir():
+        from dcfkit.datasets import load_dataset
+
+        seq = load_dataset("uav123_10fps", args.root)[0]
+        image, box = str(seq.frames[0]), seq.init_box
+    print("\nfirst frame in a fresh process (median of 3; decoding excluded):")
+    for config in configs:
+        runs = sorted((first_frame_fresh(config, image, box) for _ in range(3)), key=sum)
+        imports, init = runs[1]
+        first[config] = {"import_and_load_s": imports, "init_and_first_update_s": init}
+        print(f"  {config:<10} import + load_tracker {imports:5.2f} s, init + first update {init:5.2f} s, "
+              f"total {imports + init:5.2f} s")
     if args.json:
-        Path(args.json).write_text(json.dumps({"rows": rows, "median_fps": summary, "peak_rss_mb": rss}, indent=2))
+        Path(args.json).write_text(json.dumps({"rows": rows, "median_fps": summary, "peak_rss_mb": rss,
+                                               "first_frame_fresh_process": first}, indent=2))
 
 
 if __name__ == "__main__":
