@@ -31,16 +31,20 @@ tracker.init(frames[0], seq.init_box)
 start = time.perf_counter()
 for frame in frames[1:]:
     tracker.update(frame)
-print((len(frames) - 1) / (time.perf_counter() - start))
+print(dcfkit.__file__, (len(frames) - 1) / (time.perf_counter() - start))
 """
 
 
 def fps(checkout: Path, root: str, sequence: str, config: str) -> float:
     env = dict(os.environ, PYTHONPATH=str(checkout), OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1",
                MKL_NUM_THREADS="1")
+    # run in the checkout: `python -c` puts the working folder first on sys.path
     out = subprocess.run([sys.executable, "-c", RUN, root, sequence, config], env=env, check=True,
-                         capture_output=True, text=True)
-    return float(out.stdout.split()[-1])
+                         capture_output=True, text=True, cwd=checkout)
+    module, value = out.stdout.split()[-2:]
+    if not Path(module).resolve().is_relative_to(checkout.resolve()):
+        raise SystemExit(f"{checkout}: the run imported dcfkit from {module}, not from the checkout")
+    return float(value)
 
 
 def main():

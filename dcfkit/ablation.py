@@ -383,9 +383,9 @@ def _exclusive(out: Path):
 
 
 def _pool_worker_init(parent_pid: int) -> None:
-    from .evaluation import _worker_init
+    from .evaluation import worker_init
 
-    _worker_init(parent_pid)
+    worker_init(parent_pid)
 
 
 _worker_ready = False
@@ -393,20 +393,20 @@ _worker_ready = False
 
 def _track(config: dict, seq, job_dir: str, key: str, version: str) -> dict:
     """Run one (config, sequence) and write its files (``dcfkit.evaluation``'s runner)."""
-    from .evaluation import _track_sequence
+    from .evaluation import track_sequence
 
     folder = Path(job_dir)
     folder.mkdir(parents=True, exist_ok=True)
-    return _track_sequence(config, seq, folder, None, key, version)
+    return track_sequence(config, seq, folder, None, key, version)
 
 
 def _run_job(config: dict, seq, job_dir: str, key: str, version: str) -> dict:
     """:func:`_track` in a worker process (pool or dask)."""
     global _worker_ready
-    from .evaluation import _worker_init, dcfkit_version
+    from .evaluation import worker_init, dcfkit_version
 
     if not _worker_ready:  # dask workers have no initializer: one OpenCV thread each
-        _worker_init()
+        worker_init()
         _worker_ready = True
     if dcfkit_version() != version:
         raise DcfkitError(f"this worker runs dcfkit {dcfkit_version()}, the client {version}; "
@@ -425,7 +425,7 @@ class _Task:
 
 def _record_crash(task: _Task, exc: BaseException, version: str) -> dict:
     """A task that died outside the tracker (worker killed, unpicklable, scheduler lost)."""
-    from .evaluation import _atomic_write, _json_default
+    from .evaluation import atomic_write, json_default
 
     message = f"sequence {task.seq.name!r}: the worker failed: {type(exc).__name__}: {exc}"
     record = {"sequence": task.seq.name, "dataset": task.seq.dataset, "tracker": task.config.get("name"),
@@ -434,8 +434,8 @@ def _record_crash(task: _Task, exc: BaseException, version: str) -> dict:
               "dcfkit_version": version, "time": datetime.now(timezone.utc).isoformat(timespec="seconds")}
     with contextlib.suppress(OSError):
         task.folder.mkdir(parents=True, exist_ok=True)
-        _atomic_write(task.folder / f"{task.seq.name}.error.json",
-                      json.dumps(record, indent=1, default=_json_default) + "\n")
+        atomic_write(task.folder / f"{task.seq.name}.error.json",
+                      json.dumps(record, indent=1, default=json_default) + "\n")
     return {"sequence": task.seq.name, "status": "failed", "error": message, "frames": len(task.seq)}
 
 
@@ -445,9 +445,9 @@ def _run_inline(tasks, version, on_result):
 
 
 def _run_pool(tasks, jobs, version, on_result):
-    from .evaluation import _single_threaded_env
+    from .evaluation import single_threaded_env
 
-    with _single_threaded_env():  # workers are spawned on submit and inherit it
+    with single_threaded_env():  # workers are spawned on submit and inherit it
         pool = ProcessPoolExecutor(max_workers=min(jobs, len(tasks)),
                                    mp_context=multiprocessing.get_context("spawn"),
                                    initializer=_pool_worker_init, initargs=(os.getpid(),))
@@ -469,13 +469,13 @@ def _run_dask(tasks, jobs, scheduler, version, on_result):
         from distributed import Client, LocalCluster, as_completed as dask_completed
     except ImportError:
         raise DcfkitError("--executor dask needs dask.distributed: pip install 'dcfkit[dask]'") from None
-    from .evaluation import _single_threaded_env
+    from .evaluation import single_threaded_env
 
     with contextlib.ExitStack() as stack:
         if scheduler:
             client = stack.enter_context(Client(scheduler))
         else:
-            with _single_threaded_env():  # inherited by the worker processes
+            with single_threaded_env():  # inherited by the worker processes
                 cluster = stack.enter_context(LocalCluster(
                     n_workers=max(1, min(jobs, len(tasks))), threads_per_worker=1, processes=True,
                     dashboard_address=None))
@@ -511,7 +511,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     (key, sequence) pairs), ``done`` / ``skipped`` / ``failed`` (run -> message) and
     ``summary`` (what :func:`summarize` returned).
     """
-    from .evaluation import _is_done, _atomic_write, dcfkit_version
+    from .evaluation import is_done, atomic_write, dcfkit_version
 
     if executor not in ("local", "dask"):
         raise DcfkitError(f"executor must be 'local' or 'dask', got {executor!r}")
@@ -539,9 +539,9 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
             path = out / "configs" / f"{job.key}.json"
             if not path.is_file():
                 stripped = {k: v for k, v in job.config.items() if k not in LABEL_KEYS}
-                _atomic_write(path, json.dumps({"key": job.key, "dcfkit_version": version,
+                atomic_write(path, json.dumps({"key": job.key, "dcfkit_version": version,
                                                 "config": stripped}, indent=1) + "\n")
-        finished = {k for k, t in tasks.items() if _is_done(t.folder, t.seq, t.key)}
+        finished = {k for k, t in tasks.items() if is_done(t.folder, t.seq, t.key)}
         todo = sorted((t for k, t in tasks.items() if k not in finished),
                       key=lambda t: -len(t.seq))  # longest first: the workers end together
         result = {"jobs": job_list, "runs": len(tasks), "done": [],
@@ -588,11 +588,11 @@ SEQUENCE_COLUMNS = ("variant", "sequence", "precision", "auc", "fps", "frames", 
 
 
 def _status(folder: Path, seq) -> tuple[str, str | None]:
-    from .evaluation import _is_done, _read_json
+    from .evaluation import is_done, read_json
 
-    if _is_done(folder, seq, folder.name):
+    if is_done(folder, seq, folder.name):
         return "done", None
-    err = _read_json(folder / f"{seq.name}.error.json")
+    err = read_json(folder / f"{seq.name}.error.json")
     if err is not None and err.get("config_hash") == folder.name:
         return "failed", err.get("error")
     return "missing", None
@@ -639,14 +639,14 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     job_rows = [{"variant": j.variant, "sequence": j.sequence, "key": j.key,
                  "status": status[j.key, j.sequence][0], "error": status[j.key, j.sequence][1]} for j in jobs]
 
-    from .evaluation import _atomic_write
+    from .evaluation import atomic_write
 
     files = []
     for stem, rows, columns in (("summary", overall, SUMMARY_COLUMNS),
                                 ("per_sequence", per_sequence, SEQUENCE_COLUMNS)):
         for fmt, ext in (("markdown", "md"), ("csv", "csv")):
             path = out / f"{stem}.{ext}"
-            _atomic_write(path, format_rows(rows, fmt, columns))
+            atomic_write(path, format_rows(rows, fmt, columns))
             files.append(path)
     info = {"spec": str(spec.path), "name": spec.name, "description": spec.description,
             "dataset": spec.dataset, "root": str(spec.root), "sequences": [s.name for s in sequences],
@@ -656,7 +656,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
                                      for k, (lab, vals) in spec.grid.parameters.items()}}
                      if spec.grid else None)}
     path = out / "summary.json"
-    _atomic_write(path, json.dumps(_json_ready(info), indent=1, ensure_ascii=False, default=str) + "\n")
+    atomic_write(path, json.dumps(_json_ready(info), indent=1, ensure_ascii=False, default=str) + "\n")
     files.append(path)
     if spec.grid is not None:
         files += plot_sensitivity(spec, overall, out)
@@ -779,14 +779,14 @@ def cmd_ablate(args: argparse.Namespace) -> int:
         raise DcfkitError("--scheduler needs --executor dask")
     spec = load_spec(args.spec, root=args.root, sequences=args.sequences)
     if args.dry_run:
-        from .evaluation import _is_done
+        from .evaluation import is_done
 
         seqs = spec.load_sequences()
         by_name = {s.name: s for s in seqs}
         out = args.out.expanduser().resolve()
         jobs = expand(spec, seqs)
         for job in jobs:
-            done = _is_done(_job_dir(out, spec.dataset, job.key), by_name[job.sequence], job.key)
+            done = is_done(_job_dir(out, spec.dataset, job.key), by_name[job.sequence], job.key)
             print(f"{'done' if done else 'todo'}  {job.key}  {job.variant}  {job.sequence}")
         print(f"{len(jobs)} jobs, {len({(j.key, j.sequence) for j in jobs})} distinct runs")
         return 0

@@ -23,6 +23,10 @@ Every file is written to a temporary file in the same folder and moved into plac
 ``os.replace``, so an interrupted run never leaves a half-written file. On rerun a
 sequence is skipped when its sidecar has the same config hash and its ``.txt`` has one
 line per frame; failed sequences are retried.
+
+The same result files serve :mod:`dcfkit.ablation`, which uses this module's
+:func:`track_sequence`, :func:`is_done`, :func:`atomic_write` and worker set-up
+(:func:`worker_init`, :func:`single_threaded_env`).
 """
 from __future__ import annotations
 
@@ -88,7 +92,8 @@ def dcfkit_version() -> str:
         return "unknown"
 
 
-def _json_default(obj):
+def json_default(obj):
+    """``json.dumps`` fallback for numpy values, dataclasses and sets."""
     if isinstance(obj, np.generic):
         return obj.item()
     if isinstance(obj, np.ndarray):
@@ -103,7 +108,7 @@ def _json_default(obj):
 def config_hash(config: Mapping, version: str | None = None) -> str:
     """16 hex digits of SHA-256 over the canonical JSON (sorted keys) of config + dcfkit version."""
     payload = {"config": config, "dcfkit": version if version is not None else dcfkit_version()}
-    text = json.dumps(payload, sort_keys=True, separators=(",", ":"), default=_json_default)
+    text = json.dumps(payload, sort_keys=True, separators=(",", ":"), default=json_default)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -119,7 +124,7 @@ def _tracker_name(config: Mapping) -> str:
 # --------------------------------------------------------------------------- files
 
 
-def _atomic_write(path: Path, text: str) -> None:
+def atomic_write(path: Path, text: str) -> None:
     """Write ``text`` to ``path`` via a temporary file in the same folder + ``os.replace``."""
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -149,16 +154,18 @@ def _paths(tracker_dir: Path, name: str) -> tuple[Path, Path, Path]:
             tracker_dir / f"{name}.error.json")
 
 
-def _read_json(path: Path) -> dict | None:
+def read_json(path: Path) -> dict | None:
+    """The JSON object in ``path``, or None if it is missing or unreadable."""
     try:
         return json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
 
 
-def _is_done(tracker_dir: Path, seq: Sequence, chash: str) -> bool:
+def is_done(tracker_dir: Path, seq: Sequence, chash: str) -> bool:
+    """Whether ``seq`` has complete results in ``tracker_dir`` from the config with hash ``chash``."""
     txt, side, _ = _paths(tracker_dir, seq.name)
-    meta = _read_json(side)
+    meta = read_json(side)
     return (meta is not None and meta.get("config_hash") == chash
             and txt.is_file() and _count_lines(txt) == len(seq))
 
@@ -188,7 +195,7 @@ def _default_factory(config):
     return load_tracker(config)
 
 
-def _track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_tracker,
+def track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_tracker,
                     chash: str, version: str, on_frame: Callable[[], None] | None = None) -> dict:
     """Run one sequence and write its files; returns ``{"sequence", "status", ...}``."""
     txt, side, err_file = _paths(tracker_dir, seq.name)
@@ -235,7 +242,7 @@ def _track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_trac
         for stale in (side, txt):  # results of another config must not be mixed in
             with contextlib.suppress(FileNotFoundError):
                 stale.unlink()
-        _atomic_write(err_file, json.dumps(record, indent=1, default=_json_default) + "\n")
+        atomic_write(err_file, json.dumps(record, indent=1, default=json_default) + "\n")
         return {"sequence": seq.name, "status": "failed", "error": message, "frames": len(seq)}
 
     total = float(times.sum())
@@ -246,8 +253,8 @@ def _track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_trac
         "time": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         "config": config, "times": times.tolist(),
     }
-    _atomic_write(txt, _format_boxes(boxes))
-    _atomic_write(side, json.dumps(meta, indent=1, default=_json_default) + "\n")  # marks done
+    atomic_write(txt, _format_boxes(boxes))
+    atomic_write(side, json.dumps(meta, indent=1, default=json_default) + "\n")  # marks done
     with contextlib.suppress(FileNotFoundError):
         err_file.unlink()
     return {"sequence": seq.name, "status": "done", "fps": meta["fps"], "frames": len(seq)}
@@ -257,7 +264,7 @@ def _track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_trac
 
 
 @contextlib.contextmanager
-def _single_threaded_env():
+def single_threaded_env():
     """Set the BLAS/OpenMP thread variables to 1 (inherited by spawned workers), then restore."""
     saved = {k: os.environ.get(k) for k in _THREAD_VARS}
     os.environ.update({k: "1" for k in _THREAD_VARS})
@@ -271,7 +278,7 @@ def _single_threaded_env():
                 os.environ[k] = v
 
 
-def _worker_init(parent_pid: int | None = None):
+def worker_init(parent_pid: int | None = None):
     """A worker process: one BLAS/OpenMP/OpenCV thread; with ``parent_pid``, die with the parent."""
     os.environ.update({k: "1" for k in _THREAD_VARS})
     with contextlib.suppress(Exception):
@@ -322,7 +329,7 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     tracker_dir = Path(out_dir) / name
     tracker_dir.mkdir(parents=True, exist_ok=True)
 
-    todo = [s for s in sequences if not _is_done(tracker_dir, s, chash)]
+    todo = [s for s in sequences if not is_done(tracker_dir, s, chash)]
     summary = {"tracker": name, "dir": tracker_dir, "config_hash": chash,
                "done": [], "skipped": [s.name for s in sequences if s not in todo], "failed": {}}
 
@@ -342,16 +349,16 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
             for seq in todo:
                 bar.set_postfix_str(seq.name, refresh=False)
                 start = bar.n
-                record(_track_sequence(config, seq, tracker_dir, make_tracker, chash, version,
+                record(track_sequence(config, seq, tracker_dir, make_tracker, chash, version,
                                        on_frame=lambda: bar.update(1)))
                 bar.update(start + len(seq) - bar.n)  # a failed sequence skips its rest
         else:
-            with _single_threaded_env():
+            with single_threaded_env():
                 pool = ProcessPoolExecutor(max_workers=min(jobs, len(todo)),
                                            mp_context=multiprocessing.get_context("spawn"),
-                                           initializer=_worker_init, initargs=(os.getpid(),))
+                                           initializer=worker_init, initargs=(os.getpid(),))
                 try:
-                    futures = {pool.submit(_track_sequence, config, seq, tracker_dir,
+                    futures = {pool.submit(track_sequence, config, seq, tracker_dir,
                                            make_tracker, chash, version): seq for seq in todo}
                     for future in as_completed(futures):
                         result = future.result()
@@ -396,7 +403,7 @@ def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]
     for seq in sequences:
         name = seq if isinstance(seq, str) else seq.name
         txt, side, _ = _paths(tracker_dir, name)
-        meta = _read_json(side)
+        meta = read_json(side)
         if meta is None or not txt.is_file():
             continue
         boxes = read_boxes(txt)

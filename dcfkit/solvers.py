@@ -83,7 +83,7 @@ def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: n
     rhs0 = np.empty_like(xf)
     kernels.prepare(real(xf), real(yf), real(v_prev), theta, aa, real(rhs0))
     t = np.empty(xf.shape[1:], np.complex64)
-    vf, hf, uf, g = (np.empty_like(xf) for _ in range(4))  # zero h, u at the start (Remark 1)
+    vf, hf, uf, g = (np.empty_like(xf) for _ in range(4))  # h = u = 0 at first (Remark 1): unread then
     gamma = p.gamma0
     for e in range(p.iterations):
         first = e == 0

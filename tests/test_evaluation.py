@@ -156,14 +156,14 @@ def test_crash_mid_sequence_leaves_no_partial_result(tmp_path, seqs):
 
 
 def test_crash_between_result_and_sidecar_is_not_done(tmp_path, seqs, monkeypatch):
-    real_write = evaluation._atomic_write
+    real_write = evaluation.atomic_write
 
     def dying_write(path, text):
         if path.name == "b.json":
             raise Crash
         real_write(path, text)
 
-    monkeypatch.setattr(evaluation, "_atomic_write", dying_write)
+    monkeypatch.setattr(evaluation, "atomic_write", dying_write)
     with pytest.raises(Crash):
         run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
     monkeypatch.undo()
@@ -182,7 +182,7 @@ def test_atomic_write_interrupted_keeps_old_file(tmp_path, monkeypatch):
 
     monkeypatch.setattr(evaluation.os, "replace", boom)
     with pytest.raises(Crash):
-        evaluation._atomic_write(target, "new\n")
+        evaluation.atomic_write(target, "new\n")
     assert target.read_text() == "old\n" and files(tmp_path) == {"x.txt"}
 
 

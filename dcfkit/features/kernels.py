@@ -114,12 +114,12 @@ def normalise(hist, clip, eps, orient, clipped):  # pragma: no cover - compiled
     """
     n2, n, hb, wb = hist.shape
     no = n2 // 2
+    cells = n * hb * wb
     clip32 = np.float32(clip)
     half = np.float32(0.5)
     energy = np.empty((hb, wb), np.float32)
     inv = np.empty((hb + 1, wb + 1), np.float32)
-    feat = np.empty((hb, wb), np.float32)
-    acc = np.empty((hb, wb), np.float32)
+    norm = np.empty((4, n, hb, wb), np.float32)  # the 4 normalisers of every cell
     for i in range(n):
         for r in range(hb):
             for c in range(wb):
@@ -141,24 +141,32 @@ def normalise(hist, clip, eps, orient, clipped):  # pragma: no cover - compiled
         for r in range(hb + 1):
             inv[r, 0] = inv[r, 1]
             inv[r, wb] = inv[r, wb - 1]
-        for o in range(3 * no):  # channel by channel: contiguous, vectorised inner loops
+        for k in range(4):  # blocks below-right, above-right, below-left, above-left
+            dr, dc = 1 - k % 2, 1 - k // 2
             for r in range(hb):
                 for c in range(wb):
-                    if o < n2:
-                        feat[r, c] = hist[o, i, r, c]
-                    else:
-                        feat[r, c] = hist[o - n2, i, r, c] + hist[o - no, i, r, c]
-            for k in range(4):  # blocks below-right, above-right, below-left, above-left
-                dr, dc = 1 - k % 2, 1 - k // 2
-                for r in range(hb):
-                    for c in range(wb):
-                        t = min(feat[r, c] * inv[r + dr, c + dc], clip32)
-                        acc[r, c] = t if k == 0 else acc[r, c] + t
-                        if o < n2:
-                            clipped[k, o, i, r, c] = t
-            for r in range(hb):
-                for c in range(wb):
-                    orient[o, i, r, c] = acc[r, c] * half
+                    norm[k, i, r, c] = inv[r + dr, c + dc]
+    # channel by channel over all cells of all images: long contiguous loops LLVM vectorises
+    h = hist.reshape(n2, cells)
+    nk = norm.reshape(4, cells)
+    out = orient.reshape(3 * no, cells)
+    kept = clipped.reshape(4, n2, cells)
+    feat = np.empty(cells, np.float32)
+    acc = np.empty(cells, np.float32)
+    for o in range(3 * no):
+        if o < n2:
+            feat[:] = h[o]
+        else:
+            for q in range(cells):
+                feat[q] = h[o - n2, q] + h[o - no, q]
+        for k in range(4):
+            for q in range(cells):
+                t = min(feat[q] * nk[k, q], clip32)
+                acc[q] = t if k == 0 else acc[q] + t
+                if o < n2:
+                    kept[k, o, q] = t
+        for q in range(cells):
+            out[o, q] = acc[q] * half
 
 
 @numba.njit(cache=True, nogil=True)
