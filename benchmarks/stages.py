@@ -3,10 +3,10 @@ label, solver, scale), by wrapping the tracker's components with timers — the 
 itself carries no instrumentation.
 
     python benchmarks/stages.py [--config dr2track] [--root ../shared/data/UAV123_10fps]
-        [--sequence boat1] [--frames 100] [--json stages.json]
+        [--sequence boat1] [--frames 100] [--synthetic] [--json stages.json]
 
-Single-threaded; frames are decoded before timing. Synthetic 1280x720 frames when the real
-data is absent. Prints ms per frame per stage and its share of the total.
+Single-threaded; frames are decoded before timing. Synthetic 1280x720 frames with --synthetic
+or when the real data is absent. Prints ms per frame per stage and its share of the total.
 """
 import os
 
@@ -61,9 +61,10 @@ def main():
     parser.add_argument("--root", default=str(Path(__file__).resolve().parents[2] / "shared/data/UAV123_10fps"))
     parser.add_argument("--sequence", default="boat1")
     parser.add_argument("--frames", type=int, default=100)
+    parser.add_argument("--synthetic", action="store_true", help="synthetic 1280x720 frames even if the data exists")
     parser.add_argument("--json")
     args = parser.parse_args()
-    if Path(args.root).is_dir():
+    if Path(args.root).is_dir() and not args.synthetic:
         from dcfkit.datasets import load_dataset
 
         (seq,) = load_dataset("uav123_10fps", args.root, [args.sequence])
@@ -72,6 +73,7 @@ def main():
     else:
         syn = make_sequence(n_frames=args.frames, size=(720, 1280), target=(40, 70))
         frames, box = syn.frames, syn.ground_truth[0]
+        args.sequence = "synthetic_720p"
     tracker = dcfkit.load_tracker(args.config)
     instrument(tracker)
     tracker.init(frames[0], box)
