@@ -5,6 +5,8 @@ Coordinates are 0-based pixel indices, (y, x) order for centres and (h, w) for s
 """
 from __future__ import annotations
 
+from typing import Callable
+
 import cv2
 import numpy as np
 
@@ -28,22 +30,26 @@ def _origin(centre: float, size: int) -> int:
 
 def crop(image: np.ndarray, centre, region) -> np.ndarray:
     """The ``region`` (h, w) pixels around ``centre`` (y, x); outside pixels replicate the edge."""
+    return cropper(image.shape, centre, region)(image)
+
+
+def cropper(shape, centre, region) -> Callable[[np.ndarray], np.ndarray]:
+    """:func:`crop` with its geometry worked out once, for images of ``shape`` (H, W[, C])."""
     rh, rw = max(int(round(region[0])), 1), max(int(round(region[1])), 1)
     y0, x0 = _origin(centre[0], rh), _origin(centre[1], rw)
-    height, width = image.shape[:2]
+    height, width = shape[:2]
     if y0 >= 0 and x0 >= 0 and y0 + rh <= height and x0 + rw <= width:
-        return image[y0:y0 + rh, x0:x0 + rw]
+        return lambda image: image[y0:y0 + rh, x0:x0 + rw]
     # the part inside the image (at least its nearest edge pixel), then replicate its borders
     ya, xa = min(max(y0, 0), height - 1), min(max(x0, 0), width - 1)
     yb, xb = max(min(y0 + rh, height), ya + 1), max(min(x0 + rw, width), xa + 1)
-    inside = image[ya:yb, xa:xb]
     top, left = max(ya - y0, 0), max(xa - x0, 0)
-    bottom, right = rh - top - inside.shape[0], rw - left - inside.shape[1]
+    bottom, right = rh - top - (yb - ya), rw - left - (xb - xa)
     if min(top, bottom, left, right) < 0:  # region entirely beyond one edge: rows/cols replicate it
-        rows = np.clip(np.arange(y0, y0 + rh), 0, height - 1)
-        cols = np.clip(np.arange(x0, x0 + rw), 0, width - 1)
-        return image[rows[:, None], cols[None, :]]
-    return cv2.copyMakeBorder(inside, top, bottom, left, right, cv2.BORDER_REPLICATE)
+        rows = np.clip(np.arange(y0, y0 + rh), 0, height - 1)[:, None]
+        cols = np.clip(np.arange(x0, x0 + rw), 0, width - 1)[None, :]
+        return lambda image: image[rows, cols]
+    return lambda image: cv2.copyMakeBorder(image[ya:yb, xa:xb], top, bottom, left, right, cv2.BORDER_REPLICATE)
 
 
 def resize(patch: np.ndarray, out) -> np.ndarray:
@@ -61,18 +67,29 @@ def sample(image: np.ndarray, centre, region, out) -> np.ndarray:
     A shrink by k >= 2 first averages k x k blocks (OpenCV's fast integer path; a non-integer
     area resize of a ~1000 px region costs 2-3x more), then maps the exact region onto the
     output grid bilinearly (the remaining factor is below 2)."""
+    return sampler(image.shape, centre, region, out)(image)
+
+
+def sampler(shape, centre, region, out) -> Callable[[np.ndarray], np.ndarray]:
+    """:func:`sample` with its geometry worked out once, for images of ``shape`` (H, W[, C]):
+    the DSST resamples the same working patch to the same 33 scales every frame."""
     oh, ow = int(out[0]), int(out[1])
     k = int(min(region[0] / oh, region[1] / ow))
     if k < 2:
-        return resize(crop(image, centre, region), out)
+        cut = cropper(shape, centre, region)
+        return lambda image: resize(cut(image), (oh, ow))
     ch, cw = (int(np.ceil(region[0] / k)) + 2) * k, (int(np.ceil(region[1] / k)) + 2) * k
-    big = crop(image, centre, (ch, cw))
-    small = cv2.resize(big, (cw // k, ch // k), interpolation=cv2.INTER_AREA)
+    cut = cropper(shape, centre, (ch, cw))
     # output pixel u samples image row cy + (u - (oh - 1) / 2) * region_h / oh; small row i
     # averages image rows y0 + k i .. y0 + k i + k - 1, centred at y0 + k i + (k - 1) / 2
     sy, sx = region[0] / oh, region[1] / ow
     ty = (centre[0] - (oh - 1) / 2 * sy - _origin(centre[0], ch) - (k - 1) / 2) / k
     tx = (centre[1] - (ow - 1) / 2 * sx - _origin(centre[1], cw) - (k - 1) / 2) / k
     warp = np.array([[sx / k, 0.0, tx], [0.0, sy / k, ty]])
-    return cv2.warpAffine(small, warp, (ow, oh), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-                          borderMode=cv2.BORDER_REPLICATE)
+
+    def run(image: np.ndarray) -> np.ndarray:
+        small = cv2.resize(cut(image), (cw // k, ch // k), interpolation=cv2.INTER_AREA)
+        return cv2.warpAffine(small, warp, (ow, oh), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+                              borderMode=cv2.BORDER_REPLICATE)
+
+    return run

@@ -13,7 +13,7 @@ import numpy as np
 
 from .features.fhog import fhog
 from .params import param
-from .patches import sample
+from .patches import sample, sampler
 from .registry import Component
 
 
@@ -94,6 +94,12 @@ class DSST(ScaleEstimator):
         area = float(np.prod(self.base_target))
         shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
         self.model_size = np.maximum(np.round(self.base_target * shrink), 2 * p.cell_size).astype(int)
+        # the working patch and its resampling to each scale keep their geometry every frame
+        span = self.factors[-1] / self.factors[0]
+        self.work_size = np.ceil(self.model_size * span).astype(int)
+        middle = (self.work_size - 1) / 2
+        self.resamplers = [sampler(self.work_size, middle, self.work_size * (f / self.factors[-1]), self.model_size)
+                           for f in self.factors]
         self.num = self.den = None
         self._learn(np.fft.fft(self._samples(image, centre, scale), axis=1))
 
@@ -102,12 +108,8 @@ class DSST(ScaleEstimator):
 
         The largest region is cut from the image and resampled once to a small working
         patch (fine enough for the smallest scale); every scale sample is resized from it."""
-        span = self.factors[-1] / self.factors[0]
-        work_size = np.ceil(self.model_size * span).astype(int)
-        work = sample(image, centre, self.base_target * scale * self.factors[-1], work_size)
-        middle = (work_size - 1) / 2
-        patches = np.stack([sample(work, middle, work_size * (f / self.factors[-1]), self.model_size)
-                            for f in self.factors])
+        work = sample(image, centre, self.base_target * scale * self.factors[-1], self.work_size)
+        patches = np.stack([resample(work) for resample in self.resamplers])
         feats = fhog(patches, cell_size=self.params.cell_size, batch=True)
         return feats.reshape(len(self.factors), -1).T * self.window[None, :]
 
