@@ -6,7 +6,8 @@ passes with temporaries, with the same single-precision operations in the same o
 products as ``fma(ar, br, -ai bi) + i fma(ar, bi, ai br)`` (numpy's SIMD loops on FMA
 hardware), channel sums in channel order, a division by a real number as a product with its
 float32 reciprocal, Python scalars rounded to float32. The trackers' boxes are therefore
-bit-identical to the numpy formulation's on the machines these were measured on.
+bit-identical to the numpy formulation's on the development machine (x86-64 with FMA); where
+numpy's complex loops do not use FMA, the two differ in the last bit.
 
 Spectra are passed as float32 views of (C, H, Wr) complex64 arrays, (C, H, 2 Wr) with real
 and imaginary parts interleaved, so that every operation is explicitly single precision.

@@ -7,9 +7,10 @@ cache directory when that is read-only), so only the first process after install
 the compilation (a few seconds); later ones load it in milliseconds.
 
 Every float32 operation is the one the numpy/OpenCV formulation performed, in the same
-order, so results are bit-identical to it. For fhog: gradients of 8-bit images are multiples of 1/2,
-their squared magnitudes are exact in float32, and the bilinear cell weights are sums of
-exact float64 products, whatever the summation order, before the one rounding to float32.
+order, so results are bit-identical to it (for fhog with the cell size 4: gradients of 8-bit
+images are multiples of 1/2, their squared magnitudes are exact in float32, and the bilinear
+cell sums are of exact float64 products, whatever their order, before the one rounding to
+float32; the Color Names sums follow OpenCV's integer-factor area resize).
 """
 from __future__ import annotations
 
