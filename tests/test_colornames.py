@@ -22,9 +22,10 @@ def test_table_index_is_r_plus_32g_plus_1024b():
     assert cn.table_index(bgr).tolist() == [[31, 31 * 32, 31 * 1024, 9 // 8 + 32 * (130 // 8) + 1024 * (17 // 8)]]
 
 
-def test_feature_is_the_cell_mean_of_table_rows():
+@pytest.mark.parametrize("shape", [(8, 12, 3), (10, 15, 3)])  # the second: partial cells dropped
+def test_feature_is_the_cell_mean_of_table_rows(shape):
     rng = np.random.default_rng(0)
-    patch = rng.integers(0, 256, (8, 12, 3), dtype=np.uint8)
+    patch = rng.integers(0, 256, shape, dtype=np.uint8)
     got = ColorNames().extract(patch, 4)
     table = cn.load_table()
     assert got.shape == (10, 2, 3)
@@ -56,3 +57,6 @@ def test_gray_feature_is_centred_cell_mean():
     np.testing.assert_allclose(got[0], [[-0.5, 0.5], [0.5, 0.5]], atol=1e-6)
     np.testing.assert_allclose(cell_average(np.arange(16, dtype=np.float32).reshape(4, 4), 2),
                                [[2.5, 4.5], [10.5, 12.5]])
+    # rows and columns beyond the last whole cell are left out, as fhog and Color Names do
+    np.testing.assert_allclose(cell_average(np.arange(20, dtype=np.float32).reshape(4, 5), 2),
+                               [[3.0, 5.0], [13.0, 15.0]])
