@@ -4,7 +4,8 @@ the Color Names cell averages.
 Imported on the first extraction, not with the package: importing numba takes about 0.25 s.
 Machine code is cached on disk (numba's ``cache=True``: next to this file, or in the user's
 cache directory when that is read-only), so only the first process after installation pays
-the compilation (a few seconds); later ones load it in milliseconds.
+the compilation (about 10 s on this machine); later ones load it (about 0.45 s per process,
+mostly numba's own start-up).
 
 Every float32 operation is the one the numpy/OpenCV formulation performed, in the same
 order, so results are bit-identical to it (for fhog with the cell size 4: gradients of 8-bit
