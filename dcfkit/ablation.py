@@ -435,7 +435,7 @@ def _record_crash(task: _Task, exc: BaseException, version: str) -> dict:
     with contextlib.suppress(OSError):
         task.folder.mkdir(parents=True, exist_ok=True)
         atomic_write(task.folder / f"{task.seq.name}.error.json",
-                      json.dumps(record, indent=1, default=json_default) + "\n")
+                     json.dumps(record, indent=1, default=json_default) + "\n")
     return {"sequence": task.seq.name, "status": "failed", "error": message, "frames": len(task.seq)}
 
 
@@ -540,7 +540,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
             if not path.is_file():
                 stripped = {k: v for k, v in job.config.items() if k not in LABEL_KEYS}
                 atomic_write(path, json.dumps({"key": job.key, "dcfkit_version": version,
-                                                "config": stripped}, indent=1) + "\n")
+                                               "config": stripped}, indent=1) + "\n")
         finished = {k for k, t in tasks.items() if is_done(t.folder, t.seq, t.key)}
         todo = sorted((t for k, t in tasks.items() if k not in finished),
                       key=lambda t: -len(t.seq))  # longest first: the workers end together

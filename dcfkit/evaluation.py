@@ -196,7 +196,7 @@ def _default_factory(config):
 
 
 def track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_tracker,
-                    chash: str, version: str, on_frame: Callable[[], None] | None = None) -> dict:
+                   chash: str, version: str, on_frame: Callable[[], None] | None = None) -> dict:
     """Run one sequence and write its files; returns ``{"sequence", "status", ...}``."""
     txt, side, err_file = _paths(tracker_dir, seq.name)
     factory = make_tracker or _default_factory
@@ -350,7 +350,7 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
                 bar.set_postfix_str(seq.name, refresh=False)
                 start = bar.n
                 record(track_sequence(config, seq, tracker_dir, make_tracker, chash, version,
-                                       on_frame=lambda: bar.update(1)))
+                                      on_frame=lambda: bar.update(1)))
                 bar.update(start + len(seq) - bar.n)  # a failed sequence skips its rest
         else:
             with single_threaded_env():
