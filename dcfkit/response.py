@@ -59,9 +59,9 @@ def local_maxima(r: np.ndarray, size: int = 3) -> tuple[np.ndarray, np.ndarray]:
     """Local maxima of a circular (H, W) map: rows, cols of pixels equal to the max of their
     ``size`` x ``size`` (odd; wrapped) neighbourhood and strictly above its minimum (no plateaus
     of a flat map). Sorted by value, highest first."""
-    # cv2's morphology on a wrap-padded copy (scipy.ndimage would cost 0.3 s of import)
     if size < 1 or size % 2 == 0:
         raise ValueError(f"local_maxima: size must be odd and positive, got {size}")
+    # cv2's morphology on a wrap-padded copy (scipy.ndimage would cost 0.3 s of import)
     half = size // 2
     padded = np.pad(r, half, mode="wrap")
     kernel = np.ones((size, size), np.uint8)

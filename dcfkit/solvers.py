@@ -27,6 +27,11 @@ from .params import param
 from .registry import Component
 
 
+def _floats(z: np.ndarray) -> np.ndarray:
+    """(..., W) complex64 as the (..., 2 W) float32 view the compiled kernels take (re, im interleaved)."""
+    return z.view(np.float32)
+
+
 def sherman_morrison_solve(a: np.ndarray, b: np.ndarray, c: float) -> np.ndarray:
     """Solve (a aᴴ + c I) x = b independently per pixel (Eq. 9): x = (b - a (aᴴb) / (c + aᴴa)) / c.
 
@@ -40,8 +45,7 @@ def sherman_morrison_solve(a: np.ndarray, b: np.ndarray, c: float) -> np.ndarray
     b = np.ascontiguousarray(b, np.complex64).reshape(a.shape)
     aa = np.einsum("cij,cij->ij", a.conj(), a).real.astype(np.float32)
     t, x = np.empty(a.shape[1:], np.complex64), np.empty_like(a)
-    real = lambda z: z.view(np.float32)  # noqa: E731 - interleaved (re, im) float32 view
-    kernels.v_step(real(a), real(b), real(b), real(b), 1.0, c, aa, True, real(t), real(x))
+    kernels.v_step(_floats(a), _floats(b), _floats(b), _floats(b), 1.0, c, aa, True, _floats(t), _floats(x))
     return x.reshape(shape)
 
 
@@ -73,33 +77,33 @@ def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: n
 
     shape = w2.shape
     K = float(shape[0] * shape[1])
-    if v_prev is None:
-        theta = 0.0
     xf = np.ascontiguousarray(xf, np.complex64)
     yf = np.ascontiguousarray(yf, np.complex64)
-    v_prev = xf if v_prev is None else np.ascontiguousarray(v_prev, np.complex64)
-    real = lambda a: a.view(np.float32)  # noqa: E731 - interleaved (re, im) float32 view
+    if v_prev is None:  # no previous filter, no temporal term (v_prev only fills the argument)
+        theta, v_prev = 0.0, xf
+    v_prev = np.ascontiguousarray(v_prev, np.complex64)
     aa = np.empty(xf.shape[1:], np.float32)
     rhs0 = np.empty_like(xf)
-    kernels.prepare(real(xf), real(yf), real(v_prev), theta, aa, real(rhs0))
+    kernels.prepare(_floats(xf), _floats(yf), _floats(v_prev), theta, aa, _floats(rhs0))
     t = np.empty(xf.shape[1:], np.complex64)
-    vf, hf, uf, g = (np.empty_like(xf) for _ in range(4))  # h = u = 0 at first (Remark 1): unread then
+    vf, uf, g = (np.empty_like(xf) for _ in range(3))
+    hf = uf  # h = u = 0 at first (Remark 1): the first v-step reads neither
     gamma = p.gamma0
     for e in range(p.iterations):
         first = e == 0
         # v-step (Eq. 9): Sherman-Morrison per frequency, b = a conj(ŷ) + θ v̂ˡ + γ ĥ - û
-        kernels.v_step(real(xf), real(rhs0), real(hf), real(uf), gamma, theta + gamma, aa, first, real(t),
-                       real(vf))
+        kernels.v_step(_floats(xf), _floats(rhs0), _floats(hf), _floats(uf), gamma, theta + gamma, aa, first,
+                       _floats(t), _floats(vf))
         if e == p.iterations - 1 and not need_h:
             return vf, None
         # h-step (Eq. 10) in the spatial domain
         if not first:
-            kernels.h_input(real(vf), real(uf), gamma, real(g))
+            kernels.h_input(_floats(vf), _floats(uf), gamma, _floats(g))
         h = fft.irfft2(vf if first else g, shape)
         h *= (gamma * K) / (w2 + gamma * K)
         hf = np.ascontiguousarray(fft.rfft2(h.astype(np.float32, copy=False)), np.complex64)
         # multiplier (Eq. 11) and penalty schedule
-        kernels.multiplier(real(vf), real(hf), gamma, first, real(uf))
+        kernels.multiplier(_floats(vf), _floats(hf), gamma, first, _floats(uf))
         gamma = min(p.gamma_max, p.beta * gamma)
     return vf, hf
 

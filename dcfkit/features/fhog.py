@@ -228,7 +228,7 @@ def _histograms(
     theta = np.arctan2(gy, gx, out=_buf(ws, "theta", (n, rows, cols)))
     hist = _buf(ws, "hist", (n_bins, n, hb, wb))
     kernels.cell_histograms(mag, theta, cell_size, n_bins, soft_orientation,
-                                 _border_scale(hb, wb, cell_size), hist)
+                            _border_scale(hb, wb, cell_size), hist)
     return hist
 
 
@@ -256,7 +256,7 @@ def _normalise(hist: np.ndarray, n_orients: int, clip: float, cell_size: int, ws
     clipped = _buf(ws, "clipped", (4, 2 * n_orients, cells))
     eps = np.float32(1e-4 / 4 / cell_size**4)  # Piotr's eps on this scale
     kernels.normalise(hist, clip, eps, out[:no].reshape(no, n, hb, wb),
-                           clipped.reshape(4, 2 * n_orients, n, hb, wb))
+                      clipped.reshape(4, 2 * n_orients, n, hb, wb))
     # the texture channel of a normalisation: 0.2357 times the sum of its clipped sensitive
     # channels, by numpy's matmul as before (its summation order decides the last bit)
     texture_weights = np.full((1, 2 * n_orients), _TEXTURE_SCALE, np.float32)
