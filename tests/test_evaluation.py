@@ -145,6 +145,36 @@ def test_resume_recomputes_nothing(tmp_path, seqs):
     assert fourth.made == 3
 
 
+def test_default_trackers_are_warmed_up_once_per_process_and_config(tmp_path, seqs, monkeypatch):
+    made = []
+
+    def factory(config):
+        made.append(RecordingTracker(config))
+        return made[-1]
+
+    class RecordingTracker(DriftTracker):
+        def init(self, image, box):
+            self.calls = ["init"]
+            super().init(image, box)
+
+        def update(self, image):
+            self.calls.append("update")
+            return super().update(image)
+
+    monkeypatch.setattr(evaluation, "_default_factory", factory)
+    monkeypatch.setattr(evaluation, "_warmed_up", set())
+    run_one_pass(CONFIG, seqs, tmp_path, progress=False)
+    # sequence a: its tracker, then the throw-away one (one init and one update); b, c: theirs
+    assert len(made) == 4 and made[1].calls == ["init", "update"]
+    assert [len(t.calls) for t in made] == [N_FRAMES, 2, N_FRAMES, N_FRAMES]
+    run_one_pass({**CONFIG, "drift": 2.0}, seqs, tmp_path, progress=False)
+    assert len(made) == 8  # a new config is warmed up again
+    # a user's factory is used as given: one tracker per sequence, no throw-away copy
+    custom = Counter()
+    run_one_pass({**CONFIG, "drift": 3.0}, seqs, tmp_path, make_tracker=custom, progress=False)
+    assert custom.made == 3
+
+
 def test_crash_mid_sequence_leaves_no_partial_result(tmp_path, seqs):
     with pytest.raises(Crash):
         run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter({2: (3, Crash)}), progress=False)
