@@ -28,7 +28,9 @@ class ScipyFFT:
 
 
 class PyFFTW:
-    """pyfftw with plans cached per (shape, dtype); outputs are copied out of FFTW's buffers."""
+    """pyfftw with plans cached per (shape, dtype). Inputs are copied into the plan's own
+    buffer (FFTW's multi-dimensional c2r transform overwrites its input) and outputs copied
+    out of it, so callers' arrays are never touched or aliased."""
 
     name = "pyfftw"
 
@@ -49,14 +51,16 @@ class PyFFTW:
         plan = self._plan(("r", x.shape, x.dtype.str),
                           lambda: builders.rfft2(self._pyfftw.empty_aligned(x.shape, x.dtype), axes=(-2, -1),
                                                  threads=1, planner_effort="FFTW_ESTIMATE"))
-        return plan(x).copy()
+        plan.input_array[...] = x
+        return plan().copy()
 
     def irfft2(self, xf: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
         builders = self._pyfftw.builders
         plan = self._plan(("i", xf.shape, xf.dtype.str, tuple(shape)),
                           lambda: builders.irfft2(self._pyfftw.empty_aligned(xf.shape, xf.dtype), s=shape,
                                                   axes=(-2, -1), threads=1, planner_effort="FFTW_ESTIMATE"))
-        return plan(xf).copy()
+        plan.input_array[...] = xf
+        return plan().copy()
 
 
 def make_fft(backend: str = "scipy"):

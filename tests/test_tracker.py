@@ -102,3 +102,10 @@ def test_target_leaving_the_image_keeps_boxes_finite():
                               borderMode=cv2.BORDER_REPLICATE) for k, f in enumerate(frames)]
     boxes = run(dcfkit.load_tracker("dr2track"), shifted, (20, 150, 30, 20))
     assert np.all(np.isfinite(boxes))
+
+
+def test_pyfftw_backend_tracks_like_scipy(sequence):
+    frames, box = sequence.frames[:30], sequence.ground_truth[0]
+    reference = np.array(run(dcfkit.load_tracker("dr2track"), frames, box))
+    boxes = np.array(run(dcfkit.load_tracker("dr2track", overrides={"tracker.fft_backend": "pyfftw"}), frames, box))
+    assert np.abs(boxes - reference).max() < 0.5  # the two FFT libraries differ in the last bits only
