@@ -112,9 +112,13 @@ def _load_file(path: Path, chain: tuple[Path, ...] = ()) -> dict:
         return data
     if not isinstance(base, str):
         raise ConfigError(f"{path}: 'base' must be a file name, got {base!r}")
-    base_path = (path.parent / base)
-    if not base_path.is_file():
-        raise ConfigError(f"{path}: base config '{base}' not found (looked for {base_path})")
+    base_path = path.parent / base
+    if not base_path.is_file():  # a shipped config by name ('dr2track' or 'dr2track.yaml')
+        shipped = shipped_config_dir() / (base if base.endswith((".yaml", ".yml")) else f"{base}.yaml")
+        if Path(base).name != base or not shipped.is_file():
+            raise ConfigError(f"{path}: base config '{base}' not found (looked for {base_path} "
+                              f"and for a shipped config of that name)")
+        base_path = shipped
     return merge(_load_file(base_path, chain + (path,)), data)
 
 

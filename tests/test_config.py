@@ -67,6 +67,20 @@ def test_wrong_type_is_reported_with_key():
         load_config("dr2track", {"label.mu": -1})
 
 
+@pytest.mark.parametrize("key,value", [("label.mu", float("nan")), ("search.gain", float("inf")),
+                                       ("tracker.search_area_scale", "inf"), ("scale.step", "-inf")])
+def test_non_finite_numbers_are_refused(key, value):
+    with pytest.raises(ConfigError, match=rf"{key.split('.')[-1]}: expected a finite number"):
+        load_config("dr2track", {key: value})
+
+
+def test_non_finite_number_in_a_yaml_file_is_refused(tmp_path):
+    path = tmp_path / "mine.yaml"
+    path.write_text("base: dr2track\nregularizers:\n  temporal: {theta: .inf}\n")
+    with pytest.raises(ConfigError, match=r"mine.yaml.*theta: expected a finite number"):
+        load_config(path)
+
+
 def test_yaml_syntax_error_names_file_and_line(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("name: x\nlabel: {name: gaussian\nsolver: admm_strcf\n")
@@ -81,6 +95,24 @@ def test_unknown_top_level_key_and_wrong_regularizer_role(tmp_path):
         load_config(cfg)
     with pytest.raises(ConfigError, match=r"regularizers.spatial: 'temporal' is a temporal regularizer"):
         load_config("strcf", {"regularizers.spatial": {"name": "temporal"}})
+
+
+def test_base_may_name_a_shipped_config(tmp_path):
+    (tmp_path / "sub").mkdir()
+    for base in ("dr2track", "dr2track.yaml"):
+        path = tmp_path / "sub" / "mine.yaml"
+        path.write_text(f"base: {base}\nname: mine\nlabel: {{mu: 0.3}}\n")
+        config = load_config(path)
+        assert config["name"] == "mine" and config["label"]["mu"] == 0.3
+        assert {k: v for k, v in config.items() if k not in ("name", "label")} == \
+            {k: v for k, v in load_config("dr2track").items() if k not in ("name", "label")}
+    # a file next to the config comes first
+    (tmp_path / "sub" / "dr2track.yaml").write_text("base: strcf\nname: local\n")
+    path.write_text("base: dr2track.yaml\n")
+    assert load_config(path)["name"] == "local"
+    path.write_text("base: ../nowhere/dr2track.yaml\n")
+    with pytest.raises(ConfigError, match=r"base config '../nowhere/dr2track.yaml' not found"):
+        load_config(path)
 
 
 def test_circular_base_is_an_error(tmp_path):
