@@ -26,7 +26,7 @@ from typing import Any, Mapping
 
 import yaml
 
-from .errors import ConfigError
+from .errors import ConfigError, DcfkitError
 from .params import closest, param, parse_params
 
 SLOTS = ("features", "label", "regularizers", "solver", "search", "scale")
@@ -68,18 +68,32 @@ class TrackerParams:
             return "output_sigma_factor must be > 0"
 
 
+class _StrictLoader(yaml.SafeLoader):
+    """safe_load that refuses a key given twice in one mapping (YAML keeps the last silently)."""
+
+    def construct_mapping(self, node, deep=False):
+        seen = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            if isinstance(key, str) and key in seen:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"key '{key}' is given twice in this mapping", key_node.start_mark)
+            seen.add(key)
+        return super().construct_mapping(node, deep)
+
+
 def _read_yaml(path: Path) -> dict:
     try:
         text = path.read_text()
     except OSError as exc:
         raise ConfigError(f"cannot read config {path}: {exc.strerror}") from None
     try:
-        data = yaml.safe_load(text)
+        data = yaml.load(text, Loader=_StrictLoader)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
         problem = getattr(exc, "problem", None) or str(exc)
-        raise ConfigError(f"{where}: YAML syntax error: {problem}") from None
+        raise ConfigError(f"{where}: YAML error: {problem}") from None
     if data is None:
         return {}
     if not isinstance(data, dict):
@@ -102,14 +116,15 @@ def merge(base: Mapping, override: Mapping) -> dict:
     return out
 
 
-def _load_file(path: Path, chain: tuple[Path, ...] = ()) -> dict:
+def _load_file(path: Path, chain: tuple[Path, ...] = ()) -> tuple[dict, tuple[Path, ...]]:
+    """The file merged over its ``base`` chain, and the files read (this one first)."""
     path = path.resolve()
     if path in chain:
         raise ConfigError(f"{path}: circular 'base' chain: {' -> '.join(map(str, chain + (path,)))}")
     data = _read_yaml(path)
     base = data.pop("base", None)
     if base is None:
-        return data
+        return data, (path,)
     if not isinstance(base, str):
         raise ConfigError(f"{path}: 'base' must be a file name, got {base!r}")
     base_path = path.parent / base
@@ -119,7 +134,8 @@ def _load_file(path: Path, chain: tuple[Path, ...] = ()) -> dict:
             raise ConfigError(f"{path}: base config '{base}' not found (looked for {base_path} "
                               f"and for a shipped config of that name)")
         base_path = shipped
-    return merge(_load_file(base_path, chain + (path,)), data)
+    inherited, files = _load_file(base_path, chain + (path,))
+    return merge(inherited, data), (path,) + files
 
 
 def parse_value(text: str) -> Any:
@@ -178,19 +194,29 @@ def load_config(source: str | Path | Mapping, overrides: Mapping[str, Any] | Non
     """Read a config (path, or a dict), apply dotted overrides, validate, fill in defaults.
 
     A bare name such as 'dr2track' finds ``configs/dr2track.yaml``. Returns the fully
-    resolved config: every component with all its parameters.
+    resolved config: every component with all its parameters. An error in a config with a
+    ``base`` lists the files it was merged from (the key may sit in any of them).
     """
+    files: tuple[Path, ...] = ()
     if isinstance(source, Mapping):
         data, origin = copy.deepcopy(dict(source)), "<config dict>"
         base = data.pop("base", None)
         if base is not None:
-            data = merge(_load_file(_find(base)), data)
+            inherited, files = _load_file(_find(base))
+            data = merge(inherited, data)
     else:
         path = _find(source)
-        data, origin = _load_file(path), str(path)
+        data, files = _load_file(path)
+        origin = str(path)
     for key, value in (overrides or {}).items():
         set_dotted(data, key, value)
-    return resolve(data, origin)
+    try:
+        return resolve(data, origin)
+    except DcfkitError as exc:
+        chain = [origin] * isinstance(source, Mapping) + [str(f) for f in files]
+        if len(chain) < 2:
+            raise
+        raise type(exc)(f"{exc} (config merged from {' <- '.join(chain)})") from None
 
 
 def _find(source: str | Path) -> Path:
@@ -222,7 +248,10 @@ def resolve(data: Mapping, origin: str) -> dict:
     missing = [k for k in ("features", "label", "solver") if k not in data]
     if missing:
         raise ConfigError(f"{origin}: missing required key '{missing[0]}'")
-    out: dict[str, Any] = {"name": str(data.get("name") or Path(origin).stem)}
+    for key in ("name", "description"):
+        if data.get(key) is not None and not isinstance(data[key], str):
+            raise ConfigError(f"{origin}: {key}: expected a string, got {data[key]!r}")
+    out: dict[str, Any] = {"name": data.get("name") or Path(origin).stem}
     if data.get("description"):
         out["description"] = str(data["description"])
     tracker = parse_params(TrackerParams, data.get("tracker"), f"{origin}: tracker")

@@ -98,6 +98,8 @@ def fields(schema: type) -> list[dict]:
 
 def parse_params(schema: type, values: Mapping[str, Any] | None, where: str) -> Any:
     """Build ``schema`` from ``values``; ``where`` (e.g. 'dr2track.yaml: label') prefixes errors."""
+    if values is not None and not isinstance(values, Mapping):
+        raise ConfigError(f"{where}: expected a mapping of parameters, got {values!r}")
     values = dict(values or {})
     hints = typing.get_type_hints(schema)
     known = {f.name: f for f in dataclasses.fields(schema)}

@@ -94,7 +94,7 @@ class Registry:
         """Instantiate a component from ``{'name': ..., **params}`` (or a bare name)."""
         if isinstance(spec, str):
             spec = {"name": spec}
-        if not isinstance(spec, Mapping) or "name" not in spec:
+        if not isinstance(spec, Mapping) or not isinstance(spec.get("name"), str):
             raise RegistryError(f"{where}: expected a mapping with a 'name' key "
                                 f"(one of {', '.join(self.names(kind))}), got {spec!r}")
         values = dict(spec)

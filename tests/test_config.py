@@ -4,7 +4,7 @@ from pathlib import Path
 import pytest
 
 from dcfkit.config import load_config, shipped_config_dir
-from dcfkit.errors import ConfigError, RegistryError
+from dcfkit.errors import ConfigError, DcfkitError, RegistryError
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
@@ -67,6 +67,17 @@ def test_wrong_type_is_reported_with_key():
         load_config("dr2track", {"label.mu": -1})
 
 
+@pytest.mark.parametrize("section,match", [
+    ({"tracker": 5}, r"tracker: expected a mapping of parameters, got 5"),
+    ({"label": {"name": ["a"]}}, r"label: expected a mapping with a 'name' key"),
+    ({"solver": {"name": "admm_strcf", "iterations": [4]}}, r"iterations: expected an integer"),
+    ({"name": [1]}, r"name: expected a string"),
+])
+def test_wrong_section_types_are_config_errors(section, match):
+    with pytest.raises(DcfkitError, match=match):
+        load_config({"base": "dr2track", **section})
+
+
 @pytest.mark.parametrize("key,value", [("label.mu", float("nan")), ("search.gain", float("inf")),
                                        ("tracker.search_area_scale", "inf"), ("scale.step", "-inf")])
 def test_non_finite_numbers_are_refused(key, value):
@@ -84,8 +95,26 @@ def test_non_finite_number_in_a_yaml_file_is_refused(tmp_path):
 def test_yaml_syntax_error_names_file_and_line(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("name: x\nlabel: {name: gaussian\nsolver: admm_strcf\n")
-    with pytest.raises(ConfigError, match=r"bad.yaml:\d+:\d+: YAML syntax error"):
+    with pytest.raises(ConfigError, match=r"bad.yaml:\d+:\d+: YAML error"):
         load_config(bad)
+
+
+def test_error_in_an_inherited_file_lists_the_files_merged(tmp_path):
+    (tmp_path / "parent.yaml").write_text("base: strcf\nlabel: {name: gaussian, sigma: 2}\n")
+    (tmp_path / "child.yaml").write_text("base: parent.yaml\nname: child\n")
+    with pytest.raises(ConfigError, match=r"unknown parameter 'sigma'.*merged from .*child.yaml <- "
+                                          r".*parent.yaml <- .*strcf.yaml\)"):
+        load_config(tmp_path / "child.yaml")
+
+
+def test_key_given_twice_names_file_and_line(tmp_path):
+    path = tmp_path / "twice.yaml"
+    path.write_text("base: strcf\nlabel: {name: gaussian}\nsolver: {iterations: 3, iterations: 4}\n")
+    with pytest.raises(ConfigError, match=r"twice.yaml:3:\d+: .*key 'iterations' is given twice"):
+        load_config(path)
+    path.write_text("base: strcf\nlabel: {name: gaussian}\nlabel: {name: gaussian}\n")
+    with pytest.raises(ConfigError, match=r"twice.yaml:3:1: .*key 'label' is given twice"):
+        load_config(path)
 
 
 def test_unknown_top_level_key_and_wrong_regularizer_role(tmp_path):
