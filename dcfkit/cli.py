@@ -1,11 +1,13 @@
-"""The ``dcfkit`` command line: track, demo, components, eval, report."""
+"""dcfkit: discriminative correlation filter trackers assembled from YAML.
+
+Commands: track (one video), demo (a generated sequence, no data needed), components,
+eval (one-pass evaluation on a benchmark), report, ablate."""
 from __future__ import annotations
 
 import argparse
 import json
 import sys
 import time
-from pathlib import Path
 
 from . import __version__
 from .errors import DcfkitError
@@ -21,12 +23,23 @@ def _parse_box(text: str) -> tuple[float, ...]:
     return box
 
 
+def _frame_count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 2:
+        raise argparse.ArgumentTypeError(f"expected a whole number of frames >= 2, got {text!r}")
+    return value
+
+
 def cmd_track(args) -> int:
     from .config import parse_overrides
     from .tracker import load_tracker
-    from .video import VideoWriter, iter_frames
+    from .video import VideoWriter, check_writable, iter_frames
 
     tracker = load_tracker(args.config, overrides=parse_overrides(args.set))
+    out = check_writable(args.out, "--out") if args.out else None
     offset = 1.0 if args.one_based else 0.0
     box = _parse_box(args.box)
     box = (box[0] - offset, box[1] - offset, box[2], box[3])
@@ -48,9 +61,8 @@ def cmd_track(args) -> int:
         if writer:
             writer.close()
         lines = [",".join(f"{v + (offset if k < 2 else 0):.3f}" for k, v in enumerate(b)) for b in boxes]
-        if args.out and boxes:
-            Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-            Path(args.out).write_text("\n".join(lines) + "\n")
+        if out and boxes:
+            out.write_text("\n".join(lines) + "\n")
         elif boxes:
             print("\n".join(lines))
         print(f"{tracker.name}: {len(boxes)} frames, {len(boxes) / max(seconds, 1e-9):.1f} fps", file=sys.stderr)
@@ -63,6 +75,7 @@ def cmd_demo(args) -> int:
     from .tracker import load_tracker
     from .video import VideoWriter
 
+    writer = VideoWriter(args.save_video) if args.save_video else None  # fail before tracking
     seq = make_sequence(n_frames=args.frames, seed=args.seed)
     results = {}
     for name in args.trackers.split(","):
@@ -79,8 +92,7 @@ def cmd_demo(args) -> int:
     print(f"{'tracker':<12} {'precision@20':>12} {'AUC':>6} {'fps':>7}")
     for name, (_, scores, fps) in results.items():
         print(f"{name:<12} {scores['precision']:>12.3f} {scores['auc']:>6.3f} {fps:>7.1f}")
-    if args.save_video:
-        writer = VideoWriter(args.save_video)
+    if writer:
         for i, image in enumerate(seq.frames):
             boxes = {"ground truth": seq.ground_truth[i]}
             boxes.update({name: r[0][i] for name, r in results.items()})
@@ -129,7 +141,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("demo", help="run STRCF and DR²Track on a generated sequence (no data needed)")
     p.add_argument("--trackers", default="strcf,dr2track", help="comma-separated configs")
-    p.add_argument("--frames", type=int, default=120, help="sequence length")
+    p.add_argument("--frames", type=_frame_count, default=120, help="sequence length (at least 2)")
     p.add_argument("--seed", type=int, default=0, help="random seed of the generated sequence")
     p.add_argument("--save-video", default="dcfkit_demo.mp4", help="annotated video ('' to skip)")
     p.set_defaults(func=cmd_demo)

@@ -118,14 +118,28 @@ class Sequence:
 
 
 def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
-    """``cv2.imread`` that raises :class:`DatasetError` naming the file instead of returning None."""
+    """A BGR image; :class:`DatasetError` naming the file when it is missing, not an image, or
+    a truncated JPEG (decoded from memory: ``cv2.imread`` would return such a file grey below
+    the cut, with only a warning)."""
     import cv2
 
-    image = cv2.imread(os.fspath(path), cv2.IMREAD_COLOR)
+    try:
+        data = np.fromfile(os.fspath(path), np.uint8)
+    except OSError as exc:
+        reason = "file does not exist" if not os.path.exists(path) else exc.strerror
+        raise DatasetError(f"cannot read {what}: {path} ({reason})") from None
+    image = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
     if image is None:
-        reason = "file does not exist" if not os.path.exists(path) else "not a readable image"
+        reason = ("truncated JPEG: no end-of-image marker after the last scan" if _truncated_jpeg(data.tobytes())
+                  else "not a readable image")
         raise DatasetError(f"cannot read {what}: {path} ({reason})")
     return image
+
+
+def _truncated_jpeg(data: bytes) -> bool:
+    """A JPEG whose last scan (SOS marker) has no end-of-image marker after it (markers cannot
+    occur inside entropy-coded data, where 0xFF is stuffed)."""
+    return data.startswith(b"\xff\xd8") and data.rfind(b"\xff\xd9") < data.rfind(b"\xff\xda")
 
 
 # --------------------------------------------------------------------------- annotation files

@@ -49,12 +49,12 @@ def check_box(box: Any, image_shape: tuple[int, ...]) -> np.ndarray:
         raise InputError(f"initial box must be 4 numbers (x, y, w, h), got {box!r}") from None
     if b.size != 4 or not np.all(np.isfinite(b)):
         raise InputError(f"initial box must be 4 finite numbers (x, y, w, h), got {box!r}")
-    x, y, w, h = b
+    x, y, w, h = (float(v) for v in b)
     if w <= 0 or h <= 0:
-        raise InputError(f"initial box {tuple(b)} has non-positive size (w={w}, h={h})")
+        raise InputError(f"initial box {(x, y, w, h)} has non-positive size (w={w:g}, h={h:g})")
     height, width = image_shape[:2]
     if x + w <= 0 or y + h <= 0 or x >= width or y >= height:
-        raise InputError(f"initial box {tuple(b)} lies outside the {width}x{height} image")
+        raise InputError(f"initial box {(x, y, w, h)} lies outside the {width}x{height} image")
     return b
 
 

@@ -1,6 +1,8 @@
 """Reading frames (video file or image folder) and writing annotated videos."""
 from __future__ import annotations
 
+import os
+import re
 from pathlib import Path
 from typing import Iterator
 
@@ -13,12 +15,18 @@ IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff")
 COLOURS = ((0, 0, 255), (0, 255, 255), (255, 160, 0), (255, 0, 255), (255, 255, 255))  # BGR
 
 
+def _natural_key(path: Path) -> list:
+    """'frame2.jpg' before 'frame10.jpg': digit runs compare as numbers."""
+    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", path.name)]
+
+
 def frame_files(folder: str | Path) -> list[Path]:
-    """Image files of a folder in name order; an error when there are none."""
+    """Image files of a folder in natural name order (frame2 before frame10); an error when
+    there are none."""
     folder = Path(folder)
     if not folder.is_dir():
         raise InputError(f"--frames: {folder} is not a folder")
-    files = sorted(p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
+    files = sorted((p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES), key=_natural_key)
     if not files:
         raise InputError(f"--frames: no images ({', '.join(IMAGE_SUFFIXES)}) in {folder}")
     return files
@@ -51,11 +59,23 @@ def iter_frames(video: str | None = None, frames: str | None = None) -> Iterator
         raise InputError(f"--video: {video} has no readable frames")
 
 
+def check_writable(path: str | Path, what: str) -> Path:
+    """Create ``path``'s folder and check it can be written, before any work is done."""
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"{what}: cannot create the folder {path.parent} ({exc.strerror})") from None
+    if path.is_dir() or not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+        raise InputError(f"{what}: cannot write {path}")
+    return path
+
+
 class VideoWriter:
     """Writes frames with boxes drawn on them (.mp4: mp4v, .avi: MJPG)."""
 
-    def __init__(self, path: str | Path, fps: float = 10.0):
-        self.path = Path(path)
+    def __init__(self, path: str | Path, fps: float = 10.0, what: str = "--save-video"):
+        self.path = check_writable(path, what)
         self.fps = fps
         self._writer = None
 
@@ -76,7 +96,6 @@ class VideoWriter:
                         cv2.LINE_AA)
         if self._writer is None:
             fourcc = cv2.VideoWriter_fourcc(*("MJPG" if self.path.suffix.lower() == ".avi" else "mp4v"))
-            self.path.parent.mkdir(parents=True, exist_ok=True)
             self._writer = cv2.VideoWriter(str(self.path), fourcc, self.fps, (frame.shape[1], frame.shape[0]))
             if not self._writer.isOpened():
                 raise InputError(f"cannot write video {self.path} (try a .avi or .mp4 name)")

@@ -96,3 +96,33 @@ def test_demo_prints_scores(tmp_path, capsys):
     assert cli.main(["demo", "--frames", "10", "--save-video", str(tmp_path / "demo.avi")]) == 0
     out = capsys.readouterr().out
     assert "strcf" in out and "dr2track" in out and (tmp_path / "demo.avi").stat().st_size > 0
+
+
+def test_unwritable_outputs_fail_before_tracking(clip, tmp_path, capsys):
+    seq, frames = clip
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    for flag, target in (("--out", blocker / "boxes.txt"), ("--save-video", blocker / "v.avi"),
+                         ("--out", tmp_path)):
+        assert cli.main(["track", "strcf", "--frames", str(frames), "--box", box_arg(seq.ground_truth[0]),
+                         flag, str(target)]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"dcfkit track: error: {flag}: cannot") and "Traceback" not in err
+        assert "frames," not in err  # nothing was tracked
+    assert cli.main(["demo", "--frames", "10", "--save-video", str(blocker / "demo.avi")]) == 2
+    assert "--save-video: cannot create the folder" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("frames", ["0", "1", "-5", "ten"])
+def test_demo_needs_two_frames_or_more(frames, capsys):
+    with pytest.raises(SystemExit):
+        cli.main(["demo", "--frames", frames])
+    assert "expected a whole number of frames >= 2" in capsys.readouterr().err
+
+
+def test_frames_are_tracked_in_natural_name_order(tmp_path):
+    from dcfkit.video import frame_files
+
+    for name in ("frame10.png", "frame2.png", "frame1.png", "notes.txt"):
+        (tmp_path / name).write_bytes(b"")
+    assert [p.name for p in frame_files(tmp_path)] == ["frame1.png", "frame2.png", "frame10.png"]

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from dcfkit import datasets
-from dcfkit.datasets import DatasetError, Sequence, detect_dataset, load_dataset, read_boxes
+from dcfkit.datasets import DatasetError, Sequence, detect_dataset, load_dataset, read_boxes, read_frame
 
 REAL = Path(__file__).resolve().parents[2] / "shared" / "data"
 needs_real = pytest.mark.skipif(not REAL.is_dir(), reason=f"real benchmark data not found at {REAL}")
@@ -202,6 +202,25 @@ def test_unreadable_frame_names_the_file(tmp_path):
     (seq,) = load_dataset("dtb70", root, ["Car2"])
     with pytest.raises(DatasetError, match=r"frame 2 of sequence 'Car2'.*00003\.jpg"):
         seq.frame(2)
+
+
+def test_truncated_jpeg_is_refused_and_complete_ones_are_not(tmp_path):
+    rng = np.random.default_rng(0)
+    image = rng.integers(0, 255, (64, 80, 3), np.uint8)
+    ok, jpeg = cv2.imencode(".jpg", image)
+    data = jpeg.tobytes()
+    good, padded, cut, missing = (tmp_path / f"{n}.jpg" for n in ("good", "padded", "cut", "missing"))
+    good.write_bytes(data)
+    padded.write_bytes(data + b"\x00" * 16)
+    cut.write_bytes(data[: len(data) * 2 // 3])
+    assert read_frame(good).shape == (64, 80, 3)
+    np.testing.assert_array_equal(read_frame(padded), read_frame(good))
+    with pytest.raises(DatasetError, match=r"cannot read frame 7: .*cut\.jpg \(truncated JPEG"):
+        read_frame(cut, "frame 7")
+    with pytest.raises(DatasetError, match=r"missing\.jpg \(file does not exist\)"):
+        read_frame(missing)
+    with pytest.raises(DatasetError, match=r"Is a directory"):
+        read_frame(tmp_path)
 
 
 def test_uavdt(tmp_path):
