@@ -56,6 +56,8 @@ class TrackerParams:
     training_sample: str = param("extract", "'extract' m^t at p^t (Algorithm 1) or 'shift' the detection sample "
                                  "to p^t in the Fourier domain (the reference codes; one extraction less)",
                                  choices=("extract", "shift"))
+    blank_std: float = param(1.0, "a search patch whose grey levels vary less than this (standard deviation) "
+                             "is a dropped frame: the box is held, nothing is learnt (0: off)")
 
     def validate(self):
         if self.search_area_scale < 1:
@@ -66,6 +68,8 @@ class TrackerParams:
             return "cell_size must be >= 1"
         if self.output_sigma_factor <= 0:
             return "output_sigma_factor must be > 0"
+        if self.blank_std < 0:
+            return "blank_std must be >= 0"
 
 
 class _StrictLoader(yaml.SafeLoader):

@@ -4,6 +4,9 @@ Frame 1 (``init``): extract the sample m¹ at the ground truth, train h¹ (θ = 
 Frame t (``update``): centre the search area (Eq. 14), compute the response (Eq. 12) at each
 search scale, take the peak as p^t, update the scale, extract m^t at p^t, build the label
 (Eq. 3 for the repressed label), train h^t (Eqs. 9–11), and update the velocity (Eq. 13).
+A frame whose search patch is blank (grey-level standard deviation below
+``tracker.blank_std``: a dropped or black video frame) is held: the box stays, nothing is
+learnt, and the frame number goes to ``held_frames``.
 
 Images are (H, W, 3) uint8 BGR or (H, W) uint8 gray; boxes are (x, y, w, h) floats,
 0-based pixels. The tracker is deterministic.
@@ -13,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any, Mapping
 
+import cv2
 import numpy as np
 
 from .config import TrackerParams, load_config
@@ -94,6 +98,7 @@ class Tracker:
         self.frame = 0
         self.last_response: np.ndarray | None = None
         self.last_distractors = np.zeros((0, 2))
+        self.held_frames: list[int] = []
 
     # -- geometry ---------------------------------------------------------------------------
     def _geometry(self, target: np.ndarray) -> tuple[Geometry, float]:
@@ -112,12 +117,23 @@ class Tracker:
         geom = Geometry(base_target, cells * p.cell_size, (int(cells[0]), int(cells[1])), target_cells)
         return geom, float(scale)
 
-    def _sample(self, image: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
-        """(C, H, Wr) complex64 spectrum of the windowed features of the patch at ``centre``."""
+    def _patch(self, image: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
+        """The search patch at ``centre``, resampled to the sample size."""
         g = self.geometry
-        patch = sample(image, centre, g.sample_size * scale, g.sample_size)
+        return sample(image, centre, g.sample_size * scale, g.sample_size)
+
+    def _spectrum(self, patch: np.ndarray) -> np.ndarray:
+        """(C, H, Wr) complex64 spectrum of the windowed features of a search patch."""
         x = extract_stack(self.features, patch, self.params.cell_size)
         return self.fft.rfft2(x * self.window).astype(np.complex64, copy=False)
+
+    def _sample(self, image: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
+        return self._spectrum(self._patch(image, centre, scale))
+
+    def _blank(self, patch: np.ndarray) -> float | None:
+        """The patch's grey-level standard deviation if it is below ``blank_std``, else None."""
+        std = float(np.sqrt(np.mean(np.square(cv2.meanStdDev(patch)[1]))))
+        return std if std < self.params.blank_std else None
 
     # -- Algorithm 1 ------------------------------------------------------------------------
     def init(self, image: np.ndarray, box) -> None:
@@ -141,6 +157,11 @@ class Tracker:
         self.position = centre
         self.last_response = None
         self.last_distractors = np.zeros((0, 2))
+        self.held_frames = []
+        std = self._blank(self._patch(image, centre, self.scale))
+        if std is not None:
+            raise InputError(f"frame 1: the search area around the initial box is blank (grey-level standard "
+                             f"deviation {std:.2f} < tracker.blank_std {self.params.blank_std:g}); nothing to learn")
         self._train(image, None)
 
     def update(self, image: np.ndarray) -> tuple[float, float, float, float]:
@@ -152,7 +173,12 @@ class Tracker:
         g = self.geometry
         centre = self._clamp(self.search.centre(), image.shape)  # Eq. (14)
         factors = self.scale_estimator.search_factors()
-        samples = np.stack([self._sample(image, centre, self.scale * f) for f in factors])
+        patches = [self._patch(image, centre, self.scale * f) for f in factors]
+        if self._blank(patches[len(factors) // 2]) is not None:  # a dropped frame: hold, learn nothing
+            self.last_response, self.last_distractors = None, np.zeros((0, 2))
+            self.held_frames.append(self.frame)
+            return self.box
+        samples = np.stack([self._spectrum(patch) for patch in patches])
         maps = response(self.hf, samples, g.filter_size, self.fft)  # Eq. (12)
         if not np.all(np.isfinite(maps)):
             raise TrackingError(f"frame {self.frame}: the response map is not finite")

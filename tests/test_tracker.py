@@ -109,3 +109,32 @@ def test_pyfftw_backend_tracks_like_scipy(sequence):
     reference = np.array(run(dcfkit.load_tracker("dr2track"), frames, box))
     boxes = np.array(run(dcfkit.load_tracker("dr2track", overrides={"tracker.fft_backend": "pyfftw"}), frames, box))
     assert np.abs(boxes - reference).max() < 0.5  # the two FFT libraries differ in the last bits only
+
+
+@pytest.mark.parametrize("config", ["strcf", "bacf", "dr2track"])
+def test_dropped_black_frames_are_held_and_not_learnt(config, sequence):
+    frames = list(sequence.frames[:30])
+    frames[10] = frames[11] = np.zeros_like(frames[10])
+    tracker = dcfkit.load_tracker(config)
+    boxes = run(tracker, frames, sequence.ground_truth[0])
+    assert tracker.held_frames == [11, 12]  # 1-based frame numbers
+    assert boxes[10] == boxes[11] == boxes[9]  # held where frame 10 left it
+    assert tracker.last_response is not None  # the frames after were tracked again
+    assert score_sequence(boxes, sequence.ground_truth[:30])["precision"] >= 0.95
+    # off: the black frames are tracked like any other, and the box moves
+    tracker = dcfkit.load_tracker(config, overrides={"tracker.blank_std": 0})
+    boxes = run(tracker, frames, sequence.ground_truth[0])
+    assert tracker.held_frames == [] and boxes[10] != boxes[9]
+
+
+def test_a_held_frame_leaves_the_filter_and_scale_unchanged(sequence):
+    tracker = dcfkit.load_tracker("dr2track")
+    run(tracker, sequence.frames[:5], sequence.ground_truth[0])
+    hf, scale, position = tracker.hf.copy(), tracker.scale, tracker.position.copy()
+    tracker.update(np.zeros_like(sequence.frames[5]))
+    assert np.array_equal(tracker.hf, hf) and tracker.scale == scale and np.array_equal(tracker.position, position)
+
+
+def test_blank_first_frame_is_a_clear_error(sequence):
+    with pytest.raises(InputError, match=r"frame 1: the search area around the initial box is blank"):
+        dcfkit.load_tracker("strcf").init(np.full_like(sequence.frames[0], 90), sequence.ground_truth[0])
