@@ -96,9 +96,12 @@ class Tracker:
         self.scale_estimator = build("scale", config["scale"], "scale")
         self.fft = make_fft(self.params.fft_backend)
         self.frame = 0
+        # diagnostics of the last frame: the response map (cells, centred: fftshift), the image box
+        # (x, y, w, h) it covers, and the repressed distractors as (x, y) image pixels
         self.last_response: np.ndarray | None = None
+        self.last_search_box: tuple[float, float, float, float] | None = None
         self.last_distractors = np.zeros((0, 2))
-        self.held_frames: list[int] = []
+        self.held_frames: list[int] = []  # 1-based numbers of frames held as blank
 
     # -- geometry ---------------------------------------------------------------------------
     def _geometry(self, target: np.ndarray) -> tuple[Geometry, float]:
@@ -155,7 +158,7 @@ class Tracker:
         self.search.reset(centre)
         self.scale_estimator.init(image, centre, g.base_target, self.scale, self.limits)
         self.position = centre
-        self.last_response = None
+        self.last_response, self.last_search_box = None, None
         self.last_distractors = np.zeros((0, 2))
         self.held_frames = []
         std = self._blank(self._patch(image, centre, self.scale))
@@ -175,7 +178,7 @@ class Tracker:
         factors = self.scale_estimator.search_factors()
         patches = [self._patch(image, centre, self.scale * f) for f in factors]
         if self._blank(patches[len(factors) // 2]) is not None:  # a dropped frame: hold, learn nothing
-            self.last_response, self.last_distractors = None, np.zeros((0, 2))
+            self.last_response, self.last_search_box, self.last_distractors = None, None, np.zeros((0, 2))
             self.held_frames.append(self.frame)
             return self.box
         samples = np.stack([self._spectrum(patch) for patch in patches])
@@ -190,6 +193,7 @@ class Tracker:
         self.search.observe(self.position)  # Eq. (13)
         peak = np.unravel_index(int(np.argmax(maps[best])), g.filter_size)
         self.last_response = np.fft.fftshift(maps[best])
+        self.last_search_box = centre_size_to_box(centre, g.sample_size * step / self.params.cell_size)
         xf = None
         if self.params.training_sample == "shift":  # the detection sample, moved to p^t
             dy, dx = (self.position - centre) / step

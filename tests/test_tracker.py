@@ -42,6 +42,27 @@ def test_tracking_is_deterministic_and_exposes_diagnostics(sequence):
     assert tracker.last_distractors.ndim == 2 and tracker.last_distractors.shape[1] == 2
     assert 0 < len(tracker.last_distractors) <= 30
 
+    # last_search_box maps the response onto the image: its peak is the tracked centre, and
+    # every repressed distractor (x, y) falls on (within a cell of) a local maximum of the map
+    R = tracker.last_response
+    H, W = R.shape
+    sx, sy, sw, sh = tracker.last_search_box
+    cell = np.array([sh / H, sw / W])
+    assert np.allclose(cell, tracker.params.cell_size * tracker.scale, rtol=0.05)
+    search_centre = np.array([sy + (sh - 1) / 2, sx + (sw - 1) / 2])
+
+    def to_cell(y, x):
+        return np.round((np.array([y, x]) - search_centre) / cell).astype(int) + [H // 2, W // 2]
+
+    x, y, w, h = tracker.box
+    assert np.abs(to_cell(y + (h - 1) / 2, x + (w - 1) / 2) - peak).max() <= 1
+    padded = np.pad(R, 1, mode="wrap")
+    is_max = R >= np.max([padded[1 + a:1 + a + H, 1 + b:1 + b + W] for a in (-1, 0, 1) for b in (-1, 0, 1)], axis=0)
+    for dx_, dy_ in tracker.last_distractors:
+        r, c = to_cell(dy_, dx_)
+        near = is_max[np.ix_(np.arange(r - 1, r + 2) % H, np.arange(c - 1, c + 2) % W)]
+        assert near.any(), (r, c)
+
 
 def test_overrides_reach_the_components():
     tracker = dcfkit.load_tracker("dr2track", label__mu=0.4, overrides={"solver.iterations": 2})
