@@ -119,7 +119,7 @@ def cmd_components(args) -> int:
                 print(f"{'':<14}{f['name']} ({f['type']}, default {f['default']}): {f['help']}")
     for failure in registry.failures:
         print(f"warning: {failure}", file=sys.stderr)
-    return 0
+    return 1 if registry.failures else 0
 
 
 def build_parser() -> argparse.ArgumentParser:

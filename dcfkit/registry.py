@@ -86,8 +86,9 @@ class Registry:
     def entry(self, kind: str, name: str) -> Entry:
         entries = self._check_kind(kind)
         if name not in entries:
+            skipped = f"; skipped plugins: {' | '.join(self.failures)}" if self.failures else ""
             raise RegistryError(f"unknown {kind} '{name}'{closest(name, entries)}; "
-                                f"registered {kind}s: {', '.join(sorted(entries)) or 'none'}")
+                                f"registered {kind}s: {', '.join(sorted(entries)) or 'none'}{skipped}")
         return entries[name]
 
     def build(self, kind: str, spec: Mapping[str, Any] | str, where: str) -> Component:

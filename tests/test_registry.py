@@ -99,6 +99,20 @@ def test_misspelt_hook_is_reported(monkeypatch):
     with pytest.warns(RuntimeWarning, match=r"dcfkit_test_typo.*dcfkit_register_component"):
         r = reg.build_registry()
     assert "flat" not in r.names("label")
+    with pytest.raises(RegistryError, match=r"unknown label 'flat'.*skipped plugins: .*dcfkit_test_typo"):
+        r.entry("label", "flat")
+
+
+def test_components_command_fails_when_a_plugin_was_skipped(monkeypatch, capsys):
+    from dcfkit import cli
+
+    bad = PLUGIN.replace("def dcfkit_register_components", "def dcfkit_register_component")
+    with_entry_points(monkeypatch, [install_plugin(monkeypatch, "dcfkit_test_typo2", bad)])
+    monkeypatch.setattr(reg, "_REGISTRY", None)
+    with pytest.warns(RuntimeWarning):
+        assert cli.main(["components", "--kind", "label"]) == 1
+    assert "warning: dcfkit plugin 'dcfkit_test_typo2" in capsys.readouterr().err
+    monkeypatch.setattr(reg, "_REGISTRY", None)
 
 
 def test_environment_variable_disables_plugins(monkeypatch):
