@@ -82,23 +82,25 @@ def cmd_demo(args) -> int:
         tracker = load_tracker(name)
         boxes, seconds = [tuple(seq.ground_truth[0])], 0.0
         tracker.init(seq.frames[0], seq.ground_truth[0])
+        distractors = [tracker.last_distractors]
         for image in seq.frames[1:]:
             start = time.perf_counter()
             boxes.append(tracker.update(image))
             seconds += time.perf_counter() - start
+            distractors.append(tracker.last_distractors)
         scores = score_sequence(boxes, seq.ground_truth)
-        results[tracker.name] = (boxes, scores, (len(seq.frames) - 1) / max(seconds, 1e-9))
+        results[tracker.name] = (boxes, scores, (len(seq.frames) - 1) / max(seconds, 1e-9), distractors)
     print(f"synthetic sequence: {len(seq.frames)} frames, a look-alike distractor passes the target")
     print(f"{'tracker':<12} {'precision@20':>12} {'AUC':>6} {'fps':>7}")
-    for name, (_, scores, fps) in results.items():
+    for name, (_, scores, fps, _) in results.items():
         print(f"{name:<12} {scores['precision']:>12.3f} {scores['auc']:>6.3f} {fps:>7.1f}")
     if writer:
         for i, image in enumerate(seq.frames):
             boxes = {"ground truth": seq.ground_truth[i]}
             boxes.update({name: r[0][i] for name, r in results.items()})
-            writer.write(image, boxes, f"frame {i + 1}")
+            writer.write(image, boxes, f"frame {i + 1}", points={name: r[3][i] for name, r in results.items()})
         writer.close()
-        print(f"annotated video: {args.save_video}")
+        print(f"annotated video: {args.save_video} (circles: the distractors each tracker repressed)")
     return 0
 
 

@@ -79,7 +79,10 @@ class VideoWriter:
         self.fps = fps
         self._writer = None
 
-    def write(self, frame: np.ndarray, boxes: dict[str, tuple] | None = None, text: str = "") -> None:
+    def write(self, frame: np.ndarray, boxes: dict[str, tuple] | None = None, text: str = "",
+              points: dict[str, np.ndarray] | None = None) -> None:
+        """Draw ``boxes`` (name -> x, y, w, h) with a legend, ``points`` (name -> (N, 2) x, y,
+        e.g. repressed distractors, drawn as circles in that name's box colour) and ``text``."""
         if frame.ndim == 2:
             frame = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR)
         frame = frame.copy()
@@ -91,6 +94,9 @@ class VideoWriter:
             cv2.rectangle(frame, (x, y), (x + w - 1, y + h - 1), colour, 2)
             cv2.rectangle(frame, (6, 6 + 18 * i), (140, 24 + 18 * i), (0, 0, 0), -1)  # legend background
             cv2.putText(frame, name, (10, 20 + 18 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv2.LINE_AA)
+            for px, py in np.asarray((points or {}).get(name, np.zeros((0, 2)))).reshape(-1, 2):
+                if np.isfinite(px) and np.isfinite(py):
+                    cv2.circle(frame, (int(round(px)), int(round(py))), 3, colour, 1)
         if text:
             cv2.putText(frame, text, (10, frame.shape[0] - 10), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1,
                         cv2.LINE_AA)

@@ -126,3 +126,17 @@ def test_frames_are_tracked_in_natural_name_order(tmp_path):
     for name in ("frame10.png", "frame2.png", "frame1.png", "notes.txt"):
         (tmp_path / name).write_bytes(b"")
     assert [p.name for p in frame_files(tmp_path)] == ["frame1.png", "frame2.png", "frame10.png"]
+
+
+def test_video_writer_draws_points_in_the_colour_of_their_tracker(tmp_path):
+    from dcfkit.video import COLOURS, VideoWriter
+
+    drawn = []
+    writer = VideoWriter(tmp_path / "v.avi")
+    writer._writer = type("Capture", (), {"write": lambda self, f: drawn.append(f), "release": lambda self: None})()
+    frame = np.zeros((60, 80, 3), np.uint8)
+    writer.write(frame, {"a": (1, 40, 5, 5), "b": (60, 40, 5, 5)}, points={"b": np.array([[40.0, 30.0], [np.nan, 1]])})
+    (out,) = drawn
+    ring = out[27:34, 37:44].reshape(-1, 3)  # a circle of radius 3 around x=40, y=30
+    assert any((px == COLOURS[1]).all() for px in ring) and not any((px == COLOURS[0]).all() for px in ring)
+    assert not frame.any()  # the caller's frame is not drawn on
