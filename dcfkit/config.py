@@ -56,8 +56,9 @@ class TrackerParams:
     training_sample: str = param("extract", "'extract' m^t at p^t (Algorithm 1) or 'shift' the detection sample "
                                  "to p^t in the Fourier domain (the reference codes; one extraction less)",
                                  choices=("extract", "shift"))
-    blank_std: float = param(1.0, "a search patch whose grey levels vary less than this (standard deviation) "
-                             "is a dropped frame: the box is held, nothing is learnt (0: off)")
+    blank_std: float = param(1.0, "a search patch whose pixel values vary less than this (standard deviation, "
+                             "RMS over colour channels) is a dropped frame: the box is held, nothing is learnt "
+                             "(0: off)")
 
     def validate(self):
         if self.search_area_scale < 1:
@@ -77,11 +78,13 @@ class _StrictLoader(yaml.SafeLoader):
 
     def construct_mapping(self, node, deep=False):
         seen = set()
-        for key_node, _ in node.value:
-            key = self.construct_object(key_node, deep=True)
-            if isinstance(key, str) and key in seen:
+        for key_node, _ in node.value:  # the mapping's own scalar keys; merge keys (<<) may be overridden
+            if not isinstance(key_node, yaml.ScalarNode) or key_node.tag == "tag:yaml.org,2002:merge":
+                continue
+            key = (key_node.tag, key_node.value)
+            if key in seen:
                 raise yaml.constructor.ConstructorError(
-                    None, None, f"key '{key}' is given twice in this mapping", key_node.start_mark)
+                    None, None, f"key '{key_node.value}' is given twice in this mapping", key_node.start_mark)
             seen.add(key)
         return super().construct_mapping(node, deep)
 

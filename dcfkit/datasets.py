@@ -9,7 +9,7 @@ Conventions
   toolkits.
 * A row of NaN marks a frame where the target is out of view. Such rows are kept (the
   frame still exists and the tracker still sees it); :mod:`dcfkit.metrics` skips them.
-* Images are read with ``cv2.imread``: ``(H, W, 3) uint8``, **BGR** channel order.
+* Images are decoded by OpenCV (:func:`read_frame`): ``(H, W, 3) uint8``, **BGR** channel order.
 
 Only sequences present on disk are listed; the official UAV123 tables shipped in
 ``dcfkit/data`` give the image folder and frame range of each UAV123 sequence and are
@@ -119,8 +119,8 @@ class Sequence:
 
 def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
     """A BGR image; :class:`DatasetError` naming the file when it is missing, not an image, or
-    a truncated JPEG (decoded from memory: ``cv2.imread`` would return such a file grey below
-    the cut, with only a warning)."""
+    a truncated JPEG (``cv2.imread`` would return one grey below the cut, with a warning only).
+    A JPEG that lacks just its end-of-image marker, a common defect, is read as imread would."""
     import cv2
 
     try:
@@ -129,14 +129,20 @@ def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
         reason = "file does not exist" if not os.path.exists(path) else exc.strerror
         raise DatasetError(f"cannot read {what}: {path} ({reason})") from None
     image = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
+    if image is None and _missing_end_marker(data.tobytes()):
+        image = cv2.imdecode(np.concatenate([data, _JPEG_END]), cv2.IMREAD_COLOR)
+        if image is not None and (image[-8:, -8:] == 128).all():  # libjpeg's fill for missing data
+            raise DatasetError(f"cannot read {what}: {path} (truncated JPEG: the image data stops "
+                               f"before its end)")
     if image is None:
-        reason = ("truncated JPEG: no end-of-image marker after the last scan" if _truncated_jpeg(data.tobytes())
-                  else "not a readable image")
-        raise DatasetError(f"cannot read {what}: {path} ({reason})")
+        raise DatasetError(f"cannot read {what}: {path} (not a readable image)")
     return image
 
 
-def _truncated_jpeg(data: bytes) -> bool:
+_JPEG_END = np.array([0xFF, 0xD9], np.uint8)
+
+
+def _missing_end_marker(data: bytes) -> bool:
     """A JPEG whose last scan (SOS marker) has no end-of-image marker after it (markers cannot
     occur inside entropy-coded data, where 0xFF is stuffed)."""
     return data.startswith(b"\xff\xd8") and data.rfind(b"\xff\xd9") < data.rfind(b"\xff\xda")

@@ -223,10 +223,10 @@ def track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_track
     frame = -1
     try:
         tracker = factory(dict(config))
-        if make_tracker is None:
-            _warm_up(config, chash, seq.frame(0), seq.init_box)
         for frame in range(len(seq)):
             image = seq.frame(frame)  # decoding is not timed
+            if frame == 0 and make_tracker is None:
+                _warm_up(config, chash, image, seq.init_box)
             t0 = time.perf_counter()
             try:
                 if frame == 0:

@@ -4,7 +4,7 @@ Frame 1 (``init``): extract the sample m¹ at the ground truth, train h¹ (θ = 
 Frame t (``update``): centre the search area (Eq. 14), compute the response (Eq. 12) at each
 search scale, take the peak as p^t, update the scale, extract m^t at p^t, build the label
 (Eq. 3 for the repressed label), train h^t (Eqs. 9–11), and update the velocity (Eq. 13).
-A frame whose search patch is blank (grey-level standard deviation below
+A frame whose search patch is blank (standard deviation of its pixel values below
 ``tracker.blank_std``: a dropped or black video frame) is held: the box stays, nothing is
 learnt, and the frame number goes to ``held_frames``.
 
@@ -134,26 +134,31 @@ class Tracker:
         return self._spectrum(self._patch(image, centre, scale))
 
     def _blank(self, patch: np.ndarray) -> float | None:
-        """The patch's grey-level standard deviation if it is below ``blank_std``, else None."""
+        """The standard deviation of the patch's pixel values (RMS over colour channels) if it is
+        below ``blank_std``, else None."""
         std = float(np.sqrt(np.mean(np.square(cv2.meanStdDev(patch)[1]))))
         return std if std < self.params.blank_std else None
 
     # -- Algorithm 1 ------------------------------------------------------------------------
     def init(self, image: np.ndarray, box) -> None:
         """Frame 1: learn the first filter at ``box`` (x, y, w, h)."""
-        self.frame = 1
-        image = check_image(image, self.frame)
+        image = check_image(image, 1)
         box = check_box(box, image.shape)
         centre, target = box_to_centre_size(box)
-        self.geometry, self.scale = self._geometry(target)
-        g = self.geometry
+        g, scale = self._geometry(target)
+        limits = scale_limits(g.base_target, g.sample_size, image.shape)
+        scale = float(np.clip(scale, *limits))
+        std = self._blank(sample(image, centre, g.sample_size * scale, g.sample_size))
+        if std is not None:  # checked before any state changes: a failed init leaves the tracker as it was
+            raise InputError(f"frame 1: the search area around the initial box is blank (standard deviation "
+                             f"{std:.2f} < tracker.blank_std {self.params.blank_std:g}); nothing to learn")
+        self.frame = 1
+        self.geometry, self.scale, self.limits = g, scale, limits
         self.window = hann2d(g.filter_size)
         sigma = np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * self.params.output_sigma_factor
         self.base_label = gaussian_label(g.filter_size, sigma)
         self.w2 = (self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
                    else np.zeros(g.filter_size, np.float32))
-        self.limits = scale_limits(g.base_target, g.sample_size, image.shape)
-        self.scale = float(np.clip(self.scale, *self.limits))
         self.solver.reset()
         self.search.reset(centre)
         self.scale_estimator.init(image, centre, g.base_target, self.scale, self.limits)
@@ -161,10 +166,6 @@ class Tracker:
         self.last_response, self.last_search_box = None, None
         self.last_distractors = np.zeros((0, 2))
         self.held_frames = []
-        std = self._blank(self._patch(image, centre, self.scale))
-        if std is not None:
-            raise InputError(f"frame 1: the search area around the initial box is blank (grey-level standard "
-                             f"deviation {std:.2f} < tracker.blank_std {self.params.blank_std:g}); nothing to learn")
         self._train(image, None)
 
     def update(self, image: np.ndarray) -> tuple[float, float, float, float]:

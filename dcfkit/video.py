@@ -17,7 +17,7 @@ COLOURS = ((0, 0, 255), (0, 255, 255), (255, 160, 0), (255, 0, 255), (255, 255, 
 
 def _natural_key(path: Path) -> list:
     """'frame2.jpg' before 'frame10.jpg': digit runs compare as numbers."""
-    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", path.name)]
+    return [int(part) if part.isdecimal() else part for part in re.split(r"(\d+)", path.name)]
 
 
 def frame_files(folder: str | Path) -> list[Path]:

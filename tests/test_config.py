@@ -117,6 +117,15 @@ def test_key_given_twice_names_file_and_line(tmp_path):
         load_config(path)
 
 
+def test_yaml_merge_keys_work_and_unhashable_keys_are_config_errors(tmp_path):
+    path = tmp_path / "merge.yaml"
+    path.write_text("base: strcf\nregularizers:\n  temporal:\n    <<: {name: temporal, theta: 3}\n    theta: 12\n")
+    assert load_config(path)["regularizers"]["temporal"] == {"name": "temporal", "theta": 12.0}
+    path.write_text("base: strcf\n? [a, b]\n: 1\n")
+    with pytest.raises(ConfigError, match=r"merge.yaml:\d+:\d+: YAML error: found unhashable key"):
+        load_config(path)
+
+
 def test_unknown_top_level_key_and_wrong_regularizer_role(tmp_path):
     cfg = tmp_path / "c.yaml"
     cfg.write_text(f"base: {CONFIGS / 'strcf.yaml'}\nsolvr: {{name: admm_strcf}}\n")

@@ -209,12 +209,15 @@ def test_truncated_jpeg_is_refused_and_complete_ones_are_not(tmp_path):
     image = rng.integers(0, 255, (64, 80, 3), np.uint8)
     ok, jpeg = cv2.imencode(".jpg", image)
     data = jpeg.tobytes()
-    good, padded, cut, missing = (tmp_path / f"{n}.jpg" for n in ("good", "padded", "cut", "missing"))
+    names = ("good", "padded", "no_end", "cut", "missing")
+    good, padded, no_end, cut, missing = (tmp_path / f"{n}.jpg" for n in names)
     good.write_bytes(data)
     padded.write_bytes(data + b"\x00" * 16)
+    no_end.write_bytes(data[:-2])  # only the end-of-image marker is missing: read as imread does
     cut.write_bytes(data[: len(data) * 2 // 3])
     assert read_frame(good).shape == (64, 80, 3)
     np.testing.assert_array_equal(read_frame(padded), read_frame(good))
+    np.testing.assert_array_equal(read_frame(no_end), read_frame(good))
     with pytest.raises(DatasetError, match=r"cannot read frame 7: .*cut\.jpg \(truncated JPEG"):
         read_frame(cut, "frame 7")
     with pytest.raises(DatasetError, match=r"missing\.jpg \(file does not exist\)"):

@@ -173,6 +173,12 @@ def test_default_trackers_are_warmed_up_once_per_process_and_config(tmp_path, se
     custom = Counter()
     run_one_pass({**CONFIG, "drift": 3.0}, seqs, tmp_path, make_tracker=custom, progress=False)
     assert custom.made == 3
+    # an unreadable first frame is reported as frame 0 of its file, warm-up or not
+    seqs[0].frames[0].write_bytes(b"not an image")
+    summary = run_one_pass({**CONFIG, "drift": 4.0}, seqs[:1], tmp_path, progress=False)
+    record = json.loads((tmp_path / "drift" / "a.error.json").read_text())
+    assert record["frame"] == 0 and record["frame_file"] == str(seqs[0].frames[0])
+    assert "cannot read frame 0" in summary["failed"]["a"]
 
 
 def test_crash_mid_sequence_leaves_no_partial_result(tmp_path, seqs):

@@ -156,6 +156,17 @@ def test_a_held_frame_leaves_the_filter_and_scale_unchanged(sequence):
     assert np.array_equal(tracker.hf, hf) and tracker.scale == scale and np.array_equal(tracker.position, position)
 
 
-def test_blank_first_frame_is_a_clear_error(sequence):
+def test_blank_first_frame_is_a_clear_error_and_changes_nothing(sequence):
+    blank, box = np.full_like(sequence.frames[0], 90), sequence.ground_truth[0]
+    fresh = dcfkit.load_tracker("strcf")
     with pytest.raises(InputError, match=r"frame 1: the search area around the initial box is blank"):
-        dcfkit.load_tracker("strcf").init(np.full_like(sequence.frames[0], 90), sequence.ground_truth[0])
+        fresh.init(blank, box)
+    with pytest.raises(TrackingError, match="before init"):
+        fresh.update(sequence.frames[1])
+    # a tracker that was tracking goes on as if the failed init had not happened
+    tracking, reference = dcfkit.load_tracker("strcf"), dcfkit.load_tracker("strcf")
+    run(tracking, sequence.frames[:5], box)
+    run(reference, sequence.frames[:5], box)
+    with pytest.raises(InputError):
+        tracking.init(blank, (box[0], box[1], box[2] * 2, box[3] * 2))
+    assert tracking.update(sequence.frames[5]) == reference.update(sequence.frames[5])
