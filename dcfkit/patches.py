@@ -36,7 +36,11 @@ def crop(image: np.ndarray, centre, region) -> np.ndarray:
 def cropper(shape, centre, region) -> Callable[[np.ndarray], np.ndarray]:
     """:func:`crop` with its geometry worked out once, for images of ``shape`` (H, W[, C])."""
     rh, rw = max(int(round(region[0])), 1), max(int(round(region[1])), 1)
-    y0, x0 = _origin(centre[0], rh), _origin(centre[1], rw)
+    return _cropper_at(shape, _origin(centre[0], rh), _origin(centre[1], rw), rh, rw)
+
+
+def _cropper_at(shape, y0: int, x0: int, rh: int, rw: int) -> Callable[[np.ndarray], np.ndarray]:
+    """Rows y0..y0+rh-1 and columns x0..x0+rw-1, outside pixels replicating the edge."""
     height, width = shape[:2]
     if y0 >= 0 and x0 >= 0 and y0 + rh <= height and x0 + rw <= width:
         return lambda image: image[y0:y0 + rh, x0:x0 + rw]
@@ -79,17 +83,35 @@ def sampler(shape, centre, region, out) -> Callable[[np.ndarray], np.ndarray]:
         cut = cropper(shape, centre, region)
         return lambda image: resize(cut(image), (oh, ow))
     ch, cw = (int(np.ceil(region[0] / k)) + 2) * k, (int(np.ceil(region[1] / k)) + 2) * k
-    cut = cropper(shape, centre, (ch, cw))
+    y0, x0 = _origin(centre[0], ch), _origin(centre[1], cw)
+    # k x k blocks wholly outside the image average replicated edge pixels, so all of them on
+    # one side of a block row (column) are equal: average only the first, replicate the rest
+    top, bottom = _blocks_outside(y0, ch // k, k, shape[0])
+    left, right = _blocks_outside(x0, cw // k, k, shape[1])
+    cut = _cropper_at(shape, y0 + top * k, x0 + left * k, ch - (top + bottom) * k, cw - (left + right) * k)
     # output pixel u samples image row cy + (u - (oh - 1) / 2) * region_h / oh; small row i
     # averages image rows y0 + k i .. y0 + k i + k - 1, centred at y0 + k i + (k - 1) / 2
     sy, sx = region[0] / oh, region[1] / ow
-    ty = (centre[0] - (oh - 1) / 2 * sy - _origin(centre[0], ch) - (k - 1) / 2) / k
-    tx = (centre[1] - (ow - 1) / 2 * sx - _origin(centre[1], cw) - (k - 1) / 2) / k
+    ty = (centre[0] - (oh - 1) / 2 * sy - y0 - (k - 1) / 2) / k
+    tx = (centre[1] - (ow - 1) / 2 * sx - x0 - (k - 1) / 2) / k
     warp = np.array([[sx / k, 0.0, tx], [0.0, sy / k, ty]])
 
     def run(image: np.ndarray) -> np.ndarray:
-        small = cv2.resize(cut(image), (cw // k, ch // k), interpolation=cv2.INTER_AREA)
+        part = cut(image)
+        small = cv2.resize(part, (part.shape[1] // k, part.shape[0] // k), interpolation=cv2.INTER_AREA)
+        if top or bottom or left or right:
+            small = cv2.copyMakeBorder(small, top, bottom, left, right, cv2.BORDER_REPLICATE)
         return cv2.warpAffine(small, warp, (ow, oh), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
                               borderMode=cv2.BORDER_REPLICATE)
 
     return run
+
+
+def _blocks_outside(start: int, n: int, k: int, size: int) -> tuple[int, int]:
+    """Of ``n`` blocks of ``k`` pixels from ``start``, how many beyond the first one wholly
+    before pixel 0, and beyond the first one wholly after pixel size - 1, can be replicated."""
+    before = min(max(-start // k, 0), n)
+    after = min(max(n - ((size - 1 - start) // k + 1), 0), n)
+    if before + after >= n:  # the whole region is off the image: keep one block
+        return max(before - 1, 0), 0
+    return max(before - 1, 0), max(after - 1, 0)
