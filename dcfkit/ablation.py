@@ -33,10 +33,8 @@ import itertools
 import json
 import logging
 import math
-import multiprocessing
 import os
 import traceback
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Iterable, Mapping
@@ -382,12 +380,6 @@ def _exclusive(out: Path):
         yield
 
 
-def _pool_worker_init(parent_pid: int) -> None:
-    from .evaluation import worker_init
-
-    worker_init(parent_pid)
-
-
 _worker_ready = False
 
 
@@ -445,23 +437,10 @@ def _run_inline(tasks, version, on_result):
 
 
 def _run_pool(tasks, jobs, version, on_result):
-    from .evaluation import single_threaded_env
+    from .evaluation import run_pool
 
-    with single_threaded_env():  # workers are spawned on submit and inherit it
-        pool = ProcessPoolExecutor(max_workers=min(jobs, len(tasks)),
-                                   mp_context=multiprocessing.get_context("spawn"),
-                                   initializer=_pool_worker_init, initargs=(os.getpid(),))
-        try:
-            futures = {pool.submit(_run_job, t.config, t.seq, str(t.folder), t.key, version): t for t in tasks}
-            for future in as_completed(futures):
-                task = futures[future]
-                try:
-                    result = future.result()
-                except Exception as exc:
-                    result = _record_crash(task, exc, version)
-                on_result(task, result)
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
+    run_pool({i: (_run_job, t.config, t.seq, str(t.folder), t.key, version) for i, t in enumerate(tasks)}, jobs,
+             lambda i, result: on_result(tasks[i], result), lambda i, exc: _record_crash(tasks[i], exc, version))
 
 
 def _run_dask(tasks, jobs, scheduler, version, on_result):

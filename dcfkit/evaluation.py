@@ -35,6 +35,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import functools
 import hashlib
 import json
 import logging
@@ -46,6 +47,7 @@ import tempfile
 import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Callable, Iterable, Mapping
@@ -126,10 +128,19 @@ def _tracker_name(config: Mapping) -> str:
 # --------------------------------------------------------------------------- files
 
 
+@functools.lru_cache(maxsize=1)
+def _file_mode() -> int:
+    """The mode open() would give a new file (mkstemp's are owner-only)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def atomic_write(path: Path, text: str) -> None:
     """Write ``text`` to ``path`` via a temporary file in the same folder + ``os.replace``."""
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
+        os.fchmod(fd, _file_mode())
         with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
             f.write(text)
             f.flush()
@@ -273,6 +284,8 @@ def track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_track
         "time": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         "config": config, "times": times.tolist(),
     }
+    with contextlib.suppress(FileNotFoundError):
+        side.unlink()  # an older config's sidecar must never describe the new boxes
     atomic_write(txt, _format_boxes(boxes))
     atomic_write(side, json.dumps(meta, indent=1, default=json_default) + "\n")  # marks done
     with contextlib.suppress(FileNotFoundError):
@@ -299,14 +312,46 @@ def single_threaded_env():
 
 
 def worker_init(parent_pid: int | None = None):
-    """A worker process: one BLAS/OpenMP/OpenCV thread; with ``parent_pid``, die with the parent."""
+    """A worker process: one BLAS/OpenMP/OpenCV thread. With ``parent_pid`` (a pool worker of
+    :func:`run_pool`) it dies with the parent and ignores SIGINT: Ctrl-C reaches the whole
+    process group, and a worker interrupted mid-protocol would leave the parent waiting for it
+    forever; the parent stops its workers itself."""
     os.environ.update({k: "1" for k in _THREAD_VARS})
     with contextlib.suppress(Exception):
         import cv2
 
         cv2.setNumThreads(1)
     if parent_pid is not None:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
         _die_with_parent(parent_pid)
+
+
+def run_pool(calls: Mapping[Any, tuple], jobs: int, on_result: Callable[[Any, Any], None],
+             on_crash: Callable[[Any, BaseException], Any]) -> None:
+    """Run ``fn(*args)`` for every ``key: (fn, *args)`` of ``calls`` in ``jobs`` spawned,
+    single-threaded worker processes; ``on_result(key, result)`` as each finishes.
+
+    A call whose worker raised outside ``fn``'s own handling, or died (killed, out of memory:
+    the pool then fails every call not yet finished), gets ``on_crash(key, exc)`` as its
+    result. Ctrl-C or any error in the caller terminates the workers at once."""
+    with single_threaded_env():  # workers are spawned on submit and inherit it
+        pool = ProcessPoolExecutor(max_workers=min(jobs, len(calls)), mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=worker_init, initargs=(os.getpid(),))
+        try:
+            futures = {pool.submit(*call): key for key, call in calls.items()}
+            for future in as_completed(futures):
+                key = futures[future]
+                try:
+                    result = future.result()
+                except Exception as exc:
+                    result = on_crash(key, exc)
+                on_result(key, result)
+        except BaseException:
+            for process in list((getattr(pool, "_processes", None) or {}).values()):
+                process.terminate()  # results are written atomically: nothing half-written stays
+            raise
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _die_with_parent(parent_pid: int) -> None:
@@ -373,20 +418,20 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
                                       on_frame=lambda: bar.update(1)))
                 bar.update(start + len(seq) - bar.n)  # a failed sequence skips its rest
         else:
-            with single_threaded_env():
-                pool = ProcessPoolExecutor(max_workers=min(jobs, len(todo)),
-                                           mp_context=multiprocessing.get_context("spawn"),
-                                           initializer=worker_init, initargs=(os.getpid(),))
-                try:
-                    futures = {pool.submit(track_sequence, config, seq, tracker_dir,
-                                           make_tracker, chash, version): seq for seq in todo}
-                    for future in as_completed(futures):
-                        result = future.result()
-                        record(result)
-                        bar.set_postfix_str(result["sequence"], refresh=False)
-                        bar.update(result["frames"])
-                finally:
-                    pool.shutdown(wait=True, cancel_futures=True)
+            def finished(seq, result):
+                record(result)
+                bar.set_postfix_str(seq.name, refresh=False)
+                bar.update(result["frames"])
+
+            def crashed(seq, exc):
+                died = isinstance(exc, BrokenProcessPool)
+                return {"sequence": seq.name, "status": "failed", "frames": len(seq),
+                        "error": f"sequence {seq.name!r}: " + ("a worker process died (killed or out of memory); "
+                                                              "rerun to retry" if died else
+                                                              f"the worker failed: {type(exc).__name__}: {exc}")}
+
+            run_pool({seq: (track_sequence, config, seq, tracker_dir, make_tracker, chash, version) for seq in todo},
+                     jobs, finished, crashed)
     finally:
         bar.close()
     order = {s.name: i for i, s in enumerate(sequences)}
@@ -586,9 +631,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
     from .config import parse_overrides
 
     overrides = parse_overrides(args.overrides)
+    resolved = [_resolve_config(spec, overrides) for spec in args.configs]  # all checked before any runs
     status = 0
-    for spec in args.configs:
-        config, factory = _resolve_config(spec, overrides)
+    for config, factory in resolved:
         summary = run_one_pass(config, sequences, args.out, make_tracker=factory,
                                jobs=args.jobs, progress=not args.no_progress)
         print(f"{summary['tracker']}: {len(summary['done'])} run, {len(summary['skipped'])} "

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import os
 from pathlib import Path
 
 import cv2
@@ -420,3 +421,27 @@ def test_real_sequence_with_opencv_kcf(tmp_path):
     assert first == "393.000,328.000,155.000,319.000"  # the annotation file's first line
     ev = report.evaluate({"kcf": load_results(tmp_path, "kcf", [short])}, [short])
     assert ev["overall"][0]["auc"] > 0.5 and ev["overall"][0]["fps"] > 0
+
+
+def _square_or_die(x):
+    """Module-level (picklable) pool task: the worker process dies on 3."""
+    if x == 3:
+        os._exit(1)
+    return x * x
+
+
+def test_run_pool_reports_a_dead_worker_as_a_crash_of_the_unfinished_calls():
+    results, crashes = {}, {}
+    evaluation.run_pool({x: (_square_or_die, x) for x in range(4)}, 2, results.__setitem__,
+                        lambda key, exc: crashes.setdefault(key, type(exc).__name__))
+    assert set(results) == {0, 1, 2, 3} and 3 in crashes  # every call is reported, the dead one as a crash
+    assert set(crashes.values()) == {"BrokenProcessPool"}
+    assert all(results[x] == x * x for x in results if x not in crashes)
+
+
+def test_result_files_get_the_usual_permissions(tmp_path):
+    path = tmp_path / "r.txt"
+    evaluation.atomic_write(path, "1\n")
+    mask = os.umask(0)
+    os.umask(mask)
+    assert path.stat().st_mode & 0o777 == 0o666 & ~mask and path.read_text() == "1\n"
