@@ -165,6 +165,8 @@ def read_boxes(path: str | os.PathLike, one_based: bool = True) -> np.ndarray:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         raise DatasetError(f"annotation file not found: {path}") from None
+    except UnicodeDecodeError as exc:
+        raise DatasetError(f"{path}: not a text annotation file (byte {exc.start} is not UTF-8)") from None
     lines = text.rstrip().splitlines()
     boxes = np.empty((len(lines), 4), dtype=np.float64)
     for n, line in enumerate(lines):
@@ -235,8 +237,19 @@ def _numbered_frames(folder: Path, pattern: str, first: int, last: int, what: st
     return tuple(folder / n for n in names)
 
 
-def _count_jpgs(folder: Path) -> int:
-    return sum(1 for f in os.listdir(folder) if f.lower().endswith(".jpg"))
+def _annotated_frames(folder: Path, pattern: str, boxes: np.ndarray, anno: Path, what: str) -> tuple[Path, ...]:
+    """Frames 1..N of a folder holding exactly the N annotated ``.jpg`` frames; the error names
+    either the missing frames or, when the images simply run out, the annotation's length."""
+    if not folder.is_dir():
+        raise DatasetError(f"{what}: image folder not found: {folder}")
+    n_jpgs = sum(1 for f in os.listdir(folder) if f.lower().endswith(".jpg"))
+    counted = f"{n_jpgs} .jpg files in {folder}"
+    if n_jpgs < len(boxes) and all((folder / (pattern % k)).is_file() for k in range(1, n_jpgs + 1)):
+        raise DatasetError(f"{anno}: {len(boxes)} annotation lines but {counted}: either the annotation has "
+                           f"extra lines or frames {pattern % (n_jpgs + 1)}..{pattern % len(boxes)} are missing")
+    frames = _numbered_frames(folder, pattern, 1, len(boxes), what)
+    _check_count(boxes, n_jpgs, anno, counted)  # extra images
+    return frames
 
 
 def _check_count(boxes: np.ndarray, n_frames: int, anno: Path, frames_desc: str):
@@ -246,8 +259,12 @@ def _check_count(boxes: np.ndarray, n_frames: int, anno: Path, frames_desc: str)
             f"one line per frame is required")
 
 
-def _select(available: list[str], requested: Iterable[str] | None, where: str) -> list[str]:
-    """Names to load: all available, or the requested ones (case-insensitive match)."""
+def _select(available: list[str], requested: Iterable[str] | None, where: str,
+            annotation_of: Mapping[str, Path] | None = None) -> list[str]:
+    """Names to load: all available, or the requested ones (case-insensitive match, each once).
+
+    ``annotation_of`` maps the benchmark's other sequences (not available) to the annotation
+    file that is missing, for a clearer error."""
     if requested is None:
         return available
     if isinstance(requested, str):
@@ -255,6 +272,7 @@ def _select(available: list[str], requested: Iterable[str] | None, where: str) -
     by_lower: dict[str, list[str]] = {}
     for name in available:
         by_lower.setdefault(name.lower(), []).append(name)
+    missing = {name.lower(): path for name, path in (annotation_of or {}).items()}
     chosen = []
     for want in requested:
         want = want.strip()
@@ -262,6 +280,8 @@ def _select(available: list[str], requested: Iterable[str] | None, where: str) -
             chosen.append(want)
         elif len(by_lower.get(want.lower(), [])) == 1:
             chosen.append(by_lower[want.lower()][0])
+        elif want.lower() in missing:
+            raise DatasetError(f"sequence {want!r} of {where}: annotation file not found: {missing[want.lower()]}")
         else:
             close = difflib.get_close_matches(want, available, n=1, cutoff=0.5)
             hint = f" Did you mean {close[0]!r}?" if close else ""
@@ -269,7 +289,7 @@ def _select(available: list[str], requested: Iterable[str] | None, where: str) -
             raise DatasetError(
                 f"sequence {want!r} not found in {where}.{hint} "
                 f"Available ({len(available)}): {shown or 'none'}")
-    return chosen
+    return list(dict.fromkeys(chosen))
 
 
 def _require_dir(root: Path, what: str) -> Path:
@@ -312,7 +332,8 @@ def _uav_subset(subset: str, dataset: str, root, sequences) -> list[Sequence]:
     attr_names, packaged = _uav_attribute_table()
     same_as_uav123 = _uav_table()["UAV123"]
     out = []
-    for name in _select(available, sequences, f"{subset} at {root}"):
+    absent = {name: anno_dir / f"{name}.txt" for name in table if name not in available}
+    for name in _select(available, sequences, f"{subset} at {root}", absent):
         folder, first, last = table[name]
         anno = anno_dir / f"{name}.txt"
         boxes = read_boxes(anno)
@@ -357,8 +378,7 @@ def dtb70(root, sequences=None) -> list[Sequence]:
         anno = root / name / "groundtruth_rect.txt"
         boxes = read_boxes(anno)
         img = root / name / "img"
-        frames = _numbered_frames(img, "%05d.jpg", 1, len(boxes), f"DTB70 {name}")
-        _check_count(boxes, _count_jpgs(img), anno, f"{_count_jpgs(img)} .jpg files in {img}")
+        frames = _annotated_frames(img, "%05d.jpg", boxes, anno, f"DTB70 {name}")
         out.append(Sequence(name, frames, boxes, {}, "dtb70"))
     return out
 
@@ -375,8 +395,7 @@ def uavdt(root, sequences=None) -> list[Sequence]:
         anno = anno_dir / f"{name}_gt.txt"
         boxes = read_boxes(anno)
         img = root / "data_seq" / name
-        frames = _numbered_frames(img, "img%06d.jpg", 1, len(boxes), f"UAVDT {name}")
-        _check_count(boxes, _count_jpgs(img), anno, f"{_count_jpgs(img)} .jpg files in {img}")
+        frames = _annotated_frames(img, "img%06d.jpg", boxes, anno, f"UAVDT {name}")
         out.append(Sequence(name, frames, boxes, {}, "uavdt"))
     return out
 
@@ -491,7 +510,12 @@ def load_dataset(name: str | None, root, sequences: Iterable[str] | str | None =
     """
     if name is None or str(name).lower() == "auto":
         name = detect_dataset(root)
-    return DATASETS[canonical_name(name)](root, sequences)
+    key = canonical_name(name)
+    loaded = DATASETS[key](root, sequences)
+    if not loaded:
+        layout = DATASETS[key].__doc__.splitlines()[0].split(":", 1)[1].strip().rstrip(".").replace("``", "")
+        raise DatasetError(f"no {key} sequences under {root}; expected {layout}")
+    return loaded
 
 
 def _uav_subset_by_length(anno_dir: Path) -> set[str]:

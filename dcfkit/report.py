@@ -82,6 +82,9 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
                     raise DatasetError(
                         f"tracker {tracker!r}, sequence {seq.name!r}: {len(boxes)} boxes for "
                         f"{len(seq)} frames")
+                if len(boxes) < len(seq):
+                    log.warning("tracker %r, sequence %r: %d boxes for %d frames; the last %d frames are "
+                                "scored as failures", tracker, seq.name, len(boxes), len(seq), len(seq) - len(boxes))
             else:
                 boxes, seq_fps = np.empty((0, 4)), None
                 missing[tracker].append(seq.name)

@@ -124,7 +124,7 @@ def test_shipped_specs_expand():
     ("dataset: {name: otb}\nvariants: {a: {overrides: {label.mu: 1}}}\n", ["variants.a.config", "missing"]),
     ("dataset: {name: otb}\nvariants: {a: {config: dr2track, overrides: {label.mux: 1}}}\n",
      ["variants.a", "mux", "did you mean 'mu'"]),
-    ("dataset: {name: otb}\nvariants: {a: {config: nope.yaml}}\n", ["variants.a", "config not found: nope.yaml"]),
+    ("dataset: {name: otb}\nvariants: {a: {config: nope.yaml}}\n", ["variants.a", "config 'nope.yaml' not found"]),
     ("dataset: {name: otb}\nvariants: {a: {config: dr2track, overrides: [label.mu]}}\n",
      ["variants.a.overrides", "mapping of dotted keys"]),
     ("dataset: {name: otbb}\nvariants: {a: {config: dr2track}}\n", ["dataset.name", "unknown dataset 'otbb'"]),
@@ -148,6 +148,18 @@ def test_bad_spec_errors_name_the_file_and_key(tmp_path, text, expected):
     assert str(path) in message
     for part in expected:
         assert part in message
+
+
+def test_configs_are_relative_to_the_spec_never_to_the_working_directory(tmp_path, monkeypatch):
+    for folder in ("cwd", "specs"):
+        (tmp_path / folder).mkdir()
+    (tmp_path / "cwd" / "mine.yaml").write_text("base: strcf\nname: mine\n")
+    path = write_spec(tmp_path / "specs" / "s.yaml", "dataset: {name: otb}\nvariants: {a: {config: mine.yaml}}\n")
+    monkeypatch.chdir(tmp_path / "cwd")
+    with pytest.raises(ConfigError, match=r"config 'mine.yaml' not found \(looked for .*specs/mine.yaml"):
+        load_spec(path)
+    (tmp_path / "specs" / "mine.yaml").write_text("base: bacf\nname: mine\n")
+    assert load_spec(path).variants[0].config["solver"]["name"] == "admm_bacf"
 
 
 def test_root_is_relative_to_the_spec_and_overridable(tmp_path, data, monkeypatch):

@@ -146,6 +146,25 @@ def test_uav_listing_only_present_sequences_and_not_found(tmp_path):
     msg = str(e.value)
     assert "'wakeboard'" in msg and "Did you mean 'wakeboard7'" in msg and "truck4_1" in msg
     assert [s.name for s in load_dataset("uav123_10fps", root, "WAKEBOARD7")] == ["wakeboard7"]
+    # each sequence once, however often it is named
+    assert [s.name for s in load_dataset("uav123_10fps", root, "wakeboard7,truck4_1,Wakeboard7")] == \
+        ["wakeboard7", "truck4_1"]
+    # a sequence of the benchmark whose annotation file is missing: that file is named
+    with pytest.raises(DatasetError, match=r"sequence 'boat1' .*annotation file not found: .*boat1\.txt"):
+        load_dataset("uav123_10fps", root, ["boat1"])
+
+
+def test_a_root_without_sequences_of_the_dataset_is_an_error(tmp_path):
+    root = uav_root(tmp_path)
+    with pytest.raises(DatasetError, match=r"no dtb70 sequences under .*UAV123_10fps; expected ROOT/<seq>/img"):
+        load_dataset("dtb70", root)
+
+
+def test_annotation_that_is_not_text_names_the_file(tmp_path):
+    path = tmp_path / "gt.txt"
+    path.write_bytes(b"1,2,3,4\n5,6,7,8\xe9\n")
+    with pytest.raises(DatasetError, match=r"gt\.txt: not a text annotation file \(byte 15"):
+        read_boxes(path)
 
 
 def test_uav_missing_folder_missing_frames_and_count(tmp_path):
@@ -193,6 +212,12 @@ def test_dtb70(tmp_path):
     assert detect_dataset(root) == "dtb70"
     (root / "Gull1" / "img" / "00006.jpg").touch()
     with pytest.raises(DatasetError, match="5 annotation lines but 6 frames"):
+        load_dataset("dtb70", root, ["Gull1"])
+    (root / "Gull1" / "img" / "00006.jpg").unlink()
+    anno = root / "Gull1" / "groundtruth_rect.txt"
+    anno.write_text(anno.read_text() + "1,1,1,1\n")
+    with pytest.raises(DatasetError, match=r"groundtruth_rect\.txt: 6 annotation lines but 5 \.jpg files .*"
+                                           r"extra lines or frames 00006\.jpg\.\.00006\.jpg are missing"):
         load_dataset("dtb70", root, ["Gull1"])
 
 

@@ -14,6 +14,7 @@ import pytest
 
 from dcfkit import evaluation, report
 from dcfkit.datasets import DatasetError, Sequence, load_dataset
+from dcfkit.errors import ConfigError
 from dcfkit.evaluation import (config_hash, import_results, load_results, opencv_tracker,
                                run_one_pass)
 
@@ -353,6 +354,14 @@ def test_evaluate_scores_and_sorting(seqs):
     assert "perfect" in report.format_rows(ev["overall"], "table")
 
 
+def test_short_results_are_scored_as_failures_with_a_warning(seqs, caplog):
+    short = {s.name: gt_boxes()[:2] for s in seqs[:1]}
+    with caplog.at_level("WARNING"):
+        ev = report.evaluate({"short": short}, seqs[:1])
+    assert f"'short', sequence 'a': 2 boxes for {N_FRAMES} frames" in caplog.text
+    assert ev["overall"][0]["precision"] == pytest.approx(2 / N_FRAMES)
+
+
 def test_write_report_files(tmp_path, seqs):
     out = tmp_path / "out"
     run_one_pass(CONFIG, seqs, out, make_tracker=Counter(), progress=False)
@@ -399,6 +408,14 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
     assert seen["overrides"] == {"drift": 0.5}
     assert files(tmp_path / "out" / "fast") == {"a.txt", "a.json", "c.txt", "c.json"}
     assert "fast: 2 run, 0 already done, 0 failed" in capsys.readouterr().out
+    # every config is checked before any runs: a typo in the second costs nothing of the first
+    monkeypatch.undo()
+    args = parser.parse_args(["strcf", "strcff.yaml", "--root", str(root), "--out", str(tmp_path / "out2"),
+                              "--no-progress"])
+    with pytest.raises(ConfigError, match="config not found: strcff.yaml"):
+        evaluation.cmd_eval(args)
+    assert not (tmp_path / "out2").exists()
+    monkeypatch.setattr(evaluation, "_resolve_config", fake_resolve)
 
     parser = argparse.ArgumentParser()
     report.add_report_arguments(parser)
