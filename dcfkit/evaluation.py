@@ -395,6 +395,11 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     tracker_dir.mkdir(parents=True, exist_ok=True)
 
     todo = [s for s in sequences if not is_done(tracker_dir, s, chash)]
+    replaced = [s.name for s in todo if (read_json(_paths(tracker_dir, s.name)[1]) or {}).get("config_hash")
+                not in (None, chash)]
+    if replaced:
+        log.warning("%s: replacing the results of another config named %r for %d sequence(s): %s (give this "
+                    "config another name to keep both)", tracker_dir, name, len(replaced), ", ".join(replaced[:10]))
     summary = {"tracker": name, "dir": tracker_dir, "config_hash": chash,
                "done": [], "skipped": [s.name for s in sequences if s not in todo], "failed": {}}
 

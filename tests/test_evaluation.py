@@ -128,7 +128,7 @@ def test_nan_first_box_and_bad_name_are_errors(tmp_path, seqs):
 # --------------------------------------------------------------------------- resume and atomicity
 
 
-def test_resume_recomputes_nothing(tmp_path, seqs):
+def test_resume_recomputes_nothing(tmp_path, seqs, caplog):
     first = Counter()
     run_one_pass(CONFIG, seqs, tmp_path, make_tracker=first, progress=False)
     assert first.made == 3
@@ -141,10 +141,12 @@ def test_resume_recomputes_nothing(tmp_path, seqs):
     third = Counter()
     assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=third, progress=False)["done"] == ["b"]
     assert third.made == 1
-    # another config (same name) is recomputed
+    # another config (same name) is recomputed, with a warning
     fourth = Counter()
-    run_one_pass({**CONFIG, "drift": 2.0}, seqs, tmp_path, make_tracker=fourth, progress=False)
+    with caplog.at_level("WARNING"):
+        run_one_pass({**CONFIG, "drift": 2.0}, seqs, tmp_path, make_tracker=fourth, progress=False)
     assert fourth.made == 3
+    assert "replacing the results of another config named 'drift' for 3 sequence(s): a, b, c" in caplog.text
 
 
 def test_default_trackers_are_warmed_up_once_per_process_and_config(tmp_path, seqs, monkeypatch):
