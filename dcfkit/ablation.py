@@ -34,8 +34,6 @@ import json
 import logging
 import math
 import os
-import traceback
-from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
@@ -422,18 +420,10 @@ class _Task:
 
 def _record_crash(task: _Task, exc: BaseException, version: str) -> dict:
     """A task that died outside the tracker (worker killed, unpicklable, scheduler lost)."""
-    from .evaluation import atomic_write, json_default
+    from .evaluation import crash_message, record_failure
 
-    message = f"sequence {task.seq.name!r}: the worker failed: {type(exc).__name__}: {exc}"
-    record = {"sequence": task.seq.name, "dataset": task.seq.dataset, "tracker": task.config.get("name"),
-              "frame": None, "frame_file": None, "error": message, "type": type(exc).__name__,
-              "traceback": "".join(traceback.format_exception(exc)), "config_hash": task.key,
-              "dcfkit_version": version, "time": datetime.now(timezone.utc).isoformat(timespec="seconds")}
-    with contextlib.suppress(OSError):
-        task.folder.mkdir(parents=True, exist_ok=True)
-        atomic_write(task.folder / f"{task.seq.name}.error.json",
-                     json.dumps(record, indent=1, default=json_default) + "\n")
-    return {"sequence": task.seq.name, "status": "failed", "error": message, "frames": len(task.seq)}
+    return record_failure(task.folder, task.seq, task.config.get("name"), crash_message(task.seq, exc), exc,
+                          task.key, version)
 
 
 def _run_inline(tasks, version, on_result):

@@ -498,7 +498,7 @@ def canonical_name(name: str) -> str:
     if key not in DATASETS:
         raise DatasetError(
             f"unknown dataset {name!r}; valid names: {', '.join(DATASETS)} "
-            f"(case-insensitive; 'auto' detects from the folder)")
+            f"(case-insensitive)")
     return key
 
 

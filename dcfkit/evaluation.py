@@ -262,19 +262,8 @@ def track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_track
         else:
             message = f"sequence {seq.name!r}, frame {frame_no}: {type(exc).__name__}: {exc}"
         cause = exc.__cause__ if isinstance(exc, _TrackerFailure) and exc.__cause__ else exc
-        record = {
-            "sequence": seq.name, "dataset": seq.dataset, "tracker": config.get("name"),
-            "frame": frame_no, "frame_file": str(seq.frames[frame_no]) if frame_no >= 0 else None,
-            "error": message, "type": type(cause).__name__,
-            "traceback": "".join(traceback.format_exception(cause)),
-            "config_hash": chash, "dcfkit_version": version,
-            "time": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        }
-        for stale in (side, txt):  # results of another config must not be mixed in
-            with contextlib.suppress(FileNotFoundError):
-                stale.unlink()
-        atomic_write(err_file, json.dumps(record, indent=1, default=json_default) + "\n")
-        return {"sequence": seq.name, "status": "failed", "error": message, "frames": len(seq)}
+        return record_failure(tracker_dir, seq, config.get("name"), message, cause, chash, version,
+                              frame_no if frame_no >= 0 else None)
 
     total = float(times.sum())
     meta = {
@@ -291,6 +280,29 @@ def track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_track
     with contextlib.suppress(FileNotFoundError):
         err_file.unlink()
     return {"sequence": seq.name, "status": "done", "fps": meta["fps"], "frames": len(seq)}
+
+
+def record_failure(tracker_dir: Path, seq: Sequence, tracker: str | None, message: str, exc: BaseException,
+                   chash: str, version: str, frame: int | None = None) -> dict:
+    """Write ``<sequence>.error.json`` (removing any results, which another config may have left)
+    and return the failed-sequence summary ``{"sequence", "status", "error", "frames"}``."""
+    txt, side, err_file = _paths(tracker_dir, seq.name)
+    record = {
+        "sequence": seq.name, "dataset": seq.dataset, "tracker": tracker,
+        "frame": frame, "frame_file": str(seq.frames[frame]) if frame is not None else None,
+        "error": message, "type": type(exc).__name__, "traceback": "".join(traceback.format_exception(exc)),
+        "config_hash": chash, "dcfkit_version": version,
+        "time": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+    }
+    for stale in (side, txt):
+        with contextlib.suppress(FileNotFoundError):
+            stale.unlink()
+    try:
+        tracker_dir.mkdir(parents=True, exist_ok=True)
+        atomic_write(err_file, json.dumps(record, indent=1, default=json_default) + "\n")
+    except OSError as exc:  # the returned summary still reports the failure
+        log.warning("could not write %s: %s", err_file, exc)
+    return {"sequence": seq.name, "status": "failed", "error": message, "frames": len(seq)}
 
 
 # --------------------------------------------------------------------------- runner
@@ -324,6 +336,13 @@ def worker_init(parent_pid: int | None = None):
     if parent_pid is not None:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         _die_with_parent(parent_pid)
+
+
+def crash_message(seq: Sequence, exc: BaseException) -> str:
+    """What to say of a sequence whose worker failed outside the tracker."""
+    if isinstance(exc, BrokenProcessPool):
+        return f"sequence {seq.name!r}: a worker process died (killed or out of memory); rerun to retry"
+    return f"sequence {seq.name!r}: the worker failed: {type(exc).__name__}: {exc}"
 
 
 def run_pool(calls: Mapping[Any, tuple], jobs: int, on_result: Callable[[Any, Any], None],
@@ -429,11 +448,7 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
                 bar.update(result["frames"])
 
             def crashed(seq, exc):
-                died = isinstance(exc, BrokenProcessPool)
-                return {"sequence": seq.name, "status": "failed", "frames": len(seq),
-                        "error": f"sequence {seq.name!r}: " + ("a worker process died (killed or out of memory); "
-                                                              "rerun to retry" if died else
-                                                              f"the worker failed: {type(exc).__name__}: {exc}")}
+                return record_failure(tracker_dir, seq, name, crash_message(seq, exc), exc, chash, version)
 
             run_pool({seq: (track_sequence, config, seq, tracker_dir, make_tracker, chash, version) for seq in todo},
                      jobs, finished, crashed)

@@ -442,6 +442,28 @@ def test_real_sequence_with_opencv_kcf(tmp_path):
     assert ev["overall"][0]["auc"] > 0.5 and ev["overall"][0]["fps"] > 0
 
 
+class DyingTracker(DriftTracker):
+    """Kills its worker process on sequence 'b' (first frame of value 10)."""
+
+    def init(self, image, box):
+        if 8 <= image[0, 0, 0] <= 12:
+            os._exit(1)
+        super().init(image, box)
+
+
+def make_dying(config):
+    return DyingTracker(config)
+
+
+def test_a_dead_worker_fails_its_sequences_with_error_records(tmp_path, seqs):
+    summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=make_dying, jobs=2, progress=False)
+    assert "b" in summary["failed"] and "a worker process died" in summary["failed"]["b"]
+    for name in summary["failed"]:
+        record = json.loads((tmp_path / "drift" / f"{name}.error.json").read_text())
+        assert record["type"] == "BrokenProcessPool" and record["sequence"] == name
+    assert set(summary["failed"]) | set(summary["done"]) == {"a", "b", "c"}
+
+
 def _square_or_die(x):
     """Module-level (picklable) pool task: the worker process dies on 3."""
     if x == 3:
