@@ -196,7 +196,7 @@ def _load(spec_path: Path, config: Any, overrides: Mapping, where: str, key: str
     if not found:
         raise ConfigError(f"{spec_path}: {where}: config '{config}' not found (looked for {local} and for "
                           f"a shipped config of that name)")
-    source = str(found[0]) if found[0] == local else config
+    source = str(found[0])
     try:
         return load_config(source, overrides), source
     except DcfkitError as exc:

@@ -269,6 +269,8 @@ def _select(available: list[str], requested: Iterable[str] | None, where: str,
         return available
     if isinstance(requested, str):
         requested = [s for s in requested.split(",") if s.strip()]
+    if not requested:
+        raise DatasetError(f"no sequence names given for {where}")
     by_lower: dict[str, list[str]] = {}
     for name in available:
         by_lower.setdefault(name.lower(), []).append(name)
@@ -513,8 +515,9 @@ def load_dataset(name: str | None, root, sequences: Iterable[str] | str | None =
     key = canonical_name(name)
     loaded = DATASETS[key](root, sequences)
     if not loaded:
-        layout = DATASETS[key].__doc__.splitlines()[0].split(":", 1)[1].strip().rstrip(".").replace("``", "")
-        raise DatasetError(f"no {key} sequences under {root}; expected {layout}")
+        doc = ((DATASETS[key].__doc__ or "").splitlines() or [""])[0].partition(":")[2]  # layout (if docstrings)
+        layout = f"; expected {doc.strip().rstrip('.').replace('``', '')}" if doc else ""
+        raise DatasetError(f"no {key} sequences under {root}{layout}")
     return loaded
 
 

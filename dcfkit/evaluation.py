@@ -414,8 +414,14 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     tracker_dir.mkdir(parents=True, exist_ok=True)
 
     todo = [s for s in sequences if not is_done(tracker_dir, s, chash)]
-    replaced = [s.name for s in todo if (read_json(_paths(tracker_dir, s.name)[1]) or {}).get("config_hash")
-                not in (None, chash)]
+    same = json.dumps(config, sort_keys=True, default=json_default)
+
+    def other_config(seq: Sequence) -> bool:  # not merely another dcfkit version of this config
+        meta = read_json(_paths(tracker_dir, seq.name)[1]) or {}
+        return (meta.get("config_hash") not in (None, chash)
+                and json.dumps(meta.get("config"), sort_keys=True, default=json_default) != same)
+
+    replaced = [s.name for s in todo if other_config(s)]
     if replaced:
         log.warning("%s: replacing the results of another config named %r for %d sequence(s): %s (give this "
                     "config another name to keep both)", tracker_dir, name, len(replaced), ", ".join(replaced[:10]))

@@ -70,7 +70,10 @@ def sample(image: np.ndarray, centre, region, out) -> np.ndarray:
 
     A shrink by k >= 2 first averages k x k blocks (OpenCV's fast integer path; a non-integer
     area resize of a ~1000 px region costs 2-3x more), then maps the exact region onto the
-    output grid bilinearly (the remaining factor is below 2)."""
+    output grid bilinearly (the remaining factor is below 2). Blocks wholly outside the image
+    are replicated, not averaged: for uint8 images (the trackers' input) the result is
+    identical to averaging the whole edge-replicated region; float images may differ in the
+    last bit."""
     return sampler(image.shape, centre, region, out)(image)
 
 
@@ -112,6 +115,4 @@ def _blocks_outside(start: int, n: int, k: int, size: int) -> tuple[int, int]:
     before pixel 0, and beyond the first one wholly after pixel size - 1, can be replicated."""
     before = min(max(-start // k, 0), n)
     after = min(max(n - ((size - 1 - start) // k + 1), 0), n)
-    if before + after >= n:  # the whole region is off the image: keep one block
-        return max(before - 1, 0), 0
-    return max(before - 1, 0), max(after - 1, 0)
+    return max(before - 1, 0), max(after - 1, 0)  # a region wholly off one side keeps one block

@@ -160,6 +160,10 @@ def test_configs_are_relative_to_the_spec_never_to_the_working_directory(tmp_pat
         load_spec(path)
     (tmp_path / "specs" / "mine.yaml").write_text("base: bacf\nname: mine\n")
     assert load_spec(path).variants[0].config["solver"]["name"] == "admm_bacf"
+    # a shipped name is the shipped config, whatever file of that name the working directory holds
+    (tmp_path / "cwd" / "strcf.yaml").write_text("base: bacf\nname: strcf\n")
+    path.write_text("dataset: {name: otb}\nvariants: {a: {config: strcf.yaml}}\n")
+    assert load_spec(path).variants[0].config == load_config("strcf")
 
 
 def test_root_is_relative_to_the_spec_and_overridable(tmp_path, data, monkeypatch):

@@ -158,6 +158,9 @@ def test_a_root_without_sequences_of_the_dataset_is_an_error(tmp_path):
     root = uav_root(tmp_path)
     with pytest.raises(DatasetError, match=r"no dtb70 sequences under .*UAV123_10fps; expected ROOT/<seq>/img"):
         load_dataset("dtb70", root)
+    for empty in ("", ",", []):
+        with pytest.raises(DatasetError, match=r"no sequence names given for UAV123_10fps at"):
+            load_dataset("uav123_10fps", root, empty)
 
 
 def test_annotation_that_is_not_text_names_the_file(tmp_path):

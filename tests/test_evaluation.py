@@ -128,7 +128,7 @@ def test_nan_first_box_and_bad_name_are_errors(tmp_path, seqs):
 # --------------------------------------------------------------------------- resume and atomicity
 
 
-def test_resume_recomputes_nothing(tmp_path, seqs, caplog):
+def test_resume_recomputes_nothing(tmp_path, seqs, caplog, monkeypatch):
     first = Counter()
     run_one_pass(CONFIG, seqs, tmp_path, make_tracker=first, progress=False)
     assert first.made == 3
@@ -147,6 +147,12 @@ def test_resume_recomputes_nothing(tmp_path, seqs, caplog):
         run_one_pass({**CONFIG, "drift": 2.0}, seqs, tmp_path, make_tracker=fourth, progress=False)
     assert fourth.made == 3
     assert "replacing the results of another config named 'drift' for 3 sequence(s): a, b, c" in caplog.text
+    # the same config under another dcfkit version is recomputed without that warning
+    caplog.clear()
+    monkeypatch.setattr(evaluation, "dcfkit_version", lambda: "99.0")
+    with caplog.at_level("WARNING"):
+        summary = run_one_pass({**CONFIG, "drift": 2.0}, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    assert summary["done"] == ["a", "b", "c"] and "replacing" not in caplog.text
 
 
 def test_default_trackers_are_warmed_up_once_per_process_and_config(tmp_path, seqs, monkeypatch):
@@ -480,9 +486,13 @@ def test_run_pool_reports_a_dead_worker_as_a_crash_of_the_unfinished_calls():
     assert all(results[x] == x * x for x in results if x not in crashes)
 
 
-def test_result_files_get_the_usual_permissions(tmp_path):
-    path = tmp_path / "r.txt"
-    evaluation.atomic_write(path, "1\n")
-    mask = os.umask(0)
-    os.umask(mask)
-    assert path.stat().st_mode & 0o777 == 0o666 & ~mask and path.read_text() == "1\n"
+def test_result_files_get_the_usual_permissions(tmp_path, monkeypatch):
+    saved = os.umask(0o022)
+    try:
+        evaluation._file_mode.cache_clear()
+        path = tmp_path / "r.txt"
+        evaluation.atomic_write(path, "1\n")
+        assert path.stat().st_mode & 0o777 == 0o644 and path.read_text() == "1\n"  # mkstemp alone: 0o600
+    finally:
+        os.umask(saved)
+        evaluation._file_mode.cache_clear()
