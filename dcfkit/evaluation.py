@@ -300,8 +300,8 @@ def record_failure(tracker_dir: Path, seq: Sequence, tracker: str | None, messag
     try:
         tracker_dir.mkdir(parents=True, exist_ok=True)
         atomic_write(err_file, json.dumps(record, indent=1, default=json_default) + "\n")
-    except OSError as exc:  # the returned summary still reports the failure
-        log.warning("could not write %s: %s", err_file, exc)
+    except OSError as write_error:  # the returned summary still reports the failure
+        log.warning("could not write %s: %s", err_file, write_error)
     return {"sequence": seq.name, "status": "failed", "error": message, "frames": len(seq)}
 
 
