@@ -185,18 +185,17 @@ def _load(spec_path: Path, config: Any, overrides: Mapping, where: str, key: str
     """Resolve ``config`` (relative to the spec file, else a shipped name) with ``overrides``.
 
     ``where`` names the spec entry in errors, ``key`` the spec key holding ``config``."""
-    from .config import load_config, shipped_config_dir
+    from .config import load_config, shipped_config
 
     if not isinstance(config, str) or not config.strip():
         raise ConfigError(f"{spec_path}: {key}: expected a config file or shipped name "
                           f"(e.g. ../dr2track.yaml or dr2track), got {config!r}")
     local = spec_path.parent / config
-    shipped = [shipped_config_dir() / name for name in (config, f"{config}.yaml")]
-    found = [path for path in (local, *shipped) if path.is_file()]  # never the working directory
-    if not found:
+    found = local if local.is_file() else shipped_config(config)  # never the working directory
+    if found is None:
         raise ConfigError(f"{spec_path}: {where}: config '{config}' not found (looked for {local} and for "
                           f"a shipped config of that name)")
-    source = str(found[0])
+    source = str(found)
     try:
         return load_config(source, overrides), source
     except DcfkitError as exc:

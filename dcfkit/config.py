@@ -136,8 +136,8 @@ def _load_file(path: Path, chain: tuple[Path, ...] = ()) -> tuple[dict, tuple[Pa
         raise ConfigError(f"{path}: 'base' must be a file name, got {base!r}")
     base_path = path.parent / base
     if not base_path.is_file():  # a shipped config by name ('dr2track' or 'dr2track.yaml')
-        shipped = shipped_config_dir() / (base if base.endswith((".yaml", ".yml")) else f"{base}.yaml")
-        if Path(base).name != base or not shipped.is_file():
+        shipped = shipped_config(base) if Path(base).name == base else None
+        if shipped is None:
             raise ConfigError(f"{path}: base config '{base}' not found (looked for {base_path} "
                               f"and for a shipped config of that name)")
         base_path = shipped
@@ -226,14 +226,20 @@ def load_config(source: str | Path | Mapping, overrides: Mapping[str, Any] | Non
         raise type(exc)(f"{exc} (config merged from {' <- '.join(chain)})") from None
 
 
+def shipped_config(name: str | Path) -> Path | None:
+    """The shipped config called ``name`` ('dr2track' or 'dr2track.yaml'), or None."""
+    folder = shipped_config_dir()
+    return next((c for c in (folder / name, folder / f"{name}.yaml") if c.is_file()), None)
+
+
 def _find(source: str | Path) -> Path:
     path = Path(source)
     if path.is_file():
         return path
+    found = shipped_config(path)
+    if found is not None:
+        return found
     folder = shipped_config_dir()
-    for candidate in (folder / path, folder / f"{path}.yaml"):
-        if candidate.is_file():
-            return candidate
     shipped = sorted(p.stem for p in folder.glob("*.yaml")) if folder.is_dir() else []
     raise ConfigError(f"config not found: {source}" + (f"; shipped configs: {', '.join(shipped)}" if shipped else ""))
 
