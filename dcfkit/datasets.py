@@ -242,9 +242,10 @@ def _annotated_frames(folder: Path, pattern: str, boxes: np.ndarray, anno: Path,
     either the missing frames or, when the images simply run out, the annotation's length."""
     if not folder.is_dir():
         raise DatasetError(f"{what}: image folder not found: {folder}")
-    n_jpgs = sum(1 for f in os.listdir(folder) if f.lower().endswith(".jpg"))
+    present = set(os.listdir(folder))
+    n_jpgs = sum(1 for f in present if f.lower().endswith(".jpg"))
     counted = f"{n_jpgs} .jpg files in {folder}"
-    if n_jpgs < len(boxes) and all((folder / (pattern % k)).is_file() for k in range(1, n_jpgs + 1)):
+    if n_jpgs < len(boxes) and all(pattern % k in present for k in range(1, n_jpgs + 1)):
         raise DatasetError(f"{anno}: {len(boxes)} annotation lines but {counted}: either the annotation has "
                            f"extra lines or frames {pattern % (n_jpgs + 1)}..{pattern % len(boxes)} are missing")
     frames = _numbered_frames(folder, pattern, 1, len(boxes), what)
