@@ -148,7 +148,8 @@ class Tracker:
         g, scale = self._geometry(target)
         limits = scale_limits(g.base_target, g.sample_size, image.shape)
         scale = float(np.clip(scale, *limits))
-        std = self._blank(sample(image, centre, g.sample_size * scale, g.sample_size))
+        patch = sample(image, centre, g.sample_size * scale, g.sample_size)
+        std = self._blank(patch)
         if std is not None:  # checked before any state changes: a failed init leaves the tracker as it was
             raise InputError(f"frame 1: the search area around the initial box is blank (standard deviation "
                              f"{std:.2f} < tracker.blank_std {self.params.blank_std:g}); nothing to learn")
@@ -166,7 +167,7 @@ class Tracker:
         self.last_response, self.last_search_box = None, None
         self.last_distractors = np.zeros((0, 2))
         self.held_frames = []
-        self._train(image, None)
+        self._train(image, None, self._spectrum(patch))  # m^1: the patch checked above
 
     def update(self, image: np.ndarray) -> tuple[float, float, float, float]:
         """Frame t > 1: locate the target, return its box (x, y, w, h), and learn from it."""
