@@ -74,8 +74,8 @@ def check_writable(path: str | Path, what: str) -> Path:
 class VideoWriter:
     """Writes frames with boxes drawn on them (.mp4: mp4v, .avi: MJPG)."""
 
-    def __init__(self, path: str | Path, fps: float = 10.0, what: str = "--save-video"):
-        self.path = check_writable(path, what)
+    def __init__(self, path: str | Path, fps: float = 10.0):
+        self.path = check_writable(path, "--save-video")
         self.fps = fps
         self._writer = None
 
