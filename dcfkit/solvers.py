@@ -13,9 +13,10 @@ value. ADMM splits h = v and alternates (per frame, from h = u = 0, Remark 1):
 * multiplier (Eq. 11): û ← û + γ (v̂ - ĥ), then γ ← min(γ_max, β γ).
 
 The multiplier is kept unscaled (u = γ z of the paper), the standard form when γ changes
-between iterations; with a fixed γ the two forms are identical. Spectra are half spectra
-(rfft2) of real maps, shape (C, H, W//2+1) complex64; every equation above is per
-frequency, so solving on the half spectrum is exact.
+between iterations; the paper's update z ← z + γ(v − h) agrees with it while γ = 1
+(docs/architecture.md). Spectra are half spectra (rfft2) of real maps, shape
+(C, H, W//2+1) complex64; every equation above is per frequency, so solving on the half
+spectrum is exact.
 """
 from __future__ import annotations
 
