@@ -81,7 +81,8 @@ class Sequence:
     ``frames`` holds the image paths in order; ``ground_truth`` is ``(N, 4) float64``,
     0-based ``(x, y, w, h)``, read-only, with NaN rows kept for out-of-view frames.
     ``attributes`` maps an attribute abbreviation (e.g. ``"SV"``) to whether the sequence
-    has it; it is empty when the benchmark provides none.
+    has it; it is empty when the benchmark provides none. ``annotation`` is the file the
+    ground truth was read from (None for sequences made in code).
     """
 
     name: str
@@ -89,6 +90,7 @@ class Sequence:
     ground_truth: np.ndarray
     attributes: Mapping[str, bool] = dataclasses.field(default_factory=dict)
     dataset: str = ""
+    annotation: Path | None = None
 
     def __post_init__(self):
         gt = np.array(self.ground_truth, dtype=np.float64, copy=True).reshape(-1, 4)
@@ -350,7 +352,7 @@ def _uav_subset(subset: str, dataset: str, root, sequences) -> list[Sequence]:
             attributes = packaged.get(name, {})
         else:
             attributes = {}
-        out.append(Sequence(name, frames, boxes, attributes, dataset))
+        out.append(Sequence(name, frames, boxes, attributes, dataset, anno))
     return out
 
 
@@ -382,7 +384,7 @@ def dtb70(root, sequences=None) -> list[Sequence]:
         boxes = read_boxes(anno)
         img = root / name / "img"
         frames = _annotated_frames(img, "%05d.jpg", boxes, anno, f"DTB70 {name}")
-        out.append(Sequence(name, frames, boxes, {}, "dtb70"))
+        out.append(Sequence(name, frames, boxes, {}, "dtb70", anno))
     return out
 
 
@@ -399,7 +401,7 @@ def uavdt(root, sequences=None) -> list[Sequence]:
         boxes = read_boxes(anno)
         img = root / "data_seq" / name
         frames = _annotated_frames(img, "img%06d.jpg", boxes, anno, f"UAVDT {name}")
-        out.append(Sequence(name, frames, boxes, {}, "uavdt"))
+        out.append(Sequence(name, frames, boxes, {}, "uavdt", anno))
     return out
 
 
@@ -465,7 +467,7 @@ def otb(root, sequences=None) -> list[Sequence]:
                 f"OTB {name}: frames {missing[:3]}{' ...' if len(missing) > 3 else ''} "
                 f"missing in {img} (expected frames {first}..{last})")
         frames = tuple(numbered[k] for k in range(first, last + 1))
-        out.append(Sequence(name, frames, boxes, {}, "otb"))
+        out.append(Sequence(name, frames, boxes, {}, "otb", anno))
     return out
 
 

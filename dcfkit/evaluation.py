@@ -402,7 +402,7 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     name = _tracker_name(config)
     config = dict(config)
     sequences = list(sequences)
-    bad = [s.name for s in sequences
+    bad = [s.name + (f" (first box in {s.annotation})" if s.annotation else "") for s in sequences
            if not (np.isfinite(s.ground_truth[0]).all() and (s.ground_truth[0, 2:] > 0).all())]
     if bad:
         raise DatasetError(

@@ -99,6 +99,7 @@ def test_uav123_10fps_nested_layout(tmp_path):
     assert wb.attributes["SV"] and wb.attributes["ARC"] and not wb.attributes["FOC"]
     assert list(wb.attributes) == list(datasets.ATTRIBUTE_NAMES)
     assert wb.frame(0).shape == (8, 8, 3)
+    assert wb.annotation == root / "anno" / "UAV123_10fps" / "wakeboard7.txt"
 
 
 def test_uav_att_file_takes_precedence(tmp_path):
@@ -213,6 +214,7 @@ def test_dtb70(tmp_path):
     assert not gull.ground_truth.flags.writeable
     assert gull.frame(4)[0, 0, 0] in (4, 5, 6)  # jpeg of value 5
     assert detect_dataset(root) == "dtb70"
+    assert gull.annotation == root / "Gull1" / "groundtruth_rect.txt"
     (root / "Gull1" / "img" / "00006.jpg").touch()
     with pytest.raises(DatasetError, match="5 annotation lines but 6 frames"):
         load_dataset("dtb70", root, ["Gull1"])
@@ -262,6 +264,7 @@ def test_uavdt(tmp_path):
     (seq,) = load_dataset("uavdt", root)
     assert seq.name == "S0601" and seq.frames[-1].name == "img000004.jpg"
     np.testing.assert_array_equal(seq.ground_truth, gt)
+    assert seq.annotation == root / "anno" / "S0601_gt.txt"
     assert detect_dataset(root) == "uavdt"
     (root / "data_seq" / "S0601" / "img000004.jpg").unlink()
     with pytest.raises(DatasetError, match="img000004.jpg"):
@@ -285,6 +288,7 @@ def test_otb_separators_multi_target_and_frame_ranges(tmp_path):
     assert sorted(seqs) == ["Basketball", "David", "Human4", "Jogging-1", "Jogging-2"]
     np.testing.assert_array_equal(seqs["Basketball"].ground_truth, gt)
     assert seqs["David"].frames[0].name == "0300.jpg" and len(seqs["David"]) == 471
+    assert seqs["Jogging-2"].annotation == root / "Jogging" / "groundtruth_rect.2.txt"
     assert detect_dataset(root) == "otb"
     write_anno(root / "Basketball" / "groundtruth_rect.txt", 3)
     with pytest.raises(DatasetError, match="3 annotation lines but 4 frames"):

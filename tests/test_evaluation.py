@@ -6,6 +6,7 @@ import argparse
 import dataclasses
 import json
 import os
+import re
 from pathlib import Path
 
 import cv2
@@ -123,6 +124,10 @@ def test_nan_first_box_and_bad_name_are_errors(tmp_path, seqs):
         run_one_pass(CONFIG, [seqs[0], bad], tmp_path, make_tracker=Counter(), progress=False)
     with pytest.raises(ValueError, match="'name'"):
         run_one_pass({"drift": 1}, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    anno = tmp_path / "anno" / "b.txt"
+    named = dataclasses.replace(bad, annotation=anno)
+    with pytest.raises(DatasetError, match=f"b \\(first box in {re.escape(str(anno))}\\)"):
+        run_one_pass(CONFIG, [named], tmp_path, make_tracker=Counter(), progress=False)
 
 
 # --------------------------------------------------------------------------- resume and atomicity
