@@ -341,7 +341,9 @@ def worker_init(parent_pid: int | None = None):
 def crash_message(seq: Sequence, exc: BaseException) -> str:
     """What to say of a sequence whose worker failed outside the tracker."""
     if isinstance(exc, BrokenProcessPool):
-        return f"sequence {seq.name!r}: a worker process died (killed or out of memory); rerun to retry"
+        return (f"sequence {seq.name!r}: a worker process died (killed, out of memory, or it could not start: "
+                "a script that runs this with jobs > 1 needs an `if __name__ == '__main__':` guard); "
+                "rerun to retry")
     return f"sequence {seq.name!r}: the worker failed: {type(exc).__name__}: {exc}"
 
 
@@ -624,8 +626,8 @@ def opencv_tracker(name: str) -> Callable[[Any], OpenCVTracker]:
 def add_eval_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
     """Arguments of ``dcfkit eval``."""
     parser.add_argument("configs", nargs="+", metavar="CONFIG",
-                        help="tracker config YAML file(s); 'opencv:CSRT', 'opencv:KCF' or "
-                             "'opencv:MOSSE' runs an OpenCV baseline")
+                        help="tracker config YAML file(s) or shipped config names (strcf, bacf, dr2track); "
+                             "'opencv:CSRT', 'opencv:KCF' or 'opencv:MOSSE' runs an OpenCV baseline")
     parser.add_argument("--dataset", default="auto",
                         help="uav123, uav123_10fps, uav123_20l, dtb70, uavdt, otb (default: detect)")
     parser.add_argument("--root", required=True, type=Path, help="benchmark root folder")
@@ -649,6 +651,24 @@ def _resolve_config(spec: str, overrides: Mapping[str, Any]) -> tuple[dict, Call
     return dict(load_config(spec, overrides)), None
 
 
+def _distinct_names(specs: list[str], resolved: list[tuple[dict, Callable | None]]
+                    ) -> list[tuple[dict, Callable | None]]:
+    """All configs checked before any runs: a config given twice runs once; two different
+    configs with the same name (one output folder) are a :class:`ConfigError`."""
+    seen: dict[str, tuple[str, dict]] = {}
+    out = []
+    for spec, (config, factory) in zip(specs, resolved):
+        name = _tracker_name(config)
+        if name not in seen:
+            seen[name] = (spec, config)
+            out.append((config, factory))
+        elif seen[name][1] != config:
+            raise ConfigError(
+                f"configs {seen[name][0]!r} and {spec!r} are both named {name!r} and would write to the "
+                f"same results folder; give one of them another 'name:' (--set name=... renames every CONFIG)")
+    return out
+
+
 def cmd_eval(args: argparse.Namespace) -> int:
     """``dcfkit eval``: run each config on the dataset; exit status 1 if any sequence failed."""
     from .datasets import load_dataset
@@ -657,7 +677,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
     from .config import parse_overrides
 
     overrides = parse_overrides(args.overrides)
-    resolved = [_resolve_config(spec, overrides) for spec in args.configs]  # all checked before any runs
+    resolved = _distinct_names(args.configs, [_resolve_config(spec, overrides) for spec in args.configs])
     status = 0
     for config, factory in resolved:
         summary = run_one_pass(config, sequences, args.out, make_tracker=factory,

@@ -428,7 +428,21 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
     with pytest.raises(ConfigError, match="config not found: strcff.yaml"):
         evaluation.cmd_eval(args)
     assert not (tmp_path / "out2").exists()
+    # two different configs under one name would overwrite each other's results: refused up
+    # front; the same config given twice runs once
+    mine = tmp_path / "my_strcf.yaml"
+    mine.write_text("base: strcf\nregularizers: {temporal: {theta: 20}}\n")
+    args = parser.parse_args(["strcf", str(mine), "--root", str(root), "--out", str(tmp_path / "out2"),
+                              "--no-progress"])
+    with pytest.raises(ConfigError, match="'strcf' and .*my_strcf.yaml' are both named 'strcf'"):
+        evaluation.cmd_eval(args)
+    assert not (tmp_path / "out2").exists()
     monkeypatch.setattr(evaluation, "_resolve_config", fake_resolve)
+    args = parser.parse_args(["fast.yaml", "fast.yaml", "--root", str(root), "--out", str(tmp_path / "out3"),
+                              "--sequences", "a", "--no-progress"])
+    assert evaluation.cmd_eval(args) == 0
+    assert [line for line in capsys.readouterr().out.splitlines() if line.startswith("fast:")] == [
+        f"fast: 1 run, 0 already done, 0 failed -> {tmp_path / 'out3' / 'fast'}"]
 
     parser = argparse.ArgumentParser()
     report.add_report_arguments(parser)
