@@ -285,12 +285,13 @@ def _select(available: list[str], requested: Iterable[str] | None, where: str,
             chosen.append(want)
         elif len(by_lower.get(want.lower(), [])) == 1:
             chosen.append(by_lower[want.lower()][0])
-        elif want.lower() in missing:
-            raise DatasetError(f"sequence {want!r} of {where}: annotation file not found: {missing[want.lower()]}")
         else:
+            shown = ", ".join(available[:40]) + (" ..." if len(available) > 40 else "")
+            if want.lower() in missing:
+                raise DatasetError(f"sequence {want!r} of {where}: annotation file not found: "
+                                   f"{missing[want.lower()]}. Available ({len(available)}): {shown or 'none'}")
             close = difflib.get_close_matches(want, available, n=1, cutoff=0.5)
             hint = f" Did you mean {close[0]!r}?" if close else ""
-            shown = ", ".join(available[:40]) + (" ..." if len(available) > 40 else "")
             raise DatasetError(
                 f"sequence {want!r} not found in {where}.{hint} "
                 f"Available ({len(available)}): {shown or 'none'}")

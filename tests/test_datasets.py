@@ -151,7 +151,9 @@ def test_uav_listing_only_present_sequences_and_not_found(tmp_path):
     assert [s.name for s in load_dataset("uav123_10fps", root, "wakeboard7,truck4_1,Wakeboard7")] == \
         ["wakeboard7", "truck4_1"]
     # a sequence of the benchmark whose annotation file is missing: that file is named
-    with pytest.raises(DatasetError, match=r"sequence 'boat1' .*annotation file not found: .*boat1\.txt"):
+    # and the sequences that are there are listed
+    with pytest.raises(DatasetError, match=r"sequence 'boat1' .*annotation file not found: .*boat1\.txt\. "
+                                           r"Available \(2\): truck4_1, wakeboard7"):
         load_dataset("uav123_10fps", root, ["boat1"])
 
 
