@@ -8,6 +8,7 @@ import argparse
 import json
 import sys
 import time
+import warnings
 
 from . import __version__
 from .errors import DcfkitError
@@ -65,7 +66,8 @@ def cmd_track(args) -> int:
             out.write_text("\n".join(lines) + "\n")
         elif boxes:
             print("\n".join(lines))
-        print(f"{tracker.name}: {len(boxes)} frames, {len(boxes) / max(seconds, 1e-9):.1f} fps", file=sys.stderr)
+        if boxes:
+            print(f"{tracker.name}: {len(boxes)} frames, {len(boxes) / max(seconds, 1e-9):.1f} fps", file=sys.stderr)
     return 0
 
 
@@ -108,7 +110,9 @@ def cmd_components(args) -> int:
     from .docs_gen import component_rows, components_markdown
     from .registry import get_registry
 
-    registry = get_registry()
+    with warnings.catch_warnings():  # the skipped plugins are listed below, each once
+        warnings.filterwarnings("ignore", message="dcfkit plugin ", category=RuntimeWarning)
+        registry = get_registry()
     rows = component_rows(registry, [args.kind] if args.kind else None)
     if args.format == "json":
         print(json.dumps(rows, indent=2, default=str))
@@ -137,7 +141,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--box", required=True, help="initial box x,y,w,h (0-based pixels unless --one-based)")
     p.add_argument("--one-based", action="store_true", help="--box and --out use 1-based (OTB toolkit) pixels")
     p.add_argument("--out", help="write one x,y,w,h line per frame here (default: stdout)")
-    p.add_argument("--save-video", help="write an annotated video (.mp4 or .avi)")
+    p.add_argument("--save-video", help="write an annotated video (.mp4, .avi, .mkv, .mov or .m4v)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a config key, e.g. label.mu=0.3")
     p.set_defaults(func=cmd_track)
 
@@ -169,19 +173,32 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _one_line_plugin_warnings(show):
+    """``warnings.showwarning`` for the CLI: a skipped plugin is one ``warning: ...`` line,
+    not a source location inside dcfkit's registry."""
+    def showwarning(message, category, filename, lineno, file=None, line=None):
+        if str(message).startswith("dcfkit plugin "):
+            print(f"warning: {message}", file=sys.stderr)
+        else:
+            show(message, category, filename, lineno, file, line)
+    return showwarning
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    try:
-        return args.func(args) or 0
-    except DcfkitError as exc:
-        print(f"dcfkit {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print(f"dcfkit {args.command}: interrupted", file=sys.stderr)
-        return 130
-    except BrokenPipeError:  # e.g. piped into head
-        sys.stderr.close()
-        return 0
+    with warnings.catch_warnings():
+        warnings.showwarning = _one_line_plugin_warnings(warnings.showwarning)
+        try:
+            return args.func(args) or 0
+        except DcfkitError as exc:
+            print(f"dcfkit {args.command}: error: {exc}", file=sys.stderr)
+            return 2
+        except KeyboardInterrupt:
+            print(f"dcfkit {args.command}: interrupted", file=sys.stderr)
+            return 130
+        except BrokenPipeError:  # e.g. piped into head
+            sys.stderr.close()
+            return 0
 
 
 if __name__ == "__main__":

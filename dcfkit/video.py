@@ -71,10 +71,17 @@ def check_writable(path: str | Path, what: str) -> Path:
     return path
 
 
+# containers OpenCV's FFmpeg backend writes with the codecs below (.gif, .webm: no)
+VIDEO_SUFFIXES = (".mp4", ".m4v", ".mov", ".mkv", ".avi")
+
+
 class VideoWriter:
-    """Writes frames with boxes drawn on them (.mp4: mp4v, .avi: MJPG)."""
+    """Writes frames with boxes drawn on them (.avi: MJPG, the other VIDEO_SUFFIXES: mp4v)."""
 
     def __init__(self, path: str | Path, fps: float = 10.0):
+        if Path(path).suffix.lower() not in VIDEO_SUFFIXES:
+            raise InputError(f"--save-video: cannot write a video named {str(path)!r}: the name must end in "
+                             f"{', '.join(VIDEO_SUFFIXES)}")
         self.path = check_writable(path, "--save-video")
         self.fps = fps
         self._writer = None

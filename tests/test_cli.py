@@ -63,12 +63,14 @@ def test_track_video_and_annotated_output(clip, tmp_path):
     (["--box", "10,10,0,5"], "non-positive size"),
     (["--box", "10,10,20,20", "--set", "label.mue=1"], "unknown parameter 'mue'"),
     (["--box", "10,10,20,20", "--set", "labelmu"], "--set expects KEY=VALUE"),
+    (["--box", "10,10,20,20", "--save-video", "out.gif"], "cannot write a video named 'out.gif'"),
 ])
 def test_track_errors_are_one_line_messages(clip, args, message, capsys):
     _, frames = clip
     assert cli.main(["track", "dr2track", "--frames", str(frames), *args]) == 2
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err
+    assert "frames," not in err  # no "dr2track: 0 frames, 0.0 fps" summary: nothing was tracked
 
 
 def test_unreadable_frame_names_the_frame(clip, tmp_path, capsys):
@@ -111,6 +113,10 @@ def test_unwritable_outputs_fail_before_tracking(clip, tmp_path, capsys):
         assert "frames," not in err  # nothing was tracked
     assert cli.main(["demo", "--frames", "10", "--save-video", str(blocker / "demo.avi")]) == 2
     assert "--save-video: cannot create the folder" in capsys.readouterr().err
+    assert cli.main(["demo", "--frames", "10", "--save-video", str(tmp_path / "demo.gif")]) == 2
+    captured = capsys.readouterr()
+    assert "the name must end in .mp4, .m4v, .mov, .mkv, .avi" in captured.err
+    assert "synthetic sequence" not in captured.out  # refused before the demo ran
 
 
 @pytest.mark.parametrize("frames", ["0", "1", "-5", "ten"])

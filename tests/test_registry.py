@@ -2,6 +2,7 @@
 import importlib.metadata
 import sys
 import types
+import warnings
 
 import pytest
 
@@ -109,9 +110,26 @@ def test_components_command_fails_when_a_plugin_was_skipped(monkeypatch, capsys)
     bad = PLUGIN.replace("def dcfkit_register_components", "def dcfkit_register_component")
     with_entry_points(monkeypatch, [install_plugin(monkeypatch, "dcfkit_test_typo2", bad)])
     monkeypatch.setattr(reg, "_REGISTRY", None)
-    with pytest.warns(RuntimeWarning):
+    with warnings.catch_warnings(record=True) as shown:
+        warnings.simplefilter("always")
         assert cli.main(["components", "--kind", "label"]) == 1
-    assert "warning: dcfkit plugin 'dcfkit_test_typo2" in capsys.readouterr().err
+    assert not [w for w in shown if "dcfkit plugin" in str(w.message)]  # listed by the command instead
+    err = capsys.readouterr().err
+    assert err.count("warning: dcfkit plugin 'dcfkit_test_typo2") == 1 and "RuntimeWarning" not in err
+    monkeypatch.setattr(reg, "_REGISTRY", None)
+
+
+def test_other_commands_show_a_skipped_plugin_as_one_line(monkeypatch, capsys, tmp_path):
+    from dcfkit import cli
+
+    bad = PLUGIN.replace("def dcfkit_register_components", "def dcfkit_register_component")
+    with_entry_points(monkeypatch, [install_plugin(monkeypatch, "dcfkit_test_typo3", bad)])
+    monkeypatch.setattr(reg, "_REGISTRY", None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        assert cli.main(["track", "strcf", "--frames", str(tmp_path), "--box", "1,1,5,5"]) == 2  # no frames
+    err = capsys.readouterr().err
+    assert err.count("warning: dcfkit plugin 'dcfkit_test_typo3") == 1 and "RuntimeWarning" not in err
     monkeypatch.setattr(reg, "_REGISTRY", None)
 
 
