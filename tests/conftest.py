@@ -9,14 +9,16 @@ from pathlib import Path
 
 import pytest
 
-SHARED_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+# the real development sequences: ../shared/data next to the checkout, or $DCFKIT_TEST_DATA
+SHARED_DATA = Path(os.environ.get("DCFKIT_TEST_DATA") or Path(__file__).resolve().parents[2] / "shared" / "data")
 
 
 @pytest.fixture(scope="session")
 def shared_data() -> Path:
-    """The real benchmark sequences in ../shared/data (skips when absent, as on a fresh machine)."""
+    """The real benchmark sequences (skips when absent, as on a fresh machine)."""
     if not SHARED_DATA.is_dir():
-        pytest.skip(f"real-data test: {SHARED_DATA} not found (only present next to the project in CI)")
+        pytest.skip(f"real-data test: {SHARED_DATA} not found (present next to the project in CI; "
+                    f"elsewhere set DCFKIT_TEST_DATA to the folder)")
     return SHARED_DATA
 
 

@@ -11,9 +11,6 @@ import pytest
 from dcfkit import datasets
 from dcfkit.datasets import DatasetError, Sequence, detect_dataset, load_dataset, read_boxes, read_frame
 
-REAL = Path(__file__).resolve().parents[2] / "shared" / "data"
-needs_real = pytest.mark.skipif(not REAL.is_dir(), reason=f"real benchmark data not found at {REAL}")
-
 
 # --------------------------------------------------------------------------- fixture builders
 
@@ -320,9 +317,8 @@ def test_dataset_names_and_detection_errors(tmp_path):
 # --------------------------------------------------------------------------- real data
 
 
-@needs_real
-def test_real_uav123_10fps():
-    root = REAL / "UAV123_10fps"
+def test_real_uav123_10fps(shared_data):
+    root = shared_data / "UAV123_10fps"
     assert detect_dataset(root) == "uav123_10fps"
     seqs = {s.name: s for s in load_dataset(None, root)}
     expected = {"boat1": 301, "building4": 263, "truck4_1": 193, "truck4_2": 229,
@@ -338,12 +334,11 @@ def test_real_uav123_10fps():
     assert [int(v) for v in boat1.attributes.values()] == [int(v) for v in att]
 
 
-@needs_real
-def test_real_dtb70_and_uavdt():
-    (gull,) = load_dataset(detect_dataset(REAL / "DTB70"), REAL / "DTB70")
+def test_real_dtb70_and_uavdt(shared_data):
+    (gull,) = load_dataset(detect_dataset(shared_data / "DTB70"), shared_data / "DTB70")
     assert gull.name == "Gull1" and len(gull) == 120
     np.testing.assert_array_equal(gull.ground_truth[0], [164, 639, 77, 55])
-    (s0601,) = load_dataset(detect_dataset(REAL / "UAVDT"), REAL / "UAVDT")
+    (s0601,) = load_dataset(detect_dataset(shared_data / "UAVDT"), shared_data / "UAVDT")
     assert s0601.name == "S0601" and len(s0601) == 82
     np.testing.assert_array_equal(s0601.ground_truth[0], [561, 125, 20, 23])
     assert s0601.frame(81).shape == (540, 1024, 3)

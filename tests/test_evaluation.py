@@ -19,7 +19,6 @@ from dcfkit.errors import ConfigError
 from dcfkit.evaluation import (config_hash, import_results, load_results, opencv_tracker,
                                run_one_pass)
 
-REAL = Path(__file__).resolve().parents[2] / "shared" / "data"
 
 N_FRAMES = 6
 
@@ -454,11 +453,10 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
     assert (tmp_path / "out" / "report" / "success.png").is_file()
 
 
-@pytest.mark.skipif(not (REAL / "UAV123_10fps").is_dir(), reason=f"real data not found at {REAL}")
-def test_real_sequence_with_opencv_kcf(tmp_path):
+def test_real_sequence_with_opencv_kcf(tmp_path, shared_data):
     if "KCF" not in evaluation.available_opencv_trackers():
         pytest.skip("OpenCV KCF is not in this OpenCV build")
-    (boat1,) = load_dataset("uav123_10fps", REAL / "UAV123_10fps", ["boat1"])
+    (boat1,) = load_dataset("uav123_10fps", shared_data / "UAV123_10fps", ["boat1"])
     short = dataclasses.replace(boat1, frames=boat1.frames[:12], ground_truth=boat1.ground_truth[:12])
     run_one_pass({"name": "kcf"}, [short], tmp_path, make_tracker=opencv_tracker("KCF"), progress=False)
     first = (tmp_path / "kcf" / "boat1.txt").read_text().splitlines()[0]
