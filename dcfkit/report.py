@@ -91,7 +91,8 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
             per_seq[tracker][seq.name] = metrics.score_sequence(boxes, seq.ground_truth, include_first)
             fps[tracker][seq.name] = seq_fps
         if missing[tracker]:
-            log.warning("tracker %r has no results for %d of %d sequences (scored as failures): %s",
+            log.warning("tracker %r has no results for %d of %d sequences (scored as failures; "
+                        "report on the sequences that were run, e.g. with --sequences, to leave them out): %s",
                         tracker, len(missing[tracker]), len(sequences), ", ".join(missing[tracker][:10]))
 
     overall, curves = [], {}
