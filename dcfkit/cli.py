@@ -138,7 +138,8 @@ def build_parser() -> argparse.ArgumentParser:
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--video", help="video file")
     src.add_argument("--frames", help="folder of image files, tracked in natural name order (frame2 before frame10)")
-    p.add_argument("--box", required=True, help="initial box x,y,w,h (0-based pixels unless --one-based)")
+    p.add_argument("--box", required=True, help="initial box x,y,w,h (0-based pixels unless --one-based); "
+                   "write --box=-5,10,40,30 when x is negative")
     p.add_argument("--one-based", action="store_true", help="--box and --out use 1-based (OTB toolkit) pixels")
     p.add_argument("--out", help="write one x,y,w,h line per frame here (default: stdout)")
     p.add_argument("--save-video", help="write an annotated video (.mp4, .avi, .mkv, .mov or .m4v)")

@@ -60,13 +60,13 @@ class TrackerParams:
                              "RMS over colour channels) is a dropped frame: the box is held, nothing is learnt "
                              "(0: off)")
 
-    def validate(self):
-        if self.search_area_scale < 1:
-            return "search_area_scale must be >= 1"
-        if not 0 < self.min_image_sample_size <= self.max_image_sample_size:
-            return "need 0 < min_image_sample_size <= max_image_sample_size"
-        if self.cell_size < 1:
-            return "cell_size must be >= 1"
+    def validate(self):  # upper bounds: far beyond any tracker's, where patches stop fitting in memory
+        if not 1 <= self.search_area_scale <= 50:
+            return "search_area_scale must be in [1, 50]"
+        if not 8**2 <= self.min_image_sample_size <= self.max_image_sample_size <= 2000**2:
+            return "need 8² <= min_image_sample_size <= max_image_sample_size <= 2000²"
+        if not 1 <= self.cell_size <= 64:
+            return "cell_size must be in [1, 64]"
         if self.output_sigma_factor <= 0:
             return "output_sigma_factor must be > 0"
         if self.blank_std < 0:

@@ -39,7 +39,8 @@ def gaussian_label(shape: tuple[int, int], sigma: float) -> np.ndarray:
     """g of Eq. (1): exp(-(dy² + dx²) / 2σ²) over circular offsets, peak at (0, 0)."""
     dy = wrap(np.arange(shape[0]), shape[0])[:, None]
     dx = wrap(np.arange(shape[1]), shape[1])[None, :]
-    return np.exp(-0.5 * (dy**2 + dx**2) / sigma**2).astype(np.float32)
+    with np.errstate(over="ignore"):  # a σ so small that σ² underflows: a delta label, not NaN
+        return np.exp(-0.5 * (dy**2 + dx**2) / max(sigma**2, np.finfo(float).tiny)).astype(np.float32)
 
 
 class Label(Component):

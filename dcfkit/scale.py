@@ -8,6 +8,7 @@ Both keep the scale within limits set at init (target at least ~5 px, at most th
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -39,6 +40,17 @@ def _factors(n: int, step: float) -> np.ndarray:
     return step ** (np.arange(n) - (n - 1) / 2)
 
 
+def _check_span(n: int, step: float) -> str | None:
+    """Sanity bounds shared by both estimators: beyond them the samples stop fitting in memory."""
+    if not 1 <= n <= 101:
+        return "n_scales must be in [1, 101]"
+    if step <= 1:
+        return "step must be > 1"
+    if (n - 1) / 2 * math.log(step) > math.log(10):
+        return (f"step={step:g} with n_scales={n}: the scales may span at most x10 each way "
+                f"(step ** ((n_scales - 1) / 2) <= 10)")
+
+
 class Pyramid(ScaleEstimator):
     """Evaluate the translation filter at ``n_scales`` scales ``step`` apart."""
 
@@ -50,10 +62,7 @@ class Pyramid(ScaleEstimator):
         step: float = param(1.01, "ratio between neighbouring scales")
 
         def validate(self):
-            if self.n_scales < 1:
-                return "n_scales must be >= 1"
-            if self.step <= 1:
-                return "step must be > 1"
+            return _check_span(self.n_scales, self.step)
 
     def search_factors(self):
         return _factors(self.params.n_scales, self.params.step)
@@ -77,10 +86,15 @@ class DSST(ScaleEstimator):
         def validate(self):
             if self.n_scales < 3:
                 return "n_scales must be >= 3"
-            if self.step <= 1:
-                return "step must be > 1"
+            if self.sigma_factor <= 0:
+                return "sigma_factor must be > 0"
             if not 0 < self.learning_rate <= 1:
                 return "learning_rate must be in (0, 1]"
+            if not 1 <= self.model_max_area <= 10000:
+                return "model_max_area must be in [1, 10000]"
+            if not 1 <= self.cell_size <= 16:
+                return "cell_size must be in [1, 16]"
+            return _check_span(self.n_scales, self.step)
 
     def init(self, image, centre, base_target, scale, limits):
         super().init(image, centre, base_target, scale, limits)
@@ -89,7 +103,8 @@ class DSST(ScaleEstimator):
         self.factors = _factors(n, p.step)
         offsets = np.arange(n) - (n - 1) // 2
         sigma = n / np.sqrt(33) * p.sigma_factor
-        self.label_f = np.fft.fft(np.exp(-0.5 * offsets**2 / sigma**2))
+        with np.errstate(over="ignore"):  # a σ so small that σ² underflows: a delta label, not NaN
+            self.label_f = np.fft.fft(np.exp(-0.5 * offsets**2 / max(sigma**2, np.finfo(float).tiny)))
         self.window = np.hanning(n + 2)[1:-1]
         area = float(np.prod(self.base_target))
         shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0

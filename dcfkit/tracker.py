@@ -48,10 +48,11 @@ def check_image(image: Any, frame: int) -> np.ndarray:
 def check_box(box: Any, image_shape: tuple[int, ...]) -> np.ndarray:
     """A finite (x, y, w, h) with positive size that overlaps the image."""
     try:
-        b = np.asarray(box, dtype=float).reshape(-1)
+        raw = np.asarray(box)
+        b = raw.astype(float).reshape(-1)
     except (TypeError, ValueError):
         raise InputError(f"initial box must be 4 numbers (x, y, w, h), got {box!r}") from None
-    if b.size != 4 or not np.all(np.isfinite(b)):
+    if raw.dtype == bool or b.size != 4 or not np.all(np.isfinite(b)):
         raise InputError(f"initial box must be 4 finite numbers (x, y, w, h), got {box!r}")
     x, y, w, h = (float(v) for v in b)
     if w <= 0 or h <= 0:
@@ -146,14 +147,19 @@ class Tracker:
         box = check_box(box, image.shape)
         centre, target = box_to_centre_size(box)
         g, scale = self._geometry(target)
-        limits = scale_limits(g.base_target, g.sample_size, image.shape)
+        lo, hi = scale_limits(g.base_target, g.sample_size, image.shape)
+        limits = (lo, max(hi, scale))  # a box longer than the image on one axis keeps its size
         scale = float(np.clip(scale, *limits))
         patch = sample(image, centre, g.sample_size * scale, g.sample_size)
         std = self._blank(patch)
         if std is not None:  # checked before any state changes: a failed init leaves the tracker as it was
+            outside = not (0 <= centre[0] < image.shape[0] and 0 <= centre[1] < image.shape[1])
             raise InputError(f"frame 1: the search area around the initial box is blank (standard deviation "
-                             f"{std:.2f} < tracker.blank_std {self.params.blank_std:g}); nothing to learn")
+                             f"{std:.2f} < tracker.blank_std {self.params.blank_std:g}); nothing to learn"
+                             + (f" (the box centre (x={centre[1]:g}, y={centre[0]:g}) is outside the "
+                                f"{image.shape[1]}x{image.shape[0]} image)" if outside else ""))
         self.frame = 1
+        self.image_size = image.shape[:2]
         self.geometry, self.scale, self.limits = g, scale, limits
         self.window = hann2d(g.filter_size)
         sigma = np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * self.params.output_sigma_factor
@@ -173,8 +179,11 @@ class Tracker:
         """Frame t > 1: locate the target, return its box (x, y, w, h), and learn from it."""
         if self.frame == 0:
             raise TrackingError("update() called before init()")
-        self.frame += 1
+        self.frame += 1  # every frame given counts, rejected ones too: numbers match the caller's video
         image = check_image(image, self.frame)
+        if image.shape[:2] != self.image_size:
+            raise InputError(f"frame {self.frame}: the image is {image.shape[1]}x{image.shape[0]}, but the "
+                             f"sequence's first frame was {self.image_size[1]}x{self.image_size[0]}")
         g = self.geometry
         centre = self._clamp(self.search.centre(), image.shape)  # Eq. (14)
         factors = self.scale_estimator.search_factors()
@@ -186,7 +195,8 @@ class Tracker:
         samples = np.stack([self._spectrum(patch) for patch in patches])
         maps = response(self.hf, samples, g.filter_size, self.fft)  # Eq. (12)
         if not np.all(np.isfinite(maps)):
-            raise TrackingError(f"frame {self.frame}: the response map is not finite")
+            raise TrackingError(f"frame {self.frame}: the response map is not finite (the filter overflowed: "
+                                f"look for extreme solver, regularizer or label values in the config)")
         best = int(np.argmax(maps.reshape(len(factors), -1).max(axis=1)))
         dy, dx, _ = subpixel_peak(maps[best])
         step = self.params.cell_size * self.scale * factors[best]

@@ -85,6 +85,23 @@ def test_non_finite_numbers_are_refused(key, value):
         load_config("dr2track", {key: value})
 
 
+@pytest.mark.parametrize("config,key,value,match", [
+    ("strcf", "scale.step", 1e6, r"scale.*step=1e\+06 with n_scales=5: the scales may span at most x10"),
+    ("strcf", "scale.n_scales", 10**6, r"scale.*n_scales must be in \[1, 101\]"),
+    ("dr2track", "scale.model_max_area", -5, r"scale.*model_max_area must be in"),
+    ("dr2track", "scale.cell_size", 0, r"scale.*cell_size must be in"),
+    ("dr2track", "scale.sigma_factor", 0, r"scale.*sigma_factor must be > 0"),
+    ("strcf", "tracker.search_area_scale", 1e6, r"tracker: search_area_scale must be in \[1, 50\]"),
+    ("strcf", "tracker.cell_size", 10000, r"tracker: cell_size must be in \[1, 64\]"),
+    ("strcf", "tracker.min_image_sample_size", 1e-300, r"tracker: need 8² <= min_image_sample_size"),
+    ("strcf", "solver.iterations", 10**9, r"solver.*iterations must be in \[1, 1000\]"),
+])
+def test_values_whose_patches_would_not_fit_in_memory_are_refused(config, key, value, match):
+    # each used to pass validation and fail inside OpenCV (out of memory, int overflow) or never finish
+    with pytest.raises(ConfigError, match=match):
+        load_config(config, {key: value})
+
+
 def test_error_in_an_inherited_file_lists_the_files_merged(tmp_path):
     (tmp_path / "parent.yaml").write_text("base: strcf\nlabel: {name: gaussian, sigma: 2}\n")
     (tmp_path / "child.yaml").write_text("base: parent.yaml\nname: child\n")
