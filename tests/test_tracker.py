@@ -105,6 +105,45 @@ def test_bad_frames_are_clear_errors_naming_the_frame(sequence):
         tracker.update(None)
 
 
+def test_a_frame_of_another_size_is_refused(sequence):
+    tracker = dcfkit.load_tracker("strcf")
+    tracker.init(sequence.frames[0], sequence.ground_truth[0])
+    before = tracker.box
+    with pytest.raises(InputError, match=r"frame 2: the image is 2x2, but the sequence's first frame was 480x360"):
+        tracker.update(sequence.frames[1][:2, :2])  # used to snap the box to the corner for good
+    assert tracker.box == before
+    assert np.hypot(*np.subtract(tracker.update(sequence.frames[2])[:2], sequence.ground_truth[2][:2])) < 5
+
+
+@pytest.mark.parametrize("box", [(-600, 100, 1000, 40), (100, -500, 40, 800)], ids=["wide", "tall"])
+def test_a_box_longer_than_the_image_keeps_its_size(box, sequence):
+    tracker = dcfkit.load_tracker("strcf")
+    tracker.init(sequence.frames[0], box)  # the scale limit used to shrink it: 1000x40 -> 480x19.2
+    np.testing.assert_allclose(tracker.box, box)
+
+
+def test_initial_box_errors_say_what_is_wrong(sequence):
+    tracker = dcfkit.load_tracker("strcf")
+    with pytest.raises(InputError, match="must be 4 finite numbers"):
+        tracker.init(sequence.frames[0], (True, True, True, True))
+    flat = np.full_like(sequence.frames[0], 90)
+    flat[300:, 400:] = sequence.frames[0][300:, 400:]  # texture far from the box
+    with pytest.raises(InputError, match=r"blank.*the box centre \(x=-18, y=-18\) is outside the 480x360 image"):
+        tracker.init(flat, (-40, -40, 45, 45))  # said only "blank" before
+
+
+def test_labels_stay_finite_for_a_vanishing_sigma():
+    from dcfkit.labels import gaussian_label
+    from dcfkit.scale import DSST
+
+    g = gaussian_label((8, 8), 1e-300)  # σ² underflows to 0: used to give NaN at the peak
+    assert g[0, 0] == 1 and g.sum() == 1
+    dsst = DSST(DSST.Params(sigma_factor=1e-300))
+    image = make_sequence(n_frames=2).frames[0]
+    dsst.init(image, np.array([180.0, 200.0]), np.array([22.0, 36.0]), 1.0, (0.1, 10.0))
+    assert np.all(np.isfinite(dsst.label_f))
+
+
 @pytest.mark.parametrize("config", ["strcf", "bacf", "dr2track"])
 @pytest.mark.parametrize("box", [(200, 150, 5, 4), (0, 0, 480, 360), (470, 350, 30, 30)],
                          ids=["tiny", "whole-image", "partly-outside"])
