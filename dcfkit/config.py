@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import os
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -91,9 +92,11 @@ class _StrictLoader(yaml.SafeLoader):
 
 def _read_yaml(path: Path) -> dict:
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ConfigError(f"cannot read config {path}: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{path}: not a UTF-8 text file (byte {exc.start} is not UTF-8)") from None
     try:
         data = yaml.load(text, Loader=_StrictLoader)
     except yaml.YAMLError as exc:
@@ -205,6 +208,8 @@ def load_config(source: str | Path | Mapping, overrides: Mapping[str, Any] | Non
     ``base`` lists the files it was merged from (the key may sit in any of them).
     """
     files: tuple[Path, ...] = ()
+    if not isinstance(source, (str, os.PathLike, Mapping)):
+        raise ConfigError(f"a config is a file path, a shipped config name or a mapping, got {type(source).__name__}")
     if isinstance(source, Mapping):
         data, origin = copy.deepcopy(dict(source)), "<config dict>"
         base = data.pop("base", None)
@@ -216,6 +221,8 @@ def load_config(source: str | Path | Mapping, overrides: Mapping[str, Any] | Non
         data, files = _load_file(path)
         origin = str(path)
     for key, value in (overrides or {}).items():
+        if not isinstance(key, str):
+            raise ConfigError(f"override keys are dotted strings such as 'label.mu', got {key!r}")
         set_dotted(data, key, value)
     try:
         return resolve(data, origin)

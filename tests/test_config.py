@@ -102,6 +102,19 @@ def test_values_whose_patches_would_not_fit_in_memory_are_refused(config, key, v
         load_config(config, {key: value})
 
 
+def test_what_is_not_a_config_is_a_config_error(tmp_path):
+    latin = tmp_path / "latin.yaml"
+    latin.write_bytes("name: caf\xe9\n".encode("latin-1"))
+    with pytest.raises(ConfigError, match=r"latin.yaml: not a UTF-8 text file \(byte 9"):
+        load_config(latin)
+    for source in (None, 5):
+        with pytest.raises(ConfigError, match=f"a file path, a shipped config name or a mapping, got "
+                                              f"{type(source).__name__}"):
+            load_config(source)
+    with pytest.raises(ConfigError, match=r"override keys are dotted strings .* got 1"):
+        load_config("strcf", {1: 2})
+
+
 def test_error_in_an_inherited_file_lists_the_files_merged(tmp_path):
     (tmp_path / "parent.yaml").write_text("base: strcf\nlabel: {name: gaussian, sigma: 2}\n")
     (tmp_path / "child.yaml").write_text("base: parent.yaml\nname: child\n")
