@@ -168,18 +168,21 @@ def _paths(tracker_dir: Path, name: str) -> tuple[Path, Path, Path]:
 
 
 def read_json(path: Path) -> dict | None:
-    """The JSON object in ``path``, or None if it is missing or unreadable."""
+    """The JSON object in ``path``, or None if it is missing, unreadable or not an object."""
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
+        data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
+    return data if isinstance(data, dict) else None
 
 
 def is_done(tracker_dir: Path, seq: Sequence, chash: str) -> bool:
-    """Whether ``seq`` has complete results in ``tracker_dir`` from the config with hash ``chash``."""
+    """Whether ``seq`` has complete results in ``tracker_dir`` from the config with hash ``chash``,
+    started from ``seq``'s current initial box (a corrected annotation is run again)."""
     txt, side, _ = _paths(tracker_dir, seq.name)
     meta = read_json(side)
     return (meta is not None and meta.get("config_hash") == chash
+            and meta.get("init_box") == [float(v) for v in seq.init_box]
             and txt.is_file() and _count_lines(txt) == len(seq))
 
 
@@ -268,6 +271,7 @@ def track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_track
     total = float(times.sum())
     meta = {
         "sequence": seq.name, "dataset": seq.dataset, "tracker": config["name"],
+        "init_box": [float(v) for v in seq.init_box],
         "frames": len(seq), "fps": len(seq) / total if total > 0 else None,
         "total_time": total, "config_hash": chash, "dcfkit_version": version,
         "time": datetime.now(timezone.utc).isoformat(timespec="seconds"),
@@ -413,13 +417,22 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     version = dcfkit_version()
     chash = config_hash(config, version)
     tracker_dir = Path(out_dir) / name
-    tracker_dir.mkdir(parents=True, exist_ok=True)
+    try:
+        tracker_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise DatasetError(f"cannot create the results folder {tracker_dir}: {exc.strerror}") from None
 
     todo = [s for s in sequences if not is_done(tracker_dir, s, chash)]
+    old = {s.name: read_json(_paths(tracker_dir, s.name)[1]) or {} for s in todo}
+    for seq in todo:  # OUT/<tracker>/<sequence> has no benchmark level: never mix two benchmarks there
+        if old[seq.name].get("dataset") and seq.dataset and old[seq.name]["dataset"] != seq.dataset:
+            raise DatasetError(
+                f"{_paths(tracker_dir, seq.name)[1]} holds results on dataset {old[seq.name]['dataset']!r}, and "
+                f"this run is on {seq.dataset!r}: use a separate --out for each benchmark")
     same = json.dumps(config, sort_keys=True, default=json_default)
 
     def other_config(seq: Sequence) -> bool:  # not merely another dcfkit version of this config
-        meta = read_json(_paths(tracker_dir, seq.name)[1]) or {}
+        meta = old[seq.name]
         return (meta.get("config_hash") not in (None, chash)
                 and json.dumps(meta.get("config"), sort_keys=True, default=json_default) != same)
 
@@ -502,10 +515,16 @@ def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]
         boxes = read_boxes(txt)
         if not isinstance(seq, str) and len(boxes) != len(seq):
             raise DatasetError(f"{txt}: {len(boxes)} lines but sequence {name!r} has {len(seq)} frames")
-        times = np.asarray(meta.get("times", []), dtype=np.float64)
-        fps = meta.get("fps")
-        results[name] = SequenceResult(boxes, times if times.size else None,
-                                       float(fps) if fps is not None else None, meta.get("config_hash"))
+        try:
+            times = np.asarray(meta.get("times", []), dtype=np.float64).reshape(-1)
+            fps = meta.get("fps")
+            fps = float(fps) if fps is not None else None
+            if not isinstance(meta.get("config_hash"), (str, type(None))):
+                raise TypeError(f"config_hash is {meta['config_hash']!r}")
+        except (TypeError, ValueError) as exc:
+            raise DatasetError(f"{side}: malformed results sidecar ({exc}); delete it and rerun `dcfkit eval` "
+                               f"to recompute {name!r}") from None
+        results[name] = SequenceResult(boxes, times if times.size else None, fps, meta.get("config_hash"))
         hashes.setdefault(meta.get("config_hash"), []).append(name)
     if len(hashes) > 1:
         detail = "; ".join(f"{h}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}" for h, v in hashes.items())

@@ -159,6 +159,46 @@ def test_resume_recomputes_nothing(tmp_path, seqs, caplog, monkeypatch):
     assert summary["done"] == ["a", "b", "c"] and "replacing" not in caplog.text
 
 
+def test_resume_checks_the_initial_box_and_the_benchmark(tmp_path, seqs):
+    run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    # a corrected annotation (another first box) makes the old boxes stale: run again
+    moved = dataclasses.replace(seqs[0], ground_truth=gt_boxes(x0=4.0))
+    again = Counter()
+    assert run_one_pass(CONFIG, [moved, *seqs[1:]], tmp_path, make_tracker=again, progress=False)["done"] == ["a"]
+    assert again.made == 1
+    # results of one benchmark are never replaced by a same-named sequence of another
+    other = dataclasses.replace(seqs[1], dataset="otb")
+    with pytest.raises(DatasetError, match=r"b.json holds results on dataset 'fake', and this run is on 'otb': "
+                                           r"use a separate --out"):
+        run_one_pass({**CONFIG, "drift": 3.0}, [other], tmp_path, make_tracker=Counter(), progress=False)
+    assert json.loads((tmp_path / "drift" / "b.json").read_text())["dataset"] == "fake"
+
+
+@pytest.mark.parametrize("content", ["[]", '"x"', "{bad"])
+def test_a_sidecar_that_is_not_an_object_means_not_done(tmp_path, seqs, content):
+    run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    (tmp_path / "drift" / "b.json").write_text(content)  # used to crash eval, report and ablate
+    assert "b" not in load_results(tmp_path, "drift", seqs)
+    rerun = Counter()
+    assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=rerun, progress=False)["done"] == ["b"]
+
+
+@pytest.mark.parametrize("field,value", [("times", "abc"), ("times", [1, [2, 3]]), ("fps", "fast"),
+                                         ("fps", [1]), ("config_hash", [1])])
+def test_a_sidecar_with_wrong_types_is_named(tmp_path, seqs, field, value):
+    run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    side = tmp_path / "drift" / "b.json"
+    side.write_text(json.dumps({**json.loads(side.read_text()), field: value}))
+    with pytest.raises(DatasetError, match=rf"b.json: malformed results sidecar .*delete it and rerun"):
+        load_results(tmp_path, "drift", seqs)
+
+
+def test_results_folder_that_is_a_file_is_a_clear_error(tmp_path, seqs):
+    (tmp_path / "drift").write_text("")
+    with pytest.raises(DatasetError, match=r"cannot create the results folder .*drift"):
+        run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+
+
 def test_default_trackers_are_warmed_up_once_per_process_and_config(tmp_path, seqs, monkeypatch):
     made = []
 
