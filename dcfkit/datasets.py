@@ -155,6 +155,18 @@ def _missing_end_marker(data: bytes) -> bool:
 _SEPARATORS = re.compile(r"[,\s]+")
 
 
+def _read_text(path: Path) -> str:
+    """A benchmark text file (UTF-8, optional BOM); :class:`DatasetError` naming it otherwise."""
+    try:
+        return path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise DatasetError(f"annotation file not found: {path}") from None
+    except UnicodeDecodeError as exc:
+        raise DatasetError(f"{path}: not a text annotation file (byte {exc.start} is not UTF-8)") from None
+    except OSError as exc:
+        raise DatasetError(f"cannot read {path}: {exc.strerror}") from None
+
+
 def read_boxes(path: str | os.PathLike, one_based: bool = True) -> np.ndarray:
     """Read one ``x,y,w,h`` box per line (commas, tabs or spaces) as ``(N, 4) float64``.
 
@@ -163,13 +175,7 @@ def read_boxes(path: str | os.PathLike, one_based: bool = True) -> np.ndarray:
     or malformed line inside the file is a :class:`DatasetError` naming file and line.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise DatasetError(f"annotation file not found: {path}") from None
-    except UnicodeDecodeError as exc:
-        raise DatasetError(f"{path}: not a text annotation file (byte {exc.start} is not UTF-8)") from None
-    lines = text.rstrip().splitlines()
+    lines = _read_text(path).rstrip().splitlines()
     boxes = np.empty((len(lines), 4), dtype=np.float64)
     for n, line in enumerate(lines):
         fields = [f for f in _SEPARATORS.split(line.strip()) if f]
@@ -187,7 +193,7 @@ def read_boxes(path: str | os.PathLike, one_based: bool = True) -> np.ndarray:
 
 
 def _read_flags(path: Path, names: tuple[str, ...]) -> dict[str, bool]:
-    fields = [f for f in _SEPARATORS.split(path.read_text().strip()) if f]
+    fields = [f for f in _SEPARATORS.split(_read_text(path).strip()) if f]
     if len(fields) != len(names) or any(f not in ("0", "1") for f in fields):
         raise DatasetError(
             f"{path}, line 1: expected {len(names)} 0/1 flags ({' '.join(names)}), "
@@ -425,7 +431,7 @@ def _otb_targets(root: Path) -> dict[str, Path]:
             targets[folder.name] = folder / "groundtruth_rect.txt"
             continue
         numbered = sorted(
-            (p for p in folder.glob("groundtruth_rect.*.txt") if p.read_text().strip()),
+            (p for p in folder.glob("groundtruth_rect.*.txt") if _read_text(p).strip()),
             key=lambda p: p.name)
         if len(numbered) == 1:
             targets[folder.name] = numbered[0]
@@ -454,6 +460,9 @@ def otb(root, sequences=None) -> list[Sequence]:
         for f in os.listdir(img):
             stem, ext = os.path.splitext(f)
             if ext.lower() == ".jpg" and stem.isdigit():
+                if int(stem) in numbered:
+                    raise DatasetError(f"OTB {name}: {numbered[int(stem)].name} and {f} in {img} are both "
+                                       f"frame {int(stem)}")
                 numbered[int(stem)] = img / f
         if anno.parent.name in _OTB_FRAME_RANGES:
             first, last = _OTB_FRAME_RANGES[anno.parent.name]
@@ -530,7 +539,7 @@ def _uav_subset_by_length(anno_dir: Path) -> set[str]:
     table = _uav_table()
     candidates = set(_UAV_SUBSETS)
     for anno in sorted(anno_dir.glob("*.txt"))[:5]:
-        n = len(anno.read_text().rstrip().splitlines())
+        n = len(_read_text(anno).rstrip().splitlines())
         match = {s for s in table if anno.stem in table[s]
                  and table[s][anno.stem][2] - table[s][anno.stem][1] + 1 == n}
         candidates &= match

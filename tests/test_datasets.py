@@ -170,6 +170,18 @@ def test_annotation_that_is_not_text_names_the_file(tmp_path):
         read_boxes(path)
 
 
+def test_other_text_files_that_are_not_utf8_name_the_file(tmp_path):
+    root = uav_root(tmp_path)
+    att = root / "anno" / "UAV123_10fps" / "att" / "wakeboard7.txt"
+    att.parent.mkdir()
+    att.write_bytes(b"0,1,0,1,0,0,0,0,0,0,1,0\xe9\n")  # a UnicodeDecodeError traceback before
+    with pytest.raises(DatasetError, match=r"att.wakeboard7.txt: not a text annotation file \(byte 23"):
+        load_dataset("uav123_10fps", root)
+    att.write_text("\ufeff1,1,0,0,0,0,0,0,0,0,0,0\n")  # a BOM, as annotation files may have
+    (seq,) = load_dataset("uav123_10fps", root)
+    assert seq.attributes["SV"] and seq.attributes["ARC"] and not seq.attributes["LR"]
+
+
 def test_uav_missing_folder_missing_frames_and_count(tmp_path):
     root = uav_root(tmp_path)
     frames = root / "data_seq" / "UAV123_10fps" / "wakeboard7"
@@ -292,6 +304,9 @@ def test_otb_separators_multi_target_and_frame_ranges(tmp_path):
     write_anno(root / "Basketball" / "groundtruth_rect.txt", 3)
     with pytest.raises(DatasetError, match="3 annotation lines but 4 frames"):
         load_dataset("otb", root, ["Basketball"])
+    write_jpg(root / "Human4" / "img" / "2.jpg")  # frame 2 twice: one of them was dropped silently
+    with pytest.raises(DatasetError, match=r"OTB Human4: (0002.jpg and 2.jpg|2.jpg and 0002.jpg) .* both frame 2"):
+        load_dataset("otb", root, ["Human4"])
 
 
 def test_dataset_names_and_detection_errors(tmp_path):

@@ -189,7 +189,7 @@ def test_a_sidecar_with_wrong_types_is_named(tmp_path, seqs, field, value):
     run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
     side = tmp_path / "drift" / "b.json"
     side.write_text(json.dumps({**json.loads(side.read_text()), field: value}))
-    with pytest.raises(DatasetError, match=rf"b.json: malformed results sidecar .*delete it and rerun"):
+    with pytest.raises(DatasetError, match=r"b.json: malformed results sidecar .*delete it and rerun"):
         load_results(tmp_path, "drift", seqs)
 
 
