@@ -365,23 +365,6 @@ def _job_dir(out: Path, dataset: str, key: str) -> Path:
     return out / "jobs" / dataset / key
 
 
-@contextlib.contextmanager
-def _exclusive(out: Path):
-    """Hold ``OUT/.lock`` so two runs never write the same results folder (released on any exit)."""
-    try:
-        import fcntl
-    except ImportError:  # not POSIX: no lock
-        yield
-        return
-    with open(out / ".lock", "a+") as handle:
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            raise DcfkitError(f"another `dcfkit ablate` is writing to {out} (it holds {out / '.lock'}); "
-                              f"wait for it or use another --out") from None
-        yield
-
-
 _worker_ready = False
 
 
@@ -484,7 +467,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     (key, sequence) pairs), ``done`` / ``skipped`` / ``failed`` (run -> message) and
     ``summary`` (what :func:`summarize` returned).
     """
-    from .evaluation import is_done, atomic_write, dcfkit_version
+    from .evaluation import atomic_write, dcfkit_version, exclusive, is_done
 
     if executor not in ("local", "dask"):
         raise DcfkitError(f"executor must be 'local' or 'dask', got {executor!r}")
@@ -498,7 +481,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     by_name = {s.name: s for s in seqs}
 
     out.mkdir(parents=True, exist_ok=True)
-    with _exclusive(out):
+    with exclusive(out, "dcfkit ablate"):
         for stale in (out / "jobs").glob("*/*/.*.tmp"):  # left by a killed run; never read
             with contextlib.suppress(OSError):
                 stale.unlink()

@@ -167,6 +167,23 @@ def _paths(tracker_dir: Path, name: str) -> tuple[Path, Path, Path]:
             tracker_dir / f"{name}.error.json")
 
 
+@contextlib.contextmanager
+def exclusive(folder: Path, command: str):
+    """Hold ``folder/.lock`` so two runs never write the same results (released on any exit)."""
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: no lock
+        yield
+        return
+    with open(folder / ".lock", "a+") as handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise DcfkitError(f"another `{command}` is writing to {folder} (it holds {folder / '.lock'}); "
+                              f"wait for it or use another --out") from None
+        yield
+
+
 def read_json(path: Path) -> dict | None:
     """The JSON object in ``path``, or None if it is missing, unreadable or not an object."""
     try:
@@ -422,62 +439,63 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     except OSError as exc:
         raise DatasetError(f"cannot create the results folder {tracker_dir}: {exc.strerror}") from None
 
-    todo = [s for s in sequences if not is_done(tracker_dir, s, chash)]
-    old = {s.name: read_json(_paths(tracker_dir, s.name)[1]) or {} for s in todo}
-    for seq in todo:  # OUT/<tracker>/<sequence> has no benchmark level: never mix two benchmarks there
-        if old[seq.name].get("dataset") and seq.dataset and old[seq.name]["dataset"] != seq.dataset:
-            raise DatasetError(
-                f"{_paths(tracker_dir, seq.name)[1]} holds results on dataset {old[seq.name]['dataset']!r}, and "
-                f"this run is on {seq.dataset!r}: use a separate --out for each benchmark")
-    same = json.dumps(config, sort_keys=True, default=json_default)
+    with exclusive(tracker_dir, "dcfkit eval"):  # another eval writing here would lose results
+        todo = [s for s in sequences if not is_done(tracker_dir, s, chash)]
+        old = {s.name: read_json(_paths(tracker_dir, s.name)[1]) or {} for s in todo}
+        for seq in todo:  # OUT/<tracker>/<sequence> has no benchmark level: never mix two benchmarks there
+            if old[seq.name].get("dataset") and seq.dataset and old[seq.name]["dataset"] != seq.dataset:
+                raise DatasetError(
+                    f"{_paths(tracker_dir, seq.name)[1]} holds results on dataset {old[seq.name]['dataset']!r}, and "
+                    f"this run is on {seq.dataset!r}: use a separate --out for each benchmark")
+        same = json.dumps(config, sort_keys=True, default=json_default)
 
-    def other_config(seq: Sequence) -> bool:  # not merely another dcfkit version of this config
-        meta = old[seq.name]
-        return (meta.get("config_hash") not in (None, chash)
-                and json.dumps(meta.get("config"), sort_keys=True, default=json_default) != same)
+        def other_config(seq: Sequence) -> bool:  # not merely another dcfkit version of this config
+            meta = old[seq.name]
+            return (meta.get("config_hash") not in (None, chash)
+                    and json.dumps(meta.get("config"), sort_keys=True, default=json_default) != same)
 
-    replaced = [s.name for s in todo if other_config(s)]
-    if replaced:
-        log.warning("%s: replacing the results of another config named %r for %d sequence(s): %s (give this "
-                    "config another name to keep both)", tracker_dir, name, len(replaced), ", ".join(replaced[:10]))
-    summary = {"tracker": name, "dir": tracker_dir, "config_hash": chash,
-               "done": [], "skipped": [s.name for s in sequences if s not in todo], "failed": {}}
+        replaced = [s.name for s in todo if other_config(s)]
+        if replaced:
+            log.warning("%s: replacing the results of another config named %r for %d sequence(s): %s (give this "
+                        "config another name to keep both)", tracker_dir, name, len(replaced), ", ".join(replaced[:10]))
+        summary = {"tracker": name, "dir": tracker_dir, "config_hash": chash,
+                   "done": [], "skipped": [s.name for s in sequences if s not in todo], "failed": {}}
 
-    def record(result):
-        if result["status"] == "done":
-            summary["done"].append(result["sequence"])
-        else:
-            summary["failed"][result["sequence"]] = result["error"]
-            log.warning("%s: %s", name, result["error"])
+        def record(result):
+            if result["status"] == "done":
+                summary["done"].append(result["sequence"])
+            else:
+                summary["failed"][result["sequence"]] = result["error"]
+                log.warning("%s: %s", name, result["error"])
 
-    from tqdm.auto import tqdm
+        from tqdm.auto import tqdm
 
-    bar = tqdm(total=sum(len(s) for s in todo), unit="frame", desc=name,
-               disable=not progress or not todo, dynamic_ncols=True)
-    try:
-        if jobs <= 1 or len(todo) <= 1:
-            for seq in todo:
-                bar.set_postfix_str(seq.name, refresh=False)
-                start = bar.n
-                record(track_sequence(config, seq, tracker_dir, make_tracker, chash, version,
-                                      on_frame=lambda: bar.update(1)))
-                bar.update(start + len(seq) - bar.n)  # a failed sequence skips its rest
-        else:
-            def finished(seq, result):
-                record(result)
-                bar.set_postfix_str(seq.name, refresh=False)
-                bar.update(result["frames"])
+        bar = tqdm(total=sum(len(s) for s in todo), unit="frame", desc=name,
+                   disable=not progress or not todo, dynamic_ncols=True)
+        try:
+            if jobs <= 1 or len(todo) <= 1:
+                for seq in todo:
+                    bar.set_postfix_str(seq.name, refresh=False)
+                    start = bar.n
+                    record(track_sequence(config, seq, tracker_dir, make_tracker, chash, version,
+                                          on_frame=lambda: bar.update(1)))
+                    bar.update(start + len(seq) - bar.n)  # a failed sequence skips its rest
+            else:
+                def finished(seq, result):
+                    record(result)
+                    bar.set_postfix_str(seq.name, refresh=False)
+                    bar.update(result["frames"])
 
-            def crashed(seq, exc):
-                return record_failure(tracker_dir, seq, name, crash_message(seq, exc), exc, chash, version)
+                def crashed(seq, exc):
+                    return record_failure(tracker_dir, seq, name, crash_message(seq, exc), exc, chash, version)
 
-            run_pool({seq: (track_sequence, config, seq, tracker_dir, make_tracker, chash, version) for seq in todo},
-                     jobs, finished, crashed)
-    finally:
-        bar.close()
-    order = {s.name: i for i, s in enumerate(sequences)}
-    summary["done"].sort(key=order.get)
-    return summary
+                calls = {seq: (track_sequence, config, seq, tracker_dir, make_tracker, chash, version) for seq in todo}
+                run_pool(calls, jobs, finished, crashed)
+        finally:
+            bar.close()
+        order = {s.name: i for i, s in enumerate(sequences)}
+        summary["done"].sort(key=order.get)
+        return summary
 
 
 # --------------------------------------------------------------------------- reading results

@@ -85,7 +85,8 @@ CONFIG = {"name": "drift", "drift": 1.0}
 
 
 def files(folder: Path) -> set[str]:
-    return {p.name for p in folder.iterdir()}
+    """Result files in ``folder`` (not the ``.lock`` that ``run_one_pass`` holds while it writes)."""
+    return {p.name for p in folder.iterdir() if p.name != ".lock"}
 
 
 # --------------------------------------------------------------------------- output files
@@ -191,6 +192,17 @@ def test_a_sidecar_with_wrong_types_is_named(tmp_path, seqs, field, value):
     side.write_text(json.dumps({**json.loads(side.read_text()), field: value}))
     with pytest.raises(DatasetError, match=r"b.json: malformed results sidecar .*delete it and rerun"):
         load_results(tmp_path, "drift", seqs)
+
+
+def test_a_second_eval_into_the_same_results_folder_is_refused(tmp_path, seqs):
+    fcntl = pytest.importorskip("fcntl", reason="POSIX file locks")
+    (tmp_path / "drift").mkdir()
+    with open(tmp_path / "drift" / ".lock", "a+") as held:  # as a running `dcfkit eval` holds it
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        with pytest.raises(evaluation.DcfkitError, match=r"another `dcfkit eval` is writing to .*drift"):
+            run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    assert files(tmp_path / "drift") == set()  # nothing was run
+    assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["done"] == ["a", "b", "c"]
 
 
 def test_results_folder_that_is_a_file_is_a_clear_error(tmp_path, seqs):
