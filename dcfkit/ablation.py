@@ -300,14 +300,17 @@ def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
     else:
         root_path, origin = None, "not given"
 
+    where = f"{path}: sequences"
     if sequences is None:
         sequences = data.get("sequences")
+    else:
+        where = "--sequences (replacing the spec's sequences)"
     if isinstance(sequences, str):
         sequences = [s.strip() for s in sequences.split(",") if s.strip()]
     if sequences is not None:
         if not isinstance(sequences, (list, tuple)) or not sequences or \
                 not all(isinstance(s, str) and s for s in sequences):
-            raise ConfigError(f"{path}: sequences: expected a non-empty list of sequence names, got {sequences!r}")
+            raise ConfigError(f"{where}: expected a non-empty list of sequence names, got {sequences!r}")
         sequences = tuple(dict.fromkeys(sequences))
 
     raw_variants = _mapping(data.get("variants"), f"{path}: variants",
@@ -315,6 +318,8 @@ def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
     named: dict[str, Variant] = {}
     for name, entry in raw_variants.items():
         where = f"variants.{name}"
+        if str(name) in named:  # YAML keys 1 and "1" (or true and "True") are one name here
+            raise ConfigError(f"{path}: {where}: variant names must be unique, and {name!r} is given twice")
         if isinstance(entry, str):
             entry = {"config": entry}
         entry = _mapping(entry, f"{path}: {where}", "{config: path-or-name, overrides: {dotted.key: value}}")
@@ -467,7 +472,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     (key, sequence) pairs), ``done`` / ``skipped`` / ``failed`` (run -> message) and
     ``summary`` (what :func:`summarize` returned).
     """
-    from .evaluation import atomic_write, dcfkit_version, exclusive, is_done
+    from .evaluation import atomic_write, dcfkit_version, exclusive, is_done, make_dir, read_json
 
     if executor not in ("local", "dask"):
         raise DcfkitError(f"executor must be 'local' or 'dask', got {executor!r}")
@@ -480,7 +485,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     job_list = expand(spec, seqs, version)
     by_name = {s.name: s for s in seqs}
 
-    out.mkdir(parents=True, exist_ok=True)
+    make_dir(out)
     with exclusive(out, "dcfkit ablate"):
         for stale in (out / "jobs").glob("*/*/.*.tmp"):  # left by a killed run; never read
             with contextlib.suppress(OSError):
@@ -490,10 +495,11 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
             if (job.key, job.sequence) not in tasks:
                 tasks[job.key, job.sequence] = _Task(job.key, job.variant, job.config, by_name[job.sequence],
                                                      _job_dir(out, spec.dataset, job.key))
-        (out / "configs").mkdir(exist_ok=True)
+        for folder in {t.folder for t in tasks.values()} | {out / "configs"}:  # before anything runs
+            make_dir(folder)
         for job in {j.key: j for j in job_list}.values():
             path = out / "configs" / f"{job.key}.json"
-            if not path.is_file():
+            if (read_json(path) or {}).get("key") != job.key:  # missing or damaged: (re)write the record
                 stripped = {k: v for k, v in job.config.items() if k not in LABEL_KEYS}
                 atomic_write(path, json.dumps({"key": job.key, "dcfkit_version": version,
                                                "config": stripped}, indent=1) + "\n")

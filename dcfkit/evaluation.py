@@ -167,6 +167,15 @@ def _paths(tracker_dir: Path, name: str) -> tuple[Path, Path, Path]:
             tracker_dir / f"{name}.error.json")
 
 
+def make_dir(folder: Path) -> Path:
+    """``mkdir -p``, with a :class:`DcfkitError` naming the folder (e.g. a file is in the way)."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise DcfkitError(f"cannot create the folder {folder}: {exc.strerror}") from None
+    return folder
+
+
 @contextlib.contextmanager
 def exclusive(folder: Path, command: str):
     """Hold ``folder/.lock`` so two runs never write the same results (released on any exit)."""
@@ -434,10 +443,7 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     version = dcfkit_version()
     chash = config_hash(config, version)
     tracker_dir = Path(out_dir) / name
-    try:
-        tracker_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise DatasetError(f"cannot create the results folder {tracker_dir}: {exc.strerror}") from None
+    make_dir(tracker_dir)
 
     with exclusive(tracker_dir, "dcfkit eval"):  # another eval writing here would lose results
         todo = [s for s in sequences if not is_done(tracker_dir, s, chash)]

@@ -318,7 +318,9 @@ def _json_ready(obj):
 
 
 def _write(evaluation: dict, report_dir: Path) -> list[Path]:
-    report_dir.mkdir(parents=True, exist_ok=True)
+    from .evaluation import make_dir
+
+    make_dir(report_dir)
     paths = []
 
     def text(name, content):

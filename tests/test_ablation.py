@@ -139,6 +139,8 @@ def test_shipped_specs_expand():
      ["grid (label.topn=10)", "topn"]),
     ("dataset: {name: otb}\ngrid: {parameters: {label.mu: [0]}}\n", ["grid.base", "missing"]),
     ("dataset: {name: otb}\n", ["nothing to run"]),
+    ("dataset: {name: otb}\nvariants: {1: strcf, '1': bacf}\n", ["variants.1", "given twice"]),  # was one
+    ("dataset: {name: otb}\nvariants: {true: strcf, 'True': bacf}\n", ["variants.True", "given twice"]),
 ])
 def test_bad_spec_errors_name_the_file_and_key(tmp_path, text, expected):
     path = write_spec(tmp_path / "bad.yaml", text)
@@ -148,6 +150,12 @@ def test_bad_spec_errors_name_the_file_and_key(tmp_path, text, expected):
     assert str(path) in message
     for part in expected:
         assert part in message
+
+
+def test_an_empty_sequences_option_is_blamed_on_the_option(tmp_path):
+    path = write_spec(tmp_path / "spec.yaml", "dataset: {name: otb}\nvariants: {a: strcf}\n")
+    with pytest.raises(ConfigError, match=r"^--sequences \(replacing the spec's sequences\): expected a non-empty"):
+        load_spec(path, sequences=" , ")  # the message used to name the spec file
 
 
 def test_configs_are_relative_to_the_spec_never_to_the_working_directory(tmp_path, monkeypatch):
@@ -298,6 +306,12 @@ variants: {s: {config: strcf, overrides: {scale.n_scales: 3}}}
     rows = {r["sequence"]: r for r in res["summary"]["per_sequence"]}
     assert [rows[s]["status"] for s in ("seqA", "seqB", "seqC")] == ["done", "failed", "done"]
     assert res["summary"]["overall"][0]["failed"] == 1
+    # the record of which config made the results is rewritten when damaged (it never was)
+    record = out / "configs" / f"{key}.json"
+    good = record.read_text()
+    record.write_text("garbage")
+    run_ablation(spec, out, jobs=1, progress=False)
+    assert record.read_text() == good
     assert [j["error"] is not None for j in res["summary"]["jobs"]] == [False, True, False]
 
     # what a job stored is what the tracker returns when run directly (0-based in memory)
@@ -356,3 +370,6 @@ def test_a_second_run_on_the_same_folder_is_refused(tmp_path, data):
         with pytest.raises(ablation.DcfkitError, match="another `dcfkit ablate` is writing to"):
             run_ablation(spec, out, jobs=1, progress=False)
     assert not (out / "jobs").exists()
+    (out / "jobs").write_text("")  # a file where the job folders go: refused before anything runs
+    with pytest.raises(ablation.DcfkitError, match=r"cannot create the folder .*jobs"):
+        run_ablation(spec, out, jobs=1, progress=False)

@@ -207,8 +207,12 @@ def test_a_second_eval_into_the_same_results_folder_is_refused(tmp_path, seqs):
 
 def test_results_folder_that_is_a_file_is_a_clear_error(tmp_path, seqs):
     (tmp_path / "drift").write_text("")
-    with pytest.raises(DatasetError, match=r"cannot create the results folder .*drift"):
+    with pytest.raises(evaluation.DcfkitError, match=r"cannot create the folder .*drift"):
         run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
+    (tmp_path / "report").write_text("")
+    with pytest.raises(evaluation.DcfkitError, match=r"cannot create the folder .*report"):
+        report.write_report(tmp_path / "out", seqs, report_dir=tmp_path / "report")
 
 
 def test_default_trackers_are_warmed_up_once_per_process_and_config(tmp_path, seqs, monkeypatch):
