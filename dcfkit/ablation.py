@@ -486,7 +486,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     by_name = {s.name: s for s in seqs}
 
     make_dir(out)
-    with exclusive(out, "dcfkit ablate"):
+    with exclusive(out / ".lock", "dcfkit ablate", f"to {out}"):
         for stale in (out / "jobs").glob("*/*/.*.tmp"):  # left by a killed run; never read
             with contextlib.suppress(OSError):
                 stale.unlink()

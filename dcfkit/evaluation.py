@@ -46,6 +46,7 @@ import sys
 import tempfile
 import time
 import traceback
+import warnings
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
@@ -177,19 +178,27 @@ def make_dir(folder: Path) -> Path:
 
 
 @contextlib.contextmanager
-def exclusive(folder: Path, command: str):
-    """Hold ``folder/.lock`` so two runs never write the same results (released on any exit)."""
+def exclusive(lock: Path, command: str, what: str):
+    """Hold the file lock ``lock`` so two runs never write the same results (released on any
+    exit). Where no lock can be taken (not POSIX, a read-only folder, a file system without
+    flock) the run goes on unlocked, with a warning."""
     try:
         import fcntl
-    except ImportError:  # not POSIX: no lock
+
+        handle = open(lock, "a+")
+    except (ImportError, OSError) as exc:
+        if not isinstance(exc, ImportError):
+            log.warning("cannot create the lock %s (%s): running without it", lock, exc.strerror)
         yield
         return
-    with open(folder / ".lock", "a+") as handle:
+    with handle:
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            raise DcfkitError(f"another `{command}` is writing to {folder} (it holds {folder / '.lock'}); "
+        except BlockingIOError:
+            raise DcfkitError(f"another `{command}` is writing {what} (it holds {lock}); "
                               f"wait for it or use another --out") from None
+        except OSError as exc:
+            log.warning("cannot lock %s (%s): running without the lock", lock, exc.strerror)
         yield
 
 
@@ -207,8 +216,9 @@ def is_done(tracker_dir: Path, seq: Sequence, chash: str) -> bool:
     started from ``seq``'s current initial box (a corrected annotation is run again)."""
     txt, side, _ = _paths(tracker_dir, seq.name)
     meta = read_json(side)
+    init = [float(v) for v in seq.init_box]
     return (meta is not None and meta.get("config_hash") == chash
-            and meta.get("init_box") == [float(v) for v in seq.init_box]
+            and meta.get("init_box", init) == init  # (sidecars older than the field: trusted)
             and txt.is_file() and _count_lines(txt) == len(seq))
 
 
@@ -359,6 +369,7 @@ def worker_init(parent_pid: int | None = None):
     process group, and a worker interrupted mid-protocol would leave the parent waiting for it
     forever; the parent stops its workers itself."""
     os.environ.update({k: "1" for k in _THREAD_VARS})
+    warnings.filterwarnings("ignore", message="dcfkit plugin ", category=RuntimeWarning)  # the parent said it
     with contextlib.suppress(Exception):
         import cv2
 
@@ -445,7 +456,13 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     tracker_dir = Path(out_dir) / name
     make_dir(tracker_dir)
 
-    with exclusive(tracker_dir, "dcfkit eval"):  # another eval writing here would lose results
+    with contextlib.ExitStack() as locks:  # a run on other sequences of this folder may go on alongside
+        lock_dir = tracker_dir / ".locks"
+        with contextlib.suppress(OSError):  # e.g. read-only results: exclusive() then runs unlocked
+            lock_dir.mkdir(exist_ok=True)
+        for seq in sequences:
+            locks.enter_context(exclusive(lock_dir / f"{seq.name}.lock", "dcfkit eval",
+                                          f"{name}'s results of sequence {seq.name!r} to {tracker_dir}"))
         todo = [s for s in sequences if not is_done(tracker_dir, s, chash)]
         old = {s.name: read_json(_paths(tracker_dir, s.name)[1]) or {} for s in todo}
         for seq in todo:  # OUT/<tracker>/<sequence> has no benchmark level: never mix two benchmarks there
@@ -546,8 +563,8 @@ def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]
             if not isinstance(meta.get("config_hash"), (str, type(None))):
                 raise TypeError(f"config_hash is {meta['config_hash']!r}")
         except (TypeError, ValueError) as exc:
-            raise DatasetError(f"{side}: malformed results sidecar ({exc}); delete it and rerun `dcfkit eval` "
-                               f"to recompute {name!r}") from None
+            raise DatasetError(f"{side}: malformed results sidecar ({exc}); delete it and run again to "
+                               f"recompute {name!r}") from None
         results[name] = SequenceResult(boxes, times if times.size else None, fps, meta.get("config_hash"))
         hashes.setdefault(meta.get("config_hash"), []).append(name)
     if len(hashes) > 1:

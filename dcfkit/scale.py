@@ -40,10 +40,10 @@ def _factors(n: int, step: float) -> np.ndarray:
     return step ** (np.arange(n) - (n - 1) / 2)
 
 
-def _check_span(n: int, step: float) -> str | None:
+def _check_span(n: int, step: float, least: int = 1) -> str | None:
     """Sanity bounds shared by both estimators: beyond them the samples stop fitting in memory."""
-    if not 1 <= n <= 101:
-        return "n_scales must be in [1, 101]"
+    if not least <= n <= 101:
+        return f"n_scales must be in [{least}, 101]"
     if step <= 1:
         return "step must be > 1"
     if (n - 1) / 2 * math.log(step) > math.log(10):
@@ -84,8 +84,6 @@ class DSST(ScaleEstimator):
         cell_size: int = param(4, "fHOG cell size of the scale samples")
 
         def validate(self):
-            if self.n_scales < 3:
-                return "n_scales must be >= 3"
             if self.sigma_factor <= 0:
                 return "sigma_factor must be > 0"
             if not 0 < self.learning_rate <= 1:
@@ -94,7 +92,7 @@ class DSST(ScaleEstimator):
                 return "model_max_area must be in [1, 10000]"
             if not 1 <= self.cell_size <= 16:
                 return "cell_size must be in [1, 16]"
-            return _check_span(self.n_scales, self.step)
+            return _check_span(self.n_scales, self.step, least=3)
 
     def init(self, image, centre, base_target, scale, limits):
         super().init(image, centre, base_target, scale, limits)

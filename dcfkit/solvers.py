@@ -58,8 +58,8 @@ class ADMMParams:
     gamma_max: float = param(10000.0, "γ_max: largest penalty")
 
     def validate(self):
-        if not 1 <= self.iterations <= 1000:
-            return "iterations must be in [1, 1000]"
+        if not 1 <= self.iterations <= 10000:
+            return "iterations must be in [1, 10000]"
         if self.gamma0 <= 0 or self.gamma_max <= 0 or self.beta <= 0:
             return "gamma0, beta and gamma_max must be > 0"
 

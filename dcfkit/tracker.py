@@ -49,10 +49,12 @@ def check_box(box: Any, image_shape: tuple[int, ...]) -> np.ndarray:
     """A finite (x, y, w, h) with positive size that overlaps the image."""
     try:
         raw = np.asarray(box)
+        if raw.dtype.kind not in "iuf":  # not booleans, complex numbers, strings or objects
+            raise TypeError
         b = raw.astype(float).reshape(-1)
     except (TypeError, ValueError):
         raise InputError(f"initial box must be 4 numbers (x, y, w, h), got {box!r}") from None
-    if raw.dtype == bool or b.size != 4 or not np.all(np.isfinite(b)):
+    if b.size != 4 or not np.all(np.isfinite(b)):
         raise InputError(f"initial box must be 4 finite numbers (x, y, w, h), got {box!r}")
     x, y, w, h = (float(v) for v in b)
     if w <= 0 or h <= 0:

@@ -94,7 +94,8 @@ def test_non_finite_numbers_are_refused(key, value):
     ("strcf", "tracker.search_area_scale", 1e6, r"tracker: search_area_scale must be in \[1, 50\]"),
     ("strcf", "tracker.cell_size", 10000, r"tracker: cell_size must be in \[1, 64\]"),
     ("strcf", "tracker.min_image_sample_size", 1e-300, r"tracker: need 8² <= min_image_sample_size"),
-    ("strcf", "solver.iterations", 10**9, r"solver.*iterations must be in \[1, 1000\]"),
+    ("strcf", "solver.iterations", 10**9, r"solver.*iterations must be in \[1, 10000\]"),
+    ("dr2track", "scale.n_scales", 200, r"scale.*n_scales must be in \[3, 101\]"),
 ])
 def test_values_whose_patches_would_not_fit_in_memory_are_refused(config, key, value, match):
     # each used to pass validation and fail inside OpenCV (out of memory, int overflow) or never finish

@@ -7,6 +7,7 @@ import dataclasses
 import json
 import os
 import re
+import warnings
 from pathlib import Path
 
 import cv2
@@ -85,8 +86,8 @@ CONFIG = {"name": "drift", "drift": 1.0}
 
 
 def files(folder: Path) -> set[str]:
-    """Result files in ``folder`` (not the ``.lock`` that ``run_one_pass`` holds while it writes)."""
-    return {p.name for p in folder.iterdir() if p.name != ".lock"}
+    """Result files in ``folder`` (not the ``.locks`` folder of ``run_one_pass``)."""
+    return {p.name for p in folder.iterdir() if p.name != ".locks"}
 
 
 # --------------------------------------------------------------------------- output files
@@ -190,19 +191,47 @@ def test_a_sidecar_with_wrong_types_is_named(tmp_path, seqs, field, value):
     run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
     side = tmp_path / "drift" / "b.json"
     side.write_text(json.dumps({**json.loads(side.read_text()), field: value}))
-    with pytest.raises(DatasetError, match=r"b.json: malformed results sidecar .*delete it and rerun"):
+    with pytest.raises(DatasetError, match=r"b.json: malformed results sidecar .*delete it and run again"):
         load_results(tmp_path, "drift", seqs)
 
 
-def test_a_second_eval_into_the_same_results_folder_is_refused(tmp_path, seqs):
+def test_a_second_eval_of_the_same_sequences_is_refused_and_of_others_not(tmp_path, seqs):
     fcntl = pytest.importorskip("fcntl", reason="POSIX file locks")
-    (tmp_path / "drift").mkdir()
-    with open(tmp_path / "drift" / ".lock", "a+") as held:  # as a running `dcfkit eval` holds it
+    (tmp_path / "drift" / ".locks").mkdir(parents=True)
+    with open(tmp_path / "drift" / ".locks" / "b.lock", "a+") as held:  # as a running eval of b holds it
         fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        with pytest.raises(evaluation.DcfkitError, match=r"another `dcfkit eval` is writing to .*drift"):
+        with pytest.raises(evaluation.DcfkitError, match=r"another `dcfkit eval` is writing drift's results of "
+                                                         r"sequence 'b' to .*drift"):
             run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
-    assert files(tmp_path / "drift") == set()  # nothing was run
-    assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["done"] == ["a", "b", "c"]
+        assert files(tmp_path / "drift") == set()  # nothing was run
+        # another subset of the benchmark may run alongside
+        assert run_one_pass(CONFIG, [seqs[0], seqs[2]], tmp_path, make_tracker=Counter(),
+                            progress=False)["done"] == ["a", "c"]
+    assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["done"] == ["b"]
+
+
+def test_results_written_before_the_initial_box_was_recorded_are_still_done(tmp_path, seqs):
+    run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    side = tmp_path / "drift" / "a.json"
+    meta = json.loads(side.read_text())
+    del meta["init_box"]
+    side.write_text(json.dumps(meta))
+    assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["skipped"] == ["a", "b", "c"]
+
+
+def test_workers_leave_plugin_warnings_to_the_parent(monkeypatch):
+    for var in evaluation._THREAD_VARS:
+        monkeypatch.setenv(var, os.environ.get(var, "1"))  # restored after the test
+    threads = cv2.getNumThreads()
+    try:
+        with warnings.catch_warnings(record=True) as shown:
+            warnings.simplefilter("always")
+            evaluation.worker_init()
+            warnings.warn("dcfkit plugin 'x' failed and was skipped: boom", RuntimeWarning)
+            warnings.warn("something else", RuntimeWarning)
+    finally:
+        cv2.setNumThreads(threads)
+    assert [str(w.message) for w in shown] == ["something else"]
 
 
 def test_results_folder_that_is_a_file_is_a_clear_error(tmp_path, seqs):

@@ -124,8 +124,9 @@ def test_a_box_longer_than_the_image_keeps_its_size(box, sequence):
 
 def test_initial_box_errors_say_what_is_wrong(sequence):
     tracker = dcfkit.load_tracker("strcf")
-    with pytest.raises(InputError, match="must be 4 finite numbers"):
-        tracker.init(sequence.frames[0], (True, True, True, True))
+    for box in [(True, True, True, True), (10 + 1j, 10, 20, 20), ("10", "10", "20", "20")]:
+        with pytest.raises(InputError, match="must be 4 numbers"):
+            tracker.init(sequence.frames[0], box)
     flat = np.full_like(sequence.frames[0], 90)
     flat[300:, 400:] = sequence.frames[0][300:, 400:]  # texture far from the box
     with pytest.raises(InputError, match=r"blank.*the box centre \(x=-18, y=-18\) is outside the 480x360 image"):
