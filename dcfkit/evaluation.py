@@ -215,7 +215,11 @@ def is_done(tracker_dir: Path, seq: Sequence, chash: str) -> bool:
     """Whether ``seq`` has complete results in ``tracker_dir`` from the config with hash ``chash``,
     started from ``seq``'s current initial box (a corrected annotation is run again)."""
     txt, side, _ = _paths(tracker_dir, seq.name)
-    meta = read_json(side)
+    return _complete(read_json(side), txt, seq, chash)
+
+
+def _complete(meta: dict | None, txt: Path, seq: Sequence, chash: str) -> bool:
+    """:func:`is_done` given the sequence's sidecar ``meta`` (None: missing) and result file."""
     init = [float(v) for v in seq.init_box]
     return (meta is not None and meta.get("config_hash") == chash
             and meta.get("init_box", init) == init  # (sidecars older than the field: trusted)
@@ -463,8 +467,9 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
         for seq in sequences:
             locks.enter_context(exclusive(lock_dir / f"{seq.name}.lock", "dcfkit eval",
                                           f"{name}'s results of sequence {seq.name!r} to {tracker_dir}"))
-        todo = [s for s in sequences if not is_done(tracker_dir, s, chash)]
-        old = {s.name: read_json(_paths(tracker_dir, s.name)[1]) or {} for s in todo}
+        metas = {s.name: read_json(_paths(tracker_dir, s.name)[1]) for s in sequences}  # each read once
+        todo = [s for s in sequences if not _complete(metas[s.name], _paths(tracker_dir, s.name)[0], s, chash)]
+        old = {s.name: metas[s.name] or {} for s in todo}
         for seq in todo:  # OUT/<tracker>/<sequence> has no benchmark level: never mix two benchmarks there
             if old[seq.name].get("dataset") and seq.dataset and old[seq.name]["dataset"] != seq.dataset:
                 raise DatasetError(
