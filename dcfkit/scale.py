@@ -3,7 +3,8 @@
 ``pyramid`` (STRCF, BACF): the translation filter is evaluated on samples at a few relative
 scales and the best response picks the scale. ``dsst`` (DR²Track, after Danelljan et al.
 PAMI 2017): a separate 1-D correlation filter over a pyramid of target-sized fHOG samples.
-Both keep the scale within limits set at init (target at least ~5 px, at most the image).
+Both keep the scale within limits set at init (search region at least ~5 px; target at most
+the image, or its initial size if that is larger).
 """
 from __future__ import annotations
 
@@ -147,10 +148,14 @@ class DSST(ScaleEstimator):
         return new_scale
 
 
-def scale_limits(base_target: np.ndarray, base_region: np.ndarray, image_shape, min_pixels: float = 5.0) -> tuple[float, float]:
-    """(min, max) scale: the search region keeps ≥ ``min_pixels`` px; the target fits in the image."""
+def scale_limits(base_target: np.ndarray, base_region: np.ndarray, image_shape, initial: float | None = None,
+                 min_pixels: float = 5.0) -> tuple[float, float]:
+    """(min, max) scale: the search region keeps ≥ ``min_pixels`` px; the target fits in the image,
+    unless it is larger at the ``initial`` scale (a box longer than the image keeps its size)."""
     lo = np.max(min_pixels / np.asarray(base_region, dtype=float))
     hi = np.min(np.asarray(image_shape[:2], dtype=float) / np.asarray(base_target, dtype=float))
+    if initial is not None:
+        hi = max(hi, initial)
     return float(lo), float(max(hi, lo))
 
 

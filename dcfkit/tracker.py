@@ -149,8 +149,7 @@ class Tracker:
         box = check_box(box, image.shape)
         centre, target = box_to_centre_size(box)
         g, scale = self._geometry(target)
-        lo, hi = scale_limits(g.base_target, g.sample_size, image.shape)
-        limits = (lo, max(hi, scale))  # a box longer than the image on one axis keeps its size
+        limits = scale_limits(g.base_target, g.sample_size, image.shape, initial=scale)
         scale = float(np.clip(scale, *limits))
         patch = sample(image, centre, g.sample_size * scale, g.sample_size)
         std = self._blank(patch)
