@@ -13,9 +13,9 @@ Results are stored per *run*, keyed by what determines the boxes::
     OUT/configs/<key>.json                           the config behind <key>
 
 ``key`` is :func:`dcfkit.evaluation.config_hash` of the resolved config without its
-``name`` and ``description`` (which do not change a box) plus the dcfkit version, so two
-variants with the same parameters (the base point of every one-at-a-time sweep) share
-one run. The files are written by :mod:`dcfkit.evaluation`'s one-sequence runner:
+``name`` and ``description`` (which do not change a box) plus the dcfkit version and the
+versions of the plugin packages it uses, so two variants with the same parameters (the
+base point of every one-at-a-time sweep) share one run. The files are written by :mod:`dcfkit.evaluation`'s one-sequence runner:
 temporary file + ``os.replace``, sidecar last. A rerun skips runs whose sidecar has the
 key and whose ``.txt`` has one line per frame; failed runs are retried.
 
@@ -385,7 +385,7 @@ def _track(config: dict, seq, job_dir: str, key: str, version: str) -> dict:
 def _run_job(config: dict, seq, job_dir: str, key: str, version: str) -> dict:
     """:func:`_track` in a worker process (pool or dask)."""
     global _worker_ready
-    from .evaluation import worker_init, dcfkit_version
+    from .evaluation import dcfkit_version, plugin_versions, worker_init
 
     if not _worker_ready:  # dask workers have no initializer: one OpenCV thread each
         worker_init()
@@ -393,6 +393,9 @@ def _run_job(config: dict, seq, job_dir: str, key: str, version: str) -> dict:
     if dcfkit_version() != version:
         raise DcfkitError(f"this worker runs dcfkit {dcfkit_version()}, the client {version}; "
                           f"install the same version on every worker")
+    if job_key(config, version) != key:
+        raise DcfkitError(f"this worker's plugins ({', '.join(plugin_versions(config)) or 'none'}) are not the "
+                          f"client's: install the same plugin versions on every worker")
     return _track(config, seq, job_dir, key, version)
 
 

@@ -233,6 +233,18 @@ def load_config(source: str | Path | Mapping, overrides: Mapping[str, Any] | Non
         raise type(exc)(f"{exc} (config merged from {' <- '.join(chain)})") from None
 
 
+def components(config: Mapping) -> list[tuple[str, str]]:
+    """The ``(kind, name)`` of every component a resolved config uses."""
+    def name(spec):
+        return spec.get("name") if isinstance(spec, Mapping) else None
+
+    found = [("feature", name(f)) for f in config.get("features") or ()]
+    found += [("regularizer", name(r)) for r in (config.get("regularizers") or {}).values()]
+    found += [(kind, name(config.get(slot))) for kind, slot in
+              (("label", "label"), ("solver", "solver"), ("search", "search"), ("scale", "scale"))]
+    return [(kind, n) for kind, n in found if isinstance(n, str)]
+
+
 def shipped_config(name: str | Path) -> Path | None:
     """The shipped config called ``name`` ('dr2track' or 'dr2track.yaml'), or None."""
     folder = shipped_config_dir()

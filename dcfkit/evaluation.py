@@ -17,7 +17,7 @@ Output layout of :func:`run_one_pass` (``OUT/<tracker name>/``):
     image decoding excluded; before its first sequence of a dcfkit config, a process runs a
     throw-away copy of the tracker on the first frame, untimed, so one-time loading of
     compiled code is not counted), ``fps`` = frames / total tracker time, the config, its
-    hash and the dcfkit version. Written last, so it marks the sequence as done.
+    hash, the dcfkit version and the plugin packages the config uses. Written last, so it marks the sequence as done.
 ``<sequence>.error.json``
     written instead when the tracker raised: frame, error and traceback.
 
@@ -110,9 +110,22 @@ def json_default(obj):
     return str(obj)
 
 
+def plugin_versions(config: Mapping) -> list[str]:
+    """``"package version"`` of each installed plugin whose components ``config`` uses."""
+    from .config import components
+    from .registry import get_registry
+
+    return get_registry().plugin_versions(components(config))
+
+
 def config_hash(config: Mapping, version: str | None = None) -> str:
-    """16 hex digits of SHA-256 over the canonical JSON (sorted keys) of config + dcfkit version."""
+    """16 hex digits of SHA-256 over the canonical JSON (sorted keys) of config + dcfkit version,
+    and the versions of the plugins whose components the config uses (so a plugin's new
+    release gives new results, while configs of built-ins only keep their hashes)."""
     payload = {"config": config, "dcfkit": version if version is not None else dcfkit_version()}
+    plugins = plugin_versions(config)
+    if plugins:
+        payload["plugins"] = plugins
     text = json.dumps(payload, sort_keys=True, separators=(",", ":"), default=json_default)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -313,7 +326,7 @@ def track_sequence(config: Mapping, seq: Sequence, tracker_dir: Path, make_track
         "sequence": seq.name, "dataset": seq.dataset, "tracker": config["name"],
         "init_box": [float(v) for v in seq.init_box],
         "frames": len(seq), "fps": len(seq) / total if total > 0 else None,
-        "total_time": total, "config_hash": chash, "dcfkit_version": version,
+        "total_time": total, "config_hash": chash, "dcfkit_version": version, "plugins": plugin_versions(config),
         "time": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         "config": config, "times": times.tolist(),
     }

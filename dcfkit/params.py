@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import math
+import types
 import typing
 from typing import Any, Mapping
 
@@ -20,8 +21,8 @@ def param(default: Any, help: str, choices: tuple | None = None) -> Any:
     meta = {"help": help}
     if choices is not None:
         meta["choices"] = tuple(choices)
-    if isinstance(default, (list, dict)):
-        raise TypeError("use tuples for sequence defaults")
+    if isinstance(default, (list, dict, set)):
+        raise TypeError(f"param({default!r}, {help!r}): a default must be immutable (use a tuple)")
     return dataclasses.field(default=default, metadata=meta)
 
 
@@ -40,7 +41,7 @@ def _coerce(value: Any, kind: Any, where: str) -> Any:
     origin = typing.get_origin(kind)
     if kind is Any:
         return value
-    if origin is typing.Union:
+    if origin in (typing.Union, types.UnionType):
         args = [a for a in typing.get_args(kind) if a is not type(None)]
         if value is None:
             return None
@@ -48,7 +49,12 @@ def _coerce(value: Any, kind: Any, where: str) -> Any:
     if origin in (tuple, list):
         if not isinstance(value, (list, tuple)):
             raise ConfigError(f"{where}: expected a list, got {value!r}")
-        (item,) = typing.get_args(kind)[:1] or (Any,)
+        args = typing.get_args(kind)
+        if origin is tuple and args and Ellipsis not in args:  # tuple[X, Y]: exactly these items
+            if len(value) != len(args):
+                raise ConfigError(f"{where}: expected a list of {len(args)} values, got {value!r}")
+            return tuple(_coerce(v, a, f"{where}[{i}]") for i, (v, a) in enumerate(zip(value, args)))
+        item = args[0] if args else Any
         return tuple(_coerce(v, item, f"{where}[{i}]") for i, v in enumerate(value))
     if kind is bool:
         if isinstance(value, bool):
@@ -79,6 +85,40 @@ def _coerce(value: Any, kind: Any, where: str) -> Any:
             return value
         raise ConfigError(f"{where}: expected a string, got {value!r}")
     return value
+
+
+_SCALARS = (bool, int, float, str)
+
+
+def _supported(kind: Any) -> bool:
+    """Whether :func:`_coerce` checks values of this annotation."""
+    origin = typing.get_origin(kind)
+    if kind is Any or kind in _SCALARS:
+        return True
+    if origin in (typing.Union, types.UnionType):
+        args = [a for a in typing.get_args(kind) if a is not type(None)]
+        return len(args) == 1 and _supported(args[0])
+    if origin in (tuple, list):
+        return all(_supported(a) for a in typing.get_args(kind) if a is not Ellipsis)
+    return False
+
+
+def check_schema(schema: type) -> None:
+    """A ConfigError if a ``Params`` field has no default, an annotation that parameters cannot be
+    checked against, or a default that its own checks refuse (caught when a component registers)."""
+    try:
+        hints = typing.get_type_hints(schema)
+    except Exception as exc:
+        raise ConfigError(f"Params annotations cannot be resolved: {exc}") from None
+    defaults = {}
+    for f in dataclasses.fields(schema):
+        if f.default is dataclasses.MISSING:
+            raise ConfigError(f"parameter '{f.name}' has no default (give every field param(default, help))")
+        if not _supported(hints[f.name]):
+            raise ConfigError(f"parameter '{f.name}': annotation {hints[f.name]!r} is not supported; use bool, "
+                              f"int, float, str, Any, tuple[X, ...] or X | None")
+        defaults[f.name] = f.default
+    parse_params(schema, defaults, "default Params")
 
 
 def fields(schema: type) -> list[dict]:
@@ -122,7 +162,11 @@ def parse_params(schema: type, values: Mapping[str, Any] | None, where: str) -> 
         raise ConfigError(f"{where}: {exc}") from None
     check = getattr(instance, "validate", None)
     if check is not None:
-        problem = check()
+        try:
+            problem = check()
+        except Exception as exc:
+            raise ConfigError(f"{where}: invalid parameters ({schema.__qualname__}.validate() raised "
+                              f"{type(exc).__name__}{': ' + str(exc) if str(exc) else ''})") from None
         if problem:
             raise ConfigError(f"{where}: {problem}")
     return instance

@@ -13,13 +13,14 @@ import dataclasses
 import importlib
 import importlib.metadata
 import os
+import traceback
 import warnings
 from typing import Any, Mapping
 
 import pluggy
 
-from .errors import RegistryError
-from .params import NoParams, closest, parse_params
+from .errors import ConfigError, DcfkitError, RegistryError
+from .params import NoParams, check_schema, closest, parse_params
 
 PROJECT = "dcfkit"
 KINDS = ("feature", "label", "regularizer", "solver", "search", "scale")
@@ -53,6 +54,16 @@ class Component:
 class Entry:
     cls: type
     provider: str
+    distribution: str | None = None  # "name version" of the plugin's package; None for built-ins
+
+
+def describe_error(exc: BaseException) -> str:
+    """``Type: message (at file:line)``: an exception as one line that says where it was raised."""
+    text = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
+    if isinstance(exc, SyntaxError) and exc.filename:
+        return f"{text} (at {exc.filename}:{exc.lineno})"
+    frames = traceback.extract_tb(exc.__traceback__)
+    return f"{text} (at {frames[-1].filename}:{frames[-1].lineno})" if frames else text
 
 
 class Registry:
@@ -60,11 +71,16 @@ class Registry:
 
     def __init__(self):
         self._entries: dict[str, dict[str, Entry]] = {k: {} for k in KINDS}
-        self._provider = "?"
+        self._ambiguous: dict[str, dict[str, list[str]]] = {k: {} for k in KINDS}
+        self._provider, self._distribution = "?", None
         self.failures: list[str] = []
 
     def register(self, cls: type) -> type:
-        """Register a component class; its ``kind`` and ``name`` must be set and new."""
+        """Register a component class; its ``kind`` and ``name`` must be set and new.
+
+        A name that two plugins both register is withdrawn: which one a config got would
+        depend on the order of installation, so using it is an error naming both.
+        """
         kind, name = getattr(cls, "kind", ""), getattr(cls, "name", "")
         if kind not in KINDS:
             raise RegistryError(f"{cls.__qualname__} (from {self._provider}): kind {kind!r} is not one of "
@@ -73,11 +89,22 @@ class Registry:
             raise RegistryError(f"{cls.__qualname__} (from {self._provider}): component has no name")
         if not dataclasses.is_dataclass(cls.Params):
             raise RegistryError(f"{kind} '{name}' (from {self._provider}): Params must be a dataclass")
+        try:
+            check_schema(cls.Params)
+        except ConfigError as exc:
+            raise RegistryError(f"{kind} '{name}' (from {self._provider}): {exc}") from None
+        if name in self._ambiguous[kind]:
+            self._ambiguous[kind][name].append(self._provider)
+            return cls
         existing = self._entries[kind].get(name)
         if existing is not None:
-            raise RegistryError(f"{kind} '{name}' from {self._provider} is already registered by "
-                                f"{existing.provider}")
-        self._entries[kind][name] = Entry(cls, self._provider)
+            if existing.distribution is None or self._distribution is None or existing.provider == self._provider:
+                raise RegistryError(f"{kind} '{name}' from {self._provider} is already registered by "
+                                    f"{existing.provider}")
+            del self._entries[kind][name]
+            self._ambiguous[kind][name] = [existing.provider, self._provider]
+            return cls
+        self._entries[kind][name] = Entry(cls, self._provider, self._distribution)
         return cls
 
     def names(self, kind: str) -> list[str]:
@@ -85,6 +112,10 @@ class Registry:
 
     def entry(self, kind: str, name: str) -> Entry:
         entries = self._check_kind(kind)
+        if name in self._ambiguous[kind]:
+            raise RegistryError(f"{kind} '{name}' is registered by more than one plugin "
+                                f"({' and '.join(self._ambiguous[kind][name])}), so it is not used; "
+                                f"uninstall all but one of them")
         if name not in entries:
             skipped = f"; skipped plugins: {' | '.join(self.failures)}" if self.failures else ""
             raise RegistryError(f"unknown {kind} '{name}'{closest(name, entries)}; "
@@ -111,24 +142,45 @@ class Registry:
             raise RegistryError(f"unknown component kind {kind!r}{closest(kind, KINDS)}; kinds: {', '.join(KINDS)}")
         return self._entries[kind]
 
-    def _run_plugin(self, pm: pluggy.PluginManager, plugin: Any, provider: str) -> None:
+    def plugin_versions(self, components) -> list[str]:
+        """The plugin packages (``"name version"``, sorted) behind ``(kind, name)`` components."""
+        found = {self._entries.get(kind, {}).get(name) for kind, name in components}
+        return sorted({e.distribution for e in found if e is not None and e.distribution})
+
+    def _fail(self, message: str) -> None:
+        """Record and warn about a plugin problem (``dcfkit components`` lists them)."""
+        self.failures.append(message)
+        warnings.warn(message, RuntimeWarning, stacklevel=3)
+
+    def _run_plugin(self, pm: pluggy.PluginManager, plugin: Any, provider: str,
+                    distribution: str | None = None) -> None:
         """Register one plugin's components; on failure undo them and remember why."""
         before = {k: dict(v) for k, v in self._entries.items()}
-        self._provider = provider
+        ambiguous = {k: {n: list(p) for n, p in v.items()} for k, v in self._ambiguous.items()}
+        self._provider, self._distribution = provider, distribution
         try:
             pm.register(plugin, name=provider)
             pm.check_pending()  # catches misspelt hook names
+            if not pm.get_hookcallers(plugin):
+                raise RegistryError(
+                    "it has no dcfkit hook: mark dcfkit_register_components with @dcfkit.registry.hookimpl"
+                    + (", and let the entry point name the module that holds it (not module:function)"
+                       if callable(plugin) else ""))
             others = [p for p in pm.get_plugins() if p is not plugin]
             pm.subset_hook_caller("dcfkit_register_components", remove_plugins=others)(registry=self)
-        except Exception as exc:  # a broken plugin must not break dcfkit
-            self._entries = before
+        except (Exception, SystemExit) as exc:  # a broken plugin must not break dcfkit
+            self._entries, self._ambiguous = before, ambiguous
             if pm.is_registered(plugin):
                 pm.unregister(plugin)
-            message = f"dcfkit plugin '{provider}' failed and was skipped: {exc}"
-            self.failures.append(message)
-            warnings.warn(message, RuntimeWarning, stacklevel=3)
+            self._fail(f"dcfkit plugin '{provider}' failed and was skipped: " + (str(exc) if isinstance(exc, DcfkitError)
+                                                              else describe_error(exc)))
         finally:
-            self._provider = "?"
+            self._provider, self._distribution = "?", None
+        for kind, clashes in self._ambiguous.items():  # names this plugin made ambiguous
+            for name, providers in clashes.items():
+                if providers != ambiguous[kind].get(name):
+                    self._fail(f"dcfkit plugins {' and '.join(providers)} all register {kind} '{name}', "
+                               f"so it is not used (uninstall all but one)")
 
 
 _REGISTRY: Registry | None = None
@@ -157,12 +209,13 @@ def build_registry(external: bool = True) -> Registry:
             if ep.value.split(":")[0] == "dcfkit.builtin":
                 continue
             provider = f"{ep.name} ({ep.value})"
+            dist = getattr(ep, "dist", None)
+            distribution = f"{dist.name} {dist.version}" if dist is not None else provider
             try:
                 plugin = ep.load()
-            except Exception as exc:
-                message = f"dcfkit plugin '{provider}' could not be imported and was skipped: {exc!r}"
-                registry.failures.append(message)
-                warnings.warn(message, RuntimeWarning, stacklevel=2)
+            except (Exception, SystemExit) as exc:
+                registry._fail(f"dcfkit plugin '{provider}' could not be imported and was skipped: "
+                               f"{describe_error(exc)}")
                 continue
-            registry._run_plugin(pm, plugin, provider)
+            registry._run_plugin(pm, plugin, provider, distribution)
     return registry

@@ -20,12 +20,12 @@ import cv2
 import numpy as np
 
 from .config import TrackerParams, load_config
-from .errors import InputError, TrackingError
+from .errors import DcfkitError, InputError, TrackingError
 from .features import extract_stack
 from .fft import make_fft
 from .labels import Detection, gaussian_label
 from .patches import box_to_centre_size, centre_size_to_box, sample
-from .registry import get_registry
+from .registry import describe_error, get_registry
 from .response import response, shift_spectrum, subpixel_peak
 from .scale import scale_limits
 
@@ -130,7 +130,7 @@ class Tracker:
 
     def _spectrum(self, patch: np.ndarray) -> np.ndarray:
         """(C, H, Wr) complex64 spectrum of the windowed features of a search patch."""
-        x = extract_stack(self.features, patch, self.params.cell_size)
+        x = extract_stack(self.features, patch, self.params.cell_size, f"frame {self.frame}: ")
         return self.fft.rfft2(x * self.window).astype(np.complex64, copy=False)
 
     def _sample(self, image: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
@@ -165,6 +165,7 @@ class Tracker:
         self.window = hann2d(g.filter_size)
         sigma = np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * self.params.output_sigma_factor
         self.base_label = gaussian_label(g.filter_size, sigma)
+        self.base_label.setflags(write=False)  # every frame's label starts from it
         self.w2 = (self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
                    else np.zeros(g.filter_size, np.float32))
         self.solver.reset()
@@ -217,13 +218,36 @@ class Tracker:
     def _train(self, image: np.ndarray, detection: Detection | None, xf: np.ndarray | None = None) -> None:
         if xf is None:
             xf = self._sample(image, self.position, self.scale)  # m^t at p^t
-        y, offsets = self.label.make(self.base_label, detection)  # Eq. (3)
+        y, offsets = self._label(detection)  # Eq. (3)
         yf = self.fft.rfft2(y).astype(np.complex64, copy=False)
         theta = self.temporal.params.theta if self.temporal is not None else 0.0
         self.hf = self.solver.train(xf, yf, self.w2, theta, self.fft)  # Eqs. (9)-(11)
         step = self.params.cell_size * self.scale
         self.last_distractors = (self.position[None, ::-1] + offsets[:, ::-1] * step) if len(offsets) else \
             np.zeros((0, 2))
+
+    def _label(self, detection: Detection | None) -> tuple[np.ndarray, np.ndarray]:
+        """The label component's ``(y, offsets)``, with what a (plugin) label got wrong said as a
+        TrackingError naming the frame."""
+        what = f"frame {self.frame}: label '{self.label.name}'"
+        try:
+            out = self.label.make(self.base_label, detection)
+        except DcfkitError:
+            raise
+        except Exception as exc:
+            raise TrackingError(f"{what} raised {describe_error(exc)}") from exc
+        if not (isinstance(out, tuple) and len(out) == 2):
+            raise TrackingError(f"{what}: make() must return (y, offsets), got {type(out).__name__}")
+        y, offsets = np.asarray(out[0]), np.asarray(out[1])
+        if y.shape != self.base_label.shape:
+            raise TrackingError(f"{what} returned y of shape {y.shape}, expected g's {self.base_label.shape}")
+        if not np.isfinite(y).all():
+            raise TrackingError(f"{what} returned NaN or infinite values")
+        if offsets.size == 0:
+            offsets = np.zeros((0, 2), int)
+        elif offsets.ndim != 2 or offsets.shape[1] != 2:
+            raise TrackingError(f"{what} returned offsets of shape {offsets.shape}, expected (N, 2) (dy, dx) cells")
+        return y.astype(np.float32, copy=False), offsets
 
     @staticmethod
     def _clamp(centre: np.ndarray, shape) -> np.ndarray:

@@ -1,14 +1,17 @@
 """The component registry: built-ins, plugins, duplicates and broken plugins."""
+import dataclasses
 import importlib.metadata
 import sys
 import types
 import warnings
 
+import numpy as np
 import pytest
 
 from dcfkit import registry as reg
-from dcfkit.errors import RegistryError
+from dcfkit.errors import ConfigError, RegistryError
 from dcfkit.labels import Label
+from dcfkit.params import param, parse_params
 
 
 class FakeEntryPoint:
@@ -39,6 +42,7 @@ def with_entry_points(monkeypatch, eps):
 
 PLUGIN = '''
 import dataclasses
+import numpy as np
 from dcfkit.registry import hookimpl
 from dcfkit.labels import Label
 from dcfkit.params import param
@@ -50,7 +54,7 @@ class Flat(Label):
     class Params:
         level: float = param(0.5, "constant value")
     def make(self, g, detection):
-        return g * 0 + self.params.level, None
+        return g * 0 + self.params.level, np.zeros((0, 2), int)
 
 @hookimpl
 def dcfkit_register_components(registry):
@@ -158,3 +162,132 @@ def test_bad_registrations_are_errors():
         r.register(Wrong)
     with pytest.raises(RegistryError, match=r"unknown component kind 'labels'.*did you mean 'label'"):
         r.names("labels")
+
+
+def test_a_name_two_plugins_register_is_withdrawn_and_their_other_components_stay(monkeypatch):
+    # which plugin won used to depend on entry-point order; results of either could be mixed up
+    both = PLUGIN.replace("registry.register(Flat)", "registry.register(Flat)\n    registry.register(Other)")
+    first = both.replace("@hookimpl", 'class Other(Flat):\n    name = "other_a"\n\n@hookimpl')
+    second = both.replace("@hookimpl", 'class Other(Flat):\n    name = "other_b"\n\n@hookimpl')
+    with_entry_points(monkeypatch, [install_plugin(monkeypatch, "dcfkit_test_a", first),
+                                    install_plugin(monkeypatch, "dcfkit_test_b", second)])
+    with pytest.warns(RuntimeWarning, match=r"dcfkit_test_a.*and dcfkit_test_b.*all register label 'flat'"):
+        r = reg.build_registry()
+    assert {"other_a", "other_b"} <= set(r.names("label")) and "flat" not in r.names("label")
+    with pytest.raises(RegistryError, match=r"label 'flat' is registered by more than one plugin "
+                                            r"\(dcfkit_test_a .* and dcfkit_test_b .*\)"):
+        r.build("label", "flat", "test: label")
+
+
+def test_a_plugin_registering_one_name_twice_is_skipped(monkeypatch):
+    twice = PLUGIN.replace("registry.register(Flat)", "registry.register(Flat)\n    registry.register(Flat)")
+    with_entry_points(monkeypatch, [install_plugin(monkeypatch, "dcfkit_test_twice", twice)])
+    with pytest.warns(RuntimeWarning, match=r"dcfkit_test_twice.*label 'flat'.*already registered by dcfkit_test_twice"):
+        r = reg.build_registry()
+    assert "flat" not in r.names("label")
+
+
+@pytest.mark.parametrize("source, message", [
+    (PLUGIN.replace("@hookimpl\n", ""), r"it has no dcfkit hook: mark dcfkit_register_components with "
+                                        r"@dcfkit.registry.hookimpl$"),
+    ("import sys\nsys.exit(2)", r"could not be imported and was skipped: SystemExit: 2 \(at "),
+    ("import json\njson.loads('{')", r"could not be imported and was skipped: JSONDecodeError: .* \(at .*:\d+\)"),
+    (PLUGIN.replace("registry.register(Flat)", "{}['label_class']"),
+     r"failed and was skipped: KeyError: 'label_class' \(at <string>:\d+\)"),
+])
+def test_plugin_problems_say_what_and_where(monkeypatch, source, message):
+    ep = install_plugin(monkeypatch, "dcfkit_test_problem", "")
+    def load():  # import the source now, as an entry point does
+        module = types.ModuleType("dcfkit_test_problem")
+        exec(compile(source, "<string>", "exec"), module.__dict__)
+        return module
+    ep.load = load
+    with_entry_points(monkeypatch, [ep])
+    with pytest.warns(RuntimeWarning) as shown:
+        r = reg.build_registry()
+    assert any(__import__("re").search(message, str(w.message)) for w in shown), [str(w.message) for w in shown]
+    assert "flat" not in r.names("label") and "gaussian" in r.names("label")
+
+
+def test_an_entry_point_naming_the_hook_function_gets_a_hint(monkeypatch):
+    ep = install_plugin(monkeypatch, "dcfkit_test_function", PLUGIN)
+    ep.value, ep.load = "dcfkit_test_function:dcfkit_register_components", \
+        lambda: sys.modules["dcfkit_test_function"].dcfkit_register_components
+    with_entry_points(monkeypatch, [ep])
+    with pytest.warns(RuntimeWarning, match=r"no dcfkit hook.*name the module that holds it \(not module:function\)"):
+        r = reg.build_registry()
+    assert "flat" not in r.names("label")
+
+
+@pytest.mark.parametrize("field, message", [
+    ("level: float = 0.5", None),
+    ("level: float = dataclasses.field(default=0.5)", None),
+    ("level: float = dataclasses.field(default_factory=float)", r"parameter 'level' has no default"),
+    ("level: int = param(2.5, 'a count')", r"default Params.level: expected an integer, got 2.5"),
+    ("level: np.float32 = param(0.5, 'x')", r"parameter 'level': annotation .*float32.* is not supported"),
+    ("level: 'float | None' = param(None, 'x')", None),
+    ("level: 'tuple[float, ...]' = param((1.0, 2.0), 'x')", None),
+])
+def test_params_schemas_are_checked_when_the_component_registers(field, message):
+    namespace = {"dataclasses": dataclasses, "np": np, "param": param}
+    exec(f"@dataclasses.dataclass(frozen=True)\nclass Params:\n    {field}\n", namespace)
+
+    class Checked(Label):
+        name = "checked"
+        Params = namespace["Params"]
+
+    r = reg.Registry()
+    if message is None:
+        r.register(Checked)
+        assert r.entry("label", "checked").cls is Checked
+    else:
+        with pytest.raises(RegistryError, match=r"label 'checked' \(from \?\): " + message):
+            r.register(Checked)
+
+
+def test_union_and_fixed_tuple_annotations_are_checked():
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        sigma: float | None = param(None, "optional width")
+        size: tuple[int, int] = param((3, 4), "rows, columns")
+
+        def validate(self):
+            assert self.size[0] > 0
+
+    assert parse_params(Params, {"sigma": "1e-3"}, "x").sigma == 1e-3
+    assert parse_params(Params, {"sigma": None}, "x").sigma is None
+    with pytest.raises(ConfigError, match=r"x.sigma: expected a number, got 'abc'"):
+        parse_params(Params, {"sigma": "abc"}, "x")
+    with pytest.raises(ConfigError, match=r"x.size: expected a list of 2 values, got \[1, 2, 3\]"):
+        parse_params(Params, {"size": [1, 2, 3]}, "x")
+    with pytest.raises(ConfigError, match=r"x.size\[1\]: expected an integer, got 'a'"):
+        parse_params(Params, {"size": [1, "a"]}, "x")
+    with pytest.raises(ConfigError, match=r"x: invalid parameters \(.*Params.validate\(\) raised AssertionError.*\)"):
+        parse_params(Params, {"size": [0, 1]}, "x")
+
+
+def test_result_hashes_change_with_the_version_of_a_plugin_the_config_uses(monkeypatch):
+    from dcfkit.ablation import _run_job, job_key
+    from dcfkit.config import load_config
+    from dcfkit.errors import DcfkitError
+    from dcfkit.evaluation import config_hash, dcfkit_version
+
+    def registry_with(version):
+        ep = install_plugin(monkeypatch, "dcfkit_test_versioned", PLUGIN)
+        ep.dist = types.SimpleNamespace(name="dcfkit-test-versioned", version=version)
+        with_entry_points(monkeypatch, [ep])
+        monkeypatch.setattr(reg, "_REGISTRY", reg.build_registry())
+
+    monkeypatch.setattr(reg, "_REGISTRY", reg.build_registry(external=False))
+    plain = config_hash(load_config("strcf"))
+    registry_with("0.1.0")
+    flat = load_config("strcf", {"label.name": "flat"})
+    assert config_hash(load_config("strcf")) == plain  # built-ins only: unchanged by installed plugins
+    assert reg.get_registry().plugin_versions([("label", "flat")]) == ["dcfkit-test-versioned 0.1.0"]
+    old, old_key = config_hash(flat), job_key(flat)
+    registry_with("0.2.0")
+    assert config_hash(flat) != old and job_key(flat) != old_key
+    monkeypatch.setattr("dcfkit.ablation._worker_ready", True)  # no worker set-up in the test process
+    with pytest.raises(DcfkitError, match=r"this worker's plugins \(dcfkit-test-versioned 0.2.0\) are not the client's"):
+        _run_job(flat, None, "unused", old_key, dcfkit_version())
+    monkeypatch.setattr(reg, "_REGISTRY", None)

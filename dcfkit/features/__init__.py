@@ -8,12 +8,14 @@ the maps of the configured features along the channel axis (the paper uses gray 
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import cv2
 import numpy as np
 
+from ..errors import DcfkitError, TrackingError
 from ..params import param
-from ..registry import Component
+from ..registry import Component, describe_error
 from .colornames import load_table
 from .fhog import fhog
 
@@ -103,9 +105,31 @@ class ColorNames(Feature):
 BUILTIN = (Gray, FHOG, ColorNames)
 
 
-def extract_stack(features, patch: np.ndarray, cell_size: int) -> np.ndarray:
-    """Concatenate every feature's map of ``patch`` (gray patches are treated as BGR)."""
+def checked_map(feature: Feature, patch: np.ndarray, cell_size: int, where: str) -> np.ndarray:
+    """``feature.extract``, with what a (plugin) feature got wrong said as a TrackingError."""
+    what = f"{where}feature '{feature.name}'"
+    try:
+        fmap = feature.extract(patch, cell_size)
+    except DcfkitError:
+        raise
+    except Exception as exc:
+        raise TrackingError(f"{what} raised {describe_error(exc)}") from exc
+    expected = (feature.channels(), patch.shape[0] // cell_size, patch.shape[1] // cell_size)
+    shape = getattr(fmap, "shape", None)
+    if shape != expected:
+        got = f"shape {shape}" if shape is not None else type(fmap).__name__
+        raise TrackingError(f"{what} returned {got} for a {patch.shape[0]}x{patch.shape[1]} patch, expected "
+                            f"(channels(), H // cell_size, W // cell_size) = {expected}")
+    if not math.isfinite(float(np.sum(fmap, dtype=np.float64))):
+        raise TrackingError(f"{what} returned NaN or infinite values")
+    return fmap
+
+
+def extract_stack(features, patch: np.ndarray, cell_size: int, where: str = "") -> np.ndarray:
+    """Concatenate every feature's map of ``patch`` (gray patches are treated as BGR);
+    ``where`` (e.g. 'frame 3: ') prefixes errors."""
     if patch.ndim == 2:
         patch = cv2.cvtColor(patch, cv2.COLOR_GRAY2BGR)
-    maps = [f.extract(patch, cell_size) for f in features]
-    return maps[0] if len(maps) == 1 else np.concatenate(maps, axis=0)
+    maps = [checked_map(f, patch, cell_size, where) for f in features]
+    stack = maps[0] if len(maps) == 1 else np.concatenate(maps, axis=0)
+    return stack.astype(np.float32, copy=False)
