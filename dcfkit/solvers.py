@@ -2,13 +2,17 @@
 
 Objective solved each frame (Eq. 2, with λ = 1 on the spatial term as in Eq. 10):
 
-    E(h) = ½‖ŷ - Σ_c conj(ĥ_c) m̂_c‖² + θ/2 Σ_c‖ĥ_c - v̂ˡ_c‖² + ½ Σ_c‖w ⊙ h_c‖²,
+    E(h) = ½‖y - Σ_c m_c ⋆ h_c‖² + θ/2 Σ_c‖ĥ_c - v̂ˡ_c‖² + ½ Σ_c‖w ⊙ h_c‖²,
 
-the first two terms in the (unnormalised) Fourier domain, i.e. K times their spatial
-value. ADMM splits h = v and alternates (per frame, from h = u = 0, Remark 1):
+the data and spatial terms at their spatial value, the temporal term (and the ADMM penalty)
+on unnormalised spectra, i.e. θK in spatial terms. This is the scaling of the authors' code,
+for which the published θ, w and γ were chosen (STRCF's, BACF's and DR²Track's MATLAB
+solve the v-step with B = S_xx + T(γ + μ) and the data terms over T); read with every term
+on the spectra, Eqs. (7)–(9) would weigh the data K times more (K ≈ 2500: the temporal term
+all but vanishes). ADMM splits h = v and alternates (per frame, from h = u = 0, Remark 1):
 
-* v-step (Eqs. 6–9): per frequency, (a aᴴ + (θ+γ) I) v = a conj(ŷ) + θ v̂ˡ + γ ĥ - û, with
-  a = m̂ at that frequency, solved by Sherman–Morrison;
+* v-step (Eqs. 6–9): per frequency, (a aᴴ/K + (θ+γ) I) v = a conj(ŷ)/K + θ v̂ˡ + γ ĥ - û,
+  with a = m̂ at that frequency, solved by Sherman–Morrison;
 * h-step (Eq. 10): h = γK (v + u/γ) / (w² + γK) in the spatial domain;
 * multiplier (Eq. 11): û ← û + γ (v̂ - ĥ), then γ ← min(γ_max, β γ).
 
@@ -78,8 +82,11 @@ def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: n
 
     shape = w2.shape
     K = float(shape[0] * shape[1])
-    xf = np.ascontiguousarray(xf, np.complex64)
-    yf = np.ascontiguousarray(yf, np.complex64)
+    # the data term at its spatial value (Parseval: 1/K of its unnormalised-spectrum value),
+    # the temporal and penalty terms on the spectra: (a aᴴ/K + (θ+γ) I) v = a conj(ŷ)/K + ...
+    s = np.float32(1.0 / np.sqrt(K))
+    xf = np.ascontiguousarray(np.multiply(xf, s, dtype=np.complex64))
+    yf = np.ascontiguousarray(np.multiply(yf, s, dtype=np.complex64))
     if v_prev is None:  # no previous filter, no temporal term (v_prev only fills the argument)
         theta, v_prev = 0.0, xf
     v_prev = np.ascontiguousarray(v_prev, np.complex64)

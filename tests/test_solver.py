@@ -20,9 +20,12 @@ def correlation_matrix(m: np.ndarray) -> np.ndarray:
 
 
 def dense_minimiser(m, y, w2, theta, h_prev):
-    """argmin K/2‖y - A h‖² + Kθ/2‖h - h_prev‖² + ½ Σ_c‖w ⊙ h_c‖² by a dense linear solve.
+    """argmin ½‖y - A h‖² + Kθ/2‖h - h_prev‖² + ½ Σ_c‖w ⊙ h_c‖² by a dense linear solve.
 
-    Entries with w² = inf are fixed to zero (BACF's cropping matrix)."""
+    The data and spatial terms at their spatial value, the temporal one K times (θ weighs
+    unnormalised spectra), as in the authors' code: its v-step solves with
+    B = S_xx + T (γ + μ) and the data terms divided by T. Entries with w² = inf are fixed to
+    zero (BACF's cropping matrix)."""
     C, H, W = m.shape
     K = H * W
     A = correlation_matrix(m)
@@ -30,8 +33,8 @@ def dense_minimiser(m, y, w2, theta, h_prev):
     free = np.isfinite(d)
     A = A[:, free]
     hp = h_prev.reshape(-1)[free] if h_prev is not None else np.zeros(free.sum())
-    lhs = K * A.T @ A + K * theta * np.eye(free.sum()) + np.diag(d[free])
-    rhs = K * A.T @ y.reshape(-1) + K * theta * hp
+    lhs = A.T @ A + K * theta * np.eye(free.sum()) + np.diag(d[free])
+    rhs = A.T @ y.reshape(-1) + K * theta * hp
     h = np.zeros(C * K)
     h[free] = np.linalg.solve(lhs, rhs)
     return h.reshape(C, H, W)
@@ -91,6 +94,24 @@ def test_admm_with_growing_penalty_reaches_the_minimum_objective():
     p = ADMMParams(iterations=300, gamma0=0.01, beta=2.0, gamma_max=0.1)
     vf, _ = admm(fft.rfft2(m).astype(np.complex64), fft.rfft2(y).astype(np.complex64), w2, 0.0, None, p, fft)
     assert np.abs(fft.irfft2(vf, shape) - expected).max() < 2e-3 * np.abs(expected).max()
+
+
+def test_first_v_step_is_the_per_frequency_solve_of_the_reference_scaling():
+    """E = 1 from h = u = 0: at every frequency (x xᴴ/K + (θ+γ) I) v = x conj(ŷ)/K + θ v_prev,
+    the authors' v-step (B = S_xx + T(γ + μ), data terms over T), by numpy.linalg.solve."""
+    rng = np.random.default_rng(6)
+    fft = make_fft("scipy")
+    shape, C, theta, gamma = (6, 7), 3, 0.4, 2.0
+    xf = fft.rfft2(rng.standard_normal((C, *shape)).astype(np.float32)).astype(np.complex64)
+    yf = fft.rfft2(rng.standard_normal(shape).astype(np.float32)).astype(np.complex64)
+    v_prev = fft.rfft2(rng.standard_normal((C, *shape)).astype(np.float32)).astype(np.complex64)
+    vf, _ = admm(xf, yf, np.ones(shape, np.float32), theta, v_prev, ADMMParams(iterations=1, gamma0=gamma), fft)
+    K = shape[0] * shape[1]
+    for i, j in np.ndindex(xf.shape[1:]):
+        x = xf[:, i, j].astype(complex)
+        lhs = np.outer(x, x.conj()) / K + (theta + gamma) * np.eye(C)
+        expected = np.linalg.solve(lhs, x * np.conj(yf[i, j]) / K + theta * v_prev[:, i, j])
+        np.testing.assert_allclose(vf[:, i, j], expected, rtol=2e-4, atol=1e-5 * np.abs(expected).max())
 
 
 def test_sherman_morrison_matches_linalg_solve():
