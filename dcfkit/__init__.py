@@ -1,7 +1,8 @@
 """dcfkit: discriminative correlation filter trackers assembled from registered components."""
 from __future__ import annotations
 
-__version__ = "0.2.0"  # part of every result key (dcfkit.evaluation.config_hash): bump it when boxes change; docs/changes.md
+# part of every result key (dcfkit.evaluation.config_hash): bump it when boxes change (docs/changes.md)
+__version__ = "0.2.0"
 
 __all__ = ["__version__", "load_tracker", "load_config", "Tracker"]
 

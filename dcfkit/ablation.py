@@ -15,14 +15,16 @@ Results are stored per *run*, keyed by what determines the boxes::
 ``key`` is :func:`dcfkit.evaluation.config_hash` of the resolved config without its
 ``name`` and ``description`` (which do not change a box) plus the dcfkit version and the
 versions of the plugin packages it uses, so two variants with the same parameters (the
-base point of every one-at-a-time sweep) share one run. The files are written by :mod:`dcfkit.evaluation`'s one-sequence runner:
-temporary file + ``os.replace``, sidecar last. A rerun skips runs whose sidecar has the
-key and whose ``.txt`` has one line per frame; failed runs are retried.
+base point of every one-at-a-time sweep) share one run. The files are written by
+:mod:`dcfkit.evaluation`'s one-sequence runner: temporary file + ``os.replace``, sidecar
+last. A rerun skips runs whose sidecar has the key and whose ``.txt`` has one line per
+frame; failed runs are retried.
 
 Runs go to a local process pool (spawned workers, one BLAS/OpenMP/OpenCV thread each,
 killed with the parent) or to dask.distributed. Then ``OUT/summary.{md,csv}``,
 ``OUT/per_sequence.{md,csv}``, ``OUT/summary.json`` and, for a grid, one
-``OUT/sensitivity_<parameter>.png`` per parameter are written.
+``OUT/sensitivity_<parameter>.png`` per parameter (else ``OUT/precision`` and
+``OUT/success`` plots, PNG and SVG) are written.
 """
 from __future__ import annotations
 
@@ -135,6 +137,15 @@ def job_key(config: Mapping, version: str | None = None) -> str:
     return config_hash({k: v for k, v in config.items() if k not in LABEL_KEYS}, version)
 
 
+def variant_names(jobs: Iterable[Job]) -> dict[str, list[str]]:
+    """key -> the names of the variants that share that run, in spec order."""
+    names: dict[str, list[str]] = {}
+    for job in jobs:
+        if job.variant not in names.setdefault(job.key, []):
+            names[job.key].append(job.variant)
+    return names
+
+
 def _find_spec(source: str | os.PathLike) -> Path:
     path = Path(source)
     if path.is_file():
@@ -199,7 +210,11 @@ def _load(spec_path: Path, config: Any, overrides: Mapping, where: str, key: str
     try:
         return load_config(source, overrides), source
     except DcfkitError as exc:
-        raise ConfigError(f"{spec_path}: {where}: {exc}") from None
+        try:
+            load_config(source)
+        except DcfkitError:
+            raise ConfigError(f"{spec_path}: {where}: {exc}") from None
+        raise ConfigError(f"{spec_path}: {where} overrides ({', '.join(overrides)}): {exc}") from None
 
 
 def _format_value(value: Any) -> str:
@@ -494,6 +509,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
             with contextlib.suppress(OSError):
                 stale.unlink()
         tasks: dict[tuple[str, str], _Task] = {}
+        variants = variant_names(job_list)
         for job in job_list:
             if (job.key, job.sequence) not in tasks:
                 tasks[job.key, job.sequence] = _Task(job.key, job.variant, job.config, by_name[job.sequence],
@@ -522,7 +538,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
                 result["done"].append((task.key, task.seq.name))
             else:
                 result["failed"][task.key, task.seq.name] = res["error"]
-                bar.write(f"FAILED {task.variant}: {res['error']}")
+                bar.write(f"FAILED {', '.join(variants[task.key])}: {res['error']}")
             bar.set_postfix_str(f"{task.variant} / {task.seq.name}", refresh=False)
             bar.update(1)
 
@@ -625,6 +641,11 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     files.append(path)
     if spec.grid is not None:
         files += plot_sensitivity(spec, overall, out)
+    else:  # named variants: the OTB plots, one curve each
+        from .report import plot_curves
+
+        for kind in ("precision", "success"):
+            files += plot_curves(scores["curves"], kind, out / kind)
     return {"overall": overall, "per_sequence": per_sequence, "jobs": job_rows, "files": files}
 
 
@@ -763,6 +784,7 @@ def cmd_ablate(args: argparse.Namespace) -> int:
     print(format_rows(summary["overall"], "markdown", SUMMARY_COLUMNS), end="")
     print(f"\n{spec.name}: {len(res['jobs'])} jobs ({res['runs']} distinct runs): {len(res['done'])} run, "
           f"{len(res['skipped'])} already done, {len(res['failed'])} failed -> {Path(args.out)}")
+    variants = variant_names(res["jobs"])
     for (key, seq), message in res["failed"].items():
-        print(f"  FAILED [{key}] {message}")
+        print(f"  FAILED {', '.join(variants.get(key, []))} [{key}] {message}")
     return 1 if res["failed"] else 0

@@ -172,8 +172,8 @@ class Registry:
             self._entries, self._ambiguous = before, ambiguous
             if pm.is_registered(plugin):
                 pm.unregister(plugin)
-            self._fail(f"dcfkit plugin '{provider}' failed and was skipped: " + (str(exc) if isinstance(exc, DcfkitError)
-                                                              else describe_error(exc)))
+            why = str(exc) if isinstance(exc, DcfkitError) else describe_error(exc)
+            self._fail(f"dcfkit plugin '{provider}' failed and was skipped: {why}")
         finally:
             self._provider, self._distribution = "?", None
         for kind, clashes in self._ambiguous.items():  # names this plugin made ambiguous

@@ -123,7 +123,7 @@ def test_shipped_specs_expand():
     ("dataset: {name: otb}\nvariant: {a: {config: dr2track}}\n", ["'variant'", "did you mean 'variants'"]),
     ("dataset: {name: otb}\nvariants: {a: {overrides: {label.mu: 1}}}\n", ["variants.a.config", "missing"]),
     ("dataset: {name: otb}\nvariants: {a: {config: dr2track, overrides: {label.mux: 1}}}\n",
-     ["variants.a", "mux", "did you mean 'mu'"]),
+     ["variants.a overrides (label.mux):", "did you mean 'mu'"]),  # the typo is the spec's, not the config's
     ("dataset: {name: otb}\nvariants: {a: {config: nope.yaml}}\n", ["variants.a", "config 'nope.yaml' not found"]),
     ("dataset: {name: otb}\nvariants: {a: {config: dr2track, overrides: [label.mu]}}\n",
      ["variants.a.overrides", "mapping of dotted keys"]),
@@ -196,10 +196,25 @@ def test_cli_runs_and_lists_jobs(tmp_path, data, capsys):
     printed = capsys.readouterr().out
     assert printed.startswith("| variant | precision | auc | fps | sequences | failed |")
     assert "1 jobs (1 distinct runs): 1 run, 0 already done, 0 failed" in printed
+    assert all((tmp_path / "out" / f"{kind}.{ext}").is_file() for kind in ("precision", "success")
+               for ext in ("png", "svg"))  # named variants: the OTB plots
     assert cli.main(["ablate", spec, "--out", out, "--sequences", "seqC,seqB", "--dry-run"]) == 0
     key = expand(load_spec(spec))[0].key
     assert capsys.readouterr().out.splitlines() == [f"todo  {key}  s  seqC", f"done  {key}  s  seqB",
                                                     "2 jobs, 2 distinct runs"]
+
+
+def test_cli_names_the_variants_of_a_failed_run(tmp_path, data, capsys):
+    (data / "seqB" / "img" / "0003.jpg").write_bytes(b"not a jpeg")
+    spec = str(write_spec(tmp_path / "spec.yaml", "dataset: {name: otb, root: data}\n"
+                                                  "variants: {one: strcf, two: {config: strcf}}\n"))
+    assert cli.main(["ablate", spec, "--out", str(tmp_path / "out"), "--sequences", "seqB", "--jobs", "1",
+                     "--no-progress"]) == 1
+    key = expand(load_spec(spec))[0].key
+    printed = capsys.readouterr().out.splitlines()
+    assert [line.split(": ")[0] for line in printed if line.startswith("FAILED")] == ["FAILED one, two"]  # as it runs
+    failed = [line for line in printed if line.startswith("  FAILED")]  # in the summary
+    assert len(failed) == 1 and failed[0].startswith(f"  FAILED one, two [{key}] ") and "0003.jpg" in failed[0]
 
 
 # --------------------------------------------------------------------------- running
