@@ -9,12 +9,21 @@ from dcfkit.features import ColorNames, Gray, cell_average
 from dcfkit.features import colornames as cn
 
 
+# SHA-256 of the 32768x10 float32 normalised CN table compiled into opencv-contrib-python-headless,
+# written here independently of the loader's own constant
+PUBLISHED_SHA256 = "e6a0a45f68cf5880d018f9e2f82dff180e992296d335b0fa8eb253b9db403ec0"
+
+
 def test_table_is_found_and_verified():
     table = cn.load_table()
     assert table.shape == (32768, 10) and table.dtype == np.float32
-    assert hashlib.sha256(table.tobytes()).hexdigest() == cn.SHA256
+    assert hashlib.sha256(table.tobytes()).hexdigest() == PUBLISHED_SHA256 == cn.SHA256
     # the published first row of the normalised CN table
     np.testing.assert_allclose(table[0, :4], [0.45975, 0.014802, 0.044289, -0.028193], rtol=1e-6)
+    # each row is an 11-name probability vector p projected orthonormally onto the sum-zero
+    # subspace: |row|² = |p|² - 1/11, in [0, 10/11], reaching 10/11 for a certain colour name
+    norms = np.sum(table.astype(np.float64) ** 2, axis=1)
+    assert norms.min() >= 0 and norms.max() == pytest.approx(10 / 11, abs=1e-5)
 
 
 def test_table_index_is_r_plus_32g_plus_1024b():

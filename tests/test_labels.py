@@ -54,3 +54,19 @@ def test_without_detection_or_with_flat_response_the_label_is_the_gaussian():
     flat = Detection(np.zeros((8, 8), np.float32), (0, 0), (2.0, 2.0))
     assert np.array_equal(label.make(g, flat)[0], g)
     assert np.array_equal(Gaussian().make(g, flat)[0], g)
+
+
+def test_exclusion_zone_and_wrapped_offsets_of_the_distractors():
+    """P^T of Eq. (3) keeps maxima more than half a target size from the peak, measuring circular
+    offsets: a peak near the map's edge has its neighbours across the edge."""
+    r = np.zeros((20, 20), np.float32)
+    r[18, 1] = 1.0  # the target's peak; target 4x6 cells: excluded if |dy| <= 2 and |dx| <= 3
+    r[0, 1] = 0.9   # dy = +2 across the edge: inside the zone
+    r[18, 4] = 0.8  # dx = +3: inside
+    r[18, 17] = 0.6  # dx = -4 across the edge: a distractor
+    r[15, 1] = 0.5  # dy = -3: a distractor
+    r[5, 10] = 0.3  # dy = -13 = +7 circularly, dx = +9
+    det = Detection(r, (18, 1), (4.0, 6.0))
+    offsets, values = DistractorRepressed().distractors(det)
+    assert offsets.tolist() == [[0, -4], [-3, 0], [7, 9]]
+    np.testing.assert_allclose(values, [0.6, 0.5, 0.3])

@@ -72,3 +72,16 @@ def test_shift_spectrum_matches_roll_for_whole_cells():
     x = np.random.default_rng(2).standard_normal((3, 8, 10)).astype(np.float32)
     shifted = fft.irfft2(shift_spectrum(fft.rfft2(x), 2, -3, (8, 10)), (8, 10))
     np.testing.assert_allclose(shifted, np.roll(x, (-2, 3), axis=(1, 2)), atol=1e-5)
+
+
+def test_subpixel_peak_of_a_map_whose_hessian_has_a_cross_term():
+    """cos(a·dy) + cos(b·dx) + cos(a·dy + b·dx), dy = y - y0, dx = x - x0: band-limited, maximal (3) at
+    (y0, x0), with ∂²/∂y∂x = -ab ≠ 0 there, so a Newton step without the cross term misses it."""
+    H, W, y0, x0 = 16, 16, 0.4, 0.35
+    y = np.arange(H)[:, None]
+    x = np.arange(W)[None, :]
+    a, b = 2 * np.pi / H, 2 * np.pi / W
+    r = np.cos(a * (y - y0)) + np.cos(b * (x - x0)) + np.cos(a * (y - y0) + b * (x - x0))
+    got_y, got_x, value = subpixel_peak(r.astype(np.float32))
+    assert got_y == pytest.approx(y0, abs=1e-3) and got_x == pytest.approx(x0, abs=1e-3)
+    assert value == pytest.approx(3.0, rel=1e-4)

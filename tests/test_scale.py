@@ -40,3 +40,6 @@ def test_pyramid_factors_and_limits():
     assert pyramid.update(None, np.zeros(2), 3.0) == 2.0 and pyramid.update(None, np.zeros(2), 0.1) == 0.5
     lo, hi = scale_limits(np.array([10.0, 20.0]), np.array([100.0, 100.0]), (360, 480))
     assert lo == pytest.approx(0.05) and hi == pytest.approx(24.0)
+    # the search region keeps >= 5 px on its shorter side; the target fits on both axes
+    lo, hi = scale_limits(np.array([40.0, 10.0]), np.array([100.0, 20.0]), (720, 1280))
+    assert lo == pytest.approx(0.25) and hi == pytest.approx(18.0)

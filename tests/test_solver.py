@@ -139,3 +139,43 @@ def test_skipping_the_last_h_step_leaves_v_unchanged():
     v_full, h_full = admm(xf, yf, w2, 12.0, v_prev, p, fft, need_h=True)
     assert h_none is None and h_full is not None
     np.testing.assert_array_equal(v_fast, v_full)
+
+
+def reference_admm(m, y, w2, theta, h_prev, p: ADMMParams):
+    """Eqs. (9)-(11) written out on full spectra (numpy.fft.fft2): per frequency a dense solve of
+    (a aᴴ/K + (θ+γ) I) v = a conj(ŷ)/K + θ v̂ˡ + γ ĥ - û, the h-step γK (v + u/γ) / (w² + γK) in
+    the spatial domain, û ← û + γ (v̂ - ĥ), and only then γ ← min(γmax, βγ). Returns v̂."""
+    C, H, W = m.shape
+    K = H * W
+    M, Y, V_prev = np.fft.fft2(m), np.fft.fft2(y), np.fft.fft2(h_prev)
+    h_hat, u_hat, v_hat = (np.zeros((C, H, W), complex) for _ in range(3))
+    gamma = p.gamma0
+    for _ in range(p.iterations):
+        for i, j in np.ndindex(H, W):
+            a = M[:, i, j]
+            lhs = np.outer(a, a.conj()) / K + (theta + gamma) * np.eye(C)
+            rhs = a * np.conj(Y[i, j]) / K + theta * V_prev[:, i, j] + gamma * h_hat[:, i, j] - u_hat[:, i, j]
+            v_hat[:, i, j] = np.linalg.solve(lhs, rhs)
+        h = np.fft.ifft2(v_hat + u_hat / gamma).real * (gamma * K) / (w2 + gamma * K)
+        h_hat = np.fft.fft2(h)
+        u_hat = u_hat + gamma * (v_hat - h_hat)
+        gamma = min(p.gamma_max, p.beta * gamma)
+    return v_hat
+
+
+@pytest.mark.parametrize("p", [ADMMParams(iterations=4, gamma0=1.0, beta=10.0, gamma_max=50.0),  # γ: 1, 10, 50, 50
+                               ADMMParams(iterations=2, gamma0=1.0, beta=10.0, gamma_max=0.1)])  # STRCF's 1, 0.1
+def test_the_few_iterations_trackers_run_follow_the_penalty_schedule(p):
+    """Not converged: E = 4 or 2 iterations with a growing or shrinking γ, as the shipped configs
+    run them, against the written-out reference (catches a γ updated before the multiplier)."""
+    rng = np.random.default_rng(7)
+    fft = make_fft("scipy")
+    shape, C, theta = (6, 7), 3, 0.5
+    m = rng.standard_normal((C, *shape))
+    y = rng.standard_normal(shape)
+    h_prev = rng.standard_normal((C, *shape))
+    w2 = rng.uniform(0, 3000, shape)
+    expected = reference_admm(m, y, w2, theta, h_prev, p)[..., : shape[1] // 2 + 1]
+    vf, _ = admm(fft.rfft2(m).astype(np.complex64), fft.rfft2(y).astype(np.complex64), w2.astype(np.float32),
+                 theta, fft.rfft2(h_prev).astype(np.complex64), p, fft)
+    np.testing.assert_allclose(vf, expected, rtol=0, atol=2e-4 * np.abs(expected).max())

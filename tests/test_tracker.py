@@ -5,8 +5,9 @@ import pytest
 import dcfkit
 from dcfkit.errors import InputError, TrackingError
 from dcfkit.features import Feature
-from dcfkit.labels import Label
+from dcfkit.labels import Label, gaussian_label
 from dcfkit.metrics import score_sequence
+from dcfkit.response import shift_spectrum
 from dcfkit.synthetic import make_sequence
 
 CONFIGS = ["strcf", "bacf", "dr2track", "configs/ablations/dr2track_no_dr.yaml",
@@ -263,3 +264,74 @@ def test_a_feature_returning_the_wrong_thing_is_named_with_the_frame(extract, ma
     tracker.features.append(_BadFeature(extract))
     with pytest.raises(TrackingError, match=r"^frame 1: feature 'bad_feature' " + match):
         tracker.init(sequence.frames[0], sequence.ground_truth[0])
+
+
+@pytest.mark.parametrize("config, scale, cells, sigma, rows, cols", [
+    # 40x30 box: search square 5·√1200 = 173.2 px. STRCF: area 30000 within [150², 200²], so scale 1,
+    # 43 cells of 4 px, target 7.5x10 cells (floored 7x10): σ = √70 / 16, box rows 18-24, cols 16-25
+    ("strcf", 1.0, 43, np.sqrt(70) / 16, (18, 25), (16, 26)),
+    # DR²Track: the sample is 200², scale √(30000/40000), 50 cells, target 8.66x11.5 cells (8x11):
+    # σ = √88 · 0.058, box rows 21-28, cols 19-29
+    ("dr2track", np.sqrt(0.75), 50, np.sqrt(88) * 0.058, (21, 29), (19, 30)),
+])
+def test_first_frame_geometry_label_and_window_hand_computed(config, scale, cells, sigma, rows, cols, sequence):
+    tracker = dcfkit.load_tracker(config)
+    tracker.init(sequence.frames[0], (100.0, 80.0, 40.0, 30.0))
+    assert tracker.scale == pytest.approx(scale) and tracker.geometry.filter_size == (cells, cells)
+    np.testing.assert_allclose(tracker.base_label, gaussian_label((cells, cells), sigma), atol=1e-7)
+    inside = np.zeros((cells, cells), bool)
+    inside[rows[0]:rows[1], cols[0]:cols[1]] = True
+    np.testing.assert_allclose(tracker.w2, np.where(inside, 1e-6, 1e10), rtol=1e-6)
+
+
+class _RecordingScale:
+    """Stands in for the scale estimator: keeps the scale and records where it was asked to look."""
+
+    def __init__(self):
+        self.centres = []
+
+    def search_factors(self):
+        return np.ones(1)
+
+    def update(self, image, centre, scale):
+        self.centres.append(np.array(centre, float))
+        return scale
+
+
+def test_the_scale_is_estimated_at_the_new_position_not_the_search_centre(sequence):
+    tracker = dcfkit.load_tracker("dr2track")
+    tracker.init(sequence.frames[0], sequence.ground_truth[0])
+    recorder = tracker.scale_estimator = _RecordingScale()
+    for frame in sequence.frames[1:6]:
+        centre = tracker.search.centre()
+        tracker.update(frame)
+        np.testing.assert_array_equal(recorder.centres[-1], tracker.position)  # Algorithm 1: at p^t
+    assert np.abs(centre - tracker.position).max() > 1  # the target moved off the search centre
+
+
+def test_training_on_the_shifted_detection_sample_moves_it_to_the_new_position(sequence):
+    """training_sample: shift trains on the detection sample translated by p^t - centre; it must
+    line up with the sample taken at p^t better than the opposite translation does."""
+    tracker = dcfkit.load_tracker("strcf", overrides={"tracker.training_sample": "shift", "scale.n_scales": 1})
+    frames = sequence.frames
+    tracker.init(frames[0], sequence.ground_truth[0])
+    trained = []
+    original = tracker.solver.train
+    tracker.solver.train = lambda xf, *rest: (trained.append(xf), original(xf, *rest))[1]
+    for frame in frames[1:4]:
+        tracker.update(frame)
+    centre, frame = tracker.search.centre(), frames[4]
+    tracker.update(frame)
+    size, step = tracker.geometry.filter_size, tracker.params.cell_size * tracker.scale
+    moved = (tracker.position - centre) / step
+    assert np.abs(moved).max() > 0.5  # at least half a cell
+    at_position = tracker.fft.irfft2(tracker._sample(frame, tracker.position, tracker.scale), size)
+    detection = tracker._sample(frame, centre, tracker.scale)
+
+    def agreement(xf):
+        x = tracker.fft.irfft2(xf, size)
+        return float(np.sum(x * at_position) / np.sqrt(np.sum(x * x) * np.sum(at_position * at_position)))
+
+    used = agreement(trained[-1])
+    assert used > agreement(shift_spectrum(detection, -moved[0], -moved[1], size))
+    assert used > agreement(detection)  # and better than not moving it at all
