@@ -179,14 +179,6 @@ def test_a_name_two_plugins_register_is_withdrawn_and_their_other_components_sta
         r.build("label", "flat", "test: label")
 
 
-def test_a_plugin_registering_one_name_twice_is_skipped(monkeypatch):
-    twice = PLUGIN.replace("registry.register(Flat)", "registry.register(Flat)\n    registry.register(Flat)")
-    with_entry_points(monkeypatch, [install_plugin(monkeypatch, "dcfkit_test_twice", twice)])
-    with pytest.warns(RuntimeWarning, match=r"dcfkit_test_twice.*'flat'.*already registered by dcfkit_test_twice"):
-        r = reg.build_registry()
-    assert "flat" not in r.names("label")
-
-
 @pytest.mark.parametrize("source, message", [
     (PLUGIN.replace("@hookimpl\n", ""), r"it has no dcfkit hook: mark dcfkit_register_components with "
                                         r"@dcfkit.registry.hookimpl$"),
@@ -194,6 +186,8 @@ def test_a_plugin_registering_one_name_twice_is_skipped(monkeypatch):
     ("import json\njson.loads('{')", r"could not be imported and was skipped: JSONDecodeError: .* \(at .*:\d+\)"),
     (PLUGIN.replace("registry.register(Flat)", "{}['label_class']"),
      r"failed and was skipped: KeyError: 'label_class' \(at <string>:\d+\)"),
+    (PLUGIN.replace("registry.register(Flat)", "registry.register(Flat)\n    registry.register(Flat)"),
+     r"failed and was skipped: label 'flat' from dcfkit_test_problem .* already registered by dcfkit_test_problem"),
 ])
 def test_plugin_problems_say_what_and_where(monkeypatch, source, message):
     ep = install_plugin(monkeypatch, "dcfkit_test_problem", "")
