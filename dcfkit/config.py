@@ -238,8 +238,9 @@ def components(config: Mapping) -> list[tuple[str, str]]:
     def name(spec):
         return spec.get("name") if isinstance(spec, Mapping) else None
 
-    found = [("feature", name(f)) for f in config.get("features") or ()]
-    found += [("regularizer", name(r)) for r in (config.get("regularizers") or {}).values()]
+    features, regularizers = config.get("features"), config.get("regularizers")
+    found = [("feature", name(f)) for f in features] if isinstance(features, (list, tuple)) else []
+    found += [("regularizer", name(r)) for r in regularizers.values()] if isinstance(regularizers, Mapping) else []
     found += [(kind, name(config.get(slot))) for kind, slot in
               (("label", "label"), ("solver", "solver"), ("search", "search"), ("scale", "scale"))]
     return [(kind, n) for kind, n in found if isinstance(n, str)]

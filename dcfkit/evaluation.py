@@ -115,7 +115,8 @@ def plugin_versions(config: Mapping) -> list[str]:
     from .config import components
     from .registry import get_registry
 
-    return get_registry().plugin_versions(components(config))
+    used = components(config)
+    return get_registry().plugin_versions(used) if used else []  # e.g. an OpenCV baseline: no registry
 
 
 def config_hash(config: Mapping, version: str | None = None) -> str:

@@ -46,7 +46,7 @@ def _coerce(value: Any, kind: Any, where: str) -> Any:
         if value is None:
             return None
         return _coerce(value, args[0], where)
-    if origin in (tuple, list):
+    if origin in (tuple, list) or kind in (tuple, list):
         if not isinstance(value, (list, tuple)):
             raise ConfigError(f"{where}: expected a list, got {value!r}")
         args = typing.get_args(kind)
@@ -93,7 +93,7 @@ _SCALARS = (bool, int, float, str)
 def _supported(kind: Any) -> bool:
     """Whether :func:`_coerce` checks values of this annotation."""
     origin = typing.get_origin(kind)
-    if kind is Any or kind in _SCALARS:
+    if kind is Any or kind in _SCALARS or kind in (tuple, list):
         return True
     if origin in (typing.Union, types.UnionType):
         args = [a for a in typing.get_args(kind) if a is not type(None)]
@@ -116,7 +116,8 @@ def check_schema(schema: type) -> None:
             raise ConfigError(f"parameter '{f.name}' has no default (give every field param(default, help))")
         if not _supported(hints[f.name]):
             raise ConfigError(f"parameter '{f.name}': annotation {hints[f.name]!r} is not supported; use bool, "
-                              f"int, float, str, Any, tuple[X, ...] or X | None")
+                              f"int, float, str, Any, tuple, tuple[X, ...], tuple[X, Y] or X | None "
+                              f"(for a set of allowed values: param(..., choices=...))")
         defaults[f.name] = f.default
     parse_params(schema, defaults, "default Params")
 

@@ -94,6 +94,9 @@ class Registry:
         except ConfigError as exc:
             raise RegistryError(f"{kind} '{name}' (from {self._provider}): {exc}") from None
         if name in self._ambiguous[kind]:
+            if self._distribution is None or self._provider in self._ambiguous[kind][name]:
+                raise RegistryError(f"{kind} '{name}' from {self._provider} is already registered by "
+                                    f"{' and '.join(self._ambiguous[kind][name])}")
             self._ambiguous[kind][name].append(self._provider)
             return cls
         existing = self._entries[kind].get(name)

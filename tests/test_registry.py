@@ -222,6 +222,8 @@ def test_an_entry_point_naming_the_hook_function_gets_a_hint(monkeypatch):
     ("level: np.float32 = param(0.5, 'x')", r"parameter 'level': annotation .*float32.* is not supported"),
     ("level: 'float | None' = param(None, 'x')", None),
     ("level: 'tuple[float, ...]' = param((1.0, 2.0), 'x')", None),
+    ("level: tuple = param((1, 'a'), 'x')", None),
+    ("level: 'int | float' = param(1, 'x')", r"parameter 'level': annotation .* is not supported"),
 ])
 def test_params_schemas_are_checked_when_the_component_registers(field, message):
     namespace = {"dataclasses": dataclasses, "np": np, "param": param}
@@ -286,3 +288,31 @@ def test_result_hashes_change_with_the_version_of_a_plugin_the_config_uses(monke
     with pytest.raises(DcfkitError, match=r"worker's plugins \(dcfkit-test-versioned 0.2.0\) are not the client's"):
         _run_job(flat, None, "unused", old_key, dcfkit_version())
     monkeypatch.setattr(reg, "_REGISTRY", None)
+
+
+def test_an_ambiguous_name_survives_a_plugin_failing_half_way_and_refuses_a_second_registration(monkeypatch):
+    fails = PLUGIN.replace("registry.register(Flat)", "registry.register(Flat)\n    raise RuntimeError('later')")
+    twice = PLUGIN.replace("registry.register(Flat)", "registry.register(Flat)\n    registry.register(Flat)")
+    with_entry_points(monkeypatch, [install_plugin(monkeypatch, "dcfkit_test_a1", PLUGIN),
+                                    install_plugin(monkeypatch, "dcfkit_test_a2", PLUGIN),
+                                    install_plugin(monkeypatch, "dcfkit_test_b1", fails),
+                                    install_plugin(monkeypatch, "dcfkit_test_b2", twice)])
+    with pytest.warns(RuntimeWarning) as shown:
+        r = reg.build_registry()
+    messages = [str(w.message) for w in shown]
+    assert any("dcfkit_test_b1" in m and "RuntimeError: later" in m for m in messages)
+    assert any("dcfkit_test_b2" in m and "already registered by dcfkit_test_a1 (dcfkit_test_a1) and "
+               "dcfkit_test_a2 (dcfkit_test_a2) and dcfkit_test_b2" in m for m in messages)
+    with pytest.raises(RegistryError, match=r"registered by more than one plugin \(dcfkit_test_a1 \(dcfkit_test_a1\) "
+                                            r"and dcfkit_test_a2 \(dcfkit_test_a2\)\)"):  # the failed ones undone
+        r.entry("label", "flat")
+    with pytest.raises(RegistryError, match="already registered"):  # outside plugin loading
+        r.register(type("Flat", (Label,), {"name": "flat"}))
+
+
+@pytest.mark.parametrize("config", [{"name": "csrt"}, {"name": "x", "regularizers": ["l2"]}, {"features": 3},
+                                    {"features": [{"nome": "gray"}], "label": "gaussian"}])
+def test_configs_that_are_not_dcfkit_trackers_still_hash(config):
+    from dcfkit.evaluation import config_hash
+
+    assert len(config_hash(config)) == 16

@@ -106,7 +106,8 @@ BUILTIN = (Gray, FHOG, ColorNames)
 
 
 def checked_map(feature: Feature, patch: np.ndarray, cell_size: int, where: str) -> np.ndarray:
-    """``feature.extract``, with what a (plugin) feature got wrong said as a TrackingError."""
+    """``feature.extract``, with an exception or a map of the wrong shape said as a TrackingError
+    naming the feature (NaN is checked once on the stack, by :func:`extract_stack`)."""
     what = f"{where}feature '{feature.name}'"
     try:
         fmap = feature.extract(patch, cell_size)
@@ -120,8 +121,6 @@ def checked_map(feature: Feature, patch: np.ndarray, cell_size: int, where: str)
         got = f"shape {shape}" if shape is not None else type(fmap).__name__
         raise TrackingError(f"{what} returned {got} for a {patch.shape[0]}x{patch.shape[1]} patch, expected "
                             f"(channels(), H // cell_size, W // cell_size) = {expected}")
-    if not math.isfinite(float(np.sum(fmap, dtype=np.float64))):
-        raise TrackingError(f"{what} returned NaN or infinite values")
     return fmap
 
 
@@ -131,5 +130,9 @@ def extract_stack(features, patch: np.ndarray, cell_size: int, where: str = "") 
     if patch.ndim == 2:
         patch = cv2.cvtColor(patch, cv2.COLOR_GRAY2BGR)
     maps = [checked_map(f, patch, cell_size, where) for f in features]
-    stack = maps[0] if len(maps) == 1 else np.concatenate(maps, axis=0)
-    return stack.astype(np.float32, copy=False)
+    stack = (maps[0] if len(maps) == 1 else np.concatenate(maps, axis=0)).astype(np.float32, copy=False)
+    if not math.isfinite(float(stack.sum())):  # one pass over the stack; then find the culprit
+        for feature, fmap in zip(features, maps):
+            if not np.isfinite(fmap).all():
+                raise TrackingError(f"{where}feature '{feature.name}' returned NaN or infinite values")
+    return stack
