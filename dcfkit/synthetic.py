@@ -18,6 +18,7 @@ class SyntheticSequence:
     name: str
     frames: list[np.ndarray]      # (H, W, 3) uint8 BGR
     ground_truth: np.ndarray      # (N, 4) float64 boxes
+    distractor: np.ndarray | None = None  # (N, 4) float64 boxes of the look-alike, if there is one
 
 
 def _texture(rng: np.random.Generator, shape: tuple[int, int], scales=(64, 16, 4)) -> np.ndarray:
@@ -84,7 +85,7 @@ def make_sequence(n_frames: int = 120, size: tuple[int, int] = (360, 480), targe
     mid = n_frames / 2
     dy_path = ty + 1.4 * target[0] + 0.3 * (t - mid)
     dx_path = tx + 2.2 * speed * (mid - t)
-    frames, boxes = [], []
+    frames, boxes, twins = [], [], []
     for k in range(n_frames):
         cy, cx = int(round(cam[k, 0])), int(round(cam[k, 1]))
         frame = world[cy: cy + H, cx: cx + W].copy()
@@ -96,4 +97,5 @@ def make_sequence(n_frames: int = 120, size: tuple[int, int] = (360, 480), targe
         noisy = frame.astype(np.float32) * gain + rng.normal(0, 4, frame.shape)
         frames.append(np.clip(noisy, 0, 255).astype(np.uint8))
         boxes.append((float(round(x)), float(round(y)), float(target[1]), float(target[0])))
-    return SyntheticSequence("synthetic", frames, np.array(boxes))
+        twins.append((float(round(dx_path[k] - cx)), float(round(dy_path[k] - cy)), float(target[1]), float(target[0])))
+    return SyntheticSequence("synthetic", frames, np.array(boxes), np.array(twins) if distractor else None)

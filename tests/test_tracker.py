@@ -335,3 +335,19 @@ def test_training_on_the_shifted_detection_sample_moves_it_to_the_new_position(s
     used = agreement(trained[-1])
     assert used > agreement(shift_spectrum(detection, -moved[0], -moved[1], size))
     assert used > agreement(detection)  # and better than not moving it at all
+
+
+def test_the_strongest_repressed_peak_is_the_look_alike_when_it_is_in_view(sequence):
+    """Eq. (3) in the loop: while the synthetic sequence's look-alike is inside the search area,
+    the highest background maximum that DR²Track represses is, most of the time, on it."""
+    tracker = dcfkit.load_tracker("dr2track")
+    tracker.init(sequence.frames[0], sequence.ground_truth[0])
+    on_it = in_view = 0
+    for frame, twin in zip(sequence.frames[1:], sequence.distractor[1:]):
+        tracker.update(frame)
+        centre = twin[:2] + (twin[2:] - 1) / 2
+        x, y, w, h = tracker.last_search_box
+        if x <= centre[0] <= x + w and y <= centre[1] <= y + h:
+            in_view += 1
+            on_it += np.linalg.norm(tracker.last_distractors[0] - centre) < twin[3] / 2
+    assert in_view >= 10 and on_it >= 0.7 * in_view
