@@ -1,4 +1,5 @@
 """Exceptions raised by dcfkit. Each names what was wrong and where."""
+import traceback
 
 
 class DcfkitError(Exception):
@@ -19,3 +20,12 @@ class InputError(DcfkitError, ValueError):
 
 class TrackingError(DcfkitError, RuntimeError):
     """Tracking could not continue on a frame (the message names the frame)."""
+
+
+def describe_error(exc: BaseException) -> str:
+    """``Type: message (at file:line)``: an exception as one line that says where it was raised."""
+    text = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
+    if isinstance(exc, SyntaxError) and exc.filename:
+        return f"{text} (at {exc.filename}:{exc.lineno})"
+    frames = traceback.extract_tb(exc.__traceback__)
+    return f"{text} (at {frames[-1].filename}:{frames[-1].lineno})" if frames else text

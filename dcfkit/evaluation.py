@@ -17,7 +17,8 @@ Output layout of :func:`run_one_pass` (``OUT/<tracker name>/``):
     image decoding excluded; before its first sequence of a dcfkit config, a process runs a
     throw-away copy of the tracker on the first frame, untimed, so one-time loading of
     compiled code is not counted), ``fps`` = frames / total tracker time, the config, its
-    hash, the dcfkit version and the plugin packages the config uses. Written last, so it marks the sequence as done.
+    hash, the dcfkit version and the plugin packages the config uses. Written last, so it
+    marks the sequence as done.
 ``<sequence>.error.json``
     written instead when the tracker raised: frame, error and traceback.
 

@@ -13,13 +13,12 @@ import dataclasses
 import importlib
 import importlib.metadata
 import os
-import traceback
 import warnings
 from typing import Any, Mapping
 
 import pluggy
 
-from .errors import ConfigError, DcfkitError, RegistryError
+from .errors import ConfigError, DcfkitError, RegistryError, describe_error
 from .params import NoParams, check_schema, closest, parse_params
 
 PROJECT = "dcfkit"
@@ -55,15 +54,6 @@ class Entry:
     cls: type
     provider: str
     distribution: str | None = None  # "name version" of the plugin's package; None for built-ins
-
-
-def describe_error(exc: BaseException) -> str:
-    """``Type: message (at file:line)``: an exception as one line that says where it was raised."""
-    text = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
-    if isinstance(exc, SyntaxError) and exc.filename:
-        return f"{text} (at {exc.filename}:{exc.lineno})"
-    frames = traceback.extract_tb(exc.__traceback__)
-    return f"{text} (at {frames[-1].filename}:{frames[-1].lineno})" if frames else text
 
 
 class Registry:

@@ -20,12 +20,12 @@ import cv2
 import numpy as np
 
 from .config import TrackerParams, load_config
-from .errors import DcfkitError, InputError, TrackingError
+from .errors import DcfkitError, InputError, TrackingError, describe_error
 from .features import extract_stack
 from .fft import make_fft
 from .labels import Detection, gaussian_label
 from .patches import box_to_centre_size, centre_size_to_box, sample
-from .registry import describe_error, get_registry
+from .registry import get_registry
 from .response import response, shift_spectrum, subpixel_peak
 from .scale import scale_limits
 

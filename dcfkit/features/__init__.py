@@ -13,9 +13,9 @@ import math
 import cv2
 import numpy as np
 
-from ..errors import DcfkitError, TrackingError
+from ..errors import DcfkitError, TrackingError, describe_error
 from ..params import param
-from ..registry import Component, describe_error
+from ..registry import Component
 from .colornames import load_table
 from .fhog import fhog
 
