@@ -108,10 +108,10 @@ def cmd_demo(args) -> int:
 
 def cmd_components(args) -> int:
     from .docs_gen import component_rows, components_markdown
-    from .registry import get_registry
+    from .registry import PluginWarning, get_registry
 
     with warnings.catch_warnings():  # the skipped plugins are listed below, each once
-        warnings.filterwarnings("ignore", message="dcfkit plugin ", category=RuntimeWarning)
+        warnings.simplefilter("ignore", PluginWarning)
         registry = get_registry()
     rows = component_rows(registry, [args.kind] if args.kind else None)
     if args.format == "json":
@@ -175,10 +175,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _one_line_plugin_warnings(show):
-    """``warnings.showwarning`` for the CLI: a skipped plugin is one ``warning: ...`` line,
+    """``warnings.showwarning`` for the CLI: a plugin problem is one ``warning: ...`` line,
     not a source location inside dcfkit's registry."""
+    from .registry import PluginWarning
+
     def showwarning(message, category, filename, lineno, file=None, line=None):
-        if str(message).startswith("dcfkit plugin "):
+        if issubclass(category, PluginWarning):
             print(f"warning: {message}", file=sys.stderr)
         else:
             show(message, category, filename, lineno, file, line)

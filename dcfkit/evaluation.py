@@ -387,8 +387,10 @@ def worker_init(parent_pid: int | None = None):
     :func:`run_pool`) it dies with the parent and ignores SIGINT: Ctrl-C reaches the whole
     process group, and a worker interrupted mid-protocol would leave the parent waiting for it
     forever; the parent stops its workers itself."""
+    from .registry import PluginWarning
+
     os.environ.update({k: "1" for k in _THREAD_VARS})
-    warnings.filterwarnings("ignore", message="dcfkit plugin ", category=RuntimeWarning)  # the parent said it
+    warnings.simplefilter("ignore", PluginWarning)  # the parent said it
     with contextlib.suppress(Exception):
         import cv2
 

@@ -49,6 +49,10 @@ class Component:
         return f"{type(self).__name__}({self.params})"
 
 
+class PluginWarning(RuntimeWarning):
+    """A plugin was skipped, or a name it registers withdrawn (also in ``Registry.failures``)."""
+
+
 @dataclasses.dataclass(frozen=True)
 class Entry:
     cls: type
@@ -143,7 +147,7 @@ class Registry:
     def _fail(self, message: str) -> None:
         """Record and warn about a plugin problem (``dcfkit components`` lists them)."""
         self.failures.append(message)
-        warnings.warn(message, RuntimeWarning, stacklevel=3)
+        warnings.warn(message, PluginWarning, stacklevel=3)
 
     def _run_plugin(self, pm: pluggy.PluginManager, plugin: Any, provider: str,
                     distribution: str | None = None) -> None:

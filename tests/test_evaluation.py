@@ -17,6 +17,7 @@ import pytest
 from dcfkit import evaluation, report
 from dcfkit.datasets import DatasetError, Sequence, load_dataset
 from dcfkit.errors import ConfigError
+from dcfkit.registry import PluginWarning
 from dcfkit.evaluation import (config_hash, import_results, load_results, opencv_tracker,
                                run_one_pass)
 
@@ -227,7 +228,7 @@ def test_workers_leave_plugin_warnings_to_the_parent(monkeypatch):
         with warnings.catch_warnings(record=True) as shown:
             warnings.simplefilter("always")
             evaluation.worker_init()
-            warnings.warn("dcfkit plugin 'x' failed and was skipped: boom", RuntimeWarning)
+            warnings.warn("dcfkit plugin 'x' failed and was skipped: boom", PluginWarning)
             warnings.warn("something else", RuntimeWarning)
     finally:
         cv2.setNumThreads(threads)

@@ -137,6 +137,20 @@ def test_other_commands_show_a_skipped_plugin_as_one_line(monkeypatch, capsys, t
     monkeypatch.setattr(reg, "_REGISTRY", None)
 
 
+def test_a_withdrawn_name_is_one_warning_line_too(monkeypatch, capsys, tmp_path):
+    from dcfkit import cli
+
+    with_entry_points(monkeypatch, [install_plugin(monkeypatch, "dcfkit_test_c1", PLUGIN),
+                                    install_plugin(monkeypatch, "dcfkit_test_c2", PLUGIN)])
+    monkeypatch.setattr(reg, "_REGISTRY", None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        assert cli.main(["track", "strcf", "--frames", str(tmp_path), "--box", "1,1,5,5"]) == 2  # no frames
+    err = capsys.readouterr().err
+    assert err.count("warning: dcfkit plugins dcfkit_test_c1") == 1 and "RuntimeWarning" not in err
+    monkeypatch.setattr(reg, "_REGISTRY", None)
+
+
 def test_environment_variable_disables_plugins(monkeypatch):
     with_entry_points(monkeypatch, [install_plugin(monkeypatch, "dcfkit_test_flat2", PLUGIN)])
     monkeypatch.setenv(reg.DISABLE_ENV, "1")
