@@ -20,7 +20,7 @@ import cv2
 import numpy as np
 
 from .config import TrackerParams, load_config
-from .errors import DcfkitError, InputError, TrackingError, describe_error
+from .errors import InputError, TrackingError, blamed_on
 from .features import extract_stack
 from .fft import make_fft
 from .labels import Detection, gaussian_label
@@ -230,12 +230,8 @@ class Tracker:
         """The label component's ``(y, offsets)``, with what a (plugin) label got wrong said as a
         TrackingError naming the frame."""
         what = f"frame {self.frame}: label '{self.label.name}'"
-        try:
+        with blamed_on(what):
             out = self.label.make(self.base_label, detection)
-        except DcfkitError:
-            raise
-        except Exception as exc:
-            raise TrackingError(f"{what} raised {describe_error(exc)}") from exc
         if not (isinstance(out, tuple) and len(out) == 2):
             raise TrackingError(f"{what}: make() must return (y, offsets), got {type(out).__name__}")
         y, offsets = np.asarray(out[0]), np.asarray(out[1])

@@ -13,7 +13,7 @@ import math
 import cv2
 import numpy as np
 
-from ..errors import DcfkitError, TrackingError, describe_error
+from ..errors import TrackingError, blamed_on
 from ..params import param
 from ..registry import Component
 from .colornames import load_table
@@ -109,12 +109,8 @@ def checked_map(feature: Feature, patch: np.ndarray, cell_size: int, where: str)
     """``feature.extract``, with an exception or a map of the wrong shape said as a TrackingError
     naming the feature (NaN is checked once on the stack, by :func:`extract_stack`)."""
     what = f"{where}feature '{feature.name}'"
-    try:
+    with blamed_on(what):
         fmap = feature.extract(patch, cell_size)
-    except DcfkitError:
-        raise
-    except Exception as exc:
-        raise TrackingError(f"{what} raised {describe_error(exc)}") from exc
     expected = (feature.channels(), patch.shape[0] // cell_size, patch.shape[1] // cell_size)
     shape = getattr(fmap, "shape", None)
     if shape != expected:
