@@ -123,31 +123,21 @@ def test_components_command_fails_when_a_plugin_was_skipped(monkeypatch, capsys)
     monkeypatch.setattr(reg, "_REGISTRY", None)
 
 
-def test_other_commands_show_a_skipped_plugin_as_one_line(monkeypatch, capsys, tmp_path):
+@pytest.mark.parametrize("plugins, shown", [
+    ({"dcfkit_test_typo3": PLUGIN.replace("def dcfkit_register_components", "def dcfkit_register_component")},
+     "warning: dcfkit plugin 'dcfkit_test_typo3"),
+    ({"dcfkit_test_c1": PLUGIN, "dcfkit_test_c2": PLUGIN}, "warning: dcfkit plugins dcfkit_test_c1"),  # withdrawn
+])
+def test_other_commands_show_a_plugin_problem_as_one_line(monkeypatch, capsys, tmp_path, plugins, shown):
     from dcfkit import cli
 
-    bad = PLUGIN.replace("def dcfkit_register_components", "def dcfkit_register_component")
-    with_entry_points(monkeypatch, [install_plugin(monkeypatch, "dcfkit_test_typo3", bad)])
+    with_entry_points(monkeypatch, [install_plugin(monkeypatch, name, source) for name, source in plugins.items()])
     monkeypatch.setattr(reg, "_REGISTRY", None)
     with warnings.catch_warnings():
         warnings.simplefilter("always")
         assert cli.main(["track", "strcf", "--frames", str(tmp_path), "--box", "1,1,5,5"]) == 2  # no frames
     err = capsys.readouterr().err
-    assert err.count("warning: dcfkit plugin 'dcfkit_test_typo3") == 1 and "RuntimeWarning" not in err
-    monkeypatch.setattr(reg, "_REGISTRY", None)
-
-
-def test_a_withdrawn_name_is_one_warning_line_too(monkeypatch, capsys, tmp_path):
-    from dcfkit import cli
-
-    with_entry_points(monkeypatch, [install_plugin(monkeypatch, "dcfkit_test_c1", PLUGIN),
-                                    install_plugin(monkeypatch, "dcfkit_test_c2", PLUGIN)])
-    monkeypatch.setattr(reg, "_REGISTRY", None)
-    with warnings.catch_warnings():
-        warnings.simplefilter("always")
-        assert cli.main(["track", "strcf", "--frames", str(tmp_path), "--box", "1,1,5,5"]) == 2  # no frames
-    err = capsys.readouterr().err
-    assert err.count("warning: dcfkit plugins dcfkit_test_c1") == 1 and "RuntimeWarning" not in err
+    assert err.count(shown) == 1 and "RuntimeWarning" not in err
     monkeypatch.setattr(reg, "_REGISTRY", None)
 
 
