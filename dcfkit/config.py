@@ -55,8 +55,28 @@ class TrackerParams:
     output_sigma_factor: float = param(1 / 16, "label σ as a fraction of sqrt(target area in cells)")
     fft_backend: str = param("scipy", "FFT implementation", choices=("scipy", "pyfftw"))
     training_sample: str = param("extract", "'extract' m^t at p^t (Algorithm 1) or 'shift' the detection sample "
-                                 "to p^t in the Fourier domain (the reference codes; one extraction less)",
+                                 "to p^t in the Fourier domain, as DR²Track's code (by the translation over the "
+                                 "scale after the scale update; one extraction less)",
                                  choices=("extract", "shift"))
+    init_position: str = param("exact", "'exact': the box's centre x + (w-1)/2; 'whole_pixel': the authors' BACF and "
+                               "DR²Track, centre floor(x + floor(w/2)) and size floor(w) (1-based)",
+                               choices=("exact", "whole_pixel"))
+    sampling: str = param("subpixel", "'subpixel': the search region around the exact centre, area-averaged and "
+                          "bilinearly mapped onto the sample grid; 'whole_pixel': the authors' get_pixels, whole "
+                          "pixels around round(centre), then OpenCV's resize (bilinear when the width grows, else "
+                          "area)", choices=("subpixel", "whole_pixel"))
+    window: str = param("hann_interior", "cosine window of the features: 'hann_interior' hann(n+2) without its zero "
+                        "ends (BACF, DR²Track), 'hann' hann(n) with them (STRCF)", choices=("hann_interior", "hann"))
+    peak: str = param("bounded_newton", "sub-cell peak: 'bounded_newton' Newton steps kept within the grid maximum's "
+                      "cell, the scale with the highest grid value; 'newton' the authors' resp_newton (unbounded "
+                      "steps, the scale with the highest refined value)", choices=("bounded_newton", "newton"))
+    translation: str = param("exact", "'exact', or 'whole_pixel': the displacement rounded to whole image pixels "
+                             "(BACF's and DR²Track's translation_vec)", choices=("exact", "whole_pixel"))
+    clamp_position: bool = param(True, "keep the target centre on the image (the authors' codes do not)")
+    box_output: str = param("exact", "the reported box: 'exact' x = cx - (w-1)/2 with the exact size; "
+                            "'rounded' the same rounded to whole 1-based pixels (STRCF's report_tracking_result); "
+                            "'half_size' x = cx - w/2 with the size rounded (DR²Track's rect_position)",
+                            choices=("exact", "rounded", "half_size"))
     blank_std: float = param(1.0, "a search patch whose pixel values vary less than this (standard deviation, "
                              "RMS over colour channels) is a dropped frame: the box is held, nothing is learnt "
                              "(0: off)")

@@ -6,8 +6,17 @@ peak sits on the label's peak) are repressed with strength μ. Two variants:
 
 * ``multiplicative`` — the paper's g ⊙ d, d = 1 - μ P^T Δ(R[η]). Since g is nearly zero at
   distractors far from the target, it changes the label very little.
-* ``subtractive`` — the authors' public code: y = g - μ R̃(p) at each distractor p (R̃ = R /
-  max R); their code overwrites y(p) with -μ R̃(p), which equals this where g(p) ≈ 0.
+* ``subtractive`` — y = g - μ R̃(p) at each distractor p (R̃ = R / max R);
+* ``overwrite`` — the authors' public code: y(p) = -μ R̃(p), which equals ``subtractive``
+  where g(p) ≈ 0.
+
+With ``mirrored`` the label is turned by 180° about the target (y(-p)), which is what the
+authors' code learns: its solver takes ŷ where the correlation R = F⁻¹(Σ conj(ĥ) ẑ) needs
+conj(ŷ), the same for the symmetric Gaussian but not for a repressed label.
+
+Which maxima are distractors (``selection``): ``local_maxima`` takes the maxima of 3x3
+neighbourhoods of the circular map outside the target-sized area around the grid peak;
+``authors`` follows DR²Track's tracker.m (see :func:`authors_distractors`).
 
 Labels are (H, W) float32 maps with the target peak at index (0, 0) (circular layout).
 """
@@ -27,12 +36,14 @@ class Detection:
     """What the last detection saw, in feature cells of the training grid.
 
     response: (H, W) float32 response at the chosen scale (circular layout, as computed);
-    peak: (row, col) integer index of its maximum; target_cells: (h, w) target size in cells.
+    peak: (row, col) integer index of its maximum; target_cells: (h, w) target size in cells;
+    offset: the sub-cell peak as a signed (dy, dx) offset in cells (None: the grid peak).
     """
 
     response: np.ndarray
     peak: tuple[int, int]
     target_cells: tuple[float, float]
+    offset: tuple[float, float] | None = None
 
 
 def gaussian_label(shape: tuple[int, int], sigma: float) -> np.ndarray:
@@ -73,8 +84,14 @@ class DistractorRepressed(Label):
     class Params:
         top_n: int = param(30, "N: how many of the highest background local maxima are repressed")
         mu: float = param(0.25, "μ: repression strength")
-        variant: str = param("subtractive", "'subtractive' (authors' code) or 'multiplicative' (paper's g⊙d)",
-                             choices=("subtractive", "multiplicative"))
+        variant: str = param("subtractive", "'subtractive' g - μR̃, 'overwrite' -μR̃ (the authors' code) or "
+                             "'multiplicative' (the paper's g⊙d)", choices=("subtractive", "overwrite", "multiplicative"))
+        selection: str = param("local_maxima", "'local_maxima' (3x3 maxima of the circular map outside the target "
+                               "area) or 'authors' (DR²Track's code: regional maxima, its exclusion box, at most one "
+                               "maximum means none)", choices=("local_maxima", "authors"))
+        mirrored: bool = param(False, "repress each distractor's mirror image through the target instead (the "
+                               "authors' solver reads ŷ where correlation needs its conjugate, so their filter "
+                               "learns the label turned by 180°)")
         neighbourhood: int = param(3, "side of the window in which a local maximum is the largest")
         exclusion: float = param(1.0, "P^T: ignore maxima within this many target sizes of the peak")
 
@@ -109,14 +126,95 @@ class DistractorRepressed(Label):
     def make(self, g, detection):
         if detection is None:
             return g, np.zeros((0, 2), dtype=int)
-        offsets, values = self.distractors(detection)
-        y = g.copy()
-        idx = (offsets[:, 0] % g.shape[0], offsets[:, 1] % g.shape[1])
-        if self.params.variant == "subtractive":
-            y[idx] -= self.params.mu * values
+        p = self.params
+        if p.selection == "authors":
+            offsets, values = authors_distractors(detection, p.top_n)
         else:
-            y[idx] *= 1.0 - self.params.mu * values
+            offsets, values = self.distractors(detection)
+        y = g.copy()
+        for (dy, dx), value in zip(offsets, values):  # offsets may repeat (authors): apply each once, in order
+            idx = (dy % g.shape[0], dx % g.shape[1])
+            if p.variant == "subtractive":
+                y[idx] -= p.mu * value
+            elif p.variant == "overwrite":
+                y[idx] = -p.mu * value
+            else:
+                y[idx] *= 1.0 - p.mu * value
+        if p.mirrored:  # y(-p): circular indices negated
+            y = np.roll(y[::-1, ::-1], 1, axis=(0, 1))
+            offsets = -offsets
         return y, offsets
+
+
+def regional_maxima(r: np.ndarray) -> np.ndarray:
+    """MATLAB's ``imregionalmax`` (8-connected) of a non-circular (H, W) map: the pixels of every
+    connected plateau whose neighbours outside it are all lower. Boolean (H, W)."""
+    padded = np.pad(r.astype(np.float64), 1, constant_values=-np.inf)
+    h, w = r.shape
+    shifts = [(a, b) for a in (0, 1, 2) for b in (0, 1, 2) if (a, b) != (1, 1)]
+    neighbours = np.stack([padded[a:a + h, b:b + w] for a, b in shifts])
+    top = r >= neighbours.max(axis=0)  # no higher neighbour
+    # a plateau is not a maximum if one of its pixels has an equal neighbour that has a higher one
+    top_padded = np.pad(top, 1)
+    leaks = np.zeros_like(top)
+    for (a, b), n in zip(shifts, neighbours):
+        leaks |= (n == r) & ~top_padded[a:a + h, b:b + w]
+    import scipy.ndimage  # only this label selection needs it (0.3 s of import)
+
+    labels, count = scipy.ndimage.label(top, structure=np.ones((3, 3)))
+    bad = np.unique(labels[top & leaks])
+    return top & ~np.isin(labels, bad)
+
+
+def authors_distractors(detection: Detection, top_n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Distractors as DR²Track's tracker.m picks them: (N, 2) (dy, dx) offsets from the target
+    and their values R̃, highest first; an offset appears once per value that matched it.
+
+    R̃ = R / max R is centred (circshift by floor(size/2)) and moved by the rounded sub-cell
+    peak, so the peak sits at the middle. Its regional maxima (not circular), outside a box of
+    floor(size/2 ± target/2) cells (1-based) around the middle, sorted by value; if there is at
+    most one, none is used (their code then looks up [max, 0] and finds neither outside the
+    target). The first ``top_n`` values are looked up among the pixels outside the target box
+    (:func:`~dcfkit.regularizers.target_mask`, 'authors'): every pixel holding exactly that value
+    is a distractor (MATLAB's ``y(row, col)``: rows x columns of the matches).
+    """
+    from .patches import round_half_away
+    from .regularizers import target_mask
+
+    r = detection.response
+    h, w = r.shape
+    top = r.max()
+    if not np.isfinite(top) or top <= 0 or top_n == 0:
+        return np.zeros((0, 2), dtype=int), np.zeros(0, np.float32)
+    dy, dx = detection.offset if detection.offset is not None else (0.0, 0.0)
+    shift = (h // 2 - int(round_half_away(dy)), w // 2 - int(round_half_away(dx)))
+    rn = np.roll(r / top, shift, axis=(0, 1))
+    outside = ~target_mask((h, w), detection.target_cells, "authors")
+    maxima = regional_maxima(rn)
+    reg = np.floor(detection.target_cells)
+    rows = slice(int(np.floor(h / 2 - reg[0] / 2)) - 1, int(np.floor(h / 2 + reg[0] / 2)))
+    cols = slice(int(np.floor(w / 2 - reg[1] / 2)) - 1, int(np.floor(w / 2 + reg[1] / 2)))
+    maxima[rows, cols] = False
+    import scipy.ndimage
+
+    labels, count = scipy.ndimage.label(maxima, structure=np.ones((3, 3)))
+    if count > 1:
+        first = {}  # each component's first pixel in column-major order (MATLAB's PixelIdxList{i}(1))
+        for col, row in zip(*np.nonzero(labels.T)):
+            first.setdefault(labels[row, col], rn[row, col])
+        values = sorted(first.values(), reverse=True)[:top_n]
+    else:  # their stand-in list [max, 0]: found outside the target box only if the peak moved there
+        values = [rn.max(), np.float32(0)][:top_n]
+    offsets, kept = [], []
+    for value in values:
+        found_rows, found_cols = np.nonzero(outside & (rn == value))
+        for row in np.unique(found_rows):
+            for col in np.unique(found_cols):
+                offsets.append((row - h // 2, col - w // 2))
+                kept.append(value)
+    if not offsets:
+        return np.zeros((0, 2), dtype=int), np.zeros(0, np.float32)
+    return np.array(offsets, dtype=int), np.array(kept, np.float32)
 
 
 BUILTIN = (Gaussian, DistractorRepressed)

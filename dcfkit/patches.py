@@ -110,6 +110,38 @@ def sampler(shape, centre, region, out) -> Callable[[np.ndarray], np.ndarray]:
     return run
 
 
+def round_half_away(x):
+    """MATLAB's ``round``: halves away from zero (numpy rounds them to even)."""
+    x = np.asarray(x, dtype=float)
+    return np.sign(x) * np.floor(np.abs(x) + 0.5)
+
+
+def whole_pixel_crop(image: np.ndarray, centre, size) -> np.ndarray:
+    """The authors' crop (``get_pixels``, DSST's ``get_scale_sample``): ``size`` (h, w) whole pixels,
+    1-based ``floor(pos) + (1:h) - floor(h/2)``, edges replicated. The pixel ``floor(centre)``
+    sits at index h // 2 - 1: half a pixel above and left of the middle when h, w are even."""
+    h, w = int(size[0]), int(size[1])
+    y0 = int(np.floor(centre[0])) + 1 - h // 2
+    x0 = int(np.floor(centre[1])) + 1 - w // 2
+    return _cropper_at(image.shape, y0, x0, h, w)(image)
+
+
+def resize_auto(patch: np.ndarray, out) -> np.ndarray:
+    """The authors' ``mexResize(patch, out, 'auto')``: OpenCV bilinear when the width grows,
+    area averaging otherwise (the height is not looked at)."""
+    oh, ow = int(out[0]), int(out[1])
+    grows = ow > patch.shape[1]
+    return cv2.resize(patch, (ow, oh), interpolation=cv2.INTER_LINEAR if grows else cv2.INTER_AREA)
+
+
+def whole_pixel_sample(image: np.ndarray, centre, region, out) -> np.ndarray:
+    """The search patch as the authors' code samples it (STRCF's and DR²Track's ``get_pixels``):
+    :func:`whole_pixel_crop` of ``round(region)`` pixels (a side below 1 becomes 2), then
+    :func:`resize_auto` to ``out``."""
+    size = [int(v) if v >= 1 else 2 for v in round_half_away(region)]
+    return resize_auto(whole_pixel_crop(image, centre, size), out)
+
+
 def _blocks_outside(start: int, n: int, k: int, size: int) -> tuple[int, int]:
     """Of ``n`` blocks of ``k`` pixels from ``start``, how many beyond the first one wholly
     before pixel 0, and beyond the first one wholly after pixel size - 1, can be replicated."""

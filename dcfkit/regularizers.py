@@ -16,13 +16,24 @@ from .params import param
 from .registry import Component
 
 
-def _target_mask(shape: tuple[int, int], target_cells: tuple[float, float]) -> np.ndarray:
-    """Boolean (H, W): the target-sized box (its size in cells, floored) centred on the patch."""
+PLACEMENTS = ("centred", "authors")
+
+
+def target_mask(shape: tuple[int, int], target_cells: tuple[float, float], placement: str = "centred") -> np.ndarray:
+    """Boolean (H, W): the target-sized box (its size in cells, floored) in the middle of the patch.
+
+    'centred': centred on the patch centre (size - 1) / 2, the lower of two middles when the
+    box cannot be; 'authors': STRCF's and DR²Track's init_regwindow, which starts the box at
+    1-based floor((n+1)/2) + mod(n+1, 2) - floor(r/2) (one cell lower than 'centred' when the
+    patch has an even and the box an odd number of cells)."""
     mask = np.zeros(shape, dtype=bool)
     spans = []
     for size, extent in zip(shape, target_cells):
         extent = int(min(max(np.floor(extent), 1), size))
-        start = (size - extent) // 2  # centred on the patch centre, (size - 1) / 2
+        if placement == "authors":
+            start = (size + 1) // 2 + (size + 1) % 2 - 1 - extent // 2
+        else:
+            start = (size - extent) // 2
         spans.append(slice(start, start + extent))
     mask[spans[0], spans[1]] = True
     return mask
@@ -46,13 +57,16 @@ class BoxWindow(SpatialRegularizer):
     class Params:
         inside: float = param(1e-3, "w inside the target box (reg_window_min)")
         outside: float = param(1e5, "w outside the target box (reg_window_max)")
+        placement: str = param("centred", "where an odd box sits in an even patch: 'centred' or 'authors' "
+                               "(init_regwindow's, a cell lower and to the right)", choices=PLACEMENTS)
 
         def validate(self):
             if not 0 <= self.inside <= self.outside:
                 return "need 0 <= inside <= outside"
 
     def weights_squared(self, shape, target_cells):
-        w = np.where(_target_mask(shape, target_cells), self.params.inside, self.params.outside)
+        mask = target_mask(shape, target_cells, self.params.placement)
+        w = np.where(mask, self.params.inside, self.params.outside)
         return (w**2).astype(np.float32)
 
 
@@ -94,7 +108,7 @@ class Crop(SpatialRegularizer):
                 return "lam must be >= 0"
 
     def weights_squared(self, shape, target_cells):
-        return np.where(_target_mask(shape, target_cells), self.params.lam, np.inf).astype(np.float32)
+        return np.where(target_mask(shape, target_cells), self.params.lam, np.inf).astype(np.float32)
 
 
 class Temporal(Component):

@@ -55,6 +55,60 @@ def subpixel_peak(r: np.ndarray, iterations: int = 5) -> tuple[float, float, flo
     return (y, x, value) if value >= best else (y0, x0, best)
 
 
+def _signed_frequencies(n: int) -> np.ndarray:
+    """0, 1, ..., ceil((n-1)/2), then negative: the authors' ``ky``/``kx`` grid (the Nyquist
+    frequency of an even n counts as +n/2; numpy's fftfreq makes it -n/2)."""
+    k = np.arange(n)
+    return np.where(k <= (n - 1) // 2 + (n % 2 == 0), k, k - n).astype(np.float64)
+
+
+def newton_peak(maps: np.ndarray, iterations: int = 5) -> tuple[int, float, float, float]:
+    """The authors' ``resp_newton`` (STRCF, BACF, DR²Track): over (S, H, W) circular maps, the
+    best map and its peak as a signed (dy, dx) offset in cells, with its value.
+
+    From each map's grid maximum (ties: first in column-major order, as MATLAB's max), take
+    ``iterations`` unconditional Newton steps on the trigonometric interpolant over the
+    authors' frequency grid (:func:`_signed_frequencies`, their Hessian included); a map whose
+    interpolated value ends below its grid maximum keeps the grid maximum. The best map has
+    the largest value. Unlike :func:`subpixel_peak`, nothing keeps the steps near the grid
+    maximum, and the map with the largest grid value need not be the one chosen.
+    """
+    maps = np.asarray(maps, dtype=np.float64)
+    n_maps, h, w = maps.shape
+    ky, kx = _signed_frequencies(h), _signed_frequencies(w)
+    best = (-1, 0.0, 0.0, -np.inf)
+    for s in range(n_maps):
+        r = maps[s]
+        flat = int(np.argmax(r.T))  # column-major: MATLAB's max(max(r, [], 1), [], 2)
+        row, col = flat % h, flat // h
+        init_value = float(r[row, col])
+        y0 = 2 * np.pi * (((row + (h - 1) // 2) % h) - (h - 1) // 2) / h
+        x0 = 2 * np.pi * (((col + (w - 1) // 2) % w) - (w - 1) // 2) / w
+        spectrum = np.fft.fft2(r)
+        y, x = y0, x0
+        ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
+        for _ in range(iterations):
+            y_resp, resp_x = ey @ spectrum, spectrum @ ex
+            grad_y = -((ky * ey) @ resp_x).imag
+            grad_x = -(y_resp @ (kx * ex)).imag
+            ival = 1j * (ey @ resp_x)
+            h_yy = (-((ky * ky * ey) @ resp_x) + ival).real
+            h_xx = (-(y_resp @ (kx * kx * ex)) + ival).real
+            h_xy = (-((ky * ey) @ (spectrum @ (kx * ex)))).real
+            det = h_yy * h_xx - h_xy * h_xy
+            with np.errstate(divide="ignore", invalid="ignore"):
+                y, x = y - (h_xx * grad_y - h_xy * grad_x) / det, x - (h_yy * grad_x - h_xy * grad_y) / det
+            ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
+        value = float((ey @ spectrum @ ex).real) / (h * w)
+        if not value >= init_value:  # lower (or NaN): the grid maximum
+            y, x, value = y0, x0, init_value
+        if value > best[3]:
+            dy = (np.mod(y + np.pi, 2 * np.pi) - np.pi) / (2 * np.pi) * h
+            dx = (np.mod(x + np.pi, 2 * np.pi) - np.pi) / (2 * np.pi) * w
+            best = (s, float(dy), float(dx), value)
+    return best
+
+
 def local_maxima(r: np.ndarray, size: int = 3) -> tuple[np.ndarray, np.ndarray]:
     """Local maxima of a circular (H, W) map: rows, cols of pixels equal to the max of their
     ``size`` x ``size`` (odd; wrapped) neighbourhood and strictly above its minimum (no plateaus
@@ -75,8 +129,9 @@ def local_maxima(r: np.ndarray, size: int = 3) -> tuple[np.ndarray, np.ndarray]:
 
 def shift_spectrum(xf: np.ndarray, dy: float, dx: float, shape: tuple[int, int]) -> np.ndarray:
     """Half spectra (..., H, W//2+1) of maps translated so that x'(p) = x(p + (dy, dx)), circularly
-    (sub-cell shifts interpolate in the Fourier domain)."""
-    ky = np.fft.fftfreq(shape[0])[:, None]
+    (sub-cell shifts interpolate in the Fourier domain; the Nyquist frequency of an even size
+    counts as positive, as the authors' ``shift_sample``)."""
+    ky = (_signed_frequencies(shape[0]) / shape[0])[:, None]
     kx = np.fft.rfftfreq(shape[1])[None, :]
     phase = np.exp(2j * np.pi * (ky * dy + kx * dx)).astype(np.complex64)
     return xf * phase

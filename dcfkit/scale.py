@@ -15,7 +15,7 @@ import numpy as np
 
 from .features.fhog import fhog
 from .params import param
-from .patches import sample, sampler
+from .patches import resize_auto, sample, sampler, whole_pixel_crop
 from .registry import Component
 
 
@@ -83,6 +83,20 @@ class DSST(ScaleEstimator):
         learning_rate: float = param(0.025, "interpolation rate of the scale model")
         model_max_area: int = param(512, "largest area (pixels) of a scale sample")
         cell_size: int = param(4, "fHOG cell size of the scale samples")
+        model_size: str = param("base_target", "size of a scale sample: 'base_target' the target at the search "
+                                "patch's resolution (at least 2x2 cells), 'image_target' its size in image pixels "
+                                "(the authors' init_scale: floor, at least 2 px)", choices=("base_target", "image_target"))
+        sampling: str = param("working_patch", "'working_patch': the largest region cut once and each scale "
+                              "resampled from it; 'whole_pixel': each scale cropped in whole pixels and resized "
+                              "(the authors' get_scale_sample)", choices=("working_patch", "whole_pixel"))
+        window: str = param("hann_interior", "window over the scales: 'hann_interior' hann(S+2) without its zero "
+                            "ends, or 'hann' hann(S) (the authors')", choices=("hann_interior", "hann"))
+        channel_order: str = param("bgr", "colour channel order deciding fHOG's ties (see fhog.channel_order)",
+                                   choices=("bgr", "rgb"))
+        model_update: str = param("reextract", "samples the model learns from after a scale change: 'reextract' at "
+                                  "the new scale, or 'shift' the search samples moved by the scale change, missing "
+                                  "ones extracted (DR²Track's shift_sample_scale, which leaves those at the large "
+                                  "end unwindowed)", choices=("reextract", "shift"))
 
         def validate(self):
             if self.sigma_factor <= 0:
@@ -104,10 +118,16 @@ class DSST(ScaleEstimator):
         sigma = n / np.sqrt(33) * p.sigma_factor
         with np.errstate(over="ignore"):  # a σ so small that σ² underflows: a delta label, not NaN
             self.label_f = np.fft.fft(np.exp(-0.5 * offsets**2 / max(sigma**2, np.finfo(float).tiny)))
-        self.window = np.hanning(n + 2)[1:-1]
-        area = float(np.prod(self.base_target))
-        shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
-        self.model_size = np.maximum(np.round(self.base_target * shrink), 2 * p.cell_size).astype(int)
+        self.window = np.hanning(n + 2)[1:-1] if p.window == "hann_interior" else np.hanning(n)
+        if p.model_size == "image_target":
+            target = self.base_target * scale
+            area = float(np.prod(target))
+            shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
+            self.model_size = np.maximum(np.floor(target * shrink), 2).astype(int)
+        else:
+            area = float(np.prod(self.base_target))
+            shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
+            self.model_size = np.maximum(np.round(self.base_target * shrink), 2 * p.cell_size).astype(int)
         # the working patch and its resampling to each scale keep their geometry every frame
         span = self.factors[-1] / self.factors[0]
         self.work_size = np.ceil(self.model_size * span).astype(int)
@@ -117,15 +137,24 @@ class DSST(ScaleEstimator):
         self.num = self.den = None
         self._learn(np.fft.fft(self._samples(image, centre, scale), axis=1))
 
-    def _samples(self, image, centre, scale) -> np.ndarray:
-        """(D, S) windowed fHOG of the S scale samples around ``centre``.
+    def _samples(self, image, centre, scale, which=None, windowed=True) -> np.ndarray:
+        """(D, S) windowed fHOG of the S scale samples around ``centre`` (``which``: only these
+        scales, (D, len(which))).
 
-        The largest region is cut from the image and resampled once to a small working
-        patch (fine enough for the smallest scale); every scale sample is resized from it."""
-        work = sample(image, centre, self.base_target * scale * self.factors[-1], self.work_size)
-        patches = np.stack([resample(work) for resample in self.resamplers])
-        feats = fhog(patches, cell_size=self.params.cell_size, batch=True)
-        return feats.reshape(len(self.factors), -1).T * self.window[None, :]
+        'working_patch': the largest region is cut from the image and resampled once to a
+        small working patch (fine enough for the smallest scale); every scale sample is resized
+        from it. 'whole_pixel': floor(target x scale) whole pixels per scale, resized."""
+        which = range(len(self.factors)) if which is None else which
+        if self.params.sampling == "whole_pixel":
+            patches = np.stack([
+                resize_auto(whole_pixel_crop(image, centre, np.maximum(np.floor(self.base_target * (scale * f)), 2)),
+                            self.model_size) for f in self.factors[list(which)]])
+        else:
+            work = sample(image, centre, self.base_target * scale * self.factors[-1], self.work_size)
+            patches = np.stack([self.resamplers[i](work) for i in which])
+        feats = fhog(patches, cell_size=self.params.cell_size, batch=True, channel_order=self.params.channel_order)
+        feats = feats.reshape(len(patches), -1).T
+        return feats * self.window[None, list(which)] if windowed else feats
 
     def _learn(self, xsf: np.ndarray) -> None:
         """Update the scale model with the (D, S) spectrum of the scale samples."""
@@ -139,13 +168,32 @@ class DSST(ScaleEstimator):
             self.den = (1 - lr) * self.den + lr * den
 
     def update(self, image, centre, scale):
-        xsf = np.fft.fft(self._samples(image, centre, scale), axis=1)
+        xs = self._samples(image, centre, scale)
+        xsf = np.fft.fft(xs, axis=1)
         resp = np.fft.ifft(np.einsum("ds,ds->s", self.num, xsf) / (self.den + self.params.lam)).real
-        new_scale = float(np.clip(scale * self.factors[int(np.argmax(resp))], *self.limits))
-        if new_scale != scale:  # learn from samples at the new scale; unchanged: the same samples
+        best = int(np.argmax(resp))
+        new_scale = float(np.clip(scale * self.factors[best], *self.limits))
+        if self.params.model_update == "shift":
+            xsf = np.fft.fft(self._shifted(xs, best - (len(self.factors) - 1) // 2, image, centre, new_scale), axis=1)
+        elif new_scale != scale:  # learn from samples at the new scale; unchanged: the same samples
             xsf = np.fft.fft(self._samples(image, centre, new_scale), axis=1)
         self._learn(xsf)
         return new_scale
+
+    def _shifted(self, xs, step, image, centre, new_scale) -> np.ndarray:
+        """DR²Track's shift_sample_scale: scale k of the new samples is scale k + ``step`` of the
+        search samples ``xs`` (re-windowed), the ones beyond the ends are extracted at
+        ``new_scale``; those at the large end (``step`` > 0) are left unwindowed, as theirs."""
+        if step == 0:
+            return xs
+        n, win = len(self.factors), self.window
+        out = np.zeros_like(xs)
+        source = np.arange(n) + step
+        kept = (source >= 0) & (source < n)
+        out[:, kept] = xs[:, source[kept]] / (win[source[kept]] + 1e-5) * win[kept]
+        fresh = np.flatnonzero(~kept)
+        out[:, fresh] = self._samples(image, centre, new_scale, fresh, windowed=step < 0)
+        return out
 
 
 def scale_limits(base_target: np.ndarray, base_region: np.ndarray, image_shape, initial: float | None = None,

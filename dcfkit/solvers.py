@@ -60,6 +60,9 @@ class ADMMParams:
     gamma0: float = param(1.0, "γ⁰: initial penalty")
     beta: float = param(10.0, "β: penalty growth per iteration")
     gamma_max: float = param(10000.0, "γ_max: largest penalty")
+    h_step: str = param("standard", "'standard' h from v + u/γ (Eq. 10 with the unscaled multiplier), or 'authors' "
+                        "from γ(v + u) as DR²Track's run_training.m (the same on the first iteration)",
+                        choices=("standard", "authors"))
 
     def validate(self):
         if not 1 <= self.iterations <= 10000:
@@ -106,7 +109,7 @@ def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: n
             return vf, None
         # h-step (Eq. 10) in the spatial domain
         if not first:
-            kernels.h_input(_floats(vf), _floats(uf), gamma, _floats(g))
+            kernels.h_input(_floats(vf), _floats(uf), 1.0 if p.h_step == "authors" else gamma, _floats(g))
         h = fft.irfft2(vf if first else g, shape)
         h *= (gamma * K) / (w2 + gamma * K)
         hf = np.ascontiguousarray(fft.rfft2(h.astype(np.float32, copy=False)), np.complex64)

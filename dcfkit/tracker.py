@@ -24,9 +24,9 @@ from .errors import InputError, TrackingError, blamed_on
 from .features import extract_stack
 from .fft import make_fft
 from .labels import Detection, gaussian_label
-from .patches import box_to_centre_size, centre_size_to_box, sample
+from .patches import box_to_centre_size, centre_size_to_box, round_half_away, sample, whole_pixel_sample
 from .registry import get_registry
-from .response import response, shift_spectrum, subpixel_peak
+from .response import newton_peak, response, shift_spectrum, subpixel_peak
 from .scale import scale_limits
 
 
@@ -65,9 +65,12 @@ def check_box(box: Any, image_shape: tuple[int, ...]) -> np.ndarray:
     return b
 
 
-def hann2d(shape: tuple[int, int]) -> np.ndarray:
-    """Cosine window without zero borders (hann(n + 2) trimmed), (H, W) float32."""
-    return np.outer(np.hanning(shape[0] + 2)[1:-1], np.hanning(shape[1] + 2)[1:-1]).astype(np.float32)
+def hann2d(shape: tuple[int, int], interior: bool = True) -> np.ndarray:
+    """Cosine window, (H, W) float32: without zero borders (hann(n + 2) trimmed: BACF, DR²Track)
+    or, with ``interior=False``, hann(n) itself, zero on the border (STRCF)."""
+    pad = 2 if interior else 0
+    ends = slice(1, -1) if interior else slice(None)
+    return np.outer(np.hanning(shape[0] + pad)[ends], np.hanning(shape[1] + pad)[ends]).astype(np.float32)
 
 
 @dataclasses.dataclass
@@ -108,24 +111,27 @@ class Tracker:
 
     # -- geometry ---------------------------------------------------------------------------
     def _geometry(self, target: np.ndarray) -> tuple[Geometry, float]:
+        """STRCF's init_size, in its arithmetic (a floor of a size decides a sample's pixels)."""
         p = self.params
-        region = (np.full(2, p.search_area_scale * np.sqrt(np.prod(target))) if p.search_area_shape == "square"
-                  else target * p.search_area_scale)
-        area = float(np.prod(region))
+        area = float(np.prod(target * p.search_area_scale))
         scale = 1.0
         if area > p.max_image_sample_size:
             scale = np.sqrt(area / p.max_image_sample_size)
         elif area < p.min_image_sample_size:
             scale = np.sqrt(area / p.min_image_sample_size)
-        cells = np.maximum(np.round(region / scale / p.cell_size), 4).astype(int)
         base_target = target / scale
+        region = (np.full(2, np.sqrt(np.prod(base_target * p.search_area_scale))) if p.search_area_shape == "square"
+                  else np.floor(base_target * p.search_area_scale))
+        cells = np.maximum(round_half_away(region / p.cell_size), 4).astype(int)
         target_cells = tuple(float(v) for v in base_target / p.cell_size)
         geom = Geometry(base_target, cells * p.cell_size, (int(cells[0]), int(cells[1])), target_cells)
         return geom, float(scale)
 
-    def _patch(self, image: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
-        """The search patch at ``centre``, resampled to the sample size."""
-        g = self.geometry
+    def _patch(self, image: np.ndarray, centre: np.ndarray, scale: float, g: Geometry | None = None) -> np.ndarray:
+        """The search patch at ``centre``, resampled to the sample size (``tracker.sampling``)."""
+        g = g or self.geometry
+        if self.params.sampling == "whole_pixel":
+            return whole_pixel_sample(image, round_half_away(centre), g.sample_size * scale, g.sample_size)
         return sample(image, centre, g.sample_size * scale, g.sample_size)
 
     def _spectrum(self, patch: np.ndarray) -> np.ndarray:
@@ -148,10 +154,13 @@ class Tracker:
         image = check_image(image, 1)
         box = check_box(box, image.shape)
         centre, target = box_to_centre_size(box)
+        if self.params.init_position == "whole_pixel":  # 1-based floor([y x] + floor([h w] / 2))
+            target = np.floor(target)
+            centre = np.floor(box[[1, 0]] + np.floor(target / 2))
         g, scale = self._geometry(target)
         limits = scale_limits(g.base_target, g.sample_size, image.shape, initial=scale)
         scale = float(np.clip(scale, *limits))
-        patch = sample(image, centre, g.sample_size * scale, g.sample_size)
+        patch = self._patch(image, centre, scale, g)
         std = self._blank(patch)
         if std is not None:  # checked before any state changes: a failed init leaves the tracker as it was
             outside = not (0 <= centre[0] < image.shape[0] and 0 <= centre[1] < image.shape[1])
@@ -162,7 +171,7 @@ class Tracker:
         self.frame = 1
         self.image_size = image.shape[:2]
         self.geometry, self.scale, self.limits = g, scale, limits
-        self.window = hann2d(g.filter_size)
+        self.window = hann2d(g.filter_size, interior=self.params.window == "hann_interior")
         sigma = np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * self.params.output_sigma_factor
         self.base_label = gaussian_label(g.filter_size, sigma)
         self.base_label.setflags(write=False)  # every frame's label starts from it
@@ -186,8 +195,10 @@ class Tracker:
         if image.shape[:2] != self.image_size:
             raise InputError(f"frame {self.frame}: the image is {image.shape[1]}x{image.shape[0]}, but the "
                              f"sequence's first frame was {self.image_size[1]}x{self.image_size[0]}")
-        g = self.geometry
+        g, p = self.geometry, self.params
         centre = self._clamp(self.search.centre(), image.shape)  # Eq. (14)
+        if p.sampling == "whole_pixel":  # the patch is centred on a whole pixel, and so are displacements
+            centre = round_half_away(centre)
         factors = self.scale_estimator.search_factors()
         patches = [self._patch(image, centre, self.scale * f) for f in factors]
         if self._blank(patches[len(factors) // 2]) is not None:  # a dropped frame: hold, learn nothing
@@ -199,21 +210,33 @@ class Tracker:
         if not np.all(np.isfinite(maps)):
             raise TrackingError(f"frame {self.frame}: the response map is not finite (the filter overflowed: "
                                 f"look for extreme solver, regularizer or label values in the config)")
-        best = int(np.argmax(maps.reshape(len(factors), -1).max(axis=1)))
-        dy, dx, _ = subpixel_peak(maps[best])
-        step = self.params.cell_size * self.scale * factors[best]
-        self.position = self._clamp(centre + np.array([dy, dx]) * step, image.shape)
+        best, dy, dx = self._peak(maps)
+        step = p.cell_size * self.scale * factors[best]
+        move = np.array([dy, dx]) * p.cell_size * self.scale * factors[best]  # the authors' order of products
+        if p.translation == "whole_pixel":
+            move = round_half_away(move)
+        self.position = self._clamp(centre + move, image.shape)
         self.scale = self.scale_estimator.update(image, self.position, self.scale * factors[best])
         self.search.observe(self.position)  # Eq. (13)
         peak = np.unravel_index(int(np.argmax(maps[best])), g.filter_size)
         self.last_response = np.fft.fftshift(maps[best])
-        self.last_search_box = centre_size_to_box(centre, g.sample_size * step / self.params.cell_size)
+        self.last_search_box = centre_size_to_box(centre, g.sample_size * step / p.cell_size)
         xf = None
-        if self.params.training_sample == "shift":  # the detection sample, moved to p^t
-            dy, dx = (self.position - centre) / step
+        if p.training_sample == "shift":  # the detection sample, moved to p^t in cells of the new scale
+            dy, dx = move / (p.cell_size * self.scale)
             xf = shift_spectrum(samples[best], dy, dx, g.filter_size)
-        self._train(image, Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells), xf)
+        detection = Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells, (dy, dx))
+        self._train(image, detection, xf)
         return self.box
+
+    def _peak(self, maps: np.ndarray) -> tuple[int, float, float]:
+        """The search scale whose response is best and its peak as a (dy, dx) offset in cells."""
+        if self.params.peak == "newton":
+            best, dy, dx, _ = newton_peak(maps)
+            return best, dy, dx
+        best = int(np.argmax(maps.reshape(len(maps), -1).max(axis=1)))
+        dy, dx, _ = subpixel_peak(maps[best])
+        return best, dy, dx
 
     def _train(self, image: np.ndarray, detection: Detection | None, xf: np.ndarray | None = None) -> None:
         if xf is None:
@@ -245,15 +268,24 @@ class Tracker:
             raise TrackingError(f"{what} returned offsets of shape {offsets.shape}, expected (N, 2) (dy, dx) cells")
         return y.astype(np.float32, copy=False), offsets
 
-    @staticmethod
-    def _clamp(centre: np.ndarray, shape) -> np.ndarray:
-        """Keep the centre on the image so a target leaving it never yields a NaN box."""
+    def _clamp(self, centre: np.ndarray, shape) -> np.ndarray:
+        """Keep the centre on the image (``tracker.clamp_position``)."""
+        if not self.params.clamp_position:
+            return centre
         return np.clip(centre, 0, np.array(shape[:2], dtype=float) - 1)
 
     @property
     def box(self) -> tuple[float, float, float, float]:
-        """Current (x, y, w, h), 0-based pixels."""
-        return centre_size_to_box(self.position, self.geometry.base_target * self.scale)
+        """Current (x, y, w, h), 0-based pixels (``tracker.box_output``)."""
+        size = self.geometry.base_target * self.scale
+        if self.params.box_output == "half_size":  # DR²Track's [pos - round(size) / 2, round(size)]
+            size = round_half_away(size)
+            (cy, cx), (h, w) = self.position, size
+            return float(cx - w / 2), float(cy - h / 2), float(w), float(h)
+        box = centre_size_to_box(self.position, size)
+        if self.params.box_output == "rounded":  # round([pos - (sz - 1)/2, sz]), 1-based
+            return tuple(float(v) for v in round_half_away(np.add(box, (1, 1, 0, 0))) - (1, 1, 0, 0))
+        return box
 
 
 def load_tracker(config: str | Mapping[str, Any], **overrides: Any) -> Tracker:

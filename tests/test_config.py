@@ -19,7 +19,7 @@ def test_shipped_configs_resolve(name):
 def test_dr2track_has_the_papers_parameters():
     cfg = load_config("dr2track")
     assert cfg["label"] == {"name": "distractor_repressed", "top_n": 30, "mu": 0.25, "variant": "subtractive",
-                            "neighbourhood": 3, "exclusion": 1.0}
+                            "neighbourhood": 3, "exclusion": 1.0, "selection": "local_maxima", "mirrored": False}
     assert cfg["regularizers"]["temporal"]["theta"] == 12
     assert cfg["solver"]["iterations"] == 4 and cfg["solver"]["gamma0"] == 1
     assert cfg["solver"]["beta"] == 10 and cfg["solver"]["gamma_max"] == 10000

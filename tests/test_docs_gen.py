@@ -32,8 +32,8 @@ def test_config_reference_documents_every_key_and_every_parameter():
                 assert f"| `{f['name']}` |" in text
     assert "| `output_sigma_factor` | float | `0.0625` |" in text  # the tracker section
     assert "| `scale` | `pyramid` |" in text and "| `search` | `fixed` |" in text  # what resolve() fills in
-    assert "| `variant` | str | `subtractive` | 'subtractive' (authors' code) or 'multiplicative' " \
-           "(paper's g⊙d) (one of: `subtractive`, `multiplicative`) |" in text
+    assert "| `variant` | str | `subtractive` | 'subtractive' g - μR̃, 'overwrite' -μR̃ (the authors' code) or " \
+           "'multiplicative' (the paper's g⊙d) (one of: `subtractive`, `overwrite`, `multiplicative`) |" in text
 
 
 def test_cli_reference_has_every_subcommand_and_option():

@@ -40,16 +40,30 @@ class Feature(Component):
         raise NotImplementedError
 
 
+# rgb2gray's weights of R, G, B in MATLAB and Octave, applied to the unrounded colour values
+MATLAB_GRAY_WEIGHTS = (0.298936, 0.587043, 0.114021)
+
+
 class Gray(Feature):
     """Gray level in [-0.5, 0.5], averaged over each cell."""
 
     name = "gray"
 
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        conversion: str = param("opencv", "'opencv': cv2's BGR2GRAY, rounded to whole gray levels; 'matlab': "
+                                "rgb2gray of the unrounded values, as the authors' get_colorspace",
+                                choices=("opencv", "matlab"))
+
     def channels(self) -> int:
         return 1
 
     def extract(self, patch, cell_size):
-        gray = cv2.cvtColor(patch, cv2.COLOR_BGR2GRAY).astype(np.float32)
+        if self.params.conversion == "matlab":
+            r, g, b = MATLAB_GRAY_WEIGHTS
+            gray = patch.astype(np.float32) @ np.array([b, g, r], np.float32)
+        else:
+            gray = cv2.cvtColor(patch, cv2.COLOR_BGR2GRAY).astype(np.float32)
         gray *= 1.0 / 255.0
         gray -= 0.5
         return cell_average(gray, cell_size)[None]
@@ -66,6 +80,9 @@ class FHOG(Feature):
         clip: float = param(0.2, "truncation of the normalised histograms")
         soft_orientation: bool = param(False, "split each gradient between the two nearest orientation bins "
                                               "(false: nearest bin only, as Piotr's fhog used by STRCF/BACF)")
+        channel_order: str = param("bgr", "which colour channel's gradient a pixel takes when two are equally "
+                                   "strong: the first of 'bgr' (OpenCV's order) or of 'rgb' (MATLAB's: the "
+                                   "authors' code)", choices=("bgr", "rgb"))
 
         def validate(self):
             if self.n_orients < 2:
@@ -78,7 +95,8 @@ class FHOG(Feature):
 
     def extract(self, patch, cell_size):
         p = self.params
-        return fhog(patch, cell_size=cell_size, n_orients=p.n_orients, clip=p.clip, soft_orientation=p.soft_orientation)
+        return fhog(patch, cell_size=cell_size, n_orients=p.n_orients, clip=p.clip, soft_orientation=p.soft_orientation,
+                    channel_order=p.channel_order)
 
 
 class ColorNames(Feature):

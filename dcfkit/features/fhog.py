@@ -62,6 +62,7 @@ def fhog(
     *,
     batch: bool = False,
     soft_orientation: bool = False,
+    channel_order: str = "bgr",
 ) -> np.ndarray:
     """Felzenszwalb HOG of one image, or of a batch of equally sized images.
 
@@ -80,6 +81,10 @@ def fhog(
         soft_orientation: split each magnitude between the two nearest
             orientation bins; ``False`` (default) puts it in the nearest bin, as
             Piotr's toolbox does.
+        channel_order: the order of a colour image's channels, which decides
+            which channel's gradient a pixel takes when two are equally strong
+            (the first): 'bgr' (OpenCV's images) or 'rgb' (MATLAB's, which makes
+            a BGR array's red channel win, as in the authors' trackers).
 
     Returns:
         ``(3 * n_orients + 4, H // cell_size, W // cell_size)`` float32,
@@ -92,12 +97,14 @@ def fhog(
             bad parameter.
     """
     _check_params(cell_size, n_orients, clip)
+    if channel_order not in ("bgr", "rgb"):
+        raise ValueError(f"fhog: channel_order must be 'bgr' or 'rgb', got {channel_order!r}")
     imgs = _as_stack(image, batch, cell_size)
     if imgs.shape[0] == 0:
         hb, wb = imgs.shape[1] // cell_size, imgs.shape[2] // cell_size
         return np.zeros((0, fhog_channels(n_orients), hb, wb), np.float32)
     ws = _workspace((imgs.shape, imgs.dtype.char, cell_size, n_orients))
-    hist = _histograms(imgs, cell_size, 2 * n_orients, soft_orientation, ws)
+    hist = _histograms(imgs, cell_size, 2 * n_orients, soft_orientation, ws, channel_order == "rgb")
     out = _normalise(hist, n_orients, clip, cell_size, ws)
     return out if batch else out[0]
 
@@ -211,7 +218,7 @@ def _cell_histograms(
 
 
 def _histograms(
-    imgs: np.ndarray, cell_size: int, n_bins: int, soft_orientation: bool, ws: dict
+    imgs: np.ndarray, cell_size: int, n_bins: int, soft_orientation: bool, ws: dict, reverse: bool = False
 ) -> np.ndarray:
     """``_cell_histograms`` laid out ``(n_bins, N, hb, wb)``, in the scratch ``ws``."""
     from . import kernels  # numba: imported and compiled (or loaded from disk) on first use
@@ -222,7 +229,7 @@ def _histograms(
     if imgs.ndim == 3:
         imgs = imgs[..., None]
     gx, gy, mag = (_buf(ws, name, (n, rows, cols)) for name in ("gx", "gy", "mag"))
-    kernels.gradients(np.ascontiguousarray(imgs), rows, cols, gx, gy, mag)
+    kernels.gradients(np.ascontiguousarray(imgs), rows, cols, reverse, gx, gy, mag)
     # numpy's arctan2 (its SIMD path), not the compiled loop's libm one: bins near a
     # boundary depend on the last bit
     theta = np.arctan2(gy, gx, out=_buf(ws, "theta", (n, rows, cols)))

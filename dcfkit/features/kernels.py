@@ -20,13 +20,14 @@ import numpy as np
 
 
 @numba.njit(cache=True, nogil=True)
-def gradients(imgs, rows, cols, gx, gy, mag):  # pragma: no cover - compiled
+def gradients(imgs, rows, cols, reverse, gx, gy, mag):  # pragma: no cover - compiled
     """Centred differences of the ``rows x cols`` top-left pixels, negated (Piotr's grad1).
 
     imgs: (N, H, W, C) uint8 or float32, C = 1 or 3; per pixel the channel with the largest
-    magnitude wins (the first on ties). Interior pixels get ``(I[p-1] - I[p+1]) / 2``, image
-    borders the one-sided ``I[0] - I[1]``; equal neighbours give +0.0, whose arctan2 is +pi
-    (not -pi) when gx < 0. Writes gx, gy, mag: (N, rows, cols) float32.
+    magnitude wins, the first on ties (the last with ``reverse``: an RGB image's first channel
+    is a BGR array's last). Interior pixels get ``(I[p-1] - I[p+1]) / 2``, image borders the
+    one-sided ``I[0] - I[1]``; equal neighbours give +0.0, whose arctan2 is +pi (not -pi) when
+    gx < 0. Writes gx, gy, mag: (N, rows, cols) float32.
     """
     n, h, w, channels = imgs.shape
     for i in range(n):
@@ -36,10 +37,12 @@ def gradients(imgs, rows, cols, gx, gy, mag):  # pragma: no cover - compiled
             for x in range(cols):
                 x0, x1 = max(x - 1, 0), min(x + 1, w - 1)
                 sx = np.float32(0.5) if 0 < x < w - 1 else np.float32(1.0)
-                bx = (np.float32(imgs[i, y, x0, 0]) - np.float32(imgs[i, y, x1, 0])) * sx
-                by = (np.float32(imgs[i, y0, x, 0]) - np.float32(imgs[i, y1, x, 0])) * sy
+                c0 = channels - 1 if reverse else 0
+                bx = (np.float32(imgs[i, y, x0, c0]) - np.float32(imgs[i, y, x1, c0])) * sx
+                by = (np.float32(imgs[i, y0, x, c0]) - np.float32(imgs[i, y1, x, c0])) * sy
                 best = bx * bx + by * by  # squares order magnitudes as their roots do
-                for c in range(1, channels):
+                for k in range(1, channels):
+                    c = channels - 1 - k if reverse else k
                     dx = (np.float32(imgs[i, y, x0, c]) - np.float32(imgs[i, y, x1, c])) * sx
                     dy = (np.float32(imgs[i, y0, x, c]) - np.float32(imgs[i, y1, x, c])) * sy
                     m = dx * dx + dy * dy
