@@ -151,12 +151,11 @@ def cmd_compare(args) -> int:
         print(json.dumps(_json_ready(res), indent=1))
         return 0
     print(format_table(res["rows"] + [res["mean"]], args.format, COLUMNS, args.protocol), end="")
-    if args.format != "csv":
-        left = "; ".join(f"{k.replace('_', ' ')}: {', '.join(v)}" for k, v in res["left_out"].items() if v)
-        print(f"\nresults: {res['results']}\nreference: {res['reference']}\n"
-              f"{res['diverged']} of {len(res['rows'])} sequences diverge (centres more than "
-              f"{args.divergence_px:g} px apart); d_ = results minus reference\n"
-              f"left out: {left or 'none'}")
+    left = "; ".join(f"{k.replace('_', ' ')}: {', '.join(v)}" for k, v in res["left_out"].items() if v)
+    print(f"\nresults: {res['results']}\nreference: {res['reference']}\n"
+          f"{res['diverged']} of {len(res['rows'])} sequences diverge (centres more than "
+          f"{args.divergence_px:g} px apart); d_ = results minus reference\n"
+          f"left out: {left or 'none'}", file=sys.stderr if args.format == "csv" else sys.stdout)
     return 0
 
 
@@ -211,7 +210,9 @@ def build_parser() -> argparse.ArgumentParser:
     add_protocol_argument(p)
     p.add_argument("--divergence-px", type=_pixels, default=2.0,
                    help="centres further apart than this (pixels) count as diverged")
-    p.add_argument("--format", choices=("table", "markdown", "csv", "json"), default="table")
+    p.add_argument("--format", choices=("table", "markdown", "csv", "json"), default="table",
+                   help="output format; json holds everything, with csv the closing notes (folders, "
+                        "divergences, left-out sequences) go to stderr")
     p.set_defaults(func=cmd_compare)
     p = sub.add_parser("ablate", help="run an ablation spec: variants x parameter grids x sequences")
     add_ablate_arguments(p)

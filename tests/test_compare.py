@@ -99,8 +99,10 @@ def test_cli_formats(folders, tmp_path, capsys, monkeypatch):
     assert "1 of 2 sequences diverge (centres more than 2 px apart)" in out
     assert "left out: only in results: only_ours; only in reference: only_theirs; not in dataset: c" in out
     assert cli.main(base + ["--format", "csv", "--protocol", "pysot", "--divergence-px", "4"]) == 0
-    lines = capsys.readouterr().out.splitlines()
-    assert lines[0] == ("sequence,frames,precision,precision_ref,d_precision,auc,auc_ref,d_auc,iou,"
+    captured = capsys.readouterr()
+    assert "left out: only in results: only_ours;" in captured.err  # notes beside the CSV, not in it
+    lines = captured.out.splitlines()
+    assert len(lines) == 4 and lines[0] == ("sequence,frames,precision,precision_ref,d_precision,auc,auc_ref,d_auc,iou,"
                         "diverges_at,protocol")
     assert lines[1].startswith("a,5,") and lines[1].endswith(",5,pysot") and lines[3].startswith("mean,10,")
     assert cli.main(base + ["--format", "json", "--protocol", "got10k"]) == 0
