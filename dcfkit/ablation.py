@@ -575,9 +575,8 @@ def summary_columns(table: str, protocol: str = DEFAULT) -> tuple[str, ...]:
     """:data:`SUMMARY_COLUMNS` (``table="summary"``) or :data:`SEQUENCE_COLUMNS`
     (``"per_sequence"``), with AO, SR@0.5 and SR@0.75 after the AUC under ``got10k``."""
     base = SUMMARY_COLUMNS if table == "summary" else SEQUENCE_COLUMNS
-    extra = ("ao", "sr50", "sr75") if get_protocol(protocol).overlap_scores else ()
     i = base.index("auc") + 1
-    return base[:i] + extra + base[i:]
+    return base[:i] + get_protocol(protocol).overlap_keys + base[i:]
 
 
 def _status(folder: Path, seq) -> tuple[str, str | None]:
@@ -621,7 +620,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     results = {variant: stored[key] for variant, key in keys.items()}
     with _quiet(logging.getLogger("dcfkit.report")):  # missing runs are counted in 'failed'
         scores = evaluate(results, sequences, protocol=protocol)
-    extra = ("ao", "sr50", "sr75") if get_protocol(protocol).overlap_scores else ()
+    extra = get_protocol(protocol).overlap_keys
 
     order = {v: i for i, v in enumerate(keys)}
     seq_order = {s.name: i for i, s in enumerate(sequences)}

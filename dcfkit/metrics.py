@@ -44,7 +44,6 @@ __all__ = [
 ]
 
 _CURVES = ("precision_curve", "success_curve", "norm_precision_curve")
-_OVERLAP_SCORES = ("ao", "sr50", "sr75")
 
 
 def as_boxes(boxes, n: int | None = None) -> np.ndarray:
@@ -192,7 +191,7 @@ def average(scores: Iterable[Mapping], weighting: str | None = None,
     sizes = {"precision_curve": len(proto.precision_thresholds), "success_curve": len(proto.success_thresholds),
              "norm_precision_curve": len(proto.norm_precision_thresholds)}
     means = {}
-    for key in _CURVES + (_OVERLAP_SCORES if proto.overlap_scores else ()):
+    for key in _CURVES + proto.overlap_keys:
         values = [np.atleast_1d(np.asarray(s[key], dtype=np.float64)) for s in scores]
         keep = [i for i, v in enumerate(values) if not (proto.drop_zero_curves and key in _CURVES
                                                         and scores[i].get("given", 1) > 0
@@ -201,7 +200,7 @@ def average(scores: Iterable[Mapping], weighting: str | None = None,
             means[key] = np.average(np.stack([values[i] for i in keep]), axis=0, weights=w[keep])
         else:
             means[key] = np.full(sizes.get(key, 1), np.nan)
-    overlap_scores = {k: means[k][0] for k in _OVERLAP_SCORES if k in means}
+    overlap_scores = {k: means[k][0] for k in proto.overlap_keys}
     return _summarise(proto, int(sum(s["frames"] for s in scores)), int(sum(s.get("given", 0) for s in scores)),
                       means["precision_curve"], means["success_curve"], means["norm_precision_curve"],
                       **overlap_scores)

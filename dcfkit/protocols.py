@@ -111,9 +111,14 @@ class Protocol:
     norm_precision_index: int = 20       # normalized precision score: curve at 0.2
 
     @property
+    def overlap_keys(self) -> tuple[str, ...]:
+        """``("ao", "sr50", "sr75")`` for a protocol with overlap scores, else ``()``."""
+        return ("ao", "sr50", "sr75") if self.overlap_scores else ()
+
+    @property
     def score_keys(self) -> tuple[str, ...]:
         """The scalar scores of this protocol, in the order tables show them."""
-        return (("ao", "sr50", "sr75") if self.overlap_scores else ()) + ("auc", "precision", "norm_precision")
+        return self.overlap_keys + ("auc", "precision", "norm_precision")
 
     @property
     def rank_key(self) -> str:

@@ -531,10 +531,12 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
     assert not (tmp_path / "out2").exists()
     monkeypatch.setattr(evaluation, "_resolve_config", fake_resolve)
     args = parser.parse_args(["fast.yaml", "fast.yaml", "--root", str(root), "--out", str(tmp_path / "out3"),
-                              "--sequences", "a", "--no-progress"])
+                              "--sequences", "a", "--no-progress", "--protocol", "got10k"])
     assert evaluation.cmd_eval(args) == 0
-    assert [line for line in capsys.readouterr().out.splitlines() if line.startswith("fast:")] == [
+    printed = capsys.readouterr().out.splitlines()
+    assert [line for line in printed if line.startswith("fast:")] == [
         f"fast: 1 run, 0 already done, 0 failed -> {tmp_path / 'out3' / 'fast'}"]
+    assert printed[-1].startswith("  AO ") and printed[-1].endswith(" on 1 sequences (protocol got10k)")
 
     parser = argparse.ArgumentParser()
     report.add_report_arguments(parser)
