@@ -19,7 +19,8 @@ UAV123 tables.
   -1, whatever the prediction.
 * Frame 1's prediction is replaced by the ground truth.
 * From frame 2 on, a prediction is replaced by the previous frame's (already replaced)
-  prediction when MATLAB's ``if (isnan(r) | r(3)<=0 | r(4)<=0) & ~isnan(gt)`` holds: the
+  prediction -- for frame 2 the file's frame-1 box, NaN or not, since the ground-truth copy
+  comes after the loop -- when MATLAB's ``if (isnan(r) | r(3)<=0 | r(4)<=0) & ~isnan(gt)`` holds: the
   condition is a 1x4 vector and ``if`` needs all four true, so it holds when the
   prediction is all NaN or has ``w <= 0`` or ``h <= 0``, *and* no ground-truth value is
   NaN. A prediction with only some values NaN, or one in a frame whose ground truth is
@@ -43,6 +44,9 @@ UAV123 tables.
   ``> 0`` test; thresholds ``arange(0, 51) / 100``, score at index 20 (0.2).
 * Thresholds ``arange(0, 1.05, 0.05)`` and ``arange(0, 51)``; precision at index 20, AUC the
   mean of the success curve; sequences weigh equally.
+* pysot's ``UAVDataset`` passes the rows of its ``UAV123.json`` on unchanged (NaN rows
+  included) and has no ``absent`` flags (only LaSOT has them: its absent frames are dropped
+  from the frames but not from ``n_frame``), so every UAV123 frame counts as above.
 
 ``got10k``: got10k-toolkit's ``got10k/experiments/got10k.py`` (GOT-10k ``val`` report) and
 ``got10k/utils/metrics.py``.
@@ -61,6 +65,9 @@ UAV123 tables.
 * Where dcfkit differs: a NaN prediction has IoU 0 (the toolkit's NaN would make AO NaN;
   SR and the curve are the same either way), and boxes are not clipped to the image
   (``bound=resolution`` of the GOT-10k report: dcfkit's metrics do not know image sizes).
+* The same toolkit's OTB, UAV123 and LaSOT experiments score differently (frame 1 replaced
+  by the ground truth, 21 overlap thresholds, per-sequence means): ``got10k`` here is the
+  GOT-10k report.
 
 Rules every protocol shares in dcfkit: rows a result file does not have (a truncated or
 missing result) fail every threshold, substituted by nothing; ``include_first=False``
