@@ -42,6 +42,8 @@ from typing import Any, Iterable, Mapping
 import yaml
 
 from .errors import ConfigError, DcfkitError
+from .protocols import DEFAULT, get_protocol
+from .report import add_protocol_argument, format_table
 
 __all__ = [
     "AblationSpec",
@@ -477,8 +479,9 @@ def _run_dask(tasks, jobs, scheduler, version, on_result):
 
 
 def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str = "local",
-                 scheduler: str | None = None, progress: bool = True) -> dict:
-    """Run every job of ``spec`` not already done under ``out``, then write the summary.
+                 scheduler: str | None = None, progress: bool = True, protocol: str = DEFAULT) -> dict:
+    """Run every job of ``spec`` not already done under ``out``, then write the summary
+    (scored under ``protocol``, see :mod:`dcfkit.protocols`).
 
     ``executor`` is ``"local"`` (``jobs`` spawned worker processes, default: the usable
     cores; ``jobs=1`` runs in this process) or ``"dask"`` (``Client(scheduler)``, or a
@@ -552,7 +555,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
                     _run_pool(todo, jobs, version, on_result)
         finally:
             bar.close()
-        result["summary"] = summarize(spec, out, seqs, job_list)
+        result["summary"] = summarize(spec, out, seqs, job_list, protocol)
     return result
 
 
@@ -568,6 +571,14 @@ SUMMARY_COLUMNS = ("variant", "precision", "auc", "fps", "sequences", "failed")
 SEQUENCE_COLUMNS = ("variant", "sequence", "precision", "auc", "fps", "frames", "status")
 
 
+def summary_columns(table: str, protocol: str = DEFAULT) -> tuple[str, ...]:
+    """:data:`SUMMARY_COLUMNS` (``table="summary"``) or :data:`SEQUENCE_COLUMNS`
+    (``"per_sequence"``), with AO, SR@0.5 and SR@0.75 after the AUC under ``got10k``."""
+    base = SUMMARY_COLUMNS if table == "summary" else SEQUENCE_COLUMNS
+    i = base.index("auc") + 1
+    return base[:i] + get_protocol(protocol).overlap_keys + base[i:]
+
+
 def _status(folder: Path, seq) -> tuple[str, str | None]:
     from .evaluation import is_done, read_json
 
@@ -579,16 +590,19 @@ def _status(folder: Path, seq) -> tuple[str, str | None]:
     return "missing", None
 
 
-def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None = None) -> dict:
-    """Score the stored results of ``jobs`` and write the tables, ``summary.json`` and plots.
+def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None = None,
+              protocol: str = DEFAULT) -> dict:
+    """Score the stored results of ``jobs`` under ``protocol`` and write the tables,
+    ``summary.json`` and plots, each naming the protocol.
 
-    precision is the OTB precision at 20 px, auc the area under the success curve, fps the
-    mean per-sequence frames per second of tracker time (:mod:`dcfkit.report`). A job
-    without result (failed or not run) is scored as a total failure and counted in
-    ``failed``. Returns ``{"overall", "per_sequence", "jobs", "files"}``.
+    precision is the precision at 20 px, auc the area under the success curve (and under
+    ``got10k`` also ao, sr50, sr75), fps the mean per-sequence frames per second of tracker
+    time (:mod:`dcfkit.report`). A job without result (failed or not run) is scored as a
+    total failure and counted in ``failed``. Returns ``{"overall", "per_sequence", "jobs",
+    "files"}``.
     """
     from .evaluation import load_results
-    from .report import _json_ready, evaluate, format_rows
+    from .report import _json_ready, evaluate
 
     out = Path(out)
     jobs = jobs if jobs is not None else expand(spec, sequences)
@@ -605,15 +619,18 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
         stored[key] = load_results(folder.parent, key, done) if done else {}
     results = {variant: stored[key] for variant, key in keys.items()}
     with _quiet(logging.getLogger("dcfkit.report")):  # missing runs are counted in 'failed'
-        scores = evaluate(results, sequences)
+        scores = evaluate(results, sequences, protocol=protocol)
+    extra = get_protocol(protocol).overlap_keys
 
     order = {v: i for i, v in enumerate(keys)}
     seq_order = {s.name: i for i, s in enumerate(sequences)}
-    overall = sorted(({"variant": r["tracker"], "precision": r["precision"], "auc": r["auc"], "fps": r["fps"],
+    overall = sorted(({"variant": r["tracker"], "precision": r["precision"], "auc": r["auc"],
+                       **{k: r[k] for k in extra}, "fps": r["fps"],
                        "sequences": r["sequences"], "failed": r["missing"], "key": keys[r["tracker"]]}
                       for r in scores["overall"]), key=lambda r: order[r["variant"]])
     per_sequence = sorted(({"variant": r["tracker"], "sequence": r["sequence"], "precision": r["precision"],
-                            "auc": r["auc"], "fps": r["fps"], "frames": len(by_name[r["sequence"]]),
+                            "auc": r["auc"], **{k: r[k] for k in extra}, "fps": r["fps"],
+                            "frames": len(by_name[r["sequence"]]),
                             "status": status[keys[r["tracker"]], r["sequence"]][0]}
                            for r in scores["per_sequence"]),
                           key=lambda r: (order[r["variant"]], seq_order[r["sequence"]]))
@@ -623,13 +640,13 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     from .evaluation import atomic_write
 
     files = []
-    for stem, rows, columns in (("summary", overall, SUMMARY_COLUMNS),
-                                ("per_sequence", per_sequence, SEQUENCE_COLUMNS)):
+    for stem, rows in (("summary", overall), ("per_sequence", per_sequence)):
         for fmt, ext in (("markdown", "md"), ("csv", "csv")):
             path = out / f"{stem}.{ext}"
-            atomic_write(path, format_rows(rows, fmt, columns))
+            atomic_write(path, format_table(rows, fmt, summary_columns(stem, protocol), protocol))
             files.append(path)
     info = {"spec": str(spec.path), "name": spec.name, "description": spec.description,
+            "protocol": scores["protocol"],
             "dataset": spec.dataset, "root": str(spec.root), "sequences": [s.name for s in sequences],
             "overall": overall, "per_sequence": per_sequence, "jobs": job_rows,
             "grid": ({"base": spec.grid.base, "mode": spec.grid.mode,
@@ -640,12 +657,12 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     atomic_write(path, json.dumps(_json_ready(info), indent=1, ensure_ascii=False, default=str) + "\n")
     files.append(path)
     if spec.grid is not None:
-        files += plot_sensitivity(spec, overall, out)
+        files += plot_sensitivity(spec, overall, out, protocol)
     else:  # named variants: the OTB plots, one curve each
         from .report import plot_curves
 
         for kind in ("precision", "success"):
-            files += plot_curves(scores["curves"], kind, out / kind)
+            files += plot_curves(scores["curves"], kind, out / kind, protocol=protocol)
     return {"overall": overall, "per_sequence": per_sequence, "jobs": job_rows, "files": files}
 
 
@@ -675,7 +692,7 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
-def plot_sensitivity(spec: AblationSpec, overall: list[dict], out) -> list[Path]:
+def plot_sensitivity(spec: AblationSpec, overall: list[dict], out, protocol: str = DEFAULT) -> list[Path]:
     """Fig. 6 of the paper: per grid parameter, precision and AUC against its value.
 
     Sweep: the grid points of that parameter (the others at the base). Product: the mean
@@ -721,7 +738,7 @@ def plot_sensitivity(spec: AblationSpec, overall: list[dict], out) -> list[Path]
         what = "mean over the other parameters" if grid.mode == "product" and len(grid.parameters) > 1 else \
             "others at the base"
         n_seq = overall[0]["sequences"] if overall else 0
-        ax.set_title(f"{label} on {spec.dataset} ({n_seq} sequences), {what}", fontsize=9)
+        ax.set_title(f"{label} on {spec.dataset} ({n_seq} sequences), {what} [protocol {protocol}]", fontsize=9)
         ax.grid(True, linestyle=":", linewidth=0.6)
         ax.legend(fontsize=8)
         fig.tight_layout()
@@ -752,6 +769,7 @@ def add_ablate_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentPa
                         help="benchmark root folder (default: the spec's dataset.root, relative to the spec)")
     parser.add_argument("--sequences", default=None,
                         help="comma-separated sequence names (default: the spec's, else all)")
+    add_protocol_argument(parser)
     parser.add_argument("--dry-run", action="store_true",
                         help="list the jobs and whether each is done; run nothing")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -777,11 +795,11 @@ def cmd_ablate(args: argparse.Namespace) -> int:
         print(f"{len(jobs)} jobs, {len({(j.key, j.sequence) for j in jobs})} distinct runs")
         return 0
     res = run_ablation(spec, args.out, jobs=args.jobs, executor=executor, scheduler=args.scheduler,
-                       progress=not args.no_progress)
-    from .report import format_rows
+                       progress=not args.no_progress, protocol=args.protocol)
 
     summary = res["summary"]
-    print(format_rows(summary["overall"], "markdown", SUMMARY_COLUMNS), end="")
+    print(format_table(summary["overall"], "markdown", summary_columns("summary", args.protocol), args.protocol),
+          end="")
     print(f"\n{spec.name}: {len(res['jobs'])} jobs ({res['runs']} distinct runs): {len(res['done'])} run, "
           f"{len(res['skipped'])} already done, {len(res['failed'])} failed -> {Path(args.out)}")
     variants = variant_names(res["jobs"])

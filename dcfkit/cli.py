@@ -1,7 +1,8 @@
 """dcfkit: discriminative correlation filter trackers assembled from YAML.
 
 Commands: track (one video), demo (a generated sequence, no data needed), components,
-eval (one-pass evaluation on a benchmark), report, ablate."""
+eval (one-pass evaluation on a benchmark), report, compare (two result folders side by
+side), ablate."""
 from __future__ import annotations
 
 import argparse
@@ -9,6 +10,7 @@ import json
 import sys
 import time
 import warnings
+from pathlib import Path
 
 from . import __version__
 from .errors import DcfkitError
@@ -22,6 +24,16 @@ def _parse_box(text: str) -> tuple[float, ...]:
     if len(box) != 4:
         raise DcfkitError(f"--box expects x,y,w,h (four numbers), got {text!r}")
     return box
+
+
+def _pixels(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"expected a distance in pixels >= 0, got {text!r}")
+    return value
 
 
 def _frame_count(text: str) -> int:
@@ -128,6 +140,25 @@ def cmd_components(args) -> int:
     return 1 if registry.failures else 0
 
 
+def cmd_compare(args) -> int:
+    from .compare import COLUMNS, compare_folders
+    from .datasets import load_dataset
+    from .report import _json_ready, format_table
+
+    sequences = load_dataset(args.dataset, args.root, args.sequences)
+    res = compare_folders(args.results, args.reference, sequences, args.protocol, args.divergence_px)
+    if args.format == "json":
+        print(json.dumps(_json_ready(res), indent=1))
+        return 0
+    print(format_table(res["rows"] + [res["mean"]], args.format, COLUMNS, args.protocol), end="")
+    left = "; ".join(f"{k.replace('_', ' ')}: {', '.join(v)}" for k, v in res["left_out"].items() if v)
+    print(f"\nresults: {res['results']}\nreference: {res['reference']}\n"
+          f"{res['diverged']} of {len(res['rows'])} sequences diverge (centres more than "
+          f"{args.divergence_px:g} px apart); d_ = results minus reference\n"
+          f"left out: {left or 'none'}", file=sys.stderr if args.format == "csv" else sys.stdout)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="dcfkit", description=__doc__)
     parser.add_argument("--version", action="version", version=f"dcfkit {__version__}")
@@ -160,7 +191,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     from .ablation import add_ablate_arguments, cmd_ablate
     from .evaluation import add_eval_arguments, cmd_eval
-    from .report import add_report_arguments, cmd_report
+    from .report import add_protocol_argument, add_report_arguments, cmd_report
 
     p = sub.add_parser("eval", help="one-pass evaluation of configs on a benchmark")
     add_eval_arguments(p)
@@ -168,6 +199,21 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("report", help="tables and precision/success plots of evaluation results")
     add_report_arguments(p)
     p.set_defaults(func=cmd_report)
+    p = sub.add_parser("compare", help="two folders of result files side by side per sequence: scores, "
+                                       "their differences, box agreement (parity checks)")
+    p.add_argument("results", type=Path, metavar="RESULTS",
+                   help="folder of <sequence>.txt result files (1-based x,y,w,h), e.g. OUT/<tracker>")
+    p.add_argument("reference", type=Path, metavar="REFERENCE", help="folder of result files to compare with")
+    p.add_argument("--dataset", default="auto", help="dataset name (default: detect from --root)")
+    p.add_argument("--root", required=True, type=Path, help="benchmark root folder (the ground truth)")
+    p.add_argument("--sequences", default=None, help="comma-separated sequence names (default: all)")
+    add_protocol_argument(p)
+    p.add_argument("--divergence-px", type=_pixels, default=2.0,
+                   help="centres further apart than this (pixels) count as diverged")
+    p.add_argument("--format", choices=("table", "markdown", "csv", "json"), default="table",
+                   help="output format; json holds everything, with csv the closing notes (folders, "
+                        "divergences, left-out sequences) go to stderr")
+    p.set_defaults(func=cmd_compare)
     p = sub.add_parser("ablate", help="run an ablation spec: variants x parameter grids x sequences")
     add_ablate_arguments(p)
     p.set_defaults(func=cmd_ablate)

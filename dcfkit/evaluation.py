@@ -58,6 +58,7 @@ import numpy as np
 
 from .datasets import DatasetError, Sequence, read_boxes
 from .errors import ConfigError, DcfkitError
+from .report import add_protocol_argument, evaluate, score_line
 
 __all__ = [
     "OpenCVTracker",
@@ -597,15 +598,20 @@ def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]
     return results
 
 
+def result_files(folder) -> dict[str, Path]:
+    """``{sequence: folder/<sequence>.txt}``, leaving out ``*_time.txt`` (timings written by
+    some toolkits); a :class:`DatasetError` if ``folder`` is not a folder."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise DatasetError(f"results folder not found: {folder}")
+    return {p.stem: p for p in sorted(folder.glob("*.txt")) if not p.stem.endswith("_time")}
+
+
 def import_results(folder) -> dict[str, SequenceResult]:
     """Per-sequence result files of another tracker: ``folder/<sequence>.txt``, 1-based
     ``x,y,w,h`` separated by commas, tabs or spaces. Returns 0-based boxes, no timings.
     Files ending in ``_time.txt`` (timings written by some toolkits) are ignored."""
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise DatasetError(f"results folder not found: {folder}")
-    return {p.stem: SequenceResult(read_boxes(p))
-            for p in sorted(folder.glob("*.txt")) if not p.stem.endswith("_time")}
+    return {name: SequenceResult(read_boxes(path)) for name, path in result_files(folder).items()}
 
 
 # --------------------------------------------------------------------------- OpenCV baselines
@@ -719,6 +725,7 @@ def add_eval_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentPars
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                         help="override a config value (repeatable), e.g. --set solver.iterations=3")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_protocol_argument(parser)
     return parser
 
 
@@ -766,6 +773,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
                                jobs=args.jobs, progress=not args.no_progress)
         print(f"{summary['tracker']}: {len(summary['done'])} run, {len(summary['skipped'])} "
               f"already done, {len(summary['failed'])} failed -> {summary['dir']}")
+        scores = evaluate({summary["tracker"]: load_results(args.out, summary["tracker"], sequences)},
+                          sequences, protocol=args.protocol)
+        print(f"  {score_line(scores['overall'][0], args.protocol)}")
         for seq, message in summary["failed"].items():
             print(f"  FAILED {message}")
         status = status or (1 if summary["failed"] else 0)

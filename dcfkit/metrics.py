@@ -1,33 +1,28 @@
-"""One-pass evaluation (OPE) metrics in the conventions of the OTB / UAV123 toolkits.
+"""One-pass evaluation (OPE) scores under a named scoring protocol.
 
-All boxes are ``(N, 4) float64`` arrays of ``(x, y, w, h)``, 0-based (only differences
-matter, so 1-based boxes give the same scores).
+The rules that decide which frames count and what a frame scores (out-of-view ground
+truth, failed predictions, the first frame, centre and IoU conventions, thresholds,
+averaging) differ between the toolkits that published tracking results; they live in
+:mod:`dcfkit.protocols`, one :class:`~dcfkit.protocols.Protocol` per toolkit: ``otb``
+(the OTB / UAV123 MATLAB toolkit, the default), ``pysot`` and ``got10k``. This module turns
+a protocol's per-frame values into curves and scores, and averages sequences.
 
-Conventions (each one matches the OTB toolkit unless said otherwise):
+Boxes are ``(N, 4) float64`` ``(x, y, w, h)``, **0-based** as dcfkit keeps them in memory;
+:func:`score_sequence` adds 1 to x and y before applying a protocol, because some rules
+test coordinates (the OTB toolkit's ``x > 0``), not only differences.
 
-* **Centre** of a box: ``(x + w/2, y + h/2)``. The toolkit uses ``x + (w-1)/2``; the
-  ``-1/2`` cancels in the difference, so centre errors are identical.
-* **IoU**: boxes are continuous regions ``[x, x + w) x [y, y + h)``; intersection width is
-  ``max(0, min(x1 + w1, x2 + w2) - max(x1, x2))``. This equals the toolkit's
-  ``calcRectInt``, whose ``-1`` on the right edge and ``+1`` on the width cancel.
-* **Precision curve**: fraction of scored frames with centre error ``<= t`` for
-  ``t = 0, 1, ..., 50`` px; the **precision score** is the value at 20 px.
-* **Success curve**: fraction of scored frames with IoU ``> t`` (strictly greater, as the
-  toolkit) for the 21 thresholds ``t = 0, 0.05, ..., 1``; so the point at ``t = 1`` is
-  always 0 and a perfect tracker has AUC 20/21. **AUC** is the mean of the success curve.
-* **Normalized precision** (LaSOT / TrackingNet): the centre error divided by the ground
-  truth's ``(w, h)`` per axis, thresholds ``0, 0.01, ..., 0.5``; the score is the value at
-  0.2 (as pysot and pytracking report it).
-* **Scored frames**: frames whose ground truth is finite with ``w > 0`` and ``h > 0``.
-  The first frame (where the tracker is initialised with the ground truth) is scored by
-  default, as in the OTB toolkit; ``include_first=False`` drops it.
-* **Failed predictions**: a prediction containing NaN/inf, or a missing one (a result
-  shorter than the ground truth), has centre error ``inf`` and IoU 0 — it fails every
-  threshold. (The OTB toolkit instead copies the previous box; we count it as a failure.)
-  A prediction with ``w <= 0`` or ``h <= 0`` has IoU 0; its centre error is computed.
-* **Averages over sequences**: by default each sequence weighs equally (mean of the
-  per-sequence curves, as the OTB / UAV123 toolkits); ``weighting="frame"`` pools all
-  frames instead. Sequences without scored frames are left out.
+* **Precision curve**: fraction of the counted frames with centre error ``<= t``; the
+  **precision score** is its value at 20 px.
+* **Success curve**: fraction of the counted frames with overlap ``> t`` (strictly
+  greater), so the point at ``t = 1`` is 0 and a perfect tracker's **AUC** (the mean of
+  the success curve) is 20/21 with 21 thresholds.
+* **Normalized precision**: the same with the centre offset divided by the ground truth's
+  size; the score is the value at 0.2.
+* A prediction row that the result lacks (a truncated or missing result) fails every
+  threshold in every protocol.
+
+:func:`centre_error`, :func:`normalized_centre_error` and :func:`iou` are plain geometry of
+two box series (centre ``x + w/2``, boxes ``[x, x + w)``), with no protocol's rules.
 """
 from __future__ import annotations
 
@@ -35,12 +30,9 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
+from .protocols import DEFAULT, Protocol, get_protocol
+
 __all__ = [
-    "NORM_PRECISION_AT",
-    "NORM_PRECISION_THRESHOLDS",
-    "PRECISION_AT",
-    "PRECISION_THRESHOLDS",
-    "SUCCESS_THRESHOLDS",
     "as_boxes",
     "average",
     "centre_error",
@@ -48,15 +40,10 @@ __all__ = [
     "normalized_centre_error",
     "precision_curve",
     "score_sequence",
-    "scored_frames",
     "success_curve",
 ]
 
-PRECISION_THRESHOLDS = np.arange(0, 51, dtype=np.float64)  # pixels
-SUCCESS_THRESHOLDS = np.linspace(0.0, 1.0, 21)
-NORM_PRECISION_THRESHOLDS = np.linspace(0.0, 0.5, 51)
-PRECISION_AT = 20.0
-NORM_PRECISION_AT = 0.2
+_CURVES = ("precision_curve", "success_curve", "norm_precision_curve")
 
 
 def as_boxes(boxes, n: int | None = None) -> np.ndarray:
@@ -76,16 +63,6 @@ def as_boxes(boxes, n: int | None = None) -> np.ndarray:
 
 def _failed(pred: np.ndarray) -> np.ndarray:
     return ~np.isfinite(pred).all(axis=1)
-
-
-def scored_frames(gt, include_first: bool = True) -> np.ndarray:
-    """``(N,) bool``: frames whose ground truth is finite with positive width and height."""
-    gt = as_boxes(gt)
-    with np.errstate(invalid="ignore"):
-        mask = np.isfinite(gt).all(axis=1) & (gt[:, 2] > 0) & (gt[:, 3] > 0)
-    if not include_first and len(mask):
-        mask[0] = False
-    return mask
 
 
 def centre_error(pred, gt) -> np.ndarray:
@@ -125,7 +102,7 @@ def iou(pred, gt) -> np.ndarray:
     return out
 
 
-def precision_curve(errors, thresholds=PRECISION_THRESHOLDS) -> np.ndarray:
+def precision_curve(errors, thresholds) -> np.ndarray:
     """Fraction of ``errors`` with ``error <= t`` for each threshold (NaN if no frames)."""
     errors = np.asarray(errors, dtype=np.float64).ravel()
     if errors.size == 0:
@@ -133,64 +110,98 @@ def precision_curve(errors, thresholds=PRECISION_THRESHOLDS) -> np.ndarray:
     return (errors[:, None] <= np.asarray(thresholds)[None, :]).mean(axis=0)
 
 
-def success_curve(overlaps, thresholds=SUCCESS_THRESHOLDS) -> np.ndarray:
-    """Fraction of ``overlaps`` with ``IoU > t`` (strict) for each threshold (NaN if no frames)."""
+def success_curve(overlaps, thresholds) -> np.ndarray:
+    """Fraction of ``overlaps`` with ``overlap > t`` (strict) for each threshold (NaN if no frames)."""
     overlaps = np.asarray(overlaps, dtype=np.float64).ravel()
     if overlaps.size == 0:
         return np.full(len(thresholds), np.nan)
     return (overlaps[:, None] > np.asarray(thresholds)[None, :]).mean(axis=0)
 
 
-def score_sequence(pred, gt, include_first: bool = True) -> dict:
-    """Scores of one sequence, a plain dict.
+def score_sequence(pred, gt, include_first: bool = True, protocol: str | Protocol = DEFAULT) -> dict:
+    """Scores of one sequence under ``protocol`` (a name or :class:`Protocol`), a plain dict.
 
-    Keys: ``frames`` (number of scored frames), ``precision_curve`` (51,),
-    ``success_curve`` (21,), ``norm_precision_curve`` (51,), and the scalars ``precision``
-    (at 20 px), ``auc`` (mean of the success curve) and ``norm_precision`` (at 0.2).
-    Scalars are NaN when no frame is scored.
+    ``pred`` and ``gt`` are 0-based; ``pred`` may be shorter than ``gt`` (its missing rows
+    fail every threshold). ``include_first=False`` takes frame 1 out of the denominator.
+    Keys: ``protocol`` (the name), ``frames`` (frames in the denominator), ``given`` (rows
+    the result has), ``precision_curve``, ``success_curve``, ``norm_precision_curve`` and
+    the scalars ``precision``, ``auc``, ``norm_precision`` (and ``ao``, ``sr50``, ``sr75``
+    for a protocol with overlap scores). Scalars are NaN when no frame is counted.
     """
+    proto = get_protocol(protocol)
     gt = as_boxes(gt)
+    given = len(as_boxes(pred))
     pred = as_boxes(pred, len(gt))
-    mask = scored_frames(gt, include_first)
-    err = centre_error(pred, gt)[mask]
-    ov = iou(pred, gt)[mask]
-    nerr = normalized_centre_error(pred, gt)[mask]
-    return _summarise(
-        frames=int(mask.sum()),
-        precision_curve=precision_curve(err),
-        success_curve=success_curve(ov),
-        norm_precision_curve=precision_curve(nerr, NORM_PRECISION_THRESHOLDS),
-    )
+    one = np.array([1.0, 1.0, 0.0, 0.0])
+    f = proto.frames(pred + one, gt + one)
+    overlap, error, norm_error = f.overlap.copy(), f.error.copy(), f.norm_error.copy()
+    overlap[given:], error[given:], norm_error[given:] = 0.0, np.inf, np.inf
+    counted = f.counted.copy()
+    if not include_first:
+        counted[:1] = False
+    overlap = overlap[counted]
+    extra = {}
+    if proto.overlap_scores:
+        extra = {"ao": float(overlap.mean()) if overlap.size else np.nan,
+                 "sr50": float((overlap > 0.5).mean()) if overlap.size else np.nan,
+                 "sr75": float((overlap > 0.75).mean()) if overlap.size else np.nan}
+    return _summarise(proto, int(counted.sum()), given,
+                      precision_curve(error[counted], proto.precision_thresholds),
+                      success_curve(overlap, proto.success_thresholds),
+                      precision_curve(norm_error[counted], proto.norm_precision_thresholds), **extra)
 
 
-def _summarise(frames, precision_curve, success_curve, norm_precision_curve) -> dict:
-    i20 = int(np.searchsorted(PRECISION_THRESHOLDS, PRECISION_AT))
-    i02 = int(np.argmin(np.abs(NORM_PRECISION_THRESHOLDS - NORM_PRECISION_AT)))
+def _summarise(proto: Protocol, frames: int, given: int, precision_curve, success_curve,
+               norm_precision_curve, **overlap_scores) -> dict:
     return {
+        "protocol": proto.name,
         "frames": frames,
+        "given": given,
         "precision_curve": precision_curve,
         "success_curve": success_curve,
         "norm_precision_curve": norm_precision_curve,
-        "precision": float(precision_curve[i20]),
+        "precision": float(precision_curve[proto.precision_index]),
         "auc": float(np.mean(success_curve)),
-        "norm_precision": float(norm_precision_curve[i02]),
+        "norm_precision": float(norm_precision_curve[proto.norm_precision_index]),
+        **{k: float(v) for k, v in overlap_scores.items()},
     }
 
 
-def average(scores: Iterable[Mapping], weighting: str = "sequence") -> dict:
-    """Average per-sequence :func:`score_sequence` dicts into one of the same form.
+def average(scores: Iterable[Mapping], weighting: str | None = None,
+            protocol: str | Protocol = DEFAULT) -> dict:
+    """Average per-sequence :func:`score_sequence` dicts (all of ``protocol``) into one of
+    the same form.
 
-    ``weighting="sequence"`` (default, OTB/UAV123 toolkits): each sequence weighs equally.
-    ``weighting="frame"``: each scored frame weighs equally (pooled frames).
-    Sequences with no scored frame are left out; ``frames`` is the total scored frames.
+    ``weighting`` ``"sequence"``: each sequence weighs equally; ``"frame"``: each counted
+    frame does (frames pooled); ``None``: the protocol's own (``got10k`` pools frames, the
+    others weigh sequences). Sequences with no counted frame are left out, and under
+    ``otb`` a sequence whose curve is all zero is left out of that curve's mean (as the
+    toolkit's ``plotDrawSave``), unless its result was missing altogether (``given`` 0: a
+    missing result stays a total failure). ``frames`` is the total of counted frames.
     """
+    proto = get_protocol(protocol)
+    weighting = weighting or proto.weighting
     if weighting not in ("sequence", "frame"):
         raise ValueError(f"weighting must be 'sequence' or 'frame', got {weighting!r}")
     scores = [s for s in scores if s["frames"] > 0]
-    keys = ("precision_curve", "success_curve", "norm_precision_curve")
-    if not scores:
-        sizes = (len(PRECISION_THRESHOLDS), len(SUCCESS_THRESHOLDS), len(NORM_PRECISION_THRESHOLDS))
-        return _summarise(0, *(np.full(n, np.nan) for n in sizes))
+    other = {s.get("protocol") for s in scores} - {proto.name}
+    if other:
+        raise ValueError(f"averaging {proto.name!r} scores with scores of protocol {', '.join(map(str, other))}")
     w = np.array([s["frames"] if weighting == "frame" else 1 for s in scores], dtype=np.float64)
-    curves = [np.average(np.stack([s[k] for s in scores]), axis=0, weights=w) for k in keys]
-    return _summarise(int(sum(s["frames"] for s in scores)), *curves)
+    sizes = {"precision_curve": len(proto.precision_thresholds), "success_curve": len(proto.success_thresholds),
+             "norm_precision_curve": len(proto.norm_precision_thresholds)}
+    means = {}
+    for key in _CURVES + proto.overlap_keys:
+        values = [np.atleast_1d(np.asarray(s[key], dtype=np.float64)) for s in scores]
+        keep = [i for i, v in enumerate(values) if not (proto.drop_zero_curves and key in _CURVES
+                                                        and scores[i].get("given", 1) > 0
+                                                        and v.sum() <= np.finfo(float).eps)]
+        if keep:
+            means[key] = np.average(np.stack([values[i] for i in keep]), axis=0, weights=w[keep])
+        else:
+            means[key] = np.full(sizes.get(key, 1), np.nan)
+    overlap_scores = {k: means[k][0] for k in proto.overlap_keys}
+    return _summarise(proto, int(sum(s["frames"] for s in scores)), int(sum(s.get("given", 0) for s in scores)),
+                      means["precision_curve"], means["success_curve"], means["norm_precision_curve"],
+                      **overlap_scores)
+

@@ -2,12 +2,14 @@
 
 :func:`evaluate` turns results into plain dicts: one row per tracker (``overall``), per
 tracker and sequence (``per_sequence``) and per tracker and attribute
-(``per_attribute``), plus the averaged curves for plotting. Scores follow
-:mod:`dcfkit.metrics` (OTB toolkit conventions); averages weigh each sequence equally
-unless ``weighting="frame"``. A tracker's ``fps`` is the mean over sequences of the
-per-sequence fps (frames / tracker time in that sequence), not total frames / total time.
-A sequence missing from a tracker's results is scored as a total failure and counted in
-the ``missing`` column.
+(``per_attribute``), plus the averaged curves for plotting. Scores follow a named scoring
+protocol of :mod:`dcfkit.protocols` (default ``otb``, the OTB / UAV123 MATLAB toolkit),
+and every output names it: a first line of the text and Markdown tables, a ``protocol``
+column of the CSV tables, ``protocol`` in ``report.json`` and the plot titles. Averages
+weigh sequences as the protocol does unless ``weighting`` says otherwise. A tracker's
+``fps`` is the mean over sequences of the per-sequence fps (frames / tracker time in that
+sequence), not total frames / total time. A sequence missing from a tracker's results is
+scored as a total failure and counted in the ``missing`` column.
 """
 from __future__ import annotations
 
@@ -24,12 +26,17 @@ import numpy as np
 
 from . import metrics
 from .datasets import ATTRIBUTE_NAMES, DatasetError, Sequence
+from .protocols import DEFAULT, PROTOCOLS, Protocol, get_protocol
 
 __all__ = [
+    "add_protocol_argument",
     "add_report_arguments",
     "cmd_report",
+    "columns",
     "evaluate",
     "format_rows",
+    "format_table",
+    "score_line",
     "gather_results",
     "plot_curves",
     "write_report",
@@ -37,9 +44,22 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-OVERALL_COLUMNS = ("tracker", "auc", "precision", "norm_precision", "fps", "sequences", "missing")
-SEQUENCE_COLUMNS = ("tracker", "sequence", "auc", "precision", "norm_precision", "fps", "frames")
-ATTRIBUTE_COLUMNS = ("attribute", "name", "sequences", "tracker", "auc", "precision", "norm_precision")
+_TABLES = {  # the columns before and after a protocol's scores (Protocol.score_keys)
+    "overall": (("tracker",), ("fps", "sequences", "missing")),
+    "per_sequence": (("tracker", "sequence"), ("fps", "frames")),
+    "per_attribute": (("attribute", "name", "sequences", "tracker"), ()),
+}
+
+
+def columns(table: str, protocol: str | Protocol = DEFAULT) -> tuple[str, ...]:
+    """Columns of the ``overall``, ``per_sequence`` or ``per_attribute`` table under ``protocol``."""
+    lead, tail = _TABLES[table]
+    return lead + get_protocol(protocol).score_keys + tail
+
+
+OVERALL_COLUMNS = columns("overall")
+SEQUENCE_COLUMNS = columns("per_sequence")
+ATTRIBUTE_COLUMNS = columns("per_attribute")
 
 
 # --------------------------------------------------------------------------- scoring
@@ -59,16 +79,22 @@ def _mean_or_none(values) -> float | None:
 
 
 def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
-             include_first: bool = True, weighting: str = "sequence") -> dict:
-    """Score ``results`` (tracker -> sequence name -> boxes) on ``sequences``.
+             include_first: bool = True, weighting: str | None = None,
+             protocol: str | Protocol = DEFAULT) -> dict:
+    """Score ``results`` (tracker -> sequence name -> boxes) on ``sequences`` under ``protocol``.
 
     A result is a :class:`dcfkit.evaluation.SequenceResult`, a dict with ``boxes`` (and
-    optional ``fps``) or an ``(N, 4)`` array of 0-based boxes. Returns a plain dict with
-    ``overall``, ``per_sequence`` and ``per_attribute`` row lists (trackers sorted by AUC,
-    best first), ``curves`` (tracker -> averaged ``precision``/``success``/
+    optional ``fps``) or an ``(N, 4)`` array of 0-based boxes. ``weighting`` ``None`` averages
+    as the protocol does. Returns a plain dict with ``overall``, ``per_sequence`` and
+    ``per_attribute`` row lists (trackers best first by the protocol's ranking score: AO for
+    ``got10k``, else AUC), ``curves`` (tracker -> averaged ``precision``/``success``/
     ``norm_precision`` curves), ``attribute_curves`` (attribute -> tracker -> curves),
-    ``attributes`` (attribute -> number of sequences) and ``thresholds``.
+    ``attributes`` (attribute -> number of sequences), ``thresholds``, ``protocol`` (name,
+    title, source) and ``settings``.
     """
+    proto = get_protocol(protocol)
+    weighting = weighting or proto.weighting
+    keys = proto.score_keys
     sequences = list(sequences)
     per_seq: dict[str, dict[str, dict]] = {}
     fps: dict[str, dict[str, float | None]] = {}
@@ -88,29 +114,28 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
             else:
                 boxes, seq_fps = np.empty((0, 4)), None
                 missing[tracker].append(seq.name)
-            per_seq[tracker][seq.name] = metrics.score_sequence(boxes, seq.ground_truth, include_first)
+            per_seq[tracker][seq.name] = metrics.score_sequence(boxes, seq.ground_truth, include_first, proto)
             fps[tracker][seq.name] = seq_fps
         if missing[tracker]:
             log.warning("tracker %r has no results for %d of %d sequences (scored as failures; "
                         "report on the sequences that were run, e.g. with --sequences, to leave them out): %s",
                         tracker, len(missing[tracker]), len(sequences), ", ".join(missing[tracker][:10]))
 
+    def rank(rows):
+        return sorted(rows, key=lambda r: _sort_key(r[proto.rank_key]))
+
     overall, curves = [], {}
     for tracker in results:
-        avg = metrics.average(per_seq[tracker].values(), weighting)
+        avg = metrics.average(per_seq[tracker].values(), weighting, proto)
         curves[tracker] = _curves(avg)
-        overall.append({
-            "tracker": tracker, "auc": avg["auc"], "precision": avg["precision"],
-            "norm_precision": avg["norm_precision"], "fps": _mean_or_none(fps[tracker].values()),
-            "sequences": len(sequences), "missing": len(missing[tracker]), "frames": avg["frames"],
-        })
-    overall.sort(key=lambda r: _sort_key(r["auc"]))
+        overall.append({"tracker": tracker, **{k: avg[k] for k in keys},
+                        "fps": _mean_or_none(fps[tracker].values()),
+                        "sequences": len(sequences), "missing": len(missing[tracker]), "frames": avg["frames"]})
+    overall = rank(overall)
     ranked = [r["tracker"] for r in overall]
 
     per_sequence = [
-        {"tracker": t, "sequence": s.name, "auc": per_seq[t][s.name]["auc"],
-         "precision": per_seq[t][s.name]["precision"],
-         "norm_precision": per_seq[t][s.name]["norm_precision"],
+        {"tracker": t, "sequence": s.name, **{k: per_seq[t][s.name][k] for k in keys},
          "fps": fps[t][s.name], "frames": per_seq[t][s.name]["frames"]}
         for t in ranked for s in sequences]
 
@@ -127,25 +152,28 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
         attribute_curves[attr] = {}
         rows = []
         for tracker in ranked:
-            avg = metrics.average([per_seq[tracker][n] for n in names], weighting)
+            avg = metrics.average([per_seq[tracker][n] for n in names], weighting, proto)
             attribute_curves[attr][tracker] = _curves(avg)
             rows.append({"attribute": attr, "name": ATTRIBUTE_NAMES.get(attr, attr),
-                         "sequences": len(names), "tracker": tracker, "auc": avg["auc"],
-                         "precision": avg["precision"], "norm_precision": avg["norm_precision"]})
-        per_attribute += sorted(rows, key=lambda r: _sort_key(r["auc"]))
+                         "sequences": len(names), "tracker": tracker, **{k: avg[k] for k in keys}})
+        per_attribute += rank(rows)
 
     return {
+        "protocol": {"name": proto.name, "title": proto.title, "source": proto.source},
         "overall": overall,
         "per_sequence": per_sequence,
         "per_attribute": per_attribute,
         "curves": curves,
         "attribute_curves": attribute_curves,
         "attributes": {a: len(n) for a, n in attributes.items() if n},
-        "thresholds": {"precision": metrics.PRECISION_THRESHOLDS,
-                       "success": metrics.SUCCESS_THRESHOLDS,
-                       "norm_precision": metrics.NORM_PRECISION_THRESHOLDS},
-        "settings": {"include_first": include_first, "weighting": weighting},
+        "thresholds": _thresholds(proto),
+        "settings": {"protocol": proto.name, "include_first": include_first, "weighting": weighting},
     }
+
+
+def _thresholds(proto: Protocol) -> dict[str, np.ndarray]:
+    return {"precision": proto.precision_thresholds, "success": proto.success_thresholds,
+            "norm_precision": proto.norm_precision_thresholds}
 
 
 def _curves(avg: dict) -> dict:
@@ -160,23 +188,20 @@ def _sort_key(score) -> float:
 
 # --------------------------------------------------------------------------- tables
 
-_SCORE_COLUMNS = {"auc", "precision", "norm_precision"}
-
-
 def _cell(key: str, value, full: bool = False) -> str:
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "" if full else "-"
     if isinstance(value, float):
         if full:
             return repr(value)
-        return f"{value:.3f}" if key in _SCORE_COLUMNS else f"{value:.1f}"
+        return f"{value:.1f}" if key == "fps" else f"{value:.3f}"
     return str(value)
 
 
 def format_rows(rows: Seq[Mapping], fmt: str = "table", columns: Seq[str] | None = None) -> str:
     """Rows as an aligned text table (``"table"``), ``"markdown"`` or ``"csv"``.
 
-    Scores are shown with 3 decimals and fps with 1 in table/markdown; CSV keeps full
+    Floats are shown with 3 decimals (fps with 1) in table/markdown; CSV keeps full
     precision and leaves missing values empty.
     """
     if fmt not in ("table", "markdown", "csv"):
@@ -211,6 +236,24 @@ def _is_number(value) -> bool:
     return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool))
 
 
+def score_line(row: Mapping, protocol: str | Protocol = DEFAULT) -> str:
+    """One overall row as ``precision 0.891, AUC 0.520 on 6 sequences (protocol otb)``."""
+    proto = get_protocol(protocol)
+    label = {"ao": "AO", "sr50": "SR@0.5", "sr75": "SR@0.75", "auc": "AUC", "precision": "precision",
+             "norm_precision": "normalized precision"}
+    scores = ", ".join(f"{label[k]} {_cell(k, row[k])}" for k in proto.score_keys)
+    return f"{scores} on {row['sequences']} sequences (protocol {proto.name})"
+
+
+def format_table(rows: Seq[Mapping], fmt: str, columns: Seq[str], protocol: str | Protocol = DEFAULT) -> str:
+    """:func:`format_rows` naming the scoring protocol: a first line (``table``,
+    ``markdown``) or a last ``protocol`` column (``csv``, so the file stays one table)."""
+    proto = get_protocol(protocol)
+    if fmt == "csv":
+        return format_rows([{**r, "protocol": proto.name} for r in rows], fmt, (*columns, "protocol"))
+    return f"{proto.describe()}\n\n" + format_rows(rows, fmt, columns)
+
+
 # --------------------------------------------------------------------------- plots
 
 _PLOT_STYLE = {
@@ -226,19 +269,20 @@ _PLOT_STYLE = {
 
 
 def plot_curves(curves: Mapping[str, Mapping], kind: str, path_stem, title: str | None = None,
-                formats: Seq[str] = ("png", "svg")) -> list[Path]:
+                formats: Seq[str] = ("png", "svg"), protocol: str | Protocol = DEFAULT) -> list[Path]:
     """OTB-style plot of one curve per tracker; legend ``Name [score]`` sorted by score.
 
-    ``curves`` maps tracker -> the dict of :func:`evaluate`'s ``curves``; ``kind`` is
-    ``"precision"`` (score at 20 px), ``"success"`` (AUC) or ``"norm_precision"``.
+    ``curves`` maps tracker -> the dict of :func:`evaluate`'s ``curves`` (computed under
+    ``protocol``, whose thresholds are the x axis and whose name ends the title); ``kind``
+    is ``"precision"`` (score at 20 px), ``"success"`` (AUC) or ``"norm_precision"``.
     Writes ``path_stem.png`` and ``path_stem.svg``; returns the paths.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    proto = get_protocol(protocol)
     style = _PLOT_STYLE[kind]
-    x = {"precision": metrics.PRECISION_THRESHOLDS, "success": metrics.SUCCESS_THRESHOLDS,
-         "norm_precision": metrics.NORM_PRECISION_THRESHOLDS}[kind]
+    x = _thresholds(proto)[kind]
     fig = Figure(figsize=(5.2, 4.2))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(1, 1, 1)
@@ -252,7 +296,7 @@ def plot_curves(curves: Mapping[str, Mapping], kind: str, path_stem, title: str 
                 linewidth=2.0 if i < 10 else 1.5, label=label)
     ax.set_xlim(x[0], x[-1])
     ax.set_ylim(0, 1)
-    ax.set_title(title or style["title"])
+    ax.set_title(f"{title or style['title']} [protocol {proto.name}]")
     ax.set_xlabel(style["xlabel"])
     ax.set_ylabel(style["ylabel"])
     ax.grid(True, linestyle=":", linewidth=0.6)
@@ -279,6 +323,8 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
     are read with ``load_results`` (completed sequences only, timings included); other
     folders are imported as plain 1-based ``x,y,w,h`` text files. ``None`` takes every
     sub-folder of ``out_dir`` holding a ``<sequence>.txt`` of one of ``sequences``.
+    A tracker is named by its folder's name, or by ``parent/name`` where two folders share
+    a name (``reference_results/BACF/UAV123_10fps`` and ``.../DR2Track/UAV123_10fps``).
     """
     from .evaluation import import_results, load_results
 
@@ -291,17 +337,22 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
         trackers = [p.name for p in sorted(out_dir.iterdir())
                     if p.is_dir() and not p.name.startswith(".") and p.resolve() not in exclude
                     and any((p / f"{n}.txt").is_file() for n in names)]
-    results = {}
+    folders: dict[Path, Path] = {}
     for tracker in trackers:
         folder = out_dir / tracker if (out_dir / tracker).is_dir() else Path(tracker)
         if not folder.is_dir():
             raise DatasetError(f"no results for tracker {tracker!r}: neither {out_dir / tracker} "
                                f"nor {tracker} is a folder")
+        folders.setdefault(folder.resolve(), folder)
+    shared = {name for name in (f.name for f in folders.values())
+              if sum(g.name == name for g in folders.values()) > 1}
+    results = {}
+    for folder in folders.values():
         if any((folder / f"{n}.json").is_file() for n in names):
             res = load_results(folder.parent, folder.name, sequences)
         else:
             res = {k: v for k, v in import_results(folder).items() if k in names}
-        results[folder.name] = res
+        results[f"{folder.resolve().parent.name}/{folder.name}" if folder.name in shared else folder.name] = res
     return results
 
 
@@ -322,53 +373,61 @@ def _write(evaluation: dict, report_dir: Path) -> list[Path]:
 
     make_dir(report_dir)
     paths = []
+    protocol = evaluation["protocol"]["name"]
 
     def text(name, content):
         path = report_dir / name
         path.write_text(content, encoding="utf-8")
         paths.append(path)
 
-    tables = [("overall", evaluation["overall"], OVERALL_COLUMNS),
-              ("per_sequence", evaluation["per_sequence"], SEQUENCE_COLUMNS)]
-    if evaluation["per_attribute"]:
-        tables.append(("per_attribute", evaluation["per_attribute"], ATTRIBUTE_COLUMNS))
-    for stem, rows, cols in tables:
-        text(f"{stem}.txt", format_rows(rows, "table", cols))
-        text(f"{stem}.md", format_rows(rows, "markdown", cols))
-        text(f"{stem}.csv", format_rows(rows, "csv", cols))
+    tables = ["overall", "per_sequence"] + (["per_attribute"] if evaluation["per_attribute"] else [])
+    for stem in tables:
+        for fmt, ext in (("table", "txt"), ("markdown", "md"), ("csv", "csv")):
+            text(f"{stem}.{ext}", format_table(evaluation[stem], fmt, columns(stem, protocol), protocol))
     text("report.json", json.dumps(_json_ready(evaluation), indent=1) + "\n")
     for kind in ("precision", "success"):
-        paths += plot_curves(evaluation["curves"], kind, report_dir / kind)
+        paths += plot_curves(evaluation["curves"], kind, report_dir / kind, protocol=protocol)
     for attr, curves in evaluation["attribute_curves"].items():
         n = evaluation["attributes"][attr]
         title = f"Success plots of OPE - {ATTRIBUTE_NAMES.get(attr, attr)} ({n})"
-        paths += plot_curves(curves, "success", report_dir / f"success_{attr}", title=title)
+        paths += plot_curves(curves, "success", report_dir / f"success_{attr}", title=title, protocol=protocol)
     return paths
 
 
 def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,
-                 report_dir=None, include_first: bool = True, weighting: str = "sequence") -> list[Path]:
-    """Score every tracker in ``out_dir`` and write tables and plots to ``report_dir``.
+                 report_dir=None, include_first: bool = True, weighting: str | None = None,
+                 protocol: str | Protocol = DEFAULT) -> list[Path]:
+    """Score every tracker in ``out_dir`` under ``protocol`` and write tables and plots to
+    ``report_dir``.
 
     ``report_dir`` defaults to ``out_dir/report``. Writes ``overall``, ``per_sequence``
     and (when sequences have attributes) ``per_attribute`` tables as ``.txt``, ``.md`` and
     ``.csv``; ``report.json`` with all rows and curves; ``precision`` and ``success`` plots
-    and one ``success_<ATTR>`` plot per attribute, each as PNG and SVG. Returns the paths.
+    and one ``success_<ATTR>`` plot per attribute, each as PNG and SVG. Every file names
+    the protocol. Returns the paths.
     """
-    return _report(out_dir, sequences, trackers, report_dir, include_first, weighting)[1]
+    return _report(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol)[1]
 
 
-def _report(out_dir, sequences, trackers, report_dir, include_first=True, weighting="sequence"):
+def _report(out_dir, sequences, trackers, report_dir, include_first=True, weighting=None, protocol=DEFAULT):
     out_dir = Path(out_dir)
     report_dir = Path(report_dir) if report_dir is not None else out_dir / "report"
     results = gather_results(out_dir, sequences, trackers, exclude=[report_dir])
     if not results:
         raise DatasetError(f"no tracker results found under {out_dir}")
-    evaluation = evaluate(results, sequences, include_first, weighting)
+    evaluation = evaluate(results, sequences, include_first, weighting, protocol)
     return evaluation, _write(evaluation, report_dir)
 
 
 # --------------------------------------------------------------------------- CLI
+
+
+def add_protocol_argument(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """``--protocol``, shared by the commands that print scores."""
+    parser.add_argument("--protocol", choices=tuple(PROTOCOLS), default=DEFAULT,
+                        help="scoring rules: otb (the OTB / UAV123 MATLAB toolkit, which computed the published "
+                             "UAV123 tables), pysot or got10k; docs/evaluation.md lists the differences")
+    return parser
 
 
 def add_report_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
@@ -382,10 +441,13 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentPa
     parser.add_argument("--format", choices=("table", "markdown", "csv"), default="table",
                         help="format of the table printed to stdout")
     parser.add_argument("--report-dir", type=Path, default=None, help="default: OUT/report")
+    add_protocol_argument(parser)
     parser.add_argument("--skip-first", action="store_true",
-                        help="do not score frame 0 (default: scored, as the OTB toolkit)")
+                        help="do not score frame 1 (default: as the protocol; otb scores it with the ground "
+                             "truth as the prediction, pysot as the file has it, got10k never)")
     parser.add_argument("--frame-weighted", action="store_true",
-                        help="average over frames instead of sequences")
+                        help="pool the frames of all sequences (default: as the protocol; otb and pysot "
+                             "weigh sequences equally, got10k pools frames)")
     return parser
 
 
@@ -397,8 +459,9 @@ def cmd_report(args: argparse.Namespace) -> int:
     trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
     evaluation, paths = _report(args.out, sequences, trackers, args.report_dir,
                                 include_first=not args.skip_first,
-                                weighting="frame" if args.frame_weighted else "sequence")
-    print(format_rows(evaluation["overall"], args.format, OVERALL_COLUMNS), end="")
+                                weighting="frame" if args.frame_weighted else None, protocol=args.protocol)
+    print(format_table(evaluation["overall"], args.format, columns("overall", args.protocol), args.protocol),
+          end="")
     if args.format == "table":
         print(f"\n{len(paths)} files written to {paths[0].parent}")
     return 0

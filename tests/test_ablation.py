@@ -194,10 +194,18 @@ def test_cli_runs_and_lists_jobs(tmp_path, data, capsys):
     out = str(tmp_path / "out")
     assert cli.main(["ablate", spec, "--out", out, "--sequences", "seqB", "--jobs", "1", "--no-progress"]) == 0
     printed = capsys.readouterr().out
-    assert printed.startswith("| variant | precision | auc | fps | sequences | failed |")
+    assert printed.startswith("protocol otb: OTB / UAV123 MATLAB toolkit")  # the default scoring rules, named
+    assert "\n\n| variant | precision | auc | fps | sequences | failed |\n" in printed
     assert "1 jobs (1 distinct runs): 1 run, 0 already done, 0 failed" in printed
     assert all((tmp_path / "out" / f"{kind}.{ext}").is_file() for kind in ("precision", "success")
                for ext in ("png", "svg"))  # named variants: the OTB plots
+    # the summary of the same runs under another protocol: nothing reruns, the columns follow it
+    assert cli.main(["ablate", spec, "--out", out, "--sequences", "seqB", "--jobs", "1", "--no-progress",
+                     "--protocol", "got10k"]) == 0
+    printed = capsys.readouterr().out
+    assert printed.startswith("protocol got10k: ") and "0 run, 1 already done" in printed
+    assert "| variant | precision | auc | ao | sr50 | sr75 | fps | sequences | failed |" in printed
+    assert json.loads((tmp_path / "out" / "summary.json").read_text())["protocol"]["name"] == "got10k"
     assert cli.main(["ablate", spec, "--out", out, "--sequences", "seqC,seqB", "--dry-run"]) == 0
     key = expand(load_spec(spec))[0].key
     assert capsys.readouterr().out.splitlines() == [f"todo  {key}  s  seqC", f"done  {key}  s  seqB",
@@ -296,8 +304,10 @@ grid: {base: dr2, parameters: {label.mu: [0, 0.5]}}
     summary = json.loads((out / "summary.json").read_text())
     assert [r["variant"] for r in summary["overall"]] == ["dr2", "strcf", "label.mu=0", "label.mu=0.5"]
     assert all(r["failed"] == 0 and 0 <= r["precision"] <= 1 for r in summary["overall"])
-    assert (out / "summary.md").read_text().startswith("| variant | precision | auc | fps |")
+    assert summary["protocol"]["name"] == "otb"
+    assert (out / "summary.md").read_text().splitlines()[2].startswith("| variant | precision | auc | fps |")
     assert (out / "per_sequence.csv").read_text().count("\n") == 1 + total
+    assert (out / "per_sequence.csv").read_text().splitlines()[0].endswith(",status,protocol")
     assert (out / "sensitivity_label.mu.png").stat().st_size > 0
 
 

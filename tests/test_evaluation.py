@@ -438,7 +438,9 @@ def test_evaluate_scores_and_sorting(seqs):
     ev = report.evaluate({"shifted": shifted, "perfect": perfect}, seqs)
     top, low = ev["overall"]
     assert top["tracker"] == "perfect" and top["auc"] == pytest.approx(20 / 21) and top["precision"] == 1
-    assert low["tracker"] == "shifted" and low["missing"] == 1 and low["precision"] == 0
+    # otb scores frame 1 with the ground truth: 1/6 on a and b; c has no results: 0
+    assert low["tracker"] == "shifted" and low["missing"] == 1 and low["precision"] == pytest.approx(1 / 9)
+    assert ev["protocol"]["name"] == "otb" and ev["settings"]["weighting"] == "sequence"
     assert top["fps"] is None  # plain arrays carry no timing
     assert len(ev["per_sequence"]) == 6
     sv = [r for r in ev["per_attribute"] if r["attribute"] == "SV"]
@@ -457,7 +459,7 @@ def test_short_results_are_scored_as_failures_with_a_warning(seqs, caplog):
     with caplog.at_level("WARNING"):
         ev = report.evaluate({"short": short}, seqs[:1])
     assert f"'short', sequence 'a': 2 boxes for {N_FRAMES} frames" in caplog.text
-    assert ev["overall"][0]["precision"] == pytest.approx(2 / N_FRAMES)
+    assert ev["overall"][0]["precision"] == pytest.approx(2 / N_FRAMES)  # not copied forward by otb's rule
 
 
 def test_write_report_files(tmp_path, seqs):
@@ -505,7 +507,12 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
     assert evaluation.cmd_eval(args) == 0
     assert seen["overrides"] == {"drift": 0.5}
     assert files(tmp_path / "out" / "fast") == {"a.txt", "a.json", "c.txt", "c.json"}
-    assert "fast: 2 run, 0 already done, 0 failed" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "fast: 2 run, 0 already done, 0 failed" in printed
+    # the drift tracker lags the ground truth by 0.5k px on frame k (boxes 5x6): IoU (5-0.5k)/(5+0.5k) =
+    # 1, .82, .67, .54, .43, .33 pass 20+17+14+11+9+7 = 78 of 6x21 overlap thresholds; errors 0.5k <= 20 px;
+    # normalized errors 0.1k <= 0.2 on 3 of 6 frames
+    assert "\n  AUC 0.619, precision 1.000, normalized precision 0.500 on 2 sequences (protocol otb)\n" in printed
     # every config is checked before any runs: a typo in the second costs nothing of the first
     monkeypatch.undo()
     args = parser.parse_args(["strcf", "strcff.yaml", "--root", str(root), "--out", str(tmp_path / "out2"),
@@ -524,10 +531,12 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
     assert not (tmp_path / "out2").exists()
     monkeypatch.setattr(evaluation, "_resolve_config", fake_resolve)
     args = parser.parse_args(["fast.yaml", "fast.yaml", "--root", str(root), "--out", str(tmp_path / "out3"),
-                              "--sequences", "a", "--no-progress"])
+                              "--sequences", "a", "--no-progress", "--protocol", "got10k"])
     assert evaluation.cmd_eval(args) == 0
-    assert [line for line in capsys.readouterr().out.splitlines() if line.startswith("fast:")] == [
+    printed = capsys.readouterr().out.splitlines()
+    assert [line for line in printed if line.startswith("fast:")] == [
         f"fast: 1 run, 0 already done, 0 failed -> {tmp_path / 'out3' / 'fast'}"]
+    assert printed[-1].startswith("  AO ") and printed[-1].endswith(" on 1 sequences (protocol got10k)")
 
     parser = argparse.ArgumentParser()
     report.add_report_arguments(parser)
@@ -535,8 +544,14 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
                               "--sequences", "a,c", "--format", "markdown"])
     assert report.cmd_report(args) == 0
     out = capsys.readouterr().out
-    assert out.startswith("| tracker | auc |") and "| fast |" in out
+    assert out.startswith("protocol otb: ") and "\n\n| tracker | auc |" in out and "| fast |" in out
     assert (tmp_path / "out" / "report" / "success.png").is_file()
+    args = parser.parse_args([str(tmp_path / "out"), "--root", str(root), "--dataset", "dtb70",
+                              "--sequences", "a,c", "--format", "csv", "--protocol", "got10k"])
+    assert report.cmd_report(args) == 0
+    assert capsys.readouterr().out.splitlines()[0] == (
+        "tracker,ao,sr50,sr75,auc,precision,norm_precision,fps,sequences,missing,protocol")
+    assert json.loads((tmp_path / "out" / "report" / "report.json").read_text())["protocol"]["name"] == "got10k"
 
 
 def test_real_sequence_with_opencv_kcf(tmp_path, shared_data):

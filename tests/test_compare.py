@@ -1,0 +1,172 @@
+"""dcfkit compare: a hand-made pair of result folders, bad input, and the authors' results
+(skipped without ../shared/data)."""
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dcfkit import cli
+from dcfkit.compare import compare_folders, first_divergence, series_iou
+from dcfkit.datasets import DatasetError, Sequence
+
+GT = np.array([[10, 10, 10, 10]] * 5, dtype=float)  # 0-based in memory; files hold x + 1
+
+
+def sequence(name: str, n: int = 5) -> Sequence:
+    return Sequence(name=name, frames=tuple(Path(f"{k:05d}.jpg") for k in range(n)),
+                    ground_truth=GT[:n].copy(), attributes={}, dataset="test")
+
+
+def write(folder: Path, name: str, rows) -> None:
+    folder.mkdir(exist_ok=True)
+    (folder / f"{name}.txt").write_text("".join(",".join(f"{v:g}" for v in r) + "\n" for r in rows))
+
+
+# 1-based boxes of the two folders. Sequence "a": frame 3 moves 1 px (not apart at 2 px),
+# frame 4 moves 3 px in x (apart: diverges at frame 4), frame 5 moves 5 px. IoU with
+# [11, 21) x [11, 21): frames 1, 2 identical (1), frame 3: 9x10 / (200 - 90) = 90/110,
+# frame 4: 7x10 / 130, frame 5: 5x10 / 150.
+A_RESULTS = [[11, 11, 10, 10], [11, 11, 10, 10], [12, 11, 10, 10], [14, 11, 10, 10], [16, 11, 10, 10]]
+A_REFERENCE = [[11, 11, 10, 10]] * 5
+A_IOU = (1 + 1 + 90 / 110 + 70 / 130 + 50 / 150) / 5
+# Sequence "b": identical, including a NaN row (agreeing: IoU 1, not diverged).
+B_BOTH = [[11, 11, 10, 10], [11, 11, 10, 10], [float("nan")] * 4, [11, 11, 10, 10], [11, 11, 10, 10]]
+
+
+@pytest.fixture
+def folders(tmp_path):
+    ours, theirs = tmp_path / "ours", tmp_path / "theirs"
+    write(ours, "a", A_RESULTS)
+    write(theirs, "a", A_REFERENCE)
+    write(ours, "b", B_BOTH)
+    write(theirs, "b", B_BOTH)
+    write(ours, "only_ours", A_REFERENCE)
+    write(theirs, "only_theirs", A_REFERENCE)
+    write(ours, "c", A_REFERENCE)   # in both folders, not in the dataset
+    write(theirs, "c", A_REFERENCE)
+    (ours / "a_time.txt").write_text("0.1\n")  # timing files are not results
+    return ours, theirs
+
+
+def test_hand_made_pair(folders):
+    ours, theirs = folders
+    res = compare_folders(ours, theirs, [sequence("a"), sequence("b")], divergence_px=2)
+    a, b = res["rows"]
+    assert a["sequence"] == "a" and a["iou"] == pytest.approx(A_IOU) and a["diverges_at"] == 4
+    assert b["iou"] == 1 and b["diverges_at"] is None and res["diverged"] == 1
+    # the reference is perfect on a: precision 1, AUC 20/21 (otb). Ours: centre errors
+    # 0, 0, 1, 3, 5 px (precision 1); overlaps 1, 1, .818, .538, .333 pass 20, 20, 17, 11, 7
+    # of the 21 thresholds
+    assert a["precision"] == a["precision_ref"] == 1 and a["d_precision"] == 0
+    assert a["auc_ref"] == pytest.approx(20 / 21) and a["auc"] == pytest.approx(75 / 105)
+    assert a["d_auc"] == pytest.approx(75 / 105 - 20 / 21)
+    # b: the NaN row is repaired from frame 2 in both (otb), so both score a perfect sequence
+    assert b["auc"] == b["auc_ref"] == pytest.approx(20 / 21)
+    assert res["mean"]["sequence"] == "mean" and res["mean"]["frames"] == 10
+    assert res["mean"]["auc"] == pytest.approx((75 / 105 + 20 / 21) / 2)
+    assert res["mean"]["iou"] == pytest.approx((A_IOU + 1) / 2)
+    assert res["left_out"] == {"only_in_results": ["only_ours"], "only_in_reference": ["only_theirs"],
+                               "not_in_dataset": ["c"]}
+    assert res["protocol"] == "otb"
+    # a looser threshold: frame 4 is 3 px off, frame 5 is 5 px off
+    assert compare_folders(ours, theirs, [sequence("a")], divergence_px=4)["rows"][0]["diverges_at"] == 5
+    assert compare_folders(ours, theirs, [sequence("a")], divergence_px=5)["rows"][0]["diverges_at"] is None
+
+
+def test_series_helpers():
+    nan = [float("nan")] * 4
+    a = [[0, 0, 10, 10], nan, nan, [0, 0, 0, 10], [0, 0, 10, 10]]
+    b = [[0, 0, 10, 10], nan, [0, 0, 10, 10], [0, 0, 0, 10], [5, 0, 10, 10]]
+    # identical rows (also NaN or empty ones) count 1; a NaN on one side 0; else the IoU (50/150)
+    np.testing.assert_allclose(series_iou(a, b), [1, 1, 0, 1, 1 / 3])
+    assert first_divergence(a, b, 2.0) == 3  # 1-based: a NaN on one side only is apart
+    assert first_divergence(a[:2], b[:2], 0.0) is None
+
+
+def test_cli_formats(folders, tmp_path, capsys, monkeypatch):
+    ours, theirs = folders
+    import dcfkit.datasets
+
+    monkeypatch.setattr(dcfkit.datasets, "load_dataset", lambda *a, **k: [sequence("a"), sequence("b")])
+    base = ["compare", str(ours), str(theirs), "--root", str(tmp_path)]
+    assert cli.main(base) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("protocol otb: OTB / UAV123 MATLAB toolkit")
+    assert "1 of 2 sequences diverge (centres more than 2 px apart)" in out
+    assert "left out: only in results: only_ours; only in reference: only_theirs; not in dataset: c" in out
+    assert cli.main(base + ["--format", "csv", "--protocol", "pysot", "--divergence-px", "4"]) == 0
+    captured = capsys.readouterr()
+    assert "left out: only in results: only_ours;" in captured.err  # notes beside the CSV, not in it
+    lines = captured.out.splitlines()
+    assert len(lines) == 4 and lines[0] == ("sequence,frames,precision,precision_ref,d_precision,auc,auc_ref,d_auc,iou,"
+                        "diverges_at,protocol")
+    assert lines[1].startswith("a,5,") and lines[1].endswith(",5,pysot") and lines[3].startswith("mean,10,")
+    assert cli.main(base + ["--format", "json", "--protocol", "got10k"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["protocol"] == "got10k" and data["rows"][0]["diverges_at"] == 4
+    assert cli.main(base + ["--format", "markdown"]) == 0
+    assert "| sequence | frames | precision |" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("case,message", [
+    ("missing", "results folder not found: .*nowhere"),
+    ("columns", r"theirs/a.txt, line 2: expected 4 numbers 'x,y,w,h'"),
+    ("lines", r"sequence 'a': .*ours/a.txt has 5 lines but .*theirs/a.txt has 4"),
+    ("frames", r"sequence 'a': .*ours/a.txt and .*theirs/a.txt have 5 lines but the sequence has 6 frames"),
+    ("nothing", "no sequence has results in both"),
+])
+def test_bad_input_is_one_line_naming_what(folders, tmp_path, capsys, monkeypatch, case, message):
+    ours, theirs = folders
+    seqs = [sequence("a")]
+    if case == "missing":
+        theirs = tmp_path / "nowhere"
+    elif case == "columns":
+        (theirs / "a.txt").write_text("11,11,10,10\n11,11,10\n11,11,10,10\n11,11,10,10\n11,11,10,10\n")
+    elif case == "lines":
+        write(theirs, "a", A_REFERENCE[:4])
+    elif case == "frames":
+        seqs = [dataclasses.replace(sequence("a"), frames=tuple(Path(f"{k}.jpg") for k in range(6)),
+                                    ground_truth=np.tile(GT[:1], (6, 1)))]
+    elif case == "nothing":
+        seqs = [sequence("zzz")]
+    with pytest.raises(DatasetError, match=message):
+        compare_folders(ours, theirs, seqs)
+    import dcfkit.datasets
+
+    monkeypatch.setattr(dcfkit.datasets, "load_dataset", lambda *a, **k: seqs)
+    assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("dcfkit compare: error: ") and "Traceback" not in err and len(err.splitlines()) == 1
+
+
+def test_divergence_px_must_be_a_distance(folders, capsys):
+    ours, theirs = folders
+    with pytest.raises(SystemExit):
+        cli.main(["compare", str(ours), str(theirs), "--root", ".", "--divergence-px", "-1"])
+    assert "expected a distance in pixels >= 0, got '-1'" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------- the authors' results
+
+
+@pytest.fixture(scope="module")
+def uav(shared_data):
+    from dcfkit.datasets import load_dataset
+
+    return load_dataset("uav123_10fps", shared_data / "UAV123_10fps")
+
+
+def test_reference_results_against_themselves_and_another_tracker(shared_data, uav):
+    refs = shared_data / "reference_results"
+    bacf = refs / "BACF" / "UAV123_10fps"
+    same = compare_folders(bacf, bacf, uav)
+    assert len(same["rows"]) == 6 and same["diverged"] == 0
+    assert all(r["d_auc"] == 0 and r["d_precision"] == 0 and r["iou"] == 1 and r["diverges_at"] is None
+               for r in same["rows"] + [same["mean"]])
+    other = compare_folders(bacf, refs / "ARCF-HC" / "UAV123_10fps", uav)
+    assert other["diverged"] >= 1 and other["mean"]["iou"] < 1
+    assert all(r["diverges_at"] is None or 2 <= r["diverges_at"] <= r["frames"] for r in other["rows"])
