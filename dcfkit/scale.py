@@ -93,6 +93,7 @@ class DSST(ScaleEstimator):
                             "ends, or 'hann' hann(S) (the authors')", choices=("hann_interior", "hann"))
         channel_order: str = param("bgr", "colour channel order deciding fHOG's ties (see fhog.channel_order)",
                                    choices=("bgr", "rgb"))
+        fhog_arithmetic: str = param("exact", "fHOG's arithmetic (see fhog.arithmetic)", choices=("exact", "sse"))
         model_update: str = param("reextract", "samples the model learns from after a scale change: 'reextract' at "
                                   "the new scale, or 'shift' the search samples moved by the scale change, missing "
                                   "ones extracted (DR²Track's shift_sample_scale, which leaves those at the large "
@@ -152,7 +153,8 @@ class DSST(ScaleEstimator):
         else:
             work = sample(image, centre, self.base_target * scale * self.factors[-1], self.work_size)
             patches = np.stack([self.resamplers[i](work) for i in which])
-        feats = fhog(patches, cell_size=self.params.cell_size, batch=True, channel_order=self.params.channel_order)
+        feats = fhog(patches, cell_size=self.params.cell_size, batch=True, channel_order=self.params.channel_order,
+                     arithmetic=self.params.fhog_arithmetic)
         feats = feats.reshape(len(patches), -1).T
         return feats * self.window[None, list(which)] if windowed else feats
 

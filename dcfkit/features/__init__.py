@@ -83,12 +83,17 @@ class FHOG(Feature):
         channel_order: str = param("bgr", "which colour channel's gradient a pixel takes when two are equally "
                                    "strong: the first of 'bgr' (OpenCV's order) or of 'rgb' (MATLAB's: the "
                                    "authors' code)", choices=("bgr", "rgb"))
+        arithmetic: str = param("exact", "'exact' square roots and arctan, or 'sse' the estimates and acos table "
+                                "of Piotr's compiled gradientMex that the authors' MATLAB runs (x86 only)",
+                                choices=("exact", "sse"))
 
         def validate(self):
             if self.n_orients < 2:
                 return "n_orients must be at least 2"
             if not 0 < self.clip <= 1:
                 return "clip must be in (0, 1]"
+            if self.arithmetic == "sse" and self.soft_orientation:
+                return "arithmetic 'sse' (Piotr's gradientMex) bins orientations hard: set soft_orientation false"
 
     def channels(self) -> int:
         return 3 * self.params.n_orients + 4
@@ -96,7 +101,7 @@ class FHOG(Feature):
     def extract(self, patch, cell_size):
         p = self.params
         return fhog(patch, cell_size=cell_size, n_orients=p.n_orients, clip=p.clip, soft_orientation=p.soft_orientation,
-                    channel_order=p.channel_order)
+                    channel_order=p.channel_order, arithmetic=p.arithmetic)
 
 
 class ColorNames(Feature):

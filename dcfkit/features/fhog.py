@@ -63,6 +63,7 @@ def fhog(
     batch: bool = False,
     soft_orientation: bool = False,
     channel_order: str = "bgr",
+    arithmetic: str = "exact",
 ) -> np.ndarray:
     """Felzenszwalb HOG of one image, or of a batch of equally sized images.
 
@@ -85,6 +86,10 @@ def fhog(
             which channel's gradient a pixel takes when two are equally strong
             (the first): 'bgr' (OpenCV's images) or 'rgb' (MATLAB's, which makes
             a BGR array's red channel win, as in the authors' trackers).
+        arithmetic: 'exact' (square roots and arctan) or 'sse': the estimates
+            and lookup table of Piotr's compiled gradientMex, which the
+            authors' MATLAB runs (:mod:`dcfkit.features.fhog_sse`; x86 only,
+            ``soft_orientation`` not available).
 
     Returns:
         ``(3 * n_orients + 4, H // cell_size, W // cell_size)`` float32,
@@ -99,7 +104,17 @@ def fhog(
     _check_params(cell_size, n_orients, clip)
     if channel_order not in ("bgr", "rgb"):
         raise ValueError(f"fhog: channel_order must be 'bgr' or 'rgb', got {channel_order!r}")
+    if arithmetic not in ("exact", "sse"):
+        raise ValueError(f"fhog: arithmetic must be 'exact' or 'sse', got {arithmetic!r}")
     imgs = _as_stack(image, batch, cell_size)
+    if arithmetic == "sse":
+        if soft_orientation:
+            raise ValueError("fhog: arithmetic 'sse' (Piotr's gradientMex) bins orientations hard; "
+                             "soft_orientation is not available with it")
+        from .fhog_sse import fhog_sse
+
+        out = fhog_sse(imgs, cell_size, n_orients, clip, channel_order == "rgb")
+        return out if batch else out[0]
     if imgs.shape[0] == 0:
         hb, wb = imgs.shape[1] // cell_size, imgs.shape[2] // cell_size
         return np.zeros((0, fhog_channels(n_orients), hb, wb), np.float32)
