@@ -77,9 +77,9 @@ class TrackerParams:
                             "'rounded' the same rounded to whole 1-based pixels (STRCF's report_tracking_result); "
                             "'half_size' x = cx - w/2 with the size rounded (DR²Track's rect_position)",
                             choices=("exact", "rounded", "half_size"))
-    blank_std: float = param(1.0, "a search patch whose pixel values vary less than this (standard deviation, "
-                             "RMS over colour channels) is a dropped frame: the box is held, nothing is learnt "
-                             "(0: off)")
+    blank_std: float = param(1.0, "a frame whose pixel values vary less than this (standard deviation, RMS over "
+                             "colour channels) is a dropped frame: the box is held, nothing is learnt (0: off); "
+                             "the first frame's search area must vary at least this much")
 
     def validate(self):  # upper bounds: far beyond any tracker's, where patches stop fitting in memory
         if not 1 <= self.search_area_scale <= 50:

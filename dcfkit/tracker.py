@@ -4,9 +4,10 @@ Frame 1 (``init``): extract the sample m¹ at the ground truth, train h¹ (θ = 
 Frame t (``update``): centre the search area (Eq. 14), compute the response (Eq. 12) at each
 search scale, take the peak as p^t, update the scale, extract m^t at p^t, build the label
 (Eq. 3 for the repressed label), train h^t (Eqs. 9–11), and update the velocity (Eq. 13).
-A frame whose search patch is blank (standard deviation of its pixel values below
-``tracker.blank_std``: a dropped or black video frame) is held: the box stays, nothing is
-learnt, and the frame number goes to ``held_frames``.
+A blank frame (standard deviation of its pixel values below ``tracker.blank_std``: a dropped
+or black video frame) is held: the box stays, nothing is learnt, and the frame number goes
+to ``held_frames``. The whole frame is tested, not the search patch: a dark scene or a
+featureless stretch of sky is tracked as any other frame.
 
 Images are (H, W, 3) uint8 BGR or (H, W) uint8 gray; boxes are (x, y, w, h) floats,
 0-based pixels. The tracker is deterministic.
@@ -142,10 +143,10 @@ class Tracker:
     def _sample(self, image: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
         return self._spectrum(self._patch(image, centre, scale))
 
-    def _blank(self, patch: np.ndarray) -> float | None:
-        """The standard deviation of the patch's pixel values (RMS over colour channels) if it is
-        below ``blank_std``, else None."""
-        std = float(np.sqrt(np.mean(np.square(cv2.meanStdDev(patch)[1]))))
+    def _blank(self, pixels: np.ndarray) -> float | None:
+        """The standard deviation of the pixel values (RMS over colour channels) if it is below
+        ``blank_std``, else None."""
+        std = float(np.sqrt(np.mean(np.square(cv2.meanStdDev(pixels)[1]))))
         return std if std < self.params.blank_std else None
 
     # -- Algorithm 1 ------------------------------------------------------------------------
@@ -200,11 +201,11 @@ class Tracker:
         if p.sampling == "whole_pixel":  # the patch is centred on a whole pixel, and so are displacements
             centre = round_half_away(centre)
         factors = self.scale_estimator.search_factors()
-        patches = [self._patch(image, centre, self.scale * f) for f in factors]
-        if self._blank(patches[len(factors) // 2]) is not None:  # a dropped frame: hold, learn nothing
+        if self._blank(image[::4, ::4]) is not None:  # a dropped frame: hold, learn nothing
             self.last_response, self.last_search_box, self.last_distractors = None, None, np.zeros((0, 2))
             self.held_frames.append(self.frame)
             return self.box
+        patches = [self._patch(image, centre, self.scale * f) for f in factors]
         samples = np.stack([self._spectrum(patch) for patch in patches])
         maps = response(self.hf, samples, g.filter_size, self.fft)  # Eq. (12)
         if not np.all(np.isfinite(maps)):
