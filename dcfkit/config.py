@@ -75,8 +75,13 @@ class TrackerParams:
     clamp_position: bool = param(True, "keep the target centre on the image (the authors' codes do not)")
     box_output: str = param("exact", "the reported box: 'exact' x = cx - (w-1)/2 with the exact size; "
                             "'rounded' the same rounded to whole 1-based pixels (STRCF's report_tracking_result); "
-                            "'half_size' x = cx - w/2 with the size rounded (DR²Track's rect_position)",
-                            choices=("exact", "rounded", "half_size"))
+                            "'half_size' x = cx - w/2 with the size rounded (DR²Track's rect_position); "
+                            "'floor_half' x = cx - floor(w/2) with the size floored (BACF's)",
+                            choices=("exact", "rounded", "half_size", "floor_half"))
+    newton_iterations: int = param(5, "Newton steps refining the response peak")
+    cell_selection_thresh: float = param(0.0, "BACF's small-target rule: if the search area holds fewer than this "
+                                         "fraction of max_image_sample_size / cell_size² cells, use cells of "
+                                         "ceil(sqrt(area / (fraction x that many))) pixels instead (0: off)")
     blank_std: float = param(1.0, "a frame whose pixel values vary less than this (standard deviation, RMS over "
                              "colour channels) is a dropped frame: the box is held, nothing is learnt (0: off); "
                              "the first frame's search area must vary at least this much")
@@ -92,6 +97,10 @@ class TrackerParams:
             return "output_sigma_factor must be > 0"
         if self.blank_std < 0:
             return "blank_std must be >= 0"
+        if not 0 <= self.newton_iterations <= 100:
+            return "newton_iterations must be in [0, 100]"
+        if not 0 <= self.cell_selection_thresh <= 1:
+            return "cell_selection_thresh must be in [0, 1]"
 
 
 class _StrictLoader(yaml.SafeLoader):

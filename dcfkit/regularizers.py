@@ -24,8 +24,9 @@ def target_mask(shape: tuple[int, int], target_cells: tuple[float, float], place
 
     'centred': centred on the patch centre (size - 1) / 2, the lower of two middles when the
     box cannot be; 'authors': STRCF's and DR²Track's init_regwindow, which starts the box at
-    1-based floor((n+1)/2) + mod(n+1, 2) - floor(r/2) (one cell lower than 'centred' when the
-    patch has an even and the box an odd number of cells)."""
+    1-based floor((n+1)/2) + mod(n+1, 2) - floor(r/2), and BACF's crop (floor(n/2) + 1 -
+    floor(r/2)), the same cells: one lower than 'centred' when the patch has an even and the
+    box an odd number of cells."""
     mask = np.zeros(shape, dtype=bool)
     spans = []
     for size, extent in zip(shape, target_cells):
@@ -102,13 +103,16 @@ class Crop(SpatialRegularizer):
     @dataclasses.dataclass(frozen=True)
     class Params:
         lam: float = param(0.01, "λ: ridge weight on the filter inside the box")
+        placement: str = param("centred", "where an odd box sits in an even patch: 'centred' or 'authors' "
+                               "(BACF's get_subwindow_no_window, a cell lower and to the right)", choices=PLACEMENTS)
 
         def validate(self):
             if self.lam < 0:
                 return "lam must be >= 0"
 
     def weights_squared(self, shape, target_cells):
-        return np.where(target_mask(shape, target_cells), self.params.lam, np.inf).astype(np.float32)
+        return np.where(target_mask(shape, target_cells, self.params.placement), self.params.lam,
+                        np.inf).astype(np.float32)
 
 
 class Temporal(Component):

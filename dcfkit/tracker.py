@@ -82,6 +82,7 @@ class Geometry:
     sample_size: np.ndarray      # (h, w) resampled search patch, a multiple of the cell size
     filter_size: tuple[int, int]  # (H, W) in cells
     target_cells: tuple[float, float]
+    cell_size: int               # pixels per cell (tracker.cell_size, or smaller for a small target)
 
 
 class Tracker:
@@ -112,20 +113,26 @@ class Tracker:
 
     # -- geometry ---------------------------------------------------------------------------
     def _geometry(self, target: np.ndarray) -> tuple[Geometry, float]:
-        """STRCF's init_size, in its arithmetic (a floor of a size decides a sample's pixels)."""
+        """STRCF's init_size, in its arithmetic (a floor of a size decides a sample's pixels), with
+        BACF's smaller cells for a target whose search area has too few of them."""
         p = self.params
+        cell, low, high = p.cell_size, p.min_image_sample_size, p.max_image_sample_size
         area = float(np.prod(target * p.search_area_scale))
+        if p.cell_selection_thresh > 0 and area / cell**2 < p.cell_selection_thresh * high / cell**2:
+            smaller = min(cell, max(1, int(np.ceil(np.sqrt(area / (p.cell_selection_thresh * high / cell**2))))))
+            low, high = low * (smaller / cell) ** 2, high * (smaller / cell) ** 2  # the same areas in cells
+            cell = smaller
         scale = 1.0
-        if area > p.max_image_sample_size:
-            scale = np.sqrt(area / p.max_image_sample_size)
-        elif area < p.min_image_sample_size:
-            scale = np.sqrt(area / p.min_image_sample_size)
+        if area > high:
+            scale = np.sqrt(area / high)
+        elif area < low:
+            scale = np.sqrt(area / low)
         base_target = target / scale
         region = (np.full(2, np.sqrt(np.prod(base_target * p.search_area_scale))) if p.search_area_shape == "square"
                   else np.floor(base_target * p.search_area_scale))
-        cells = np.maximum(round_half_away(region / p.cell_size), 4).astype(int)
-        target_cells = tuple(float(v) for v in base_target / p.cell_size)
-        geom = Geometry(base_target, cells * p.cell_size, (int(cells[0]), int(cells[1])), target_cells)
+        cells = np.maximum(round_half_away(region / cell), 4).astype(int)
+        target_cells = tuple(float(v) for v in base_target / cell)
+        geom = Geometry(base_target, cells * cell, (int(cells[0]), int(cells[1])), target_cells, cell)
         return geom, float(scale)
 
     def _patch(self, image: np.ndarray, centre: np.ndarray, scale: float, g: Geometry | None = None) -> np.ndarray:
@@ -137,7 +144,7 @@ class Tracker:
 
     def _spectrum(self, patch: np.ndarray) -> np.ndarray:
         """(C, H, Wr) complex64 spectrum of the windowed features of a search patch."""
-        x = extract_stack(self.features, patch, self.params.cell_size, f"frame {self.frame}: ")
+        x = extract_stack(self.features, patch, self.geometry.cell_size, f"frame {self.frame}: ")
         return self.fft.rfft2(x * self.window).astype(np.complex64, copy=False)
 
     def _sample(self, image: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
@@ -212,8 +219,8 @@ class Tracker:
             raise TrackingError(f"frame {self.frame}: the response map is not finite (the filter overflowed: "
                                 f"look for extreme solver, regularizer or label values in the config)")
         best, dy, dx = self._peak(maps)
-        step = p.cell_size * self.scale * factors[best]
-        move = np.array([dy, dx]) * p.cell_size * self.scale * factors[best]  # the authors' order of products
+        step = g.cell_size * self.scale * factors[best]
+        move = np.array([dy, dx]) * g.cell_size * self.scale * factors[best]  # the authors' order of products
         if p.translation == "whole_pixel":
             move = round_half_away(move)
         self.position = self._clamp(centre + move, image.shape)
@@ -221,10 +228,10 @@ class Tracker:
         self.search.observe(self.position)  # Eq. (13)
         peak = np.unravel_index(int(np.argmax(maps[best])), g.filter_size)
         self.last_response = np.fft.fftshift(maps[best])
-        self.last_search_box = centre_size_to_box(centre, g.sample_size * step / p.cell_size)
+        self.last_search_box = centre_size_to_box(centre, g.sample_size * step / g.cell_size)
         xf = None
         if p.training_sample == "shift":  # the detection sample, moved to p^t in cells of the new scale
-            dy, dx = move / (p.cell_size * self.scale)
+            dy, dx = move / (g.cell_size * self.scale)
             xf = shift_spectrum(samples[best], dy, dx, g.filter_size)
         detection = Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells, (dy, dx))
         self._train(image, detection, xf)
@@ -233,10 +240,10 @@ class Tracker:
     def _peak(self, maps: np.ndarray) -> tuple[int, float, float]:
         """The search scale whose response is best and its peak as a (dy, dx) offset in cells."""
         if self.params.peak == "newton":
-            best, dy, dx, _ = newton_peak(maps)
+            best, dy, dx, _ = newton_peak(maps, self.params.newton_iterations)
             return best, dy, dx
         best = int(np.argmax(maps.reshape(len(maps), -1).max(axis=1)))
-        dy, dx, _ = subpixel_peak(maps[best])
+        dy, dx, _ = subpixel_peak(maps[best], self.params.newton_iterations)
         return best, dy, dx
 
     def _train(self, image: np.ndarray, detection: Detection | None, xf: np.ndarray | None = None) -> None:
@@ -246,7 +253,7 @@ class Tracker:
         yf = self.fft.rfft2(y).astype(np.complex64, copy=False)
         theta = self.temporal.params.theta if self.temporal is not None else 0.0
         self.hf = self.solver.train(xf, yf, self.w2, theta, self.fft)  # Eqs. (9)-(11)
-        step = self.params.cell_size * self.scale
+        step = self.geometry.cell_size * self.scale
         self.last_distractors = (self.position[None, ::-1] + offsets[:, ::-1] * step) if len(offsets) else \
             np.zeros((0, 2))
 
@@ -280,9 +287,11 @@ class Tracker:
         """Current (x, y, w, h), 0-based pixels (``tracker.box_output``)."""
         size = self.geometry.base_target * self.scale
         if self.params.box_output == "half_size":  # DR²Track's [pos - round(size) / 2, round(size)]
-            size = round_half_away(size)
-            (cy, cx), (h, w) = self.position, size
+            (cy, cx), (h, w) = self.position, round_half_away(size)
             return float(cx - w / 2), float(cy - h / 2), float(w), float(h)
+        if self.params.box_output == "floor_half":  # BACF's [pos - floor(floor(size) / 2), floor(size)]
+            (cy, cx), (h, w) = self.position, np.floor(size)
+            return float(cx - np.floor(w / 2)), float(cy - np.floor(h / 2)), float(w), float(h)
         box = centre_size_to_box(self.position, size)
         if self.params.box_output == "rounded":  # round([pos - (sz - 1)/2, sz]), 1-based
             return tuple(float(v) for v in round_half_away(np.add(box, (1, 1, 0, 0))) - (1, 1, 0, 0))
