@@ -1,15 +1,27 @@
 """The reference presets against the authors' own boxes (skipped without ../shared/data).
 
-``configs/reference/dr2track.yaml`` is run through ``dcfkit eval``'s runner on the six
-UAV123@10fps development sequences and DTB70 Gull1, and set beside the boxes of the authors'
-DR²Track (reference_results/DR2Track: their MATLAB code under GNU Octave) with
-``dcfkit compare``'s library function. Issue 13's bar: on every sequence |ΔAUC| <= 0.02 and
-a mean IoU between the two box series >= 0.8. Measured when written (2026-11-24): |ΔAUC| <=
-0.005, IoU 0.972-0.999, no centre more than 2 px from theirs.
+Each preset in ``configs/reference/`` is run through ``dcfkit eval``'s runner and set beside
+boxes of the authors' code with ``dcfkit compare``'s library function. Issue 13's bar: on
+every sequence |ΔAUC| <= 0.02 and a mean IoU between the two box series >= 0.8. The
+authors' boxes come from:
 
-UAVDT S0601 is left out: from its frame 28, where the scale filter's two best scales differ
-by 3e-4, the published file differs from a rerun of the authors' own code here too.
+* DR²Track: ``reference_results/DR2Track`` (their MATLAB code under GNU Octave);
+* STRCF: ``tests/data/authors_octave/STRCF`` (``run_STRCF.m`` under GNU Octave 7.3 by
+  ``benchmarks/authors_octave.sh``; see that folder's README);
+* BACF: ``reference_results/BACF`` (their published MATLAB result files), and for
+  wakeboard7 ``tests/data/authors_octave/BACF`` (their code under Octave), because from
+  frame 16 of wakeboard7, where two of the five scales score 0.07% apart, the published
+  file departs from a run of the authors' own code here (the xfail below).
+
+Measured when written (2026-11-24): DR²Track |ΔAUC| <= 0.005, IoU 0.972-0.999, no centre
+more than 2 px from theirs; STRCF identical box for box on all eight sequences; BACF
+identical or IoU >= 0.995 on the five, identical to the Octave run on wakeboard7.
+
+UAVDT S0601 is left out for DR²Track: from its frame 28, where the scale filter's two best
+scales differ by 3e-4, the published file differs from a rerun of the authors' own code here too.
 """
+from pathlib import Path
+
 import pytest
 
 from dcfkit.compare import compare_folders
@@ -17,18 +29,57 @@ from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset
 from dcfkit.evaluation import run_one_pass
 
+OCTAVE_RUNS = Path(__file__).parent / "data" / "authors_octave"
+UAV = ("uav123_10fps", "UAV123_10fps")
 
-@pytest.mark.parametrize("dataset,folder,sequences", [
-    ("uav123_10fps", "UAV123_10fps", None),
-    ("dtb70", "DTB70", ["Gull1"]),
-])
-def test_dr2track_reference_reproduces_the_authors_boxes(dataset, folder, sequences, shared_data, tmp_path):
+
+def compare_preset(preset, dataset, folder, sequences, reference, shared_data, tmp_path):
+    """Run ``configs/reference/<preset>.yaml`` on the sequences and compare it with ``reference``."""
     seqs = load_dataset(dataset, shared_data / folder, sequences)
-    config = load_config("reference/dr2track")
+    config = load_config(f"reference/{preset}")
     run_one_pass(config, seqs, tmp_path, progress=False)
-    table = compare_folders(tmp_path / config["name"], shared_data / "reference_results" / "DR2Track" / folder,
-                            seqs, protocol="otb")
+    table = compare_folders(tmp_path / config["name"], reference, seqs, protocol="otb")
     assert [r["sequence"] for r in table["rows"]] == [s.name for s in seqs]
-    for row in table["rows"]:
+    return table["rows"]
+
+
+def assert_within_the_bar(rows):
+    for row in rows:
         assert abs(row["d_auc"]) <= 0.02, row
         assert row["iou"] >= 0.8, row
+
+
+@pytest.mark.parametrize("dataset,folder,sequences", [UAV + (None,), ("dtb70", "DTB70", ["Gull1"])])
+def test_dr2track_reference_reproduces_the_authors_boxes(dataset, folder, sequences, shared_data, tmp_path):
+    reference = shared_data / "reference_results" / "DR2Track" / folder
+    assert_within_the_bar(compare_preset("dr2track", dataset, folder, sequences, reference, shared_data, tmp_path))
+
+
+@pytest.mark.parametrize("dataset,folder", [UAV, ("dtb70", "DTB70"), ("uavdt", "UAVDT")])
+def test_strcf_reference_is_the_authors_code_box_for_box(dataset, folder, shared_data, tmp_path):
+    reference = OCTAVE_RUNS / "STRCF" / folder
+    rows = compare_preset("strcf", dataset, folder, None, reference, shared_data, tmp_path)
+    assert_within_the_bar(rows)
+    for row in rows:  # as closely as floating point allows: no centre ever 2 px away
+        assert row["diverges_at"] is None and row["iou"] >= 0.999, row
+
+
+def test_bacf_reference_reproduces_the_published_boxes(shared_data, tmp_path):
+    sequences = ["boat1", "building4", "truck4_1", "truck4_2", "wakeboard10"]
+    reference = shared_data / "reference_results" / "BACF" / "UAV123_10fps"
+    assert_within_the_bar(compare_preset("bacf", *UAV, sequences, reference, shared_data, tmp_path))
+
+
+def test_bacf_reference_is_the_authors_code_on_wakeboard7(shared_data, tmp_path):
+    reference = OCTAVE_RUNS / "BACF" / "UAV123_10fps"
+    (row,) = compare_preset("bacf", *UAV, ["wakeboard7"], reference, shared_data, tmp_path)
+    assert row["diverges_at"] is None and row["iou"] >= 0.999, row
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "the published MATLAB file departs from the authors' own code run here (Octave) at frame 16 of "
+    "wakeboard7, where scales 4 and 5 score 0.0089659 and 0.0089725; dcfkit's preset gives the Octave "
+    "run's boxes exactly (test above). The platform difference (image decoding or build) is not known."))
+def test_bacf_reference_on_wakeboard7_against_the_published_file(shared_data, tmp_path):
+    reference = shared_data / "reference_results" / "BACF" / "UAV123_10fps"
+    assert_within_the_bar(compare_preset("bacf", *UAV, ["wakeboard7"], reference, shared_data, tmp_path))

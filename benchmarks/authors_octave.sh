@@ -1,0 +1,84 @@
+#!/bin/bash
+# Optional parity tool: runs the authors' own MATLAB code, STRCF (run_STRCF.m, hand-crafted:
+# gray + fHOG + CN), DR²Track (IROS version, DR2Track1) or BACF (the ARCF repository's
+# tracker_HOG.m with its aberrance term off, which is BACF_optimized.m), under GNU Octave on
+# one dataset's sequences, and writes their boxes for comparison with dcfkit.
+#
+#   bash benchmarks/authors_octave.sh {strcf|dr2track|bacf} DATASET_ROOT OUT_DIR [sequence ...]
+#
+# DATASET_ROOT is read by dcfkit.datasets (UAV123, UAV123@10fps, UAV123@20L, DTB70, UAVDT, OTB
+# layouts). Writes OUT_DIR/<DATASET>/<sequence>.txt (1-based x,y,w,h, one '%.4f' line per frame)
+# and OUT_DIR/<DATASET>/<tracker>_fps.tsv (the fps the authors' code reports, wall seconds).
+# Needs: apt-get install -y octave liboctave-dev octave-image libopencv-imgproc-dev
+# The authors' code comes from $DCFKIT_REFERENCE (default: ../shared/reference next to the repo)
+# and is built into $AUTHORS_BUILD (default: a new temp dir); it is never copied into dcfkit.
+# What the built copy changes, only for portability (algorithms and parameters untouched):
+#  - gradientMex.cpp (Piotr's toolbox) gets Octave's 64-bit mwSize and <cstdlib>/<cstddef>;
+#  - mexResize is the stand-in $DCFKIT_REFERENCE/octave/mexResize.cpp (OpenCV resize with the
+#    authors' rule: 'auto' = INTER_LINEAR when the width grows, else INTER_AREA) instead of mexopencv;
+#  - hann, ifft2(..,'symmetric'), gather, mtimesx are the .m shims of $DCFKIT_REFERENCE/octave
+#    (their mtimesx.m help file is moved aside so the shim is found);
+#  - DR²Track: built by $DCFKIT_REFERENCE/octave/setup_dr2track.sh (which applies the above);
+#  - STRCF: its Piotr's-toolbox submodule is absent from the export, so fhog.m and
+#    gradientMex.cpp/sse.hpp/wrappers.hpp come from the reference's DR2Track1/feature (the same
+#    toolbox files; that fhog.m calls gradientMex directly, with the same arguments); and
+#    benchmarks/octave/authors_run.m sets params.visualization = 0 after run_STRCF.m's settings;
+#  - BACF: the ARCF repository's copy, with sse.hpp from DR2Track1/feature (absent there);
+#    authors_run.m takes run_ARCF_H.m's settings and sets admm_gamma = 0 (no aberrance term:
+#    the filter update is BACF's) and learning_rate = 0.013 (run_BACF.m's; ARCF uses 0.019).
+set -euo pipefail
+[ $# -ge 3 ] || { sed -n '2,10p' "$0"; exit 2; }
+case $1 in strcf|dr2track|bacf) ;; *) echo "tracker must be strcf, dr2track or bacf"; exit 2 ;; esac
+TRK=$1; ROOT=$(cd "$2" && pwd); mkdir -p "$3"; OUT=$(cd "$3" && pwd); shift 3
+HERE=$(cd "$(dirname "$0")" && pwd)
+REF=$(cd "${DCFKIT_REFERENCE:-$HERE/../../shared/reference}" && pwd)
+BUILD=${AUTHORS_BUILD:-$(mktemp -d /tmp/authors_octave.XXXXXX)}; mkdir -p "$BUILD"
+command -v mkoctfile >/dev/null || { echo "needs: apt-get install -y octave liboctave-dev octave-image libopencv-imgproc-dev"; exit 1; }
+# the portability patches STRCF's and BACF's copies share (code folder, gradientMex folder)
+port_lineage() {
+  sed -i '1i #include <cstdlib>\n#include <cstddef>' "$2/wrappers.hpp"
+  sed -i 's/const int dims\[3\]={h,w,d}, n=h\*w\*d;/const mwSize dims[3]={(mwSize)h,(mwSize)w,(mwSize)d}; const int n=h*w*d;/; s/  const int \*dims; int nDims;/  const mwSize *dims; int nDims;/' "$2/gradientMex.cpp"
+  (cd "$2" && mkoctfile --mex -O2 -DMATLAB_MEX_FILE -o gradientMex.mex gradientMex.cpp)
+  mkoctfile --mex -I/usr/include/opencv4 -o "$1/external_libs/mexResize/mexResize.mex" "$REF/octave/mexResize.cpp" -lopencv_imgproc -lopencv_core
+  mv "$1/external_libs/mtimesx/mtimesx.m" "$1/external_libs/mtimesx/mtimesx_mex_help.txt"
+  cp "$REF"/octave/{hann.m,ifft2.m,gather.m,mtimesx.m} "$1/utils/"
+}
+case $TRK in
+  dr2track) bash "$REF/octave/setup_dr2track.sh" "$BUILD/code" ;;
+  strcf)
+    C=$BUILD/code; P=$C/external_libs/pdollar_toolbox/channels
+    rm -rf "$C"; cp -r "$REF/STRCF" "$C"; mkdir -p "$P"
+    cp "$REF"/DR2Track/DR2Track1/feature/{fhog.m,gradientMex.cpp,sse.hpp,wrappers.hpp} "$P/"
+    port_lineage "$C" "$P" ;;
+  bacf)
+    C=$BUILD/code; rm -rf "$C"; cp -r "$REF/ARCF" "$C"
+    cp "$REF/DR2Track/DR2Track1/feature/sse.hpp" "$C/utils/"
+    port_lineage "$C" "$C/utils" ;;
+esac
+# frame lists and 1-based first boxes, from dcfkit's own dataset loader
+DS=$(PYTHONPATH="$HERE/..${PYTHONPATH:+:$PYTHONPATH}" python3 - "$ROOT" "$BUILD/seqs" "$@" <<'EOF'
+import sys, pathlib
+from dcfkit.datasets import load_dataset
+root, dest, names = sys.argv[1], pathlib.Path(sys.argv[2]), sys.argv[3:] or None
+dest.mkdir(parents=True, exist_ok=True)
+seqs = load_dataset(None, root, names)
+for s in seqs:
+    (dest / f"{s.name}.frames").write_text("".join(f"{f}\n" for f in s.frames))
+    x, y, w, h = s.init_box
+    (dest / f"{s.name}.init").write_text(f"{x + 1},{y + 1},{w},{h}\n")
+names = {"uav123": "UAV123", "uav123_10fps": "UAV123_10fps", "uav123_20l": "UAV123_20L",
+         "dtb70": "DTB70", "uavdt": "UAVDT", "otb": "OTB"}
+print(names.get(seqs[0].dataset, seqs[0].dataset), *(s.name for s in seqs))
+EOF
+)
+set -- $DS; DSNAME=$1; shift
+mkdir -p "$OUT/$DSNAME"; FPS=$OUT/$DSNAME/${TRK}_fps.tsv
+[ -f "$FPS" ] || printf 'sequence\tframes\tfps\twall_s\n' > "$FPS"
+for s in "$@"; do  # one Octave process at a time
+  t0=$(date +%s.%N)
+  log=$(octave --no-gui -q --eval "pkg load image; warning('off','all'); addpath('$HERE/octave'); authors_run('$TRK', '$BUILD/code', '$BUILD/seqs/$s.frames', '$BUILD/seqs/$s.init', '$OUT/$DSNAME/$s.txt')" 2>&1) || { echo "$log"; exit 1; }
+  wall=$(echo "$(date +%s.%N) - $t0" | bc)
+  fps=$(echo "$log" | sed -n 's/^fps \([0-9.eE+-]*\)$/\1/p' | tail -1)
+  printf '%s\t%s\t%s\t%.1f\n' "$s" "$(wc -l < "$BUILD/seqs/$s.frames")" "$fps" "$wall" | tee -a "$FPS"
+done
+echo "boxes in $OUT/$DSNAME (build: $BUILD)"
