@@ -231,8 +231,8 @@ class Tracker:
         self.last_search_box = centre_size_to_box(centre, g.sample_size * step / g.cell_size)
         xf = None
         if p.training_sample == "shift":  # the detection sample, moved to p^t in cells of the new scale
-            dy, dx = move / (g.cell_size * self.scale)
-            xf = shift_spectrum(samples[best], dy, dx, g.filter_size)
+            sy, sx = (self.position - centre) / (g.cell_size * self.scale)
+            xf = shift_spectrum(samples[best], sy, sx, g.filter_size)
         detection = Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells, (dy, dx))
         self._train(image, detection, xf)
         return self.box

@@ -987,3 +987,27 @@ def test_translation_whole_pixel_moves_by_whole_pixels(translation):
         assert fractional.max() < 1e-9
     else:
         assert fractional.max() > 1e-3
+
+
+def test_shift_mode_gives_the_label_the_newton_peak_and_trains_at_the_clamped_position(monkeypatch):
+    # tracker.m:69 centres the distractor map with round(-[disp_row, disp_col]), resp_newton's peak,
+    # not the rounded pixel move over the new scale (they round apart, e.g. 2.45 cells -> 10 px -> 2.5)
+    import dcfkit.tracker as tracker_module
+
+    frames = sliding_frames(6, 5)  # 5 px = 1.67 cells of 3 px: sub-cell peaks
+    tracker = dcfkit.load_tracker("reference/dr2track", overrides={"tracker.clamp_position": True})
+    peaks, offsets, shifts = [], [], []
+    find_peak, make_label, shift = tracker._peak, tracker.label.make, tracker_module.shift_spectrum
+    monkeypatch.setattr(tracker, "_peak", lambda maps: peaks.append(find_peak(maps)) or peaks[-1])
+    monkeypatch.setattr(tracker.label, "make", lambda g, d: (d and offsets.append(d.offset)) or make_label(g, d))
+    monkeypatch.setattr(tracker_module, "shift_spectrum",
+                        lambda xf, dy, dx, shape: shifts.append((dy, dx)) or shift(xf, dy, dx, shape))
+    tracker.init(frames[0], (5.0, 40.6, 30.0, 30.0))  # centre x 19.5 -> -5.5: clamped at 0 at the end
+    for frame in frames[1:]:
+        centre = round_half_away(tracker._clamp(tracker.search.centre(), frame.shape))
+        tracker.update(frame)
+        expected = (tracker.position - centre) / (tracker.geometry.cell_size * tracker.scale)
+        np.testing.assert_allclose(shifts[-1], expected, rtol=0, atol=1e-12)
+    assert [tuple(o) for o in offsets] == [(dy, dx) for _, dy, dx in peaks]
+    assert any(abs(dy - round(dy)) > 0.05 or abs(dx - round(dx)) > 0.05 for _, dy, dx in peaks)
+    assert tracker.position[1] == 0.0  # the last move was clamped
