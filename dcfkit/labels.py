@@ -27,7 +27,9 @@ import dataclasses
 import numpy as np
 
 from .params import param
+from .patches import round_half_away
 from .registry import Component
+from .regularizers import target_mask
 from .response import local_maxima, wrap
 
 
@@ -159,11 +161,16 @@ def regional_maxima(r: np.ndarray) -> np.ndarray:
     leaks = np.zeros_like(top)
     for (a, b), n in zip(shifts, neighbours):
         leaks |= (n == r) & ~top_padded[a:a + h, b:b + w]
-    import scipy.ndimage  # only this label selection needs it (0.3 s of import)
-
-    labels, count = scipy.ndimage.label(top, structure=np.ones((3, 3)))
+    labels, _ = _components(top)
     bad = np.unique(labels[top & leaks])
     return top & ~np.isin(labels, bad)
+
+
+def _components(mask: np.ndarray) -> tuple[np.ndarray, int]:
+    """8-connected components of a boolean map (MATLAB's bwconncomp): labels and their count."""
+    import scipy.ndimage  # only the authors' label selection needs it (0.3 s of import)
+
+    return scipy.ndimage.label(mask, structure=np.ones((3, 3)))
 
 
 def authors_distractors(detection: Detection, top_n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -171,16 +178,11 @@ def authors_distractors(detection: Detection, top_n: int) -> tuple[np.ndarray, n
     and their values R̃, highest first; an offset appears once per value that matched it.
 
     R̃ = R / max R is centred (circshift by floor(size/2)) and moved by the rounded sub-cell
-    peak, so the peak sits at the middle. Its regional maxima (not circular), outside a box of
-    floor(size/2 ± target/2) cells (1-based) around the middle, sorted by value; if there is at
-    most one, none is used (their code then looks up [max, 0] and finds neither outside the
-    target). The first ``top_n`` values are looked up among the pixels outside the target box
-    (:func:`~dcfkit.regularizers.target_mask`, 'authors'): every pixel holding exactly that value
-    is a distractor (MATLAB's ``y(row, col)``: rows x columns of the matches).
+    peak, so the peak sits at the middle. The values are those of its regional maxima outside
+    the target (:func:`_strongest_maxima`). Each of them is looked up among the pixels outside
+    the target box (:func:`~dcfkit.regularizers.target_mask`, 'authors'): every pixel holding
+    exactly that value is a distractor (MATLAB's ``y(row, col)``: rows x columns of the matches).
     """
-    from .patches import round_half_away
-    from .regularizers import target_mask
-
     r = detection.response
     h, w = r.shape
     top = r.max()
@@ -190,23 +192,8 @@ def authors_distractors(detection: Detection, top_n: int) -> tuple[np.ndarray, n
     shift = (h // 2 - int(round_half_away(dy)), w // 2 - int(round_half_away(dx)))
     rn = np.roll(r / top, shift, axis=(0, 1))
     outside = ~target_mask((h, w), detection.target_cells, "authors")
-    maxima = regional_maxima(rn)
-    reg = np.floor(detection.target_cells)
-    rows = slice(int(np.floor(h / 2 - reg[0] / 2)) - 1, int(np.floor(h / 2 + reg[0] / 2)))
-    cols = slice(int(np.floor(w / 2 - reg[1] / 2)) - 1, int(np.floor(w / 2 + reg[1] / 2)))
-    maxima[rows, cols] = False
-    import scipy.ndimage
-
-    labels, count = scipy.ndimage.label(maxima, structure=np.ones((3, 3)))
-    if count > 1:
-        first = {}  # each component's first pixel in column-major order (MATLAB's PixelIdxList{i}(1))
-        for col, row in zip(*np.nonzero(labels.T)):
-            first.setdefault(labels[row, col], rn[row, col])
-        values = sorted(first.values(), reverse=True)[:top_n]
-    else:  # their stand-in list [max, 0]: found outside the target box only if the peak moved there
-        values = [rn.max(), np.float32(0)][:top_n]
     offsets, kept = [], []
-    for value in values:
+    for value in _strongest_maxima(rn, detection.target_cells, top_n):
         found_rows, found_cols = np.nonzero(outside & (rn == value))
         for row in np.unique(found_rows):
             for col in np.unique(found_cols):
@@ -215,6 +202,27 @@ def authors_distractors(detection: Detection, top_n: int) -> tuple[np.ndarray, n
     if not offsets:
         return np.zeros((0, 2), dtype=int), np.zeros(0, np.float32)
     return np.array(offsets, dtype=int), np.array(kept, np.float32)
+
+
+def _strongest_maxima(rn: np.ndarray, target_cells, top_n: int) -> list:
+    """The ``top_n`` highest values of the regional maxima of the centred map ``rn`` outside a
+    box of floor(size/2 ± target/2) cells (1-based) around the middle, one per connected
+    component (its first pixel in column-major order, MATLAB's PixelIdxList{i}(1)). With at
+    most one component, tracker.m's stand-in list [max, 0], which the lookup finds outside
+    the target box only if the peak moved there."""
+    h, w = rn.shape
+    maxima = regional_maxima(rn)
+    reg = np.floor(target_cells)
+    rows = slice(max(int(np.floor(h / 2 - reg[0] / 2)) - 1, 0), int(np.floor(h / 2 + reg[0] / 2)))
+    cols = slice(max(int(np.floor(w / 2 - reg[1] / 2)) - 1, 0), int(np.floor(w / 2 + reg[1] / 2)))
+    maxima[rows, cols] = False
+    labels, count = _components(maxima)
+    if count <= 1:
+        return [rn.max(), np.float32(0)][:top_n]
+    first = {}
+    for col, row in zip(*np.nonzero(labels.T)):
+        first.setdefault(labels[row, col], rn[row, col])
+    return sorted(first.values(), reverse=True)[:top_n]
 
 
 BUILTIN = (Gaussian, DistractorRepressed)

@@ -1011,3 +1011,18 @@ def test_shift_mode_gives_the_label_the_newton_peak_and_trains_at_the_clamped_po
     assert [tuple(o) for o in offsets] == [(dy, dx) for _, dy, dx in peaks]
     assert any(abs(dy - round(dy)) > 0.05 or abs(dx - round(dx)) > 0.05 for _, dy, dx in peaks)
     assert tracker.position[1] == 0.0  # the last move was clamped
+
+
+def test_authors_exclusion_box_as_tall_as_the_map_does_not_wrap():
+    # a target of 10 rows in a 10-row map: tracker.m's Bys = floor(5 - 5):... starts at 0 (MATLAB
+    # would fail on index 0); the box must cover every row, not wrap to the last one alone
+    h, w = 10, 16
+    centred = np.zeros((h, w), np.float32)
+    centred[5, 8] = 1.0     # the peak, in the middle
+    centred[2, 5] = 0.5     # inside the exclusion box's columns (floor(8 - 1.5) - 1 = 5 ... 9): excluded
+    centred[7, 1] = 0.4     # outside it: distractors
+    centred[2, 14] = 0.3
+    detection = Detection(np.roll(centred, (-(h // 2), -(w // 2)), axis=(0, 1)), (0, 0), (10.0, 3.0), (0.0, 0.0))
+    offsets, values = authors_distractors(detection, top_n=30)
+    assert sorted(map(tuple, offsets.tolist())) == [(-3, 6), (2, -7)]
+    np.testing.assert_allclose(sorted(values), [0.3, 0.4])
