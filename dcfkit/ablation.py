@@ -602,7 +602,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     "files"}``.
     """
     from .evaluation import load_results
-    from .report import _json_ready, evaluate
+    from .report import json_ready, evaluate
 
     out = Path(out)
     jobs = jobs if jobs is not None else expand(spec, sequences)
@@ -654,7 +654,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
                                      for k, (lab, vals) in spec.grid.parameters.items()}}
                      if spec.grid else None)}
     path = out / "summary.json"
-    atomic_write(path, json.dumps(_json_ready(info), indent=1, ensure_ascii=False, default=str) + "\n")
+    atomic_write(path, json.dumps(json_ready(info), indent=1, ensure_ascii=False, default=str) + "\n")
     files.append(path)
     if spec.grid is not None:
         files += plot_sensitivity(spec, overall, out, protocol)

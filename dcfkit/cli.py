@@ -143,12 +143,12 @@ def cmd_components(args) -> int:
 def cmd_compare(args) -> int:
     from .compare import COLUMNS, compare_folders
     from .datasets import load_dataset
-    from .report import _json_ready, format_table
+    from .report import json_ready, format_table
 
     sequences = load_dataset(args.dataset, args.root, args.sequences)
     res = compare_folders(args.results, args.reference, sequences, args.protocol, args.divergence_px)
     if args.format == "json":
-        print(json.dumps(_json_ready(res), indent=1))
+        print(json.dumps(json_ready(res), indent=1))
         return 0
     print(format_table(res["rows"] + [res["mean"]], args.format, COLUMNS, args.protocol), end="")
     left = "; ".join(f"{k.replace('_', ' ')}: {', '.join(v)}" for k, v in res["left_out"].items() if v)

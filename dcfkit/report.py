@@ -36,9 +36,10 @@ __all__ = [
     "evaluate",
     "format_rows",
     "format_table",
-    "score_line",
     "gather_results",
+    "json_ready",
     "plot_curves",
+    "score_line",
     "write_report",
 ]
 
@@ -356,13 +357,14 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
     return results
 
 
-def _json_ready(obj):
+def json_ready(obj):
+    """``obj`` with arrays as lists and non-finite floats as None, for ``json.dumps``."""
     if isinstance(obj, dict):
-        return {k: _json_ready(v) for k, v in obj.items()}
+        return {k: json_ready(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_json_ready(v) for v in obj]
+        return [json_ready(v) for v in obj]
     if isinstance(obj, np.ndarray):
-        return [_json_ready(v) for v in obj.tolist()]
+        return [json_ready(v) for v in obj.tolist()]
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     return obj
@@ -384,7 +386,7 @@ def _write(evaluation: dict, report_dir: Path) -> list[Path]:
     for stem in tables:
         for fmt, ext in (("table", "txt"), ("markdown", "md"), ("csv", "csv")):
             text(f"{stem}.{ext}", format_table(evaluation[stem], fmt, columns(stem, protocol), protocol))
-    text("report.json", json.dumps(_json_ready(evaluation), indent=1) + "\n")
+    text("report.json", json.dumps(json_ready(evaluation), indent=1) + "\n")
     for kind in ("precision", "success"):
         paths += plot_curves(evaluation["curves"], kind, report_dir / kind, protocol=protocol)
     for attr, curves in evaluation["attribute_curves"].items():

@@ -219,8 +219,8 @@ class Tracker:
             raise TrackingError(f"frame {self.frame}: the response map is not finite (the filter overflowed: "
                                 f"look for extreme solver, regularizer or label values in the config)")
         best, dy, dx = self._peak(maps)
-        step = g.cell_size * self.scale * factors[best]
-        move = np.array([dy, dx]) * g.cell_size * self.scale * factors[best]  # the authors' order of products
+        step = g.cell_size * self.scale * factors[best]  # pixels per cell
+        move = np.array([dy, dx]) * g.cell_size * self.scale * factors[best]  # not * step: the authors' rounding
         if p.translation == "whole_pixel":
             move = round_half_away(move)
         self.position = self._clamp(centre + move, image.shape)
