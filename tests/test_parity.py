@@ -13,12 +13,13 @@ authors' boxes come from:
   frame 16 of wakeboard7, where two of the five scales score 0.07% apart, the published
   file departs from a run of the authors' own code here (the xfail below).
 
-Measured when written (2026-11-24): DR²Track |ΔAUC| <= 0.005, IoU 0.972-0.999, no centre
+Measured when written (2026-11-24): DR²Track |ΔAUC| <= 0.006, IoU 0.969-0.999, no centre
 more than 2 px from theirs; STRCF identical box for box on all eight sequences; BACF
 identical or IoU >= 0.995 on the five, identical to the Octave run on wakeboard7.
 
-UAVDT S0601 is left out for DR²Track: from its frame 28, where the scale filter's two best
-scales differ by 3e-4, the published file differs from a rerun of the authors' own code here too.
+For DR²Track on UAVDT S0601 the stored file is not used: from its frame 28, where the scale
+filter's two best scales differ by 3e-4, it parts from a rerun of the authors' own code here
+(``tests/data/authors_octave/DR2Track``), which the preset reproduces.
 """
 from pathlib import Path
 
@@ -55,13 +56,19 @@ def test_dr2track_reference_reproduces_the_authors_boxes(dataset, folder, sequen
     assert_within_the_bar(compare_preset("dr2track", dataset, folder, sequences, reference, shared_data, tmp_path))
 
 
+def test_dr2track_reference_is_the_authors_code_on_s0601(shared_data, tmp_path):
+    reference = OCTAVE_RUNS / "DR2Track" / "UAVDT"
+    (row,) = compare_preset("dr2track", "uavdt", "UAVDT", None, reference, shared_data, tmp_path)
+    assert row["diverges_at"] is None and row["iou"] >= 0.99, row
+
+
 @pytest.mark.parametrize("dataset,folder", [UAV, ("dtb70", "DTB70"), ("uavdt", "UAVDT")])
 def test_strcf_reference_is_the_authors_code_box_for_box(dataset, folder, shared_data, tmp_path):
     reference = OCTAVE_RUNS / "STRCF" / folder
     rows = compare_preset("strcf", dataset, folder, None, reference, shared_data, tmp_path)
     assert_within_the_bar(rows)
-    for row in rows:  # as closely as floating point allows: no centre ever 2 px away
-        assert row["diverges_at"] is None and row["iou"] >= 0.999, row
+    for row in rows:  # box for box: their boxes are whole pixels (report_tracking_result's round)
+        assert row["iou"] == 1.0, row
 
 
 def test_bacf_reference_reproduces_the_published_boxes(shared_data, tmp_path):
@@ -73,7 +80,7 @@ def test_bacf_reference_reproduces_the_published_boxes(shared_data, tmp_path):
 def test_bacf_reference_is_the_authors_code_on_wakeboard7(shared_data, tmp_path):
     reference = OCTAVE_RUNS / "BACF" / "UAV123_10fps"
     (row,) = compare_preset("bacf", *UAV, ["wakeboard7"], reference, shared_data, tmp_path)
-    assert row["diverges_at"] is None and row["iou"] >= 0.999, row
+    assert row["iou"] == 1.0, row  # box for box (whole pixels: floor(target_sz), pos - floor(sz/2))
 
 
 @pytest.mark.xfail(strict=True, reason=(
