@@ -85,7 +85,7 @@ class DSST(ScaleEstimator):
         cell_size: int = param(4, "fHOG cell size of the scale samples")
         model_size: str = param("base_target", "size of a scale sample: 'base_target' the target at the search "
                                 "patch's resolution (at least 2x2 cells), 'image_target' its size in image pixels "
-                                "(the authors' init_scale: floor, at least 2 px)", choices=("base_target", "image_target"))
+                                "(the authors' init_scale: floored; at least 2 cells, where theirs allows 2 px)", choices=("base_target", "image_target"))
         sampling: str = param("working_patch", "'working_patch': the largest region cut once and each scale "
                               "resampled from it; 'whole_pixel': each scale cropped in whole pixels and resized "
                               "(the authors' get_scale_sample)", choices=("working_patch", "whole_pixel"))
@@ -124,7 +124,8 @@ class DSST(ScaleEstimator):
             target = self.base_target * scale
             area = float(np.prod(target))
             shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
-            self.model_size = np.maximum(np.floor(target * shrink), 2).astype(int)
+            # theirs floors to at least 2 px; fhog needs 2 cells (a side under 8 px differs)
+            self.model_size = np.maximum(np.floor(target * shrink), 2 * p.cell_size).astype(int)
         else:
             area = float(np.prod(self.base_target))
             shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0

@@ -811,8 +811,11 @@ def stub_samples(dsst, calls, rows=3):
 @pytest.mark.parametrize("target, model", [
     ((40.0, 30.0), (26, 19)),     # 1200 > 512: floor((40, 30) * sqrt(512/1200) = (26.13, 19.60))
     ((20.7, 24.2), (20, 24)),     # 500.94 <= 512: floor
-    ((100.0, 6.0), (92, 5)),      # 600: floor((92.38, 5.54))
-    ((1.5, 300.0), (2, 300)),     # 450: floor 1 -> at least 2
+    ((100.0, 14.0), (60, 8)),     # 1400: floor((60.47, 8.47))
+    # fhog needs 2 cells: a side under 8 px is raised to 8 (theirs: floor((92.38, 5.54)) = (92, 5),
+    # and at least 2 px: (2, 300)); a 7-px-wide target's scale samples failed in fhog before
+    ((100.0, 6.0), (92, 8)),
+    ((1.5, 300.0), (8, 300)),
 ])
 def test_dsst_model_size_image_target_is_init_scale(monkeypatch, target, model):
     # init_scale.m:16-23 with scale_model_factor = 1 and scale_model_max_area = 512, from the image target
