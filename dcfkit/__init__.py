@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 # part of every result key (dcfkit.evaluation.config_hash): bump it when boxes change (docs/changes.md)
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 __all__ = ["__version__", "load_tracker", "load_config", "Tracker"]
 
