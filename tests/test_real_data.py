@@ -1,9 +1,10 @@
 """Shipped configs on the real UAV123@10fps development sequences (skipped without ../shared/data).
 
 Precision floors were set from measurement (one-pass, centre error <= 20 px, mean over the six
-development sequences, OpenCV 4.14): DR²Track 1.000, STRCF 0.891, BACF 0.978 at the time of
-writing (2026-11-23). Six sequences are few: a last-bit change in a feature moved a tracker's
-mean by up to ±0.05 (measured), hence the margins, and no test of the ranking between trackers.
+development sequences, OpenCV 4.14): DR²Track 0.959, STRCF 0.891, BACF 0.978 at the time of
+writing (2026-11-24, 0.3.0). Six sequences are few: a last-bit change in a feature moved a
+tracker's mean by up to ±0.05 (measured), hence the margins, and no test of the ranking between
+trackers.
 """
 import numpy as np
 import pytest
@@ -12,7 +13,7 @@ import dcfkit
 from dcfkit.datasets import load_dataset
 from dcfkit.metrics import average, score_sequence
 
-FLOORS = {"dr2track": 0.92, "strcf": 0.81, "bacf": 0.90}  # measured minus ~0.08
+FLOORS = {"dr2track": 0.88, "strcf": 0.81, "bacf": 0.90}  # measured minus ~0.08
 
 
 @pytest.fixture(scope="module")
