@@ -2,8 +2,9 @@
 starting frames (OTB's temporal robustness evaluation, TRE: Wu et al., CVPR 2013), so a few
 sequences give many more chances to lose a target than one pass does.
 
-    python benchmarks/restarts.py configs/ablations/departures.yaml --variants "DR²Track (authors),DR²Track (dcfkit)" \
-        [--root DIR] [--dataset NAME] [--sequences a,b] [--starts 5] [--jobs 2] [--json restarts.json]
+    python benchmarks/restarts.py configs/ablations/departures.yaml \
+        [--variants "DR²Track (authors),DR²Track (dcfkit)"] [--root DIR] [--dataset NAME] \
+        [--sequences a,b] [--starts 5] [--jobs 2] [--json restarts.json]
 
 Segment k of a sequence of N frames starts at frame floor(k N / starts) (0-based) from that
 frame's ground truth and runs to the end (a start whose ground truth is out of view moves

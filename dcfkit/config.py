@@ -66,7 +66,8 @@ class TrackerParams:
                           "pixels around round(centre), then OpenCV's resize (bilinear when the width grows, else "
                           "area)", choices=("subpixel", "whole_pixel"))
     window: str = param("hann_interior", "cosine window of the features: 'hann_interior' hann(n+2) without its zero "
-                        "ends (DR²Track's code), 'hann' hann(n) with them (STRCF's and BACF's)", choices=("hann_interior", "hann"))
+                        "ends (DR²Track's code), 'hann' hann(n) with them (STRCF's and BACF's)",
+                        choices=("hann_interior", "hann"))
     peak: str = param("bounded_newton", "sub-cell peak: 'bounded_newton' Newton steps kept within the grid maximum's "
                       "cell, the scale with the highest grid value; 'newton' the authors' resp_newton (unbounded "
                       "steps, the scale with the highest refined value)", choices=("bounded_newton", "newton"))

@@ -87,7 +87,8 @@ class DistractorRepressed(Label):
         top_n: int = param(30, "N: how many of the highest background local maxima are repressed")
         mu: float = param(0.25, "μ: repression strength")
         variant: str = param("subtractive", "'subtractive' g - μR̃, 'overwrite' -μR̃ (the authors' code) or "
-                             "'multiplicative' (the paper's g⊙d)", choices=("subtractive", "overwrite", "multiplicative"))
+                             "'multiplicative' (the paper's g⊙d)",
+                             choices=("subtractive", "overwrite", "multiplicative"))
         selection: str = param("local_maxima", "'local_maxima' (3x3 maxima of the circular map outside the target "
                                "area) or 'authors' (DR²Track's code: regional maxima, its exclusion box, at most one "
                                "maximum means none)", choices=("local_maxima", "authors"))

@@ -85,7 +85,8 @@ class DSST(ScaleEstimator):
         cell_size: int = param(4, "fHOG cell size of the scale samples")
         model_size: str = param("base_target", "size of a scale sample: 'base_target' the target at the search "
                                 "patch's resolution (at least 2x2 cells), 'image_target' its size in image pixels "
-                                "(the authors' init_scale: floored; at least 2 cells, where theirs allows 2 px)", choices=("base_target", "image_target"))
+                                "(the authors' init_scale: floored; at least 2 cells, where theirs allows 2 px)",
+                                choices=("base_target", "image_target"))
         sampling: str = param("working_patch", "'working_patch': the largest region cut once and each scale "
                               "resampled from it; 'whole_pixel': each scale cropped in whole pixels and resized "
                               "(the authors' get_scale_sample)", choices=("working_patch", "whole_pixel"))
