@@ -83,19 +83,17 @@ def main(argv=None) -> int:
     parser.add_argument("--json", help="write every segment's scores here")
     args = parser.parse_args(argv)
 
-    spec = load_spec(args.spec, root=args.root if not args.dataset else None)
+    if args.dataset and not args.root:
+        parser.error("--dataset needs --root")
+    own_dataset = not args.dataset
+    spec = load_spec(args.spec, root=args.root if own_dataset else None,
+                     sequences=args.sequences if own_dataset else None)
     variants = {v.name: v.config for v in spec.variants}
     names = [n.strip() for n in args.variants.split(",")] if args.variants else list(variants)
     unknown = [n for n in names if n not in variants]
     if unknown:
         parser.error(f"--variants: not in {args.spec}: {', '.join(unknown)}")
-    if args.dataset:
-        if not args.root:
-            parser.error("--dataset needs --root")
-        seqs = load_dataset(args.dataset, args.root, args.sequences)
-    else:
-        spec = load_spec(args.spec, root=args.root, sequences=args.sequences)
-        seqs = spec.load_sequences()
+    seqs = spec.load_sequences() if own_dataset else load_dataset(args.dataset, args.root, args.sequences)
 
     tasks = [(name, seq, first) for name in names for seq in seqs
              for first in segment_starts(seq.ground_truth, args.starts)]

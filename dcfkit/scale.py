@@ -121,16 +121,13 @@ class DSST(ScaleEstimator):
         with np.errstate(over="ignore"):  # a σ so small that σ² underflows: a delta label, not NaN
             self.label_f = np.fft.fft(np.exp(-0.5 * offsets**2 / max(sigma**2, np.finfo(float).tiny)))
         self.window = np.hanning(n + 2)[1:-1] if p.window == "hann_interior" else np.hanning(n)
-        if p.model_size == "image_target":
-            target = self.base_target * scale
-            area = float(np.prod(target))
-            shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
-            # theirs floors to at least 2 px; fhog needs 2 cells (a side under 8 px differs)
-            self.model_size = np.maximum(np.floor(target * shrink), 2 * p.cell_size).astype(int)
-        else:
-            area = float(np.prod(self.base_target))
-            shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
-            self.model_size = np.maximum(np.round(self.base_target * shrink), 2 * p.cell_size).astype(int)
+        authors = p.model_size == "image_target"  # init_scale: the target in image pixels, floored
+        target = self.base_target * scale if authors else self.base_target
+        area = float(np.prod(target))
+        shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
+        # at least 2 cells, which fhog needs (init_scale allows 2 px: a side under 8 px differs)
+        self.model_size = np.maximum((np.floor if authors else np.round)(target * shrink),
+                                     2 * p.cell_size).astype(int)
         # the working patch and its resampling to each scale keep their geometry every frame
         span = self.factors[-1] / self.factors[0]
         self.work_size = np.ceil(self.model_size * span).astype(int)
