@@ -1,7 +1,7 @@
 """dcfkit: discriminative correlation filter trackers assembled from registered components."""
 from __future__ import annotations
 
-# part of every result key (dcfkit.evaluation.config_hash): bump it when boxes change (docs/changes.md)
+# part of every run key (dcfkit.results.run_key): bump it when boxes change (docs/changes.md)
 __version__ = "0.3.0"
 
 __all__ = ["__version__", "load_tracker", "load_config", "Tracker"]

@@ -27,7 +27,7 @@ import numpy as np
 
 from . import metrics
 from .datasets import DatasetError, Sequence, read_boxes
-from .evaluation import result_files
+from .results import result_files
 from .protocols import DEFAULT, Protocol, get_protocol
 
 __all__ = ["COLUMNS", "compare_folders", "first_divergence", "series_iou"]

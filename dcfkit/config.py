@@ -120,7 +120,7 @@ class _StrictLoader(yaml.SafeLoader):
         return super().construct_mapping(node, deep)
 
 
-def _read_yaml(path: Path) -> dict:
+def read_yaml(path: Path) -> dict:
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
@@ -161,7 +161,7 @@ def _load_file(path: Path, chain: tuple[Path, ...] = ()) -> tuple[dict, tuple[Pa
     path = path.resolve()
     if path in chain:
         raise ConfigError(f"{path}: circular 'base' chain: {' -> '.join(map(str, chain + (path,)))}")
-    data = _read_yaml(path)
+    data = read_yaml(path)
     base = data.pop("base", None)
     if base is None:
         return data, (path,)

@@ -13,7 +13,6 @@ scored as a total failure and counted in the ``missing`` column.
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import json
@@ -26,12 +25,10 @@ import numpy as np
 
 from . import metrics
 from .datasets import ATTRIBUTE_NAMES, DatasetError, Sequence
-from .protocols import DEFAULT, PROTOCOLS, Protocol, get_protocol
+from .protocols import DEFAULT, Protocol, get_protocol
+from .results import atomic_write, check_writable, import_results, load_results
 
 __all__ = [
-    "add_protocol_argument",
-    "add_report_arguments",
-    "cmd_report",
     "columns",
     "evaluate",
     "format_rows",
@@ -39,6 +36,7 @@ __all__ = [
     "gather_results",
     "json_ready",
     "plot_curves",
+    "score_and_write",
     "score_line",
     "write_report",
 ]
@@ -321,14 +319,13 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
 
     A tracker is a sub-folder name of ``out_dir`` or a path to a folder of result files.
     Folders written by :func:`dcfkit.evaluation.run_one_pass` (with ``.json`` sidecars)
-    are read with ``load_results`` (completed sequences only, timings included); other
+    are read with ``load_results`` (intact results only, timings included); other
     folders are imported as plain 1-based ``x,y,w,h`` text files. ``None`` takes every
-    sub-folder of ``out_dir`` holding a ``<sequence>.txt`` of one of ``sequences``.
+    sub-folder of ``out_dir`` holding a ``<sequence>.txt`` of one of ``sequences``, except
+    the folders in ``exclude`` that hold no tracker results (a report's own folder).
     A tracker is named by its folder's name, or by ``parent/name`` where two folders share
     a name (``reference_results/BACF/UAV123_10fps`` and ``.../DR2Track/UAV123_10fps``).
     """
-    from .evaluation import import_results, load_results
-
     out_dir = Path(out_dir)
     exclude = {Path(p).resolve() for p in exclude}
     names = {s.name for s in sequences}
@@ -336,8 +333,8 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
         if not out_dir.is_dir():
             raise DatasetError(f"results folder not found: {out_dir}")
         trackers = [p.name for p in sorted(out_dir.iterdir())
-                    if p.is_dir() and not p.name.startswith(".") and p.resolve() not in exclude
-                    and any((p / f"{n}.txt").is_file() for n in names)]
+                    if p.is_dir() and not p.name.startswith(".") and any((p / f"{n}.txt").is_file() for n in names)
+                    and (p.resolve() not in exclude or _holds_results(p, names))]
     folders: dict[Path, Path] = {}
     for tracker in trackers:
         folder = out_dir / tracker if (out_dir / tracker).is_dir() else Path(tracker)
@@ -357,6 +354,11 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
     return results
 
 
+def _holds_results(folder: Path, names: set[str]) -> bool:
+    """Whether ``folder`` has the result sidecar of a sequence (a report folder has none)."""
+    return any((folder / f"{n}.json").is_file() for n in names)
+
+
 def json_ready(obj):
     """``obj`` with arrays as lists and non-finite floats as None, for ``json.dumps``."""
     if isinstance(obj, dict):
@@ -371,15 +373,12 @@ def json_ready(obj):
 
 
 def _write(evaluation: dict, report_dir: Path) -> list[Path]:
-    from .evaluation import make_dir
-
-    make_dir(report_dir)
     paths = []
     protocol = evaluation["protocol"]["name"]
 
     def text(name, content):
         path = report_dir / name
-        path.write_text(content, encoding="utf-8")
+        atomic_write(path, content)
         paths.append(path)
 
     tables = ["overall", "per_sequence"] + (["per_attribute"] if evaluation["per_attribute"] else [])
@@ -408,62 +407,20 @@ def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | No
     and one ``success_<ATTR>`` plot per attribute, each as PNG and SVG. Every file names
     the protocol. Returns the paths.
     """
-    return _report(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol)[1]
+    return score_and_write(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol)[1]
 
 
-def _report(out_dir, sequences, trackers, report_dir, include_first=True, weighting=None, protocol=DEFAULT):
+def score_and_write(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None, report_dir=None,
+                    include_first: bool = True, weighting: str | None = None,
+                    protocol: str | Protocol = DEFAULT) -> tuple[dict, list[Path]]:
+    """:func:`write_report` that also returns what :func:`evaluate` returned: (evaluation, paths)."""
     out_dir = Path(out_dir)
     report_dir = Path(report_dir) if report_dir is not None else out_dir / "report"
+    if _holds_results(report_dir, {s.name for s in sequences}):
+        raise DatasetError(f"{report_dir} holds a tracker's results; write the report elsewhere with --report-dir")
     results = gather_results(out_dir, sequences, trackers, exclude=[report_dir])
     if not results:
         raise DatasetError(f"no tracker results found under {out_dir}")
+    check_writable(report_dir, what="the report")  # before the scoring, which can take a while
     evaluation = evaluate(results, sequences, include_first, weighting, protocol)
     return evaluation, _write(evaluation, report_dir)
-
-
-# --------------------------------------------------------------------------- CLI
-
-
-def add_protocol_argument(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
-    """``--protocol``, shared by the commands that print scores."""
-    parser.add_argument("--protocol", choices=tuple(PROTOCOLS), default=DEFAULT,
-                        help="scoring rules: otb (the OTB / UAV123 MATLAB toolkit, which computed the published "
-                             "UAV123 tables), pysot or got10k; docs/evaluation.md lists the differences")
-    return parser
-
-
-def add_report_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
-    """Arguments of ``dcfkit report``."""
-    parser.add_argument("out", type=Path, metavar="OUT", help="results folder of `dcfkit eval`")
-    parser.add_argument("--dataset", default="auto", help="dataset name (default: detect from --root)")
-    parser.add_argument("--root", required=True, type=Path, help="benchmark root folder")
-    parser.add_argument("--sequences", default=None, help="comma-separated sequence names (default: all)")
-    parser.add_argument("--trackers", default=None,
-                        help="comma-separated tracker folders (names in OUT or paths; default: all)")
-    parser.add_argument("--format", choices=("table", "markdown", "csv"), default="table",
-                        help="format of the table printed to stdout")
-    parser.add_argument("--report-dir", type=Path, default=None, help="default: OUT/report")
-    add_protocol_argument(parser)
-    parser.add_argument("--skip-first", action="store_true",
-                        help="do not score frame 1 (default: as the protocol; otb scores it with the ground "
-                             "truth as the prediction, pysot as the file has it, got10k never)")
-    parser.add_argument("--frame-weighted", action="store_true",
-                        help="pool the frames of all sequences (default: as the protocol; otb and pysot "
-                             "weigh sequences equally, got10k pools frames)")
-    return parser
-
-
-def cmd_report(args: argparse.Namespace) -> int:
-    """``dcfkit report``: print the overall table and write the report files."""
-    from .datasets import load_dataset
-
-    sequences = load_dataset(args.dataset, args.root, args.sequences)
-    trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
-    evaluation, paths = _report(args.out, sequences, trackers, args.report_dir,
-                                include_first=not args.skip_first,
-                                weighting="frame" if args.frame_weighted else None, protocol=args.protocol)
-    print(format_table(evaluation["overall"], args.format, columns("overall", args.protocol), args.protocol),
-          end="")
-    if args.format == "table":
-        print(f"\n{len(paths)} files written to {paths[0].parent}")
-    return 0

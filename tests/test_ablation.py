@@ -19,7 +19,7 @@ from dcfkit import ablation, cli
 from dcfkit.ablation import expand, load_spec, run_ablation
 from dcfkit.config import load_config, shipped_config_dir
 from dcfkit.datasets import load_dataset, read_boxes
-from dcfkit.errors import ConfigError
+from dcfkit.errors import DcfkitError, ConfigError
 from dcfkit.synthetic import make_sequence
 from dcfkit.tracker import load_tracker
 
@@ -326,7 +326,7 @@ variants: {s: {config: strcf, overrides: {scale.n_scales: 3}}}
     assert list(res["failed"]) == [(key, "seqB")]
     assert "0005.jpg" in res["failed"][key, "seqB"] and "not a readable image" in res["failed"][key, "seqB"]
     record = json.loads((out / "jobs" / "otb" / key / "seqB.error.json").read_text())
-    assert record["frame"] == 4 and record["frame_file"] == str(broken.resolve())
+    assert record["frame"] == 5 and record["frame_file"] == str(broken.resolve())
     assert not (out / "jobs" / "otb" / key / "seqB.txt").exists()
     rows = {r["sequence"]: r for r in res["summary"]["per_sequence"]}
     assert [rows[s]["status"] for s in ("seqA", "seqB", "seqC")] == ["done", "failed", "done"]
@@ -380,7 +380,7 @@ def test_dask_missing_gives_an_install_hint(tmp_path, data, monkeypatch):
     monkeypatch.setitem(sys.modules, "distributed", None)  # import fails as if not installed
     spec = load_spec(write_spec(tmp_path / "spec.yaml", "dataset: {name: otb, root: data}\nsequences: [seqA]\n"
                                                         "variants: {s: {config: strcf}}\n"))
-    with pytest.raises(ablation.DcfkitError, match=r"pip install 'dcfkit\[dask\]'"):
+    with pytest.raises(DcfkitError, match=r"pip install 'dcfkit\[dask\]'"):
         run_ablation(spec, tmp_path / "out", executor="dask", progress=False)
 
 
@@ -392,9 +392,9 @@ def test_a_second_run_on_the_same_folder_is_refused(tmp_path, data):
     out.mkdir()
     with open(out / ".lock", "a+") as held:  # as a running `dcfkit ablate` holds it
         fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        with pytest.raises(ablation.DcfkitError, match="another `dcfkit ablate` is writing to"):
+        with pytest.raises(DcfkitError, match="another `dcfkit ablate` is writing to"):
             run_ablation(spec, out, jobs=1, progress=False)
     assert not (out / "jobs").exists()
     (out / "jobs").write_text("")  # a file where the job folders go: refused before anything runs
-    with pytest.raises(ablation.DcfkitError, match=r"cannot create the folder .*jobs"):
+    with pytest.raises(DcfkitError, match=r"cannot create the folder .*jobs"):
         run_ablation(spec, out, jobs=1, progress=False)

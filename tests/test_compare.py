@@ -89,9 +89,9 @@ def test_series_helpers():
 
 def test_cli_formats(folders, tmp_path, capsys, monkeypatch):
     ours, theirs = folders
-    import dcfkit.datasets
+    import dcfkit.cli.evaluate
 
-    monkeypatch.setattr(dcfkit.datasets, "load_dataset", lambda *a, **k: [sequence("a"), sequence("b")])
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: [sequence("a"), sequence("b")])
     base = ["compare", str(ours), str(theirs), "--root", str(tmp_path)]
     assert cli.main(base) == 0
     out = capsys.readouterr().out
@@ -135,9 +135,9 @@ def test_bad_input_is_one_line_naming_what(folders, tmp_path, capsys, monkeypatc
         seqs = [sequence("zzz")]
     with pytest.raises(DatasetError, match=message):
         compare_folders(ours, theirs, seqs)
-    import dcfkit.datasets
+    import dcfkit.cli.evaluate
 
-    monkeypatch.setattr(dcfkit.datasets, "load_dataset", lambda *a, **k: seqs)
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: seqs)
     assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("dcfkit compare: error: ") and "Traceback" not in err and len(err.splitlines()) == 1

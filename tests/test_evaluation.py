@@ -14,12 +14,14 @@ import cv2
 import numpy as np
 import pytest
 
-from dcfkit import evaluation, report
+from dcfkit import evaluation, report, results, runner
+from dcfkit.baselines import OpenCVUnavailable, available_opencv_trackers, opencv_tracker
+from dcfkit.cli import evaluate as cli_evaluate
 from dcfkit.datasets import DatasetError, Sequence, load_dataset
-from dcfkit.errors import ConfigError
+from dcfkit.errors import ConfigError, DcfkitError
 from dcfkit.registry import PluginWarning
-from dcfkit.evaluation import (config_hash, import_results, load_results, opencv_tracker,
-                               run_one_pass)
+from dcfkit.evaluation import run_one_pass
+from dcfkit.results import import_results, load_results, run_key
 
 
 N_FRAMES = 6
@@ -103,19 +105,19 @@ def test_result_files_are_one_based_with_sidecar(tmp_path, seqs):
     assert lines[0] == "3.000,4.000,5.000,6.000"  # 0-based (2, 3) written 1-based
     assert lines[5] == "8.000,4.000,5.000,6.000"
     meta = json.loads((d / "a.json").read_text())
-    assert meta["config_hash"] == config_hash(CONFIG) == summary["config_hash"]
-    assert meta["dcfkit_version"] == evaluation.dcfkit_version()
+    assert meta["config_hash"] == run_key(CONFIG) == summary["config_hash"]
+    assert meta["dcfkit_version"] == results.dcfkit_version()
     assert len(meta["times"]) == N_FRAMES and meta["fps"] > 0 and meta["config"] == CONFIG
     res = load_results(tmp_path / "out", "drift", seqs)
     np.testing.assert_allclose(res["b"].boxes, gt_boxes())
     assert res["b"].times.shape == (N_FRAMES,) and res["b"].fps > 0
 
 
-def test_config_hash_is_canonical():
-    assert config_hash({"a": 1, "b": {"c": 2, "d": 3}}) == config_hash({"b": {"d": 3, "c": 2}, "a": 1})
-    assert config_hash({"a": 1}) != config_hash({"a": 2})
-    assert config_hash({"a": 1}, "1.0") != config_hash({"a": 1}, "1.1")
-    assert config_hash({"a": (1, 2)}) == config_hash({"a": [1, 2]})
+def test_run_key_is_canonical():
+    assert run_key({"a": 1, "b": {"c": 2, "d": 3}}) == run_key({"b": {"d": 3, "c": 2}, "a": 1})
+    assert run_key({"a": 1}) != run_key({"a": 2})
+    assert run_key({"a": 1}, "1.0") != run_key({"a": 1}, "1.1")
+    assert run_key({"a": (1, 2)}) == run_key({"a": [1, 2]})
 
 
 def test_nan_first_box_and_bad_name_are_errors(tmp_path, seqs):
@@ -201,7 +203,7 @@ def test_a_second_eval_of_the_same_sequences_is_refused_and_of_others_not(tmp_pa
     (tmp_path / "drift" / ".locks").mkdir(parents=True)
     with open(tmp_path / "drift" / ".locks" / "b.lock", "a+") as held:  # as a running eval of b holds it
         fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        with pytest.raises(evaluation.DcfkitError, match=r"another `dcfkit eval` is writing drift's results of "
+        with pytest.raises(DcfkitError, match=r"another `dcfkit eval` is writing drift's results of "
                                                          r"sequence 'b' to .*drift"):
             run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
         assert files(tmp_path / "drift") == set()  # nothing was run
@@ -211,23 +213,14 @@ def test_a_second_eval_of_the_same_sequences_is_refused_and_of_others_not(tmp_pa
     assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["done"] == ["b"]
 
 
-def test_results_written_before_the_initial_box_was_recorded_are_still_done(tmp_path, seqs):
-    run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
-    side = tmp_path / "drift" / "a.json"
-    meta = json.loads(side.read_text())
-    del meta["init_box"]
-    side.write_text(json.dumps(meta))
-    assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["skipped"] == ["a", "b", "c"]
-
-
 def test_workers_leave_plugin_warnings_to_the_parent(monkeypatch):
-    for var in evaluation._THREAD_VARS:
+    for var in runner._THREAD_VARS:
         monkeypatch.setenv(var, os.environ.get(var, "1"))  # restored after the test
     threads = cv2.getNumThreads()
     try:
         with warnings.catch_warnings(record=True) as shown:
             warnings.simplefilter("always")
-            evaluation.worker_init()
+            runner.worker_init()
             warnings.warn("dcfkit plugin 'x' failed and was skipped: boom", PluginWarning)
             warnings.warn("something else", RuntimeWarning)
     finally:
@@ -237,11 +230,11 @@ def test_workers_leave_plugin_warnings_to_the_parent(monkeypatch):
 
 def test_results_folder_that_is_a_file_is_a_clear_error(tmp_path, seqs):
     (tmp_path / "drift").write_text("")
-    with pytest.raises(evaluation.DcfkitError, match=r"cannot create the folder .*drift"):
+    with pytest.raises(DcfkitError, match=r"cannot create the folder .*drift"):
         run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
     run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
     (tmp_path / "report").write_text("")
-    with pytest.raises(evaluation.DcfkitError, match=r"cannot create the folder .*report"):
+    with pytest.raises(DcfkitError, match=r"cannot create the folder .*report"):
         report.write_report(tmp_path / "out", seqs, report_dir=tmp_path / "report")
 
 
@@ -261,24 +254,24 @@ def test_default_trackers_are_warmed_up_once_per_process_and_config(tmp_path, se
             self.calls.append("update")
             return super().update(image)
 
-    monkeypatch.setattr(evaluation, "_default_factory", factory)
-    monkeypatch.setattr(evaluation, "_warmed_up", set())
+    monkeypatch.setattr(runner, "load_dcfkit_tracker", factory)
+    monkeypatch.setattr(runner, "_warmed_up", set())
     run_one_pass(CONFIG, seqs, tmp_path, progress=False)
-    # sequence a: its tracker, then the throw-away one (one init and one update); b, c: theirs
-    assert len(made) == 4 and made[1].calls == ["init", "update"]
-    assert [len(t.calls) for t in made] == [N_FRAMES, 2, N_FRAMES, N_FRAMES]
+    # the throw-away tracker (one init and one update), then one per sequence
+    assert len(made) == 4 and made[0].calls == ["init", "update"]
+    assert [len(t.calls) for t in made] == [2, N_FRAMES, N_FRAMES, N_FRAMES]
     run_one_pass({**CONFIG, "drift": 2.0}, seqs, tmp_path, progress=False)
     assert len(made) == 8  # a new config is warmed up again
     # a user's factory is used as given: one tracker per sequence, no throw-away copy
     custom = Counter()
     run_one_pass({**CONFIG, "drift": 3.0}, seqs, tmp_path, make_tracker=custom, progress=False)
     assert custom.made == 3
-    # an unreadable first frame is reported as frame 0 of its file, warm-up or not
+    # an unreadable first frame is reported as frame 1 of its file, warm-up or not
     seqs[0].frames[0].write_bytes(b"not an image")
     summary = run_one_pass({**CONFIG, "drift": 4.0}, seqs[:1], tmp_path, progress=False)
     record = json.loads((tmp_path / "drift" / "a.error.json").read_text())
-    assert record["frame"] == 0 and record["frame_file"] == str(seqs[0].frames[0])
-    assert "cannot read frame 0" in summary["failed"]["a"]
+    assert record["frame"] == 1 and record["frame_file"] == str(seqs[0].frames[0])
+    assert "cannot read frame 1 " in summary["failed"]["a"]
 
 
 def test_crash_mid_sequence_leaves_no_partial_result(tmp_path, seqs):
@@ -292,14 +285,14 @@ def test_crash_mid_sequence_leaves_no_partial_result(tmp_path, seqs):
 
 
 def test_crash_between_result_and_sidecar_is_not_done(tmp_path, seqs, monkeypatch):
-    real_write = evaluation.atomic_write
+    real_write = results.atomic_write
 
     def dying_write(path, text):
         if path.name == "b.json":
             raise Crash
         real_write(path, text)
 
-    monkeypatch.setattr(evaluation, "atomic_write", dying_write)
+    monkeypatch.setattr(results, "atomic_write", dying_write)
     with pytest.raises(Crash):
         run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
     monkeypatch.undo()
@@ -316,9 +309,9 @@ def test_atomic_write_interrupted_keeps_old_file(tmp_path, monkeypatch):
     def boom(*a):
         raise Crash
 
-    monkeypatch.setattr(evaluation.os, "replace", boom)
+    monkeypatch.setattr(results.os, "replace", boom)
     with pytest.raises(Crash):
-        evaluation.atomic_write(target, "new\n")
+        results.atomic_write(target, "new\n")
     assert target.read_text() == "old\n" and files(tmp_path) == {"x.txt"}
 
 
@@ -330,11 +323,11 @@ def test_tracker_failure_is_isolated_and_retried(tmp_path, seqs, caplog):
                            progress=False)
     assert summary["done"] == ["a", "c"] and list(summary["failed"]) == ["b"]
     message = summary["failed"]["b"]
-    assert "'b'" in message and "frame 2" in message and "00003.jpg" in message and "boom" in message
-    assert "frame 2" in caplog.text
+    assert "'b'" in message and "frame 3 of 6" in message and "00003.jpg" in message and "boom" in message
+    assert "frame 3 of 6" in caplog.text
     d = tmp_path / "drift"
     record = json.loads((d / "b.error.json").read_text())
-    assert record["frame"] == 2 and record["type"] == "ValueError" and "boom" in record["traceback"]
+    assert record["frame"] == 3 and record["type"] == "ValueError" and "boom" in record["traceback"]
     assert not (d / "b.txt").exists() and set(load_results(tmp_path, "drift", seqs)) == {"a", "c"}
     rerun = Counter()
     summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=rerun, progress=False)
@@ -347,7 +340,7 @@ def test_bad_box_and_factory_errors_are_failures(tmp_path, seqs):
             return None
 
     summary = run_one_pass(CONFIG, seqs[:1], tmp_path, make_tracker=NoneTracker, progress=False)
-    assert "frame 1" in summary["failed"]["a"] and "expected 4 numbers" in summary["failed"]["a"]
+    assert "frame 2 of 6 (00002.jpg)" in summary["failed"]["a"] and "expected 4 numbers" in summary["failed"]["a"]
 
     def broken(config):
         raise KeyError("features")
@@ -395,7 +388,7 @@ def synthetic_sequence(tmp_path, n=8):
 
 @pytest.mark.parametrize("name", ["CSRT", "KCF", "MOSSE"])
 def test_opencv_baselines(tmp_path, name):
-    if name not in evaluation.available_opencv_trackers():
+    if name not in available_opencv_trackers():
         pytest.skip(f"OpenCV {name} is not in this OpenCV build")
     seq = synthetic_sequence(tmp_path)
     factory = opencv_tracker(name.lower())
@@ -413,7 +406,7 @@ def test_opencv_baselines(tmp_path, name):
 
 
 def test_opencv_unknown_name():
-    with pytest.raises(evaluation.OpenCVUnavailable, match="CSRT, KCF, MOSSE"):
+    with pytest.raises(OpenCVUnavailable, match="CSRT, KCF, MOSSE"):
         opencv_tracker("medianflow")
 
 
@@ -469,7 +462,7 @@ def test_write_report_files(tmp_path, seqs):
     other = tmp_path / "imported"
     other.mkdir()
     for s in seqs:
-        (other / f"{s.name}.txt").write_text(evaluation._format_boxes(gt_boxes()))
+        (other / f"{s.name}.txt").write_text(results.format_boxes(gt_boxes()))
     paths = report.write_report(out, seqs, trackers=["drift", "slow", str(other)])
     names = {p.name for p in paths}
     for stem in ("precision", "success", "success_SV", "success_FM"):
@@ -492,19 +485,19 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
         (root / s.name / "img").mkdir(parents=True)
         for k, f in enumerate(s.frames):
             (root / s.name / "img" / f"{k + 1:05d}.jpg").write_bytes(f.read_bytes())
-        (root / s.name / "groundtruth_rect.txt").write_text(evaluation._format_boxes(s.ground_truth))
+        (root / s.name / "groundtruth_rect.txt").write_text(results.format_boxes(s.ground_truth))
     seen = {}
 
     def fake_resolve(spec, overrides):
         seen["overrides"] = overrides
         return {"name": Path(spec).stem, **overrides}, make_drift
 
-    monkeypatch.setattr(evaluation, "_resolve_config", fake_resolve)
+    monkeypatch.setattr(cli_evaluate, "_resolve_config", fake_resolve)
     parser = argparse.ArgumentParser()
-    evaluation.add_eval_arguments(parser)
+    cli_evaluate.add_eval_arguments(parser)
     args = parser.parse_args(["fast.yaml", "--root", str(root), "--out", str(tmp_path / "out"),
                               "--sequences", "a,c", "--set", "drift=0.5", "--no-progress"])
-    assert evaluation.cmd_eval(args) == 0
+    assert cli_evaluate.run_eval(args) == 0
     assert seen["overrides"] == {"drift": 0.5}
     assert files(tmp_path / "out" / "fast") == {"a.txt", "a.json", "c.txt", "c.json"}
     printed = capsys.readouterr().out
@@ -518,7 +511,7 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
     args = parser.parse_args(["strcf", "strcff.yaml", "--root", str(root), "--out", str(tmp_path / "out2"),
                               "--no-progress"])
     with pytest.raises(ConfigError, match="config not found: strcff.yaml"):
-        evaluation.cmd_eval(args)
+        cli_evaluate.run_eval(args)
     assert not (tmp_path / "out2").exists()
     # two different configs under one name would overwrite each other's results: refused up
     # front; the same config given twice runs once
@@ -527,35 +520,35 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
     args = parser.parse_args(["strcf", str(mine), "--root", str(root), "--out", str(tmp_path / "out2"),
                               "--no-progress"])
     with pytest.raises(ConfigError, match="'strcf' and .*my_strcf.yaml' are both named 'strcf'"):
-        evaluation.cmd_eval(args)
+        cli_evaluate.run_eval(args)
     assert not (tmp_path / "out2").exists()
-    monkeypatch.setattr(evaluation, "_resolve_config", fake_resolve)
+    monkeypatch.setattr(cli_evaluate, "_resolve_config", fake_resolve)
     args = parser.parse_args(["fast.yaml", "fast.yaml", "--root", str(root), "--out", str(tmp_path / "out3"),
                               "--sequences", "a", "--no-progress", "--protocol", "got10k"])
-    assert evaluation.cmd_eval(args) == 0
+    assert cli_evaluate.run_eval(args) == 0
     printed = capsys.readouterr().out.splitlines()
     assert [line for line in printed if line.startswith("fast:")] == [
         f"fast: 1 run, 0 already done, 0 failed -> {tmp_path / 'out3' / 'fast'}"]
     assert printed[-1].startswith("  AO ") and printed[-1].endswith(" on 1 sequences (protocol got10k)")
 
     parser = argparse.ArgumentParser()
-    report.add_report_arguments(parser)
+    cli_evaluate.add_report_arguments(parser)
     args = parser.parse_args([str(tmp_path / "out"), "--root", str(root), "--dataset", "dtb70",
                               "--sequences", "a,c", "--format", "markdown"])
-    assert report.cmd_report(args) == 0
+    assert cli_evaluate.run_report(args) == 0
     out = capsys.readouterr().out
     assert out.startswith("protocol otb: ") and "\n\n| tracker | auc |" in out and "| fast |" in out
     assert (tmp_path / "out" / "report" / "success.png").is_file()
     args = parser.parse_args([str(tmp_path / "out"), "--root", str(root), "--dataset", "dtb70",
                               "--sequences", "a,c", "--format", "csv", "--protocol", "got10k"])
-    assert report.cmd_report(args) == 0
+    assert cli_evaluate.run_report(args) == 0
     assert capsys.readouterr().out.splitlines()[0] == (
         "tracker,ao,sr50,sr75,auc,precision,norm_precision,fps,sequences,missing,protocol")
     assert json.loads((tmp_path / "out" / "report" / "report.json").read_text())["protocol"]["name"] == "got10k"
 
 
 def test_real_sequence_with_opencv_kcf(tmp_path, shared_data):
-    if "KCF" not in evaluation.available_opencv_trackers():
+    if "KCF" not in available_opencv_trackers():
         pytest.skip("OpenCV KCF is not in this OpenCV build")
     (boat1,) = load_dataset("uav123_10fps", shared_data / "UAV123_10fps", ["boat1"])
     short = dataclasses.replace(boat1, frames=boat1.frames[:12], ground_truth=boat1.ground_truth[:12])
@@ -597,7 +590,7 @@ def _square_or_die(x):
 
 def test_run_pool_reports_a_dead_worker_as_a_crash_of_the_unfinished_calls():
     results, crashes = {}, {}
-    evaluation.run_pool({x: (_square_or_die, x) for x in range(4)}, 2, results.__setitem__,
+    runner.run_pool({x: (_square_or_die, x) for x in range(4)}, 2, results.__setitem__,
                         lambda key, exc: crashes.setdefault(key, type(exc).__name__))
     assert set(results) == {0, 1, 2, 3} and 3 in crashes  # every call is reported, the dead one as a crash
     assert set(crashes.values()) == {"BrokenProcessPool"}
@@ -607,10 +600,10 @@ def test_run_pool_reports_a_dead_worker_as_a_crash_of_the_unfinished_calls():
 def test_result_files_get_the_usual_permissions(tmp_path, monkeypatch):
     saved = os.umask(0o022)
     try:
-        evaluation._file_mode.cache_clear()
+        results._file_mode.cache_clear()
         path = tmp_path / "r.txt"
-        evaluation.atomic_write(path, "1\n")
+        results.atomic_write(path, "1\n")
         assert path.stat().st_mode & 0o777 == 0o644 and path.read_text() == "1\n"  # mkstemp alone: 0o600
     finally:
         os.umask(saved)
-        evaluation._file_mode.cache_clear()
+        results._file_mode.cache_clear()

@@ -268,10 +268,10 @@ def test_union_and_fixed_tuple_annotations_are_checked():
 
 
 def test_result_hashes_change_with_the_version_of_a_plugin_the_config_uses(monkeypatch):
-    from dcfkit.ablation import _run_job, job_key
     from dcfkit.config import load_config
     from dcfkit.errors import DcfkitError
-    from dcfkit.evaluation import config_hash, dcfkit_version
+    from dcfkit.results import dcfkit_version, run_key
+    from dcfkit.runner import RunTask, run_in_worker
 
     def registry_with(version):
         ep = install_plugin(monkeypatch, "dcfkit_test_versioned", PLUGIN)
@@ -280,17 +280,17 @@ def test_result_hashes_change_with_the_version_of_a_plugin_the_config_uses(monke
         monkeypatch.setattr(reg, "_REGISTRY", reg.build_registry())
 
     monkeypatch.setattr(reg, "_REGISTRY", reg.build_registry(external=False))
-    plain = config_hash(load_config("strcf"))
+    plain = run_key(load_config("strcf"))
     registry_with("0.1.0")
     flat = load_config("strcf", {"label.name": "flat"})
-    assert config_hash(load_config("strcf")) == plain  # built-ins only: unchanged by installed plugins
+    assert run_key(load_config("strcf")) == plain  # built-ins only: unchanged by installed plugins
     assert reg.get_registry().plugin_versions([("label", "flat")]) == ["dcfkit-test-versioned 0.1.0"]
-    old, old_key = config_hash(flat), job_key(flat)
+    old_key = run_key(flat)
     registry_with("0.2.0")
-    assert config_hash(flat) != old and job_key(flat) != old_key
-    monkeypatch.setattr("dcfkit.ablation._worker_ready", True)  # no worker set-up in the test process
+    assert run_key(flat) != old_key
+    monkeypatch.setattr("dcfkit.runner._worker_ready", True)  # no worker set-up in the test process
     with pytest.raises(DcfkitError, match=r"worker's plugins \(dcfkit-test-versioned 0.2.0\) are not the client's"):
-        _run_job(flat, None, "unused", old_key, dcfkit_version())
+        run_in_worker(RunTask(flat, None, "unused", old_key), dcfkit_version())
     monkeypatch.setattr(reg, "_REGISTRY", None)
 
 
@@ -317,6 +317,6 @@ def test_an_ambiguous_name_survives_a_plugin_failing_half_way_and_refuses_a_seco
 @pytest.mark.parametrize("config", [{"name": "csrt"}, {"name": "x", "regularizers": ["l2"]}, {"features": 3},
                                     {"features": [{"nome": "gray"}], "label": "gaussian"}])
 def test_configs_that_are_not_dcfkit_trackers_still_hash(config):
-    from dcfkit.evaluation import config_hash
+    from dcfkit.results import run_key
 
-    assert len(config_hash(config)) == 16
+    assert len(run_key(config)) == 16

@@ -1,12 +1,11 @@
-"""Generated reference docs (dcfkit/docs_gen.py): the committed files are current, and the renderers."""
+"""Generated reference docs (dcfkit/cli/docs.py): the committed files are current, and the renderers."""
 import dataclasses
 import difflib
 from pathlib import Path
 
 import pytest
 
-from dcfkit import docs_gen
-from dcfkit.cli import main
+from dcfkit.cli import components, docs as docs_gen, main
 from dcfkit.params import fields, param
 from dcfkit.registry import build_registry, get_registry
 
@@ -19,7 +18,7 @@ def test_committed_reference_docs_are_current(file_name):
     generated = docs_gen.GENERATED[file_name]()
     diff = "".join(difflib.unified_diff(committed.splitlines(True), generated.splitlines(True),
                                         f"docs/{file_name} (committed)", "generated", n=1))
-    assert committed == generated, f"docs/{file_name} is stale: run `python -m dcfkit.docs_gen docs/`\n{diff[:3000]}"
+    assert committed == generated, f"docs/{file_name} is stale: run `python -m dcfkit.cli.docs docs/`\n{diff[:3000]}"
 
 
 def test_config_reference_documents_every_key_and_every_parameter():
@@ -46,7 +45,7 @@ def test_cli_reference_has_every_subcommand_and_option():
 
 
 def test_defaults_are_written_as_yaml():
-    assert [docs_gen.yaml_value(v) for v in (True, None, (1, 2), "", "fhog", 1e-3, 1e5)] == \
+    assert [components.yaml_value(v) for v in (True, None, (1, 2), "", "fhog", 1e-3, 1e5)] == \
         ["true", "null", "[1, 2]", "''", "fhog", "0.001", "100000.0"]
 
 
@@ -55,15 +54,15 @@ def test_params_table_escapes_and_lists_choices():
     class Params:
         mode: str = param("a", "either a | b", choices=("a", "b"))
 
-    assert docs_gen.params_table(fields(Params)).splitlines()[2] == \
+    assert components.params_table(fields(Params)).splitlines()[2] == \
         "| `mode` | str | `a` | either a \\| b (one of: `a`, `b`) |"
-    assert docs_gen.params_table([]) == "No parameters.\n"
+    assert components.params_table([]) == "No parameters.\n"
 
 
 def test_components_markdown_command_uses_the_shared_renderer(capsys):
     assert main(["components", "--kind", "label", "--format", "markdown"]) == 0
     out = capsys.readouterr().out
-    assert out == docs_gen.components_markdown(docs_gen.component_rows(get_registry(), ["label"]))
+    assert out == components.components_markdown(components.component_rows(get_registry(), ["label"]))
     assert "### label `gaussian`\n\nThe fixed Gaussian label of STRCF/BACF (Eq. 1). (from dcfkit)\n\nNo parameters.\n" in out
     assert "| `top_n` | int | `30` | N: how many of the highest background local maxima are repressed |" in out
 
@@ -76,7 +75,7 @@ def test_summary_is_the_whole_first_paragraph():
         Details.
         """
 
-    assert docs_gen.summary(Doc) == "First line continues here."
+    assert components.summary(Doc) == "First line continues here."
 
 
 def test_check_mode_reports_stale_files(tmp_path, capsys):

@@ -1,0 +1,93 @@
+"""Running an ablation spec's jobs: each distinct (run key, sequence) once, through
+:func:`dcfkit.runner.execute`, into ``OUT/jobs/<dataset>/<key>/``."""
+from __future__ import annotations
+
+import contextlib
+import json
+from pathlib import Path
+
+from ..errors import DcfkitError
+from ..protocols import DEFAULT
+from ..results import LABEL_KEYS, ResultStore, atomic_write, check_writable, dcfkit_version, exclusive, read_json
+from ..runner import RunTask, execute, usable_cores
+from .spec import AblationSpec, Job, expand, job_dir, variant_names
+from .summary import summarize
+
+
+def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str = "local",
+                 scheduler: str | None = None, progress: bool = True, protocol: str = DEFAULT) -> dict:
+    """Run every job of ``spec`` not already done under ``out``, then write the summary
+    (scored under ``protocol``, see :mod:`dcfkit.protocols`).
+
+    ``executor`` is ``"local"`` (``jobs`` spawned worker processes, default: the usable
+    cores; ``jobs=1`` runs in this process) or ``"dask"`` (``Client(scheduler)``, or a
+    ``LocalCluster`` of ``jobs`` single-threaded worker processes when ``scheduler`` is
+    None; workers need the dataset and ``out`` at the same paths). A failing job is
+    recorded (``.error.json``) and does not stop the others.
+
+    Returns a plain dict: ``jobs`` (the :class:`Job` list), ``runs`` (distinct
+    (key, sequence) pairs), ``done`` / ``skipped`` / ``failed`` (run -> message) and
+    ``summary`` (what :func:`summarize` returned).
+    """
+    jobs = jobs if jobs is not None else usable_cores()
+    if jobs < 1:
+        raise DcfkitError(f"--jobs must be >= 1, got {jobs}")
+    out = Path(out).expanduser().resolve()
+    seqs = spec.load_sequences()
+    version = dcfkit_version()
+    job_list = expand(spec, seqs, version)
+    by_name = {s.name: s for s in seqs}
+    tasks: dict[tuple[str, str], RunTask] = {}
+    for job in job_list:
+        tasks.setdefault((job.key, job.sequence), RunTask(job.config, by_name[job.sequence],
+                                                          job_dir(out, spec.dataset, job.key), job.key))
+    check_writable(out, ["summary.md", "summary.csv", "summary.json", "per_sequence.md", "per_sequence.csv"],
+                   "the ablation")
+    with exclusive(out / ".lock", "dcfkit ablate", f"to {out}"):
+        _prepare(out, tasks.values(), job_list, version)
+        todo = sorted((t for t in tasks.values() if not ResultStore(t.folder).is_done(t.seq, t.key)),
+                      key=lambda t: -len(t.seq))  # longest first: the workers end together
+        result = {"jobs": job_list, "runs": len(tasks), "done": [],
+                  "skipped": [k for k, t in tasks.items() if t not in todo], "failed": {}}
+        _run(spec, result, todo, len(tasks), variant_names(job_list), jobs, executor, scheduler, progress, version)
+        result["summary"] = summarize(spec, out, seqs, job_list, protocol)
+    return result
+
+
+def _prepare(out: Path, tasks, job_list: list[Job], version: str) -> None:
+    """Before anything runs: stale temporary files removed, every result folder checked
+    writable, and ``OUT/configs/<key>.json`` written for each run key."""
+    for stale in (out / "jobs").glob("*/*/.*.tmp"):  # left by a killed run; never read
+        with contextlib.suppress(OSError):
+            stale.unlink()
+    for task in tasks:
+        check_writable(task.folder, ResultStore(task.folder).file_names(task.seq.name), "the ablation's results")
+    check_writable(out / "configs", [f"{j.key}.json" for j in job_list], "the ablation's configs")
+    for job in {j.key: j for j in job_list}.values():
+        path = out / "configs" / f"{job.key}.json"
+        if (read_json(path) or {}).get("key") != job.key:  # missing or damaged: (re)write the record
+            stripped = {k: v for k, v in job.config.items() if k not in LABEL_KEYS}
+            atomic_write(path, json.dumps({"key": job.key, "dcfkit_version": version, "config": stripped},
+                                          indent=1) + "\n")
+
+
+def _run(spec, result, todo, total, variants, jobs, executor, scheduler, progress, version) -> None:
+    """Execute ``todo`` with a progress bar in runs, recording each outcome in ``result``."""
+    from tqdm.auto import tqdm  # lazy: tqdm.auto probes for Jupyter on import
+
+    bar = tqdm(total=total, initial=total - len(todo), unit="job", desc=spec.name,
+               disable=not progress or not todo, dynamic_ncols=True)
+
+    def on_result(task: RunTask, res: dict) -> None:
+        if res["status"] == "done":
+            result["done"].append((task.key, task.seq.name))
+        else:
+            result["failed"][task.key, task.seq.name] = res["error"]
+            bar.write(f"FAILED {', '.join(variants[task.key])}: {res['error']}")
+        bar.set_postfix_str(f"{variants[task.key][0]} / {task.seq.name}", refresh=False)
+        bar.update(1)
+
+    try:
+        execute(todo, on_result, jobs=jobs, executor=executor, scheduler=scheduler, version=version)
+    finally:
+        bar.close()

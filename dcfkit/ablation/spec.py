@@ -1,0 +1,328 @@
+"""Ablation specs: named variants and parameter grids of tracker configs, validated and
+expanded to jobs."""
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import itertools
+import os
+from pathlib import Path
+from typing import Any, Iterable, Mapping
+
+import yaml
+
+from ..config import load_config, read_yaml, shipped_config, shipped_config_dir
+from ..datasets import DatasetError, canonical_name, load_dataset
+from ..errors import ConfigError, DcfkitError
+from ..params import closest
+from ..results import dcfkit_version, run_key
+
+SPEC_KEYS = ("name", "description", "dataset", "sequences", "variants", "grid")
+VARIANT_KEYS = ("config", "overrides", "description")
+GRID_KEYS = ("base", "overrides", "mode", "parameters")
+GRID_MODES = ("sweep", "product")
+
+
+@dataclasses.dataclass(frozen=True)
+class Variant:
+    """One row of the ablation table: ``config`` is the fully resolved config dict;
+    ``values`` holds the grid parameter values that define it (empty for a named variant)."""
+
+    name: str
+    config: dict
+    source: str
+    overrides: dict = dataclasses.field(default_factory=dict)
+    values: dict = dataclasses.field(default_factory=dict)
+
+
+@dataclasses.dataclass(frozen=True)
+class Grid:
+    """A parameter grid around ``base`` (a variant name or a config): ``parameters`` maps a
+    dotted key to ``(label, values)``; ``mode`` is ``sweep`` (one at a time) or ``product``."""
+
+    base: str
+    mode: str
+    parameters: dict
+    base_config: dict
+
+
+@dataclasses.dataclass(frozen=True)
+class AblationSpec:
+    """A validated spec (:func:`load_spec`): every variant's config already resolved."""
+
+    path: Path
+    name: str
+    description: str
+    dataset: str              # canonical dataset name
+    root: Path | None         # absolute; None when neither the spec nor --root gives one
+    root_origin: str          # where root came from, for error messages
+    sequences: tuple | None   # None: every sequence present under root
+    variants: tuple           # of Variant: named variants first, then the grid's, in spec order
+    grid: Grid | None
+
+    def load_sequences(self) -> list:
+        """The :class:`dcfkit.datasets.Sequence` objects to run: the spec's subset, else all under root."""
+        if self.root is None:
+            raise ConfigError(f"{self.path}: dataset.root is not given; pass --root DIR "
+                              f"(the {self.dataset} benchmark folder)")
+        if not self.root.is_dir():
+            hint = "" if self.root_origin == "--root" else f"; pass --root DIR (the {self.dataset} benchmark folder)"
+            raise ConfigError(f"{self.path}: dataset root {self.root} ({self.root_origin}) is not a folder{hint}")
+        return load_dataset(self.dataset, self.root, list(self.sequences) if self.sequences is not None else None)
+
+
+@dataclasses.dataclass(frozen=True)
+class Job:
+    """One tracker run to do: ``variant`` on ``sequence`` with the resolved ``config``;
+    ``key`` names the run's result folder (:func:`dcfkit.results.run_key`)."""
+
+    variant: str
+    config: dict
+    sequence: str
+    key: str
+
+
+def variant_names(jobs: Iterable[Job]) -> dict[str, list[str]]:
+    """key -> the names of the variants that share that run, in spec order."""
+    names: dict[str, list[str]] = {}
+    for job in jobs:
+        if job.variant not in names.setdefault(job.key, []):
+            names[job.key].append(job.variant)
+    return names
+
+
+def _find_spec(source: str | os.PathLike) -> Path:
+    path = Path(source)
+    if path.is_file():
+        return path.resolve()
+    folder = shipped_config_dir() / "ablations"
+    for candidate in (folder / path, folder / f"{path}.yaml"):
+        if candidate.is_file() and candidate.suffix in (".yaml", ".yml"):
+            return candidate.resolve()
+    shipped = [p.stem for p in sorted(folder.glob("*.yaml")) if _is_spec_file(p)] if folder.is_dir() else []
+    raise ConfigError(f"ablation spec not found: {source}"
+                      + (f"; shipped specs: {', '.join(shipped)}" if shipped else ""))
+
+
+def _is_spec_file(path: Path) -> bool:
+    with contextlib.suppress(OSError, yaml.YAMLError):
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        return isinstance(data, dict) and ("variants" in data or "grid" in data)
+    return False
+
+
+def _mapping(value: Any, where: str, what: str) -> dict:
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping):
+        raise ConfigError(f"{where}: expected {what}, got {type(value).__name__} {value!r}")
+    return dict(value)
+
+
+def _check_keys(data: Mapping, valid: tuple, where: str) -> None:
+    for key in data:
+        if key not in valid:
+            raise ConfigError(f"{where}: unknown key '{key}'{closest(key, valid)}; valid keys: {', '.join(valid)}")
+
+
+def _overrides(value: Any, where: str) -> dict:
+    out = _mapping(value, where, "a mapping of dotted keys to values, e.g. {label.mu: 0.3}")
+    for key in out:
+        if not isinstance(key, str) or not key.strip():
+            raise ConfigError(f"{where}: keys must be dotted config keys such as label.mu, got {key!r}")
+    return out
+
+
+def _load(spec_path: Path, config: Any, overrides: Mapping, where: str, key: str) -> tuple[dict, str]:
+    """Resolve ``config`` (relative to the spec file, else a shipped name) with ``overrides``.
+
+    ``where`` names the spec entry in errors, ``key`` the spec key holding ``config``."""
+    if not isinstance(config, str) or not config.strip():
+        raise ConfigError(f"{spec_path}: {key}: expected a config file or shipped name "
+                          f"(e.g. ../dr2track.yaml or dr2track), got {config!r}")
+    local = spec_path.parent / config
+    found = local if local.is_file() else shipped_config(config)  # never the working directory
+    if found is None:
+        raise ConfigError(f"{spec_path}: {where}: config '{config}' not found (looked for {local} and for "
+                          f"a shipped config of that name)")
+    source = str(found)
+    try:
+        return load_config(source, overrides), source
+    except DcfkitError as exc:
+        try:
+            load_config(source)
+        except DcfkitError:
+            raise ConfigError(f"{spec_path}: {where}: {exc}") from None
+        raise ConfigError(f"{spec_path}: {where} overrides ({', '.join(overrides)}): {exc}") from None
+
+
+def format_value(value: Any) -> str:
+    """A grid value as written in variant names and plot ticks."""
+    if isinstance(value, str):
+        return value
+    return yaml.safe_dump(value, default_flow_style=True, width=10**6).strip().removesuffix("...").strip()
+
+
+def _parse_grid(spec_path: Path, data: Any, named: dict[str, Variant]) -> tuple[Grid, list[Variant]]:
+    grid = _mapping(data, f"{spec_path}: grid", "a mapping with base, mode and parameters")
+    _check_keys(grid, GRID_KEYS, f"{spec_path}: grid")
+    mode = grid.get("mode", "sweep")
+    if mode not in GRID_MODES:
+        raise ConfigError(f"{spec_path}: grid.mode: expected one of {', '.join(GRID_MODES)}, got {mode!r}")
+    base = grid.get("base")
+    if base is None:
+        raise ConfigError(f"{spec_path}: grid.base: missing; name a variant or a config (e.g. dr2track)")
+    extra = _overrides(grid.get("overrides"), f"{spec_path}: grid.overrides")
+    if isinstance(base, str) and base in named:
+        base_source = named[base].source
+        base_overrides = {**named[base].overrides, **extra}
+    else:
+        base_source, base_overrides = base, extra
+    base_config, base_source = _load(spec_path, base_source, base_overrides, "grid.base", "grid.base")
+
+    params = _mapping(grid.get("parameters"), f"{spec_path}: grid.parameters",
+                      "a mapping of dotted keys to value lists, e.g. {label.mu: [0, 0.1, 0.25]}")
+    if not params:
+        raise ConfigError(f"{spec_path}: grid.parameters: empty; give at least one dotted key with a list of values")
+    parsed: dict[str, tuple[str, list]] = {}
+    for key, entry in params.items():
+        where = f"{spec_path}: grid.parameters.{key}"
+        label = key
+        if isinstance(entry, Mapping):
+            _check_keys(entry, ("values", "label"), where)
+            label = str(entry.get("label") or key)
+            entry = entry.get("values")
+        if not isinstance(entry, list) or not entry:
+            raise ConfigError(f"{where}: expected a non-empty list of values (or {{label: ..., values: [...]}}), "
+                              f"got {entry!r}")
+        names = [format_value(v) for v in entry]
+        dup = next((n for n in names if names.count(n) > 1), None)
+        if dup is not None:
+            raise ConfigError(f"{where}: value {dup} is listed twice")
+        parsed[str(key)] = (label, list(entry))
+    labels = [label for label, _ in parsed.values()]
+    dup = next((lab for lab in labels if labels.count(lab) > 1), None)
+    if dup is not None:
+        raise ConfigError(f"{spec_path}: grid.parameters: two parameters share the label {dup!r}")
+
+    if mode == "sweep":
+        points = [{key: value} for key, (_, values) in parsed.items() for value in values]
+    else:
+        keys = list(parsed)
+        points = [dict(zip(keys, combo)) for combo in itertools.product(*(parsed[k][1] for k in keys))]
+    variants = []
+    for point in points:
+        name = ", ".join(f"{parsed[k][0]}={format_value(v)}" for k, v in point.items())
+        where = "grid (" + ", ".join(f"{k}={format_value(v)}" for k, v in point.items()) + ")"
+        config, _ = _load(spec_path, base_source, {**base_overrides, **point}, where, "grid.base")
+        variants.append(Variant(name, config, base_source, {**base_overrides, **point}, dict(point)))
+    return Grid(str(base), mode, parsed, base_config), variants
+
+
+def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
+              sequences: Iterable[str] | str | None = None) -> AblationSpec:
+    """Read and validate an ablation spec (a path, or a shipped name such as ``table3``).
+
+    ``root`` replaces the spec's ``dataset.root`` (relative to the working directory);
+    the spec's own root is relative to the spec file. ``sequences`` (names, or one
+    comma-separated string) replaces the spec's subset. Every variant's config is resolved
+    here, so a wrong key or value fails before anything runs; errors name the spec file
+    and the key.
+    """
+    path = _find_spec(source)
+    data = read_yaml(path)
+    _check_keys(data, SPEC_KEYS, str(path))
+    dataset_name, root_path, origin = _parse_dataset(path, data.get("dataset"), root)
+    named = _parse_variants(path, data.get("variants"))
+    grid, grid_variants = None, []
+    if data.get("grid") is not None:
+        grid, grid_variants = _parse_grid(path, data["grid"], named)
+    for v in grid_variants:
+        if v.name in named:
+            raise ConfigError(f"{path}: grid point {v.name!r} has the same name as variants.{v.name}; "
+                              f"rename the variant")
+    if not named and not grid_variants:
+        raise ConfigError(f"{path}: no variants and no grid: nothing to run")
+    return AblationSpec(path=path, name=str(data.get("name") or path.stem),
+                        description=str(data.get("description") or ""), dataset=dataset_name,
+                        root=root_path, root_origin=origin, sequences=_parse_sequences(path, data, sequences),
+                        variants=tuple(named.values()) + tuple(grid_variants), grid=grid)
+
+
+def _parse_dataset(path: Path, dataset: Any, root) -> tuple[str, Path | None, str]:
+    """(canonical dataset name, absolute root or None, where the root came from)."""
+    if isinstance(dataset, str):
+        dataset = {"name": dataset}
+    dataset = _mapping(dataset, f"{path}: dataset", "a mapping {name: uav123_10fps, root: path}")
+    _check_keys(dataset, ("name", "root"), f"{path}: dataset")
+    if not dataset.get("name"):
+        raise ConfigError(f"{path}: dataset.name: missing (e.g. uav123_10fps, dtb70, uavdt, otb)")
+    try:
+        name = canonical_name(str(dataset["name"]))
+    except DatasetError as exc:
+        raise ConfigError(f"{path}: dataset.name: {exc}") from None
+    if root is not None:
+        return name, Path(root).expanduser().resolve(), "--root"
+    if dataset.get("root"):
+        return (name, (path.parent / Path(str(dataset["root"])).expanduser()).resolve(),
+                f"dataset.root {dataset['root']!r} relative to the spec")
+    return name, None, "not given"
+
+
+def _parse_sequences(path: Path, data: Mapping, sequences) -> tuple | None:
+    """The spec's sequence subset, or ``sequences`` (from --sequences) instead."""
+    where = f"{path}: sequences"
+    if sequences is None:
+        sequences = data.get("sequences")
+    else:
+        where = "--sequences (replacing the spec's sequences)"
+    if isinstance(sequences, str):
+        sequences = [s.strip() for s in sequences.split(",") if s.strip()]
+    if sequences is None:
+        return None
+    if not isinstance(sequences, (list, tuple)) or not sequences or \
+            not all(isinstance(s, str) and s for s in sequences):
+        raise ConfigError(f"{where}: expected a non-empty list of sequence names, got {sequences!r}")
+    return tuple(dict.fromkeys(sequences))
+
+
+def _parse_variants(path: Path, raw: Any) -> dict[str, Variant]:
+    """The named variants, each config resolved with its overrides."""
+    raw_variants = _mapping(raw, f"{path}: variants", "a mapping of variant names to {config: ..., overrides: {...}}")
+    named: dict[str, Variant] = {}
+    for name, entry in raw_variants.items():
+        where = f"variants.{name}"
+        if str(name) in named:  # YAML keys 1 and "1" (or true and "True") are one name here
+            raise ConfigError(f"{path}: {where}: variant names must be unique, and {name!r} is given twice")
+        if isinstance(entry, str):
+            entry = {"config": entry}
+        entry = _mapping(entry, f"{path}: {where}", "{config: path-or-name, overrides: {dotted.key: value}}")
+        _check_keys(entry, VARIANT_KEYS, f"{path}: {where}")
+        if "config" not in entry:
+            raise ConfigError(f"{path}: {where}.config: missing (a config file relative to the spec, "
+                              f"or a shipped name such as dr2track)")
+        overrides = _overrides(entry.get("overrides"), f"{path}: {where}.overrides")
+        config, src = _load(path, entry["config"], overrides, where, f"{where}.config")
+        named[str(name)] = Variant(str(name), config, src, overrides)
+    return named
+
+
+def expand(spec: AblationSpec, sequences: Iterable | None = None, version: str | None = None) -> list[Job]:
+    """The job list: every variant (spec order) on every sequence (dataset or given order).
+
+    ``sequences`` are names or :class:`dcfkit.datasets.Sequence` objects; default: the
+    spec's subset, else every sequence under the spec's root.
+    """
+    if sequences is None:
+        sequences = spec.sequences if spec.sequences is not None else spec.load_sequences()
+    names = [s if isinstance(s, str) else s.name for s in sequences]
+    version = version if version is not None else dcfkit_version()
+    keys = {v.name: run_key(v.config, version) for v in spec.variants}
+    return [Job(v.name, v.config, seq, keys[v.name]) for v in spec.variants for seq in names]
+
+
+
+
+def job_dir(out: Path, dataset: str, key: str) -> Path:
+    """The result store of run ``key``: ``OUT/jobs/<dataset>/<key>/``."""
+    return out / "jobs" / dataset / key

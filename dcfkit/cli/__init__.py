@@ -1,0 +1,40 @@
+"""The ``dcfkit`` command line: argument parsing and printing only; the work is the
+library's (:mod:`dcfkit.evaluation`, :mod:`dcfkit.ablation`, :mod:`dcfkit.report`, ...)."""
+from __future__ import annotations
+
+import sys
+import warnings
+
+from ..errors import DcfkitError
+from ..registry import PluginWarning
+from .parser import build_parser
+
+__all__ = ["build_parser", "main"]
+
+
+def _one_line_plugin_warnings(show):
+    """``warnings.showwarning`` for the CLI: a plugin problem is one ``warning: ...`` line,
+    not a source location inside dcfkit's registry."""
+    def showwarning(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, PluginWarning):
+            print(f"warning: {message}", file=sys.stderr)
+        else:
+            show(message, category, filename, lineno, file, line)
+    return showwarning
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    with warnings.catch_warnings():
+        warnings.showwarning = _one_line_plugin_warnings(warnings.showwarning)
+        try:
+            return args.func(args) or 0
+        except DcfkitError as exc:
+            print(f"dcfkit {args.command}: error: {exc}", file=sys.stderr)
+            return 2
+        except KeyboardInterrupt as exc:
+            print(f"dcfkit {args.command}: interrupted{f' ({exc})' if str(exc) else ''}", file=sys.stderr)
+            return 128 + getattr(exc, "signum", 2)
+        except BrokenPipeError:  # e.g. piped into head
+            sys.stderr.close()
+            return 0

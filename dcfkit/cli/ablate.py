@@ -1,0 +1,65 @@
+"""``dcfkit ablate``: run an ablation spec and print its summary table."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..ablation import expand, job_dir, load_spec, run_ablation, summary_columns, variant_names
+from ..errors import DcfkitError
+from ..report import format_table
+from ..results import ResultStore
+from .common import add_protocol_argument
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("spec", metavar="SPEC",
+                        help="ablation spec YAML, or a shipped name (table3, sensitivity)")
+    parser.add_argument("--out", required=True, type=Path,
+                        help="results folder (OUT/jobs/..., OUT/summary.md, ...); reruns resume")
+    parser.add_argument("--jobs", type=int, default=None,
+                        help="worker processes (default: the usable cores); with dask and no "
+                             "--scheduler, the LocalCluster's workers")
+    parser.add_argument("--executor", choices=("local", "dask"), default=None,
+                        help="local process pool (default) or dask.distributed (default with --scheduler)")
+    parser.add_argument("--scheduler", default=None, metavar="ADDR",
+                        help="dask scheduler address, e.g. tcp://10.0.0.5:8786 (default: a LocalCluster)")
+    parser.add_argument("--root", type=Path, default=None,
+                        help="benchmark root folder (default: the spec's dataset.root, relative to the spec)")
+    parser.add_argument("--sequences", default=None,
+                        help="comma-separated sequence names (default: the spec's, else all)")
+    add_protocol_argument(parser)
+    parser.add_argument("--dry-run", action="store_true",
+                        help="list the jobs and whether each is done; run nothing")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def _dry_run(spec, out: Path) -> int:
+    seqs = spec.load_sequences()
+    by_name = {s.name: s for s in seqs}
+    jobs = expand(spec, seqs)
+    for job in jobs:
+        status = ResultStore(job_dir(out, spec.dataset, job.key)).status(by_name[job.sequence], job.key)
+        print(f"{'done' if status == 'done' else 'todo'}  {job.key}  {job.variant}  {job.sequence}")
+    print(f"{len(jobs)} jobs, {len({(j.key, j.sequence) for j in jobs})} distinct runs")
+    return 0
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run a spec, print the summary table; exit status 1 if a job failed."""
+    executor = args.executor or ("dask" if args.scheduler else "local")
+    if args.scheduler and executor != "dask":
+        raise DcfkitError("--scheduler needs --executor dask")
+    spec = load_spec(args.spec, root=args.root, sequences=args.sequences)
+    if args.dry_run:
+        return _dry_run(spec, args.out.expanduser().resolve())
+    res = run_ablation(spec, args.out, jobs=args.jobs, executor=executor, scheduler=args.scheduler,
+                       progress=not args.no_progress, protocol=args.protocol)
+    summary = res["summary"]
+    print(format_table(summary["overall"], "markdown", summary_columns("summary", args.protocol), args.protocol),
+          end="")
+    print(f"\n{spec.name}: {len(res['jobs'])} jobs ({res['runs']} distinct runs): {len(res['done'])} run, "
+          f"{len(res['skipped'])} already done, {len(res['failed'])} failed -> {Path(args.out)}")
+    variants = variant_names(res["jobs"])
+    for (key, seq), message in res["failed"].items():
+        print(f"  FAILED {', '.join(variants.get(key, []))} [{key}] {message}")
+    return 1 if res["failed"] else 0

@@ -1,0 +1,97 @@
+"""``dcfkit components``: every registered component, its parameters and defaults, as a
+table, Markdown (also used for docs/configs.md) or JSON."""
+from __future__ import annotations
+
+import argparse
+import inspect
+import json
+import sys
+import warnings
+from typing import Any, Iterable
+
+import yaml
+
+from ..params import fields
+from ..registry import KINDS, PluginWarning, get_registry
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--kind", choices=KINDS)
+    parser.add_argument("--format", choices=("table", "markdown", "json"), default="table")
+
+
+def run(args: argparse.Namespace) -> int:
+    """List the components; exit status 1 if a plugin could not be loaded."""
+    with warnings.catch_warnings():  # the skipped plugins are listed below, each once
+        warnings.simplefilter("ignore", PluginWarning)
+        registry = get_registry()
+    rows = component_rows(registry, [args.kind] if args.kind else None)
+    if args.format == "json":
+        print(json.dumps(rows, indent=2, default=str))
+    elif args.format == "markdown":
+        print(components_markdown(rows), end="")
+    else:
+        for row in rows:
+            print(f"{row['kind']:<12} {row['name']:<22} {row['doc']}  [{row['provider']}]")
+            for f in row["params"]:
+                print(f"{'':<14}{f['name']} ({f['type']}, default {f['default']}): {f['help']}")
+    for failure in registry.failures:
+        print(f"warning: {failure}", file=sys.stderr)
+    return 1 if registry.failures else 0
+
+
+def summary(cls: type) -> str:
+    """First paragraph of a class docstring, on one line ('' without a docstring)."""
+    doc = inspect.cleandoc(cls.__doc__ or "")
+    return " ".join(doc.split("\n\n")[0].split())
+
+
+def component_rows(registry, kinds: Iterable[str] | None = None) -> list[dict]:
+    """One dict per registered component: kind, name, provider, doc, params (and role)."""
+    rows = []
+    for kind in kinds or KINDS:
+        for name in registry.names(kind):
+            entry = registry.entry(kind, name)
+            row = {"kind": kind, "name": name, "provider": entry.provider, "doc": summary(entry.cls),
+                   "params": fields(entry.cls.Params)}
+            if kind == "regularizer":
+                row["role"] = getattr(entry.cls, "role", None)
+            rows.append(row)
+    return rows
+
+
+def yaml_value(value: Any) -> str:
+    """A default as it would be written in YAML: ``true``, ``null``, ``[1, 2]``, ``''``."""
+    if isinstance(value, tuple):
+        value = list(value)
+    text = yaml.safe_dump(value, default_flow_style=True, allow_unicode=True, width=1000).strip()
+    return text.removesuffix("\n...").removesuffix("...").strip()
+
+
+def cell(text: Any) -> str:
+    """``text`` for a Markdown table cell."""
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def params_table(params: list[dict]) -> str:
+    """Markdown table of :func:`dcfkit.params.fields` output."""
+    if not params:
+        return "No parameters.\n"
+    lines = ["| parameter | type | default | description |", "|---|---|---|---|"]
+    for f in params:
+        help_ = f["help"] + (f" (one of: {', '.join(f'`{c}`' for c in f['choices'])})" if f["choices"] else "")
+        lines.append(f"| `{f['name']}` | {cell(f['type'])} | `{cell(yaml_value(f['default']))}` "
+                     f"| {cell(help_)} |")
+    return "\n".join(lines) + "\n"
+
+
+def components_markdown(rows: list[dict], level: int = 3) -> str:
+    """Each component as a heading, its docstring summary, provider, role and parameter table."""
+    out = []
+    for row in rows:
+        role = f" Role: `{row['role']}`." if row.get("role") else ""
+        out.append(f"{'#' * level} {row['kind']} `{row['name']}`\n\n{row['doc']} (from {row['provider']}){role}\n\n"
+                   f"{params_table(row['params'])}")
+    return "\n".join(out)
+
+

@@ -1,0 +1,138 @@
+"""``dcfkit eval`` (one-pass evaluation), ``report`` (tables and plots) and ``compare``
+(two result folders side by side)."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+from ..baselines import opencv_tracker
+from ..compare import COLUMNS, compare_folders
+from ..config import load_config, parse_overrides
+from ..datasets import load_dataset
+from ..errors import ConfigError
+from ..evaluation import run_one_pass, tracker_name
+from ..report import columns, evaluate, format_table, json_ready, score_and_write, score_line
+from ..results import load_results
+from .common import add_dataset_arguments, add_protocol_argument, pixels
+
+
+def add_eval_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("configs", nargs="+", metavar="CONFIG",
+                        help="tracker config YAML file(s) or shipped config names (strcf, bacf, dr2track); "
+                             "'opencv:CSRT', 'opencv:KCF' or 'opencv:MOSSE' runs an OpenCV baseline")
+    add_dataset_arguments(parser)
+    parser.add_argument("--out", required=True, type=Path, help="results folder (OUT/<tracker>/)")
+    parser.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                        help="override a config value (repeatable), e.g. --set solver.iterations=3")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_protocol_argument(parser)
+
+
+def _resolve_config(spec: str, overrides: Mapping[str, Any]) -> tuple[dict, Callable | None]:
+    """(config, make_tracker) for a CONFIG argument of ``dcfkit eval``."""
+    if spec.lower().startswith("opencv:"):
+        factory = opencv_tracker(spec.split(":", 1)[1])
+        return {"name": f"opencv-{factory.name.lower()}", "opencv": factory.name, **overrides}, factory
+    return dict(load_config(spec, overrides)), None
+
+
+def distinct_names(specs: list[str], resolved: list[tuple[dict, Callable | None]]
+                   ) -> list[tuple[dict, Callable | None]]:
+    """All configs checked before any runs: a config given twice runs once; two different
+    configs with the same name (one output folder) are a :class:`ConfigError`."""
+    seen: dict[str, tuple[str, dict]] = {}
+    out = []
+    for spec, (config, factory) in zip(specs, resolved):
+        name = tracker_name(config)
+        if name not in seen:
+            seen[name] = (spec, config)
+            out.append((config, factory))
+        elif seen[name][1] != config:
+            raise ConfigError(
+                f"configs {seen[name][0]!r} and {spec!r} are both named {name!r} and would write to the "
+                f"same results folder; give one of them another 'name:' (--set name=... renames every CONFIG)")
+    return out
+
+
+def run_eval(args: argparse.Namespace) -> int:
+    """Run each config on the dataset and print its scores; exit status 1 if a sequence failed."""
+    sequences = load_dataset(args.dataset, args.root, args.sequences)
+    overrides = parse_overrides(args.overrides)
+    resolved = distinct_names(args.configs, [_resolve_config(spec, overrides) for spec in args.configs])
+    status = 0
+    for config, factory in resolved:
+        summary = run_one_pass(config, sequences, args.out, make_tracker=factory,
+                               jobs=args.jobs, progress=not args.no_progress)
+        print(f"{summary['tracker']}: {len(summary['done'])} run, {len(summary['skipped'])} "
+              f"already done, {len(summary['failed'])} failed -> {summary['dir']}")
+        scores = evaluate({summary["tracker"]: load_results(args.out, summary["tracker"], sequences)},
+                          sequences, protocol=args.protocol)
+        print(f"  {score_line(scores['overall'][0], args.protocol)}")
+        for message in summary["failed"].values():
+            print(f"  FAILED {message}")
+        status = status or (1 if summary["failed"] else 0)
+    return status
+
+
+def add_report_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("out", type=Path, metavar="OUT", help="results folder of `dcfkit eval`")
+    add_dataset_arguments(parser)
+    parser.add_argument("--trackers", default=None,
+                        help="comma-separated tracker folders (names in OUT or paths; default: all)")
+    parser.add_argument("--format", choices=("table", "markdown", "csv"), default="table",
+                        help="format of the table printed to stdout")
+    parser.add_argument("--report-dir", type=Path, default=None, help="default: OUT/report")
+    add_protocol_argument(parser)
+    parser.add_argument("--skip-first", action="store_true",
+                        help="do not score frame 1 (default: as the protocol; otb scores it with the ground "
+                             "truth as the prediction, pysot as the file has it, got10k never)")
+    parser.add_argument("--frame-weighted", action="store_true",
+                        help="pool the frames of all sequences (default: as the protocol; otb and pysot "
+                             "weigh sequences equally, got10k pools frames)")
+
+
+def run_report(args: argparse.Namespace) -> int:
+    """Print the overall table and write the report files."""
+    sequences = load_dataset(args.dataset, args.root, args.sequences)
+    trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
+    evaluation, paths = score_and_write(args.out, sequences, trackers, args.report_dir,
+                                        include_first=not args.skip_first,
+                                        weighting="frame" if args.frame_weighted else None, protocol=args.protocol)
+    print(format_table(evaluation["overall"], args.format, columns("overall", args.protocol), args.protocol),
+          end="")
+    if args.format == "table":
+        print(f"\n{len(paths)} files written to {paths[0].parent}")
+    return 0
+
+
+def add_compare_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("results", type=Path, metavar="RESULTS",
+                   help="folder of <sequence>.txt result files (1-based x,y,w,h), e.g. OUT/<tracker>")
+    p.add_argument("reference", type=Path, metavar="REFERENCE", help="folder of result files to compare with")
+    add_dataset_arguments(p, "benchmark root folder (the ground truth)")
+    add_protocol_argument(p)
+    p.add_argument("--divergence-px", type=pixels, default=2.0,
+                   help="centres further apart than this (pixels) count as diverged")
+    p.add_argument("--format", choices=("table", "markdown", "csv", "json"), default="table",
+                   help="output format; json holds everything, with csv the closing notes (folders, "
+                        "divergences, left-out sequences) go to stderr")
+
+
+def run_compare(args: argparse.Namespace) -> int:
+    """Print the per-sequence comparison."""
+    sequences = load_dataset(args.dataset, args.root, args.sequences)
+    res = compare_folders(args.results, args.reference, sequences, args.protocol, args.divergence_px)
+    if args.format == "json":
+        print(json.dumps(json_ready(res), indent=1))
+        return 0
+    print(format_table(res["rows"] + [res["mean"]], args.format, COLUMNS, args.protocol), end="")
+    left = "; ".join(f"{k.replace('_', ' ')}: {', '.join(v)}" for k, v in res["left_out"].items() if v)
+    print(f"\nresults: {res['results']}\nreference: {res['reference']}\n"
+          f"{res['diverged']} of {len(res['rows'])} sequences diverge (centres more than "
+          f"{args.divergence_px:g} px apart); d_ = results minus reference\n"
+          f"left out: {left or 'none'}", file=sys.stderr if args.format == "csv" else sys.stdout)
+    return 0

@@ -1,0 +1,38 @@
+"""The ``dcfkit`` argument parser: one subcommand per command module."""
+from __future__ import annotations
+
+import argparse
+
+from .. import __version__
+from . import ablate, components, evaluate, track
+
+DESCRIPTION = """dcfkit: discriminative correlation filter trackers assembled from YAML.
+
+Commands: track (one video), demo (a generated sequence, no data needed), components,
+eval (one-pass evaluation on a benchmark), report, compare (two result folders side by
+side), ablate."""
+
+#: name -> (help, add_arguments, run)
+COMMANDS = {
+    "track": ("track one target through a video or a folder of frames", track.add_track_arguments, track.run_track),
+    "demo": ("run STRCF and DR²Track on a generated sequence (no data needed)", track.add_demo_arguments,
+             track.run_demo),
+    "components": ("list registered components and their parameters", components.add_arguments, components.run),
+    "eval": ("one-pass evaluation of configs on a benchmark", evaluate.add_eval_arguments, evaluate.run_eval),
+    "report": ("tables and precision/success plots of evaluation results", evaluate.add_report_arguments,
+               evaluate.run_report),
+    "compare": ("two folders of result files side by side per sequence: scores, their differences, box "
+                "agreement (parity checks)", evaluate.add_compare_arguments, evaluate.run_compare),
+    "ablate": ("run an ablation spec: variants x parameter grids x sequences", ablate.add_arguments, ablate.run),
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="dcfkit", description=DESCRIPTION)
+    parser.add_argument("--version", action="version", version=f"dcfkit {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    for name, (help_, add_arguments, run) in COMMANDS.items():
+        p = sub.add_parser(name, help=help_)
+        add_arguments(p)
+        p.set_defaults(func=run)
+    return parser

@@ -1,0 +1,95 @@
+"""``dcfkit track`` (one target through a video or a folder of frames) and ``dcfkit demo``
+(a generated sequence, no data needed)."""
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..config import parse_overrides
+from ..metrics import score_sequence
+from ..synthetic import make_sequence
+from ..tracker import load_tracker
+from ..tracking import Track, empty_track, interrupt_on_termination, track
+from ..video import VideoWriter, check_writable, iter_frames
+from .common import frame_count, parse_box
+
+
+def add_track_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("config", help="config file or shipped name (strcf, bacf, dr2track)")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--video", help="video file")
+    src.add_argument("--frames", help="folder of image files, tracked in natural name order (frame2 before frame10)")
+    p.add_argument("--box", required=True, help="initial box x,y,w,h (0-based pixels unless --one-based); "
+                   "write --box=-5,10,40,30 when x is negative")
+    p.add_argument("--one-based", action="store_true", help="--box and --out use 1-based (OTB toolkit) pixels")
+    p.add_argument("--out", help="write one x,y,w,h line per frame here (default: stdout)")
+    p.add_argument("--save-video", help="write an annotated video (.mp4, .avi, .mkv, .mov or .m4v)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a config key, e.g. label.mu=0.3")
+
+
+def run_track(args: argparse.Namespace) -> int:
+    """Track and write the boxes; whatever ends the run (an error, Ctrl-C, SIGTERM, SIGHUP),
+    the boxes of the frames done are written."""
+    tracker = load_tracker(args.config, overrides=parse_overrides(args.set))
+    out = check_writable(args.out, "--out") if args.out else None
+    offset = 1.0 if args.one_based else 0.0
+    x, y, w, h = parse_box(args.box)
+    writer = VideoWriter(args.save_video) if args.save_video else None
+
+    def annotate(index, image, box, _tracker):
+        writer.write(image, {tracker.name: box}, f"frame {index + 1}")
+
+    done = empty_track()
+    try:
+        with interrupt_on_termination():
+            track(tracker, iter_frames(args.video, args.frames), (x - offset, y - offset, w, h),
+                  annotate if writer else None, partial=done)
+    finally:  # an error on frame k keeps the boxes of frames 1..k-1
+        if writer:
+            writer.close()
+        _write_boxes(done, out, offset, tracker.name)
+    return 0
+
+
+def _write_boxes(done: Track, out, offset: float, name: str) -> None:
+    if not len(done.boxes):
+        return
+    lines = "".join("%.3f,%.3f,%.3f,%.3f\n" % tuple(b) for b in done.boxes + [offset, offset, 0, 0])
+    if out:
+        out.write_text(lines)
+    else:
+        print(lines, end="")
+    seconds = float(done.times.sum())
+    print(f"{name}: {len(done.boxes)} frames, {len(done.boxes) / max(seconds, 1e-9):.1f} fps", file=sys.stderr)
+
+
+def add_demo_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--trackers", default="strcf,dr2track", help="comma-separated configs")
+    p.add_argument("--frames", type=frame_count, default=120, help="sequence length (at least 2)")
+    p.add_argument("--seed", type=int, default=0, help="random seed of the generated sequence")
+    p.add_argument("--save-video", default="dcfkit_demo.mp4", help="annotated video ('' to skip)")
+
+
+def run_demo(args: argparse.Namespace) -> int:
+    """Each tracker on one generated sequence: scores, fps and an annotated video."""
+    writer = VideoWriter(args.save_video) if args.save_video else None  # fail before tracking
+    seq = make_sequence(n_frames=args.frames, seed=args.seed)
+    results = {}
+    for name in args.trackers.split(","):
+        tracker = load_tracker(name)
+        distractors = []
+        run = track(tracker, seq.frames, seq.ground_truth[0],
+                    lambda i, image, box, t: distractors.append(t.last_distractors))
+        fps = (len(seq.frames) - 1) / max(float(run.times[1:].sum()), 1e-9)
+        results[tracker.name] = (run.boxes, score_sequence(run.boxes, seq.ground_truth), fps, distractors)
+    print(f"synthetic sequence: {len(seq.frames)} frames, a look-alike distractor passes the target")
+    print(f"{'tracker':<12} {'precision@20':>12} {'AUC':>6} {'fps':>7}")
+    for name, (_, scores, fps, _) in results.items():
+        print(f"{name:<12} {scores['precision']:>12.3f} {scores['auc']:>6.3f} {fps:>7.1f}")
+    if writer:
+        for i, image in enumerate(seq.frames):
+            boxes = {"ground truth": seq.ground_truth[i], **{name: r[0][i] for name, r in results.items()}}
+            writer.write(image, boxes, f"frame {i + 1}", points={name: r[3][i] for name, r in results.items()})
+        writer.close()
+        print(f"annotated video: {args.save_video} (circles: the distractors each tracker repressed)")
+    return 0

@@ -1,0 +1,335 @@
+"""The results store: one folder of per-sequence result files that cannot be silently damaged.
+
+``FOLDER/<sequence>.txt``
+    one ``x,y,w,h`` line per frame, ``%.3f``, **1-based** (1 is added to x and y), so the
+    MATLAB OTB/UAV123 toolkit and pysot read it unchanged. Frame 1 holds the initial
+    ground-truth box; a lost target is ``nan,nan,nan,nan``.
+``FOLDER/<sequence>.json``
+    sidecar: the run key (:func:`run_key`), the SHA-256 of the ``.txt`` as written, per-frame
+    tracker seconds, fps, the config, the dcfkit and plugin versions. Written last: it marks
+    the sequence as done.
+``FOLDER/<sequence>.error.json``
+    instead, when the tracker raised: frame (1-based), error, traceback.
+
+Every file is written to a temporary file in the same folder and moved into place with
+``os.replace``. A result counts only when its sidecar has the expected key and the ``.txt``
+still has the recorded checksum: a file cut short, edited or left by another config is
+recomputed by ``eval``/``ablate`` and never scored by ``report`` or the ablation summary.
+"""
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import functools
+import hashlib
+import json
+import logging
+import os
+import tempfile
+import traceback
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Iterable, Mapping
+
+import numpy as np
+
+from .datasets import DatasetError, Sequence, read_boxes
+from .errors import DcfkitError
+
+log = logging.getLogger(__name__)
+
+LABEL_KEYS = ("name", "description")  # config keys that never change a box
+
+
+# --------------------------------------------------------------------------- identity
+
+
+def dcfkit_version() -> str:
+    """``dcfkit.__version__`` (part of every run key)."""
+    from . import __version__  # the package imports nothing at import time: no cycle
+
+    return __version__
+
+
+def json_default(obj):
+    """``json.dumps`` fallback for numpy values, dataclasses and sets."""
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return dataclasses.asdict(obj)
+    if isinstance(obj, (set, frozenset)):
+        return sorted(obj)
+    return str(obj)
+
+
+def plugin_versions(config: Mapping) -> list[str]:
+    """``"package version"`` of each installed plugin whose components ``config`` uses."""
+    from .config import components
+    from .registry import get_registry
+
+    used = components(config)
+    return get_registry().plugin_versions(used) if used else []  # e.g. an OpenCV baseline: no registry
+
+
+def run_key(config: Mapping, version: str | None = None) -> str:
+    """The identity of a run: 16 hex digits of SHA-256 over the canonical JSON (sorted keys)
+    of ``config`` without its ``name`` and ``description`` (they change no box), the dcfkit
+    version and the versions of the plugins whose components the config uses (a plugin's
+    new release gives new results; configs of built-ins only keep their keys)."""
+    payload = {"config": {k: v for k, v in config.items() if k not in LABEL_KEYS},
+               "dcfkit": version if version is not None else dcfkit_version()}
+    plugins = plugin_versions(config)
+    if plugins:
+        payload["plugins"] = plugins
+    text = json.dumps(payload, sort_keys=True, separators=(",", ":"), default=json_default)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def now() -> str:
+    return datetime.now(timezone.utc).isoformat(timespec="seconds")
+
+
+# --------------------------------------------------------------------------- files
+
+
+@functools.lru_cache(maxsize=1)
+def _file_mode() -> int:
+    """The mode open() would give a new file (mkstemp's are owner-only)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+def atomic_write(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` via a temporary file in the same folder + ``os.replace``;
+    a :class:`DcfkitError` naming the file if it cannot be written."""
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError as exc:
+        raise DcfkitError(f"cannot write {path}: {exc.strerror}") from None
+    try:
+        os.fchmod(fd, _file_mode())
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException as exc:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise DcfkitError(f"cannot write {path}: {exc.strerror or exc}") from None
+        raise
+
+
+def make_dir(folder: Path) -> Path:
+    """``mkdir -p``, with a :class:`DcfkitError` naming the folder (e.g. a file is in the way)."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise DcfkitError(f"cannot create the folder {folder}: {exc.strerror}") from None
+    return folder
+
+
+def check_writable(folder: Path, names: Iterable[str] = (), what: str = "results") -> None:
+    """Raise a :class:`DcfkitError` now, before any tracking, if ``folder`` cannot take
+    ``what`` (created if needed; a probe file is written and removed) or if a file to be
+    written there, ``folder/<name>``, is a folder."""
+    make_dir(folder)
+    try:
+        fd, probe = tempfile.mkstemp(dir=folder, prefix=".write-probe.")
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise DcfkitError(f"cannot write {what} to {folder}: {exc.strerror}") from None
+    blocked = [name for name in names if (folder / name).is_dir()]
+    if blocked:
+        raise DcfkitError(f"cannot write {what} to {folder}: {', '.join(blocked)} "
+                          f"{'is a folder' if len(blocked) == 1 else 'are folders'}; move it away")
+
+
+@contextlib.contextmanager
+def exclusive(lock: Path, command: str, what: str):
+    """Hold the file lock ``lock`` so two runs never write the same results (released on any
+    exit). Where no lock can be taken (not POSIX, a file system without flock) the run goes
+    on unlocked, with a warning."""
+    try:
+        import fcntl
+
+        handle = open(lock, "a+")
+    except (ImportError, OSError) as exc:
+        if not isinstance(exc, ImportError):
+            log.warning("cannot create the lock %s (%s): running without it", lock, exc.strerror)
+        yield
+        return
+    with handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise DcfkitError(f"another `{command}` is writing {what} (it holds {lock}); "
+                              f"wait for it or use another --out") from None
+        except OSError as exc:
+            log.warning("cannot lock %s (%s): running without the lock", lock, exc.strerror)
+        yield
+
+
+def read_json(path: Path) -> dict | None:
+    """The JSON object in ``path``, or None if it is missing, unreadable or not an object."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
+
+
+def format_boxes(boxes: np.ndarray) -> str:
+    """0-based ``(N, 4)`` boxes as the 1-based ``%.3f`` lines of a result file."""
+    one_based = np.asarray(boxes, dtype=np.float64) + np.array([1.0, 1.0, 0.0, 0.0])
+    return "".join("%.3f,%.3f,%.3f,%.3f\n" % tuple(b) for b in one_based)
+
+
+def checksum(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+# --------------------------------------------------------------------------- the store
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class SequenceResult:
+    """A tracker's result on one sequence: ``boxes`` ``(N, 4) float64`` 0-based;
+    ``times`` ``(N,) float64`` seconds per frame and ``fps`` when known (None for imports)."""
+
+    boxes: np.ndarray
+    times: np.ndarray | None = None
+    fps: float | None = None
+    config_hash: str | None = None
+
+
+class ResultStore:
+    """The result files of one tracker configuration: ``folder/<sequence>.{txt,json,error.json}``."""
+
+    def __init__(self, folder):
+        self.folder = Path(folder)
+
+    def boxes_path(self, name: str) -> Path:
+        return self.folder / f"{name}.txt"
+
+    def sidecar_path(self, name: str) -> Path:
+        return self.folder / f"{name}.json"
+
+    def error_path(self, name: str) -> Path:
+        return self.folder / f"{name}.error.json"
+
+    def file_names(self, name: str) -> list[str]:
+        return [p.name for p in (self.boxes_path(name), self.sidecar_path(name), self.error_path(name))]
+
+    def sidecar(self, name: str) -> dict | None:
+        return read_json(self.sidecar_path(name))
+
+    def status(self, seq: Sequence, key: str, meta: dict | None = None) -> str:
+        """``done`` (complete, intact, from run ``key`` started at ``seq``'s current first
+        box), ``damaged`` (its sidecar is ``key``'s but the boxes file is not what was
+        written), ``failed`` (``key`` raised) or ``missing``. ``meta``: the sidecar, if read."""
+        meta = self.sidecar(seq.name) if meta is None else meta
+        if meta is not None and meta.get("config_hash") == key:
+            if meta.get("init_box") != [float(v) for v in seq.init_box]:
+                return "missing"  # a corrected annotation: run again
+            return "done" if self._intact(seq.name, meta, len(seq)) else "damaged"
+        error = read_json(self.error_path(seq.name))
+        return "failed" if error is not None and error.get("config_hash") == key else "missing"
+
+    def is_done(self, seq: Sequence, key: str) -> bool:
+        return self.status(seq, key) == "done"
+
+    def _intact(self, name: str, meta: dict, frames: int) -> bool:
+        try:
+            data = self.boxes_path(name).read_bytes()
+        except OSError:
+            return False
+        return meta.get("sha256") == checksum(data) and meta.get("frames") == frames
+
+    def write(self, seq: Sequence, boxes: np.ndarray, meta: dict) -> None:
+        """Store a finished run: boxes, then the sidecar (``meta`` plus the boxes' checksum)."""
+        text = format_boxes(boxes)
+        with contextlib.suppress(FileNotFoundError):
+            self.sidecar_path(seq.name).unlink()  # an older sidecar must never describe new boxes
+        atomic_write(self.boxes_path(seq.name), text)
+        meta = {**meta, "frames": len(boxes), "sha256": checksum(text.encode())}
+        atomic_write(self.sidecar_path(seq.name), json.dumps(meta, indent=1, default=json_default) + "\n")
+        with contextlib.suppress(FileNotFoundError):
+            self.error_path(seq.name).unlink()
+
+    def write_failure(self, seq: Sequence, record: dict, exc: BaseException) -> None:
+        """Store a failed run (removing any results, which another config may have left).
+        A failure that cannot be written is logged: the caller still reports it."""
+        record = {**record, "sequence": seq.name, "dataset": seq.dataset, "type": type(exc).__name__,
+                  "traceback": "".join(traceback.format_exception(exc)), "time": now()}
+        for stale in (self.sidecar_path(seq.name), self.boxes_path(seq.name)):
+            with contextlib.suppress(FileNotFoundError):
+                stale.unlink()
+        try:
+            make_dir(self.folder)
+            atomic_write(self.error_path(seq.name), json.dumps(record, indent=1, default=json_default) + "\n")
+        except DcfkitError as write_error:
+            log.warning("%s", write_error)
+
+    def load(self, sequences: Iterable[Sequence | str]) -> dict[str, SequenceResult]:
+        """Intact results for ``sequences`` (names or :class:`Sequence`); others (not run,
+        failed, damaged: each damaged file is logged) are left out. A :class:`DatasetError`
+        if the intact results come from different configs."""
+        results, hashes = {}, {}
+        for seq in sequences:
+            name = seq if isinstance(seq, str) else seq.name
+            meta = self.sidecar(name)
+            if meta is None or not self.boxes_path(name).is_file():
+                continue
+            if not self._intact(name, meta, meta.get("frames") if isinstance(seq, str) else len(seq)):
+                log.warning("%s is not the file its run wrote (cut short or edited): left out; run again "
+                            "to recompute %r", self.boxes_path(name), name)
+                continue
+            results[name] = self._result(name, meta)
+            hashes.setdefault(meta.get("config_hash"), []).append(name)
+        if len(hashes) > 1:
+            detail = "; ".join(f"{h}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}" for h, v in hashes.items())
+            raise DatasetError(
+                f"results in {self.folder} mix {len(hashes)} configurations ({detail}); rerun "
+                f"`dcfkit eval` with one config, or give the other config a different 'name'")
+        return results
+
+    def _result(self, name: str, meta: dict) -> SequenceResult:
+        try:
+            times = np.asarray(meta.get("times", []), dtype=np.float64).reshape(-1)
+            fps = float(meta["fps"]) if meta.get("fps") is not None else None
+            if not isinstance(meta.get("config_hash"), (str, type(None))):
+                raise TypeError(f"config_hash is {meta['config_hash']!r}")
+        except (TypeError, ValueError) as exc:
+            raise DatasetError(f"{self.sidecar_path(name)}: malformed results sidecar ({exc}); delete it and "
+                               f"run again to recompute {name!r}") from None
+        return SequenceResult(read_boxes(self.boxes_path(name)), times if times.size else None, fps,
+                              meta.get("config_hash"))
+
+
+def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]) -> dict[str, SequenceResult]:
+    """Intact results of ``tracker_name`` under ``out_dir`` (:meth:`ResultStore.load`)."""
+    folder = Path(out_dir) / tracker_name
+    if not folder.is_dir():
+        raise DatasetError(f"no results folder for tracker {tracker_name!r}: {folder}")
+    return ResultStore(folder).load(sequences)
+
+
+def result_files(folder) -> dict[str, Path]:
+    """``{sequence: folder/<sequence>.txt}``, leaving out ``*_time.txt`` (timings written by
+    some toolkits); a :class:`DatasetError` if ``folder`` is not a folder."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise DatasetError(f"results folder not found: {folder}")
+    return {p.stem: p for p in sorted(folder.glob("*.txt")) if not p.stem.endswith("_time")}
+
+
+def import_results(folder) -> dict[str, SequenceResult]:
+    """Per-sequence result files of another tracker: ``folder/<sequence>.txt``, 1-based
+    ``x,y,w,h`` separated by commas, tabs or spaces. Returns 0-based boxes, no timings."""
+    return {name: SequenceResult(read_boxes(path)) for name, path in result_files(folder).items()}

@@ -1,0 +1,119 @@
+"""The one frame loop: initialise on the first frame, update on the rest, time, collect boxes.
+
+Every run path uses :func:`track`: ``dcfkit eval`` and ``ablate`` (through
+:mod:`dcfkit.runner`), ``dcfkit track``, the demo, the benchmarks and the integrations. A
+tracker is any object with ``init(image, box)`` and ``update(image) -> box``; boxes are
+``(x, y, w, h)`` floats, **0-based**. Frame numbers in messages are **1-based**, as in the
+benchmarks' file names and annotations.
+"""
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import signal
+import time
+from typing import Callable, Iterable
+
+import numpy as np
+
+from .errors import DcfkitError
+
+OnFrame = Callable[[int, np.ndarray, np.ndarray, object], None]
+
+
+@dataclasses.dataclass
+class Track:
+    """What a run produced: ``boxes`` ``(N, 4)`` 0-based (frame 1: the initial box) and
+    ``times`` ``(N,)`` tracker seconds per frame (decoding excluded)."""
+
+    boxes: np.ndarray
+    times: np.ndarray
+
+    @property
+    def fps(self) -> float | None:
+        total = float(self.times.sum())
+        return len(self.times) / total if total > 0 else None
+
+
+class TrackerFailure(DcfkitError):
+    """The tracker raised or returned something that is not a box, on ``frame`` (1-based)."""
+
+    def __init__(self, frame: int, message: str):
+        super().__init__(f"frame {frame}: {message}")
+        self.frame = frame
+        self.detail = message
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGTERM or SIGHUP, raised in the main thread like Ctrl-C so that ``finally`` blocks
+    keep what was computed."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+@contextlib.contextmanager
+def interrupt_on_termination():
+    """Turn SIGTERM and SIGHUP into :class:`Interrupted` while the block runs (e.g. a run under
+    ``timeout`` or a closed terminal keeps its boxes, as Ctrl-C does)."""
+    def handler(signum, frame):
+        raise Interrupted(signum)
+
+    names = [s for s in ("SIGTERM", "SIGHUP") if hasattr(signal, s)]
+    try:
+        saved = {name: signal.signal(getattr(signal, name), handler) for name in names}
+    except ValueError:  # not the main thread: leave signals alone
+        yield
+        return
+    try:
+        yield
+    finally:
+        for name, previous in saved.items():
+            signal.signal(getattr(signal, name), previous)
+
+
+def as_box(value, frame: int) -> np.ndarray:
+    """``value`` as a float64 ``(4,)`` box, or a :class:`TrackerFailure` saying what it was."""
+    try:
+        return np.asarray(value, dtype=np.float64).reshape(4)
+    except (TypeError, ValueError):
+        raise TrackerFailure(frame, f"update() returned {value!r}, expected 4 numbers (x, y, w, h)") from None
+
+
+def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | None = None,
+          partial: Track | None = None) -> Track:
+    """Run ``tracker`` through ``frames``: ``init`` on the first with ``init_box``, ``update`` on
+    each later one. ``on_frame(index, image, box, tracker)`` is called after each frame (0-based
+    index; progress bars, video writers, confidence read from ``tracker``).
+
+    Whatever ends the loop, ``partial`` (if given, an empty :class:`Track`) holds the frames
+    done so far, so a caller can keep them. A tracker exception becomes a
+    :class:`TrackerFailure` naming the frame and the call."""
+    boxes, times = [], []
+    init_box = np.asarray(init_box, dtype=np.float64).reshape(4)
+    try:
+        for index, image in enumerate(frames):  # decoding happens here: not timed
+            start = time.perf_counter()
+            try:
+                if index == 0:
+                    tracker.init(image, init_box)
+                    out = init_box
+                else:
+                    out = tracker.update(image)
+            except Exception as exc:
+                call = "init" if index == 0 else "update"
+                raise TrackerFailure(index + 1, f"{call} raised {type(exc).__name__}: {exc}") from exc
+            times.append(time.perf_counter() - start)
+            boxes.append(as_box(out, index + 1))
+            if on_frame is not None:
+                on_frame(index, image, boxes[-1], tracker)
+    finally:
+        if partial is not None:
+            partial.boxes = np.array(boxes, dtype=np.float64).reshape(-1, 4)
+            partial.times = np.array(times[:len(boxes)], dtype=np.float64)
+    return Track(np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(times, dtype=np.float64))
+
+
+def empty_track() -> Track:
+    return Track(np.zeros((0, 4)), np.zeros(0))
