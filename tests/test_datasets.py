@@ -2,6 +2,9 @@
 real development data in ../shared/data (skipped when absent)."""
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import cv2
@@ -9,7 +12,11 @@ import numpy as np
 import pytest
 
 from dcfkit import datasets
-from dcfkit.datasets import DatasetError, Sequence, detect_dataset, load_dataset, read_boxes, read_frame
+from dcfkit.datasets import (DatasetError, Evidence, Sequence, canonical_name, detect_dataset, layouts, load_dataset,
+                             read_boxes, read_frame, register_layout, registered_layout)
+from dcfkit.datasets.base import numbered_frames, require_root, select_sequences
+from dcfkit.datasets.uav123_layout import uav123_sequence_table
+from dcfkit.errors import RegistryError
 
 
 # --------------------------------------------------------------------------- fixture builders
@@ -46,7 +53,7 @@ def uav_root(tmp_path: Path, subset="UAV123_10fps", nested=True, seqs=("wakeboar
              anno_subset=None, data_subset=None) -> Path:
     """A UAV123-family root holding ``seqs`` with the frame ranges of the official table."""
     root = tmp_path / subset
-    table = datasets._uav_table()[subset]
+    table = uav123_sequence_table()[subset]
     anno = root / "anno" / (anno_subset or subset) if nested else root / "anno"
     data = root / "data_seq" / (data_subset or subset) if nested else root / "data_seq"
     for name in seqs:
@@ -318,7 +325,8 @@ def test_dataset_names_and_detection_errors(tmp_path):
         detect_dataset(tmp_path)
     root = uav_root(tmp_path, seqs=("wakeboard7",))
     (root / "anno" / "UAV123").mkdir()
-    with pytest.raises(DatasetError, match="cannot tell which UAV123 subset"):
+    with pytest.raises(DatasetError, match=r"cannot tell which dataset .*UAV123_10fps holds: uav123, "
+                                           r"uav123_10fps fit equally well .*\(uav123 or uav123_10fps\)"):
         detect_dataset(root)
     amb = tmp_path / "bench"
     write_anno(amb / "A" / "groundtruth_rect.txt", 1)
@@ -357,3 +365,117 @@ def test_real_dtb70_and_uavdt(shared_data):
     assert s0601.name == "S0601" and len(s0601) == 82
     np.testing.assert_array_equal(s0601.ground_truth[0], [561, 125, 20, 23])
     assert s0601.frame(81).shape == (540, 1024, 3)
+
+
+# --------------------------------------------------------------------------- the layout registry
+
+
+def toy_loader(root, sequences=None):
+    """A plugin-style loader built from the base helpers: ROOT/<seq>/boxes.txt, ROOT/<seq>/frames/%03d.jpg."""
+    root = require_root(root, "toy")
+    available = sorted(p.name for p in root.iterdir() if (p / "boxes.txt").is_file())
+    out = []
+    for name in select_sequences(available, sequences, f"toy at {root}"):
+        boxes = read_boxes(root / name / "boxes.txt")
+        frames = numbered_frames(root / name / "frames", "%03d.jpg", 1, len(boxes), f"toy {name}")
+        out.append(Sequence(name, frames, boxes, {}, "toy", root / name / "boxes.txt"))
+    return out
+
+
+def toy_root(tmp_path: Path) -> Path:
+    root = tmp_path / "somewhere"
+    for name, n in (("ant", 3), ("bee", 2)):
+        write_anno(root / name / "boxes.txt", n)
+        touch_frames(root / name / "frames", "%03d.jpg", 1, n)
+    (root / "TOY_LAYOUT").touch()
+    return root
+
+
+def is_toy(root: Path) -> bool:  # a plain bool is enough evidence when nothing else fits
+    return (root / "TOY_LAYOUT").is_file()
+
+
+def test_a_registered_layout_is_found_by_detection_by_name_and_by_alias(tmp_path):
+    root = toy_root(tmp_path)
+    with pytest.raises(DatasetError, match="no known benchmark layout"):
+        detect_dataset(root)
+    with registered_layout("Toy", toy_loader, "ROOT/<seq>/boxes.txt, ROOT/<seq>/frames/%03d.jpg",
+                           detect=is_toy, aliases=("toy-set",)) as layout:
+        assert layout.name == "toy" and layout.aliases == ("toy_set",) and layouts()[-1] is layout
+        assert "toy" in datasets.DATASETS
+        assert detect_dataset(root) == "toy"
+        auto = load_dataset("auto", root)
+        assert [(s.name, len(s), s.dataset) for s in auto] == [("ant", 3, "toy"), ("bee", 2, "toy")]
+        assert [s.name for s in load_dataset(None, root, "BEE")] == ["bee"]
+        assert [s.name for s in load_dataset("TOY", root)] == ["ant", "bee"]
+        assert [s.name for s in load_dataset("toy_set", root)] == ["ant", "bee"]  # - and _ alike
+        with pytest.raises(DatasetError, match=r"no toy sequences under .*; expected ROOT/<seq>/boxes\.txt"):
+            load_dataset("toy", tmp_path)
+    # gone after the block, aliases too, and the built-ins are as before
+    for name in ("toy", "toy_set"):
+        with pytest.raises(DatasetError, match="unknown dataset"):
+            load_dataset(name, root)
+    with pytest.raises(DatasetError, match="no known benchmark layout"):
+        detect_dataset(root)
+    assert list(datasets.DATASETS) == ["uav123", "uav123_10fps", "uav123_20l", "dtb70", "uavdt", "otb"]
+
+
+def test_a_name_or_alias_registered_twice_is_an_error_naming_it(tmp_path):
+    with pytest.raises(RegistryError, match=r"dataset layout 'otb': the name 'otb' is already registered"):
+        register_layout("OTB", toy_loader, "ROOT/<seq>/boxes.txt")
+    with pytest.raises(RegistryError, match=r"'uav20l' is already registered \(as a name of 'uav123_20l'\)"):
+        register_layout("mine", toy_loader, "ROOT/<seq>/boxes.txt", aliases=("UAV20L",))
+    with pytest.raises(RegistryError, match=r"'uav123_10fps' is already registered"):
+        register_layout("uav123-10fps", toy_loader, "ROOT/<seq>/boxes.txt")  # would shadow it
+    with pytest.raises(RegistryError, match="one non-empty line"):
+        register_layout("mine", toy_loader, "two\nlines")
+    with pytest.raises(DatasetError, match="unknown dataset 'mine'"):  # nothing was half-registered
+        canonical_name("mine")
+    with registered_layout("toy", toy_loader, "ROOT/<seq>/boxes.txt", aliases=("tiny",)):
+        with pytest.raises(RegistryError, match=r"the name 'tiny' is already registered \(as a name of 'toy'\)"):
+            register_layout("other", toy_loader, "ROOT/<seq>/boxes.txt", aliases=("tiny",))
+    with registered_layout("toy", toy_loader, "ROOT/<seq>/boxes.txt", aliases=("tiny",)):  # free again
+        assert canonical_name("TINY") == "toy"
+
+
+def test_detection_ties_are_an_error_naming_the_candidates(tmp_path):
+    root = toy_root(tmp_path)
+    with registered_layout("toy", toy_loader, "ROOT/<seq>/boxes.txt", detect=is_toy), \
+            registered_layout("toy2", toy_loader, "ROOT/<seq>/boxes.txt too", detect=is_toy):
+        with pytest.raises(DatasetError, match=r"(?s)toy, toy2 fit equally well .*\(toy or toy2\).*\n  toy2: ROOT"):
+            detect_dataset(root)
+        with registered_layout("toy3", toy_loader, "by name", detect=lambda r: Evidence.NAME * is_toy(r)):
+            assert detect_dataset(root) == "toy3"  # the more specific evidence wins
+
+
+OO_SCRIPT = """
+import sys, tempfile
+assert sys.flags.optimize == 2
+import dcfkit.datasets as d
+assert d.otb.__doc__ is None and d.load_dataset.__doc__ is None  # docstrings really are gone
+for call in (lambda: d.load_dataset("vot2018", "."), lambda: d.load_dataset("dtb70", tempfile.mkdtemp()),
+             lambda: d.detect_dataset(tempfile.mkdtemp())):
+    try:
+        call()
+    except d.DatasetError as exc:
+        print(exc, end="\\n@@\\n")
+"""
+
+
+def test_unknown_dataset_lists_the_layouts_with_descriptions_even_under_python_OO():
+    with registered_layout("toy", toy_loader, "ROOT/<seq>/boxes.txt (a test's)", aliases=("tiny",)):
+        with pytest.raises(DatasetError) as e:
+            load_dataset("vot2018", ".")
+        assert "  toy (also tiny): ROOT/<seq>/boxes.txt (a test's)" in str(e.value).splitlines()
+    worktree = Path(datasets.__file__).resolve().parents[2]
+    run = subprocess.run([sys.executable, "-OO", "-c", OO_SCRIPT], capture_output=True, text=True,
+                         env={**os.environ, "PYTHONPATH": str(worktree)}, timeout=120)
+    assert run.returncode == 0, run.stderr
+    unknown, empty, undetected, _ = run.stdout.split("\n@@\n")
+    assert unknown.startswith("unknown dataset 'vot2018'; valid names: uav123, uav123_10fps,")
+    for layout in layouts():
+        assert f"  {layout}" in unknown.splitlines() and f"  {layout}" in undetected.splitlines()
+        assert layout.description in str(layout)
+    assert "no dtb70 sequences under" in empty and empty.endswith("; expected ROOT/<seq>/img/%05d.jpg, "
+                                                                 "ROOT/<seq>/groundtruth_rect.txt")
+    assert undetected.startswith("no known benchmark layout under")

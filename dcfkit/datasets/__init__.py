@@ -1,0 +1,55 @@
+"""Benchmark sequences: UAV123 (+@10fps, 20L), DTB70, UAVDT, OTB, each in its own layout.
+
+Conventions
+-----------
+* Boxes in memory are ``(x, y, w, h)`` float64 in **0-based** pixel coordinates of the
+  top-left corner. Benchmark annotation files are **1-based** (OTB convention), so the
+  loaders subtract 1 from x and y (w and h are unchanged). Result files written by
+  :mod:`dcfkit.evaluation` add the 1 back, so they score unchanged in the MATLAB / pysot
+  toolkits.
+* A row of NaN marks a frame where the target is out of view. Such rows are kept (the
+  frame still exists and the tracker still sees it); :mod:`dcfkit.metrics` skips them.
+* Images are decoded by OpenCV (:func:`read_frame`): ``(H, W, 3) uint8``, **BGR** channel order.
+
+Only sequences present on disk are listed. Each layout lives in its own module and registers
+itself in :mod:`~dcfkit.datasets.registry` (name, aliases, loader, detection, description);
+another benchmark is added with :func:`register_layout`. See ``docs/evaluation.md`` for the
+layouts.
+"""
+from .base import ATTRIBUTE_NAMES, DatasetError, Sequence, read_boxes, read_frame
+from .registry import (DATASETS, Evidence, Layout, canonical_name, detect_dataset, get_layout, layouts,
+                       load_dataset, register_layout, registered_layout, unregister_layout)
+
+# Importing a layout module registers it; the import order is the order of the names in
+# messages ("valid names: uav123, uav123_10fps, ..."), so it is not alphabetical.
+# isort: off
+from .uav123_layout import uav123, uav123_10fps, uav123_20l
+from .dtb70_layout import dtb70
+from .uavdt_layout import uavdt
+from .otb_layout import otb
+# isort: on
+
+__all__ = [
+    "ATTRIBUTE_NAMES",
+    "DATASETS",
+    "DatasetError",
+    "Evidence",
+    "Layout",
+    "Sequence",
+    "canonical_name",
+    "detect_dataset",
+    "dtb70",
+    "get_layout",
+    "layouts",
+    "load_dataset",
+    "otb",
+    "read_boxes",
+    "read_frame",
+    "register_layout",
+    "registered_layout",
+    "uav123",
+    "uav123_10fps",
+    "uav123_20l",
+    "uavdt",
+    "unregister_layout",
+]

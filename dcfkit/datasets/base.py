@@ -1,0 +1,282 @@
+"""What every benchmark layout shares: :class:`Sequence`, :class:`DatasetError`, the readers of
+frames, boxes and attribute flags, and the helpers a loader is built from (frame lists,
+sequence selection). A layout module (or a plugin's) needs nothing else from dcfkit."""
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import os
+import re
+from pathlib import Path
+from typing import Iterable, Mapping
+
+import numpy as np
+
+from ..errors import DcfkitError
+
+
+class DatasetError(DcfkitError, ValueError):
+    """A benchmark folder, annotation file or sequence name is wrong (the message says where)."""
+
+
+#: Long names of the UAV123 attribute abbreviations (column order of the att files).
+ATTRIBUTE_NAMES = {
+    "SV": "Scale Variation",
+    "ARC": "Aspect Ratio Change",
+    "LR": "Low Resolution",
+    "FM": "Fast Motion",
+    "FOC": "Full Occlusion",
+    "POC": "Partial Occlusion",
+    "OV": "Out-of-View",
+    "BC": "Background Clutter",
+    "IV": "Illumination Variation",
+    "VC": "Viewpoint Change",
+    "CM": "Camera Motion",
+    "SOB": "Similar Object",
+}
+
+
+# --------------------------------------------------------------------------- Sequence
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Sequence:
+    """One benchmark sequence.
+
+    ``frames`` holds the image paths in order; ``ground_truth`` is ``(N, 4) float64``,
+    0-based ``(x, y, w, h)``, read-only, with NaN rows kept for out-of-view frames.
+    ``attributes`` maps an attribute abbreviation (e.g. ``"SV"``) to whether the sequence
+    has it; it is empty when the benchmark provides none. ``annotation`` is the file the
+    ground truth was read from (None for sequences made in code).
+    """
+
+    name: str
+    frames: tuple[Path, ...]
+    ground_truth: np.ndarray
+    attributes: Mapping[str, bool] = dataclasses.field(default_factory=dict)
+    dataset: str = ""
+    annotation: Path | None = None
+
+    def __post_init__(self):
+        gt = np.array(self.ground_truth, dtype=np.float64, copy=True).reshape(-1, 4)
+        if len(gt) != len(self.frames):
+            raise DatasetError(
+                f"sequence {self.name!r}: {len(self.frames)} frames but {len(gt)} boxes")
+        gt.setflags(write=False)
+        object.__setattr__(self, "ground_truth", gt)
+        object.__setattr__(self, "frames", tuple(Path(f) for f in self.frames))
+        object.__setattr__(self, "attributes", dict(self.attributes))
+
+    def __len__(self) -> int:
+        return len(self.frames)
+
+    def __repr__(self) -> str:
+        flags = ",".join(k for k, v in self.attributes.items() if v)
+        return f"Sequence({self.dataset}/{self.name}, {len(self)} frames{', ' + flags if flags else ''})"
+
+    @property
+    def init_box(self) -> np.ndarray:
+        """Frame 0's ground truth box, ``(4,) float64`` 0-based (may contain NaN)."""
+        return self.ground_truth[0].copy()
+
+    def frame(self, i: int) -> np.ndarray:
+        """Frame ``i`` (0-based) as ``(H, W, 3) uint8`` BGR; :class:`DatasetError` if unreadable."""
+        return read_frame(self.frames[i], f"frame {i} of sequence {self.name!r}")
+
+
+# --------------------------------------------------------------------------- images
+
+
+def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
+    """A BGR image; :class:`DatasetError` naming the file when it is missing, not an image, or
+    a truncated JPEG (``cv2.imread`` would return one grey below the cut, with a warning only).
+    A JPEG that lacks just its end-of-image marker, a common defect, is read as imread would."""
+    import cv2  # deferred: listing sequences needs no OpenCV
+
+    try:
+        data = np.fromfile(os.fspath(path), np.uint8)
+    except OSError as exc:
+        reason = "file does not exist" if not os.path.exists(path) else exc.strerror
+        raise DatasetError(f"cannot read {what}: {path} ({reason})") from None
+    image = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
+    if image is None and _missing_end_marker(data.tobytes()):
+        image = cv2.imdecode(np.concatenate([data, _JPEG_END]), cv2.IMREAD_COLOR)
+        if image is not None and (image[-8:, -8:] == 128).all():  # libjpeg's fill for missing data
+            raise DatasetError(f"cannot read {what}: {path} (truncated JPEG: the image data stops "
+                               f"before its end)")
+    if image is None:
+        raise DatasetError(f"cannot read {what}: {path} (not a readable image)")
+    return image
+
+
+_JPEG_END = np.array([0xFF, 0xD9], np.uint8)
+
+
+def _missing_end_marker(data: bytes) -> bool:
+    """A JPEG whose last scan (SOS marker) has no end-of-image marker after it (markers cannot
+    occur inside entropy-coded data, where 0xFF is stuffed)."""
+    return data.startswith(b"\xff\xd8") and data.rfind(b"\xff\xd9") < data.rfind(b"\xff\xda")
+
+
+# --------------------------------------------------------------------------- annotation files
+
+_SEPARATORS = re.compile(r"[,\s]+")
+
+
+def read_text(path: Path) -> str:
+    """A benchmark text file (UTF-8, optional BOM); :class:`DatasetError` naming it otherwise."""
+    try:
+        return path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise DatasetError(f"annotation file not found: {path}") from None
+    except UnicodeDecodeError as exc:
+        raise DatasetError(f"{path}: not a text annotation file (byte {exc.start} is not UTF-8)") from None
+    except OSError as exc:
+        raise DatasetError(f"cannot read {path}: {exc.strerror}") from None
+
+
+def read_boxes(path: str | os.PathLike, one_based: bool = True) -> np.ndarray:
+    """Read one ``x,y,w,h`` box per line (commas, tabs or spaces) as ``(N, 4) float64``.
+
+    With ``one_based`` (the benchmark convention), 1 is subtracted from x and y so the
+    result is 0-based. ``NaN`` values are kept. Trailing blank lines are ignored; a blank
+    or malformed line inside the file is a :class:`DatasetError` naming file and line.
+    """
+    path = Path(path)
+    lines = read_text(path).rstrip().splitlines()
+    boxes = np.empty((len(lines), 4), dtype=np.float64)
+    for n, line in enumerate(lines):
+        fields = [f for f in _SEPARATORS.split(line.strip()) if f]
+        try:
+            if len(fields) != 4:
+                raise ValueError
+            boxes[n] = [float(f) for f in fields]
+        except ValueError:
+            raise DatasetError(
+                f"{path}, line {n + 1}: expected 4 numbers 'x,y,w,h' separated by commas, "
+                f"tabs or spaces, got {line.strip()!r}") from None
+    if one_based:
+        boxes[:, :2] -= 1.0
+    return boxes
+
+
+def read_flags(path: Path, names: tuple[str, ...]) -> dict[str, bool]:
+    """One line of 0/1 flags, one per name in ``names`` (e.g. a UAV123 att file)."""
+    fields = [f for f in _SEPARATORS.split(read_text(path).strip()) if f]
+    if len(fields) != len(names) or any(f not in ("0", "1") for f in fields):
+        raise DatasetError(
+            f"{path}, line 1: expected {len(names)} 0/1 flags ({' '.join(names)}), "
+            f"got {' '.join(fields)!r}")
+    return {name: f == "1" for name, f in zip(names, fields)}
+
+
+# --------------------------------------------------------------------------- frame lists
+
+
+def numbered_frames(folder: Path, pattern: str, first: int, last: int, what: str) -> tuple[Path, ...]:
+    """Paths ``folder / (pattern % k)`` for k in first..last; all must exist."""
+    if not folder.is_dir():
+        raise DatasetError(f"{what}: image folder not found: {folder}")
+    present = set(os.listdir(folder))
+    names = [pattern % k for k in range(first, last + 1)]
+    missing = [n for n in names if n not in present]
+    if missing:
+        shown = ", ".join(missing[:3]) + (f" and {len(missing) - 3} more" if len(missing) > 3 else "")
+        raise DatasetError(
+            f"{what}: {len(missing)} of frames {pattern % first}..{pattern % last} missing "
+            f"in {folder}: {shown}")
+    return tuple(folder / n for n in names)
+
+
+def annotated_frames(folder: Path, pattern: str, boxes: np.ndarray, anno: Path, what: str) -> tuple[Path, ...]:
+    """Frames 1..N of a folder holding exactly the N annotated ``.jpg`` frames; the error names
+    either the missing frames or, when the images simply run out, the annotation's length."""
+    if not folder.is_dir():
+        raise DatasetError(f"{what}: image folder not found: {folder}")
+    present = set(os.listdir(folder))
+    n_jpgs = sum(1 for f in present if f.lower().endswith(".jpg"))
+    counted = f"{n_jpgs} .jpg files in {folder}"
+    if n_jpgs < len(boxes) and all(pattern % k in present for k in range(1, n_jpgs + 1)):
+        raise DatasetError(f"{anno}: {len(boxes)} annotation lines but {counted}: either the annotation has "
+                           f"extra lines or frames {pattern % (n_jpgs + 1)}..{pattern % len(boxes)} are missing")
+    frames = numbered_frames(folder, pattern, 1, len(boxes), what)
+    check_box_count(boxes, n_jpgs, anno, counted)  # extra images
+    return frames
+
+
+def check_box_count(boxes: np.ndarray, n_frames: int, anno: Path, frames_desc: str) -> None:
+    """:class:`DatasetError` naming ``anno`` unless it has one box per frame."""
+    if len(boxes) != n_frames:
+        raise DatasetError(
+            f"{anno}: {len(boxes)} annotation lines but {n_frames} frames ({frames_desc}); "
+            f"one line per frame is required")
+
+
+# --------------------------------------------------------------------------- roots and selection
+
+
+def require_root(root, what: str) -> Path:
+    """``root`` as a Path (``~`` expanded); :class:`DatasetError` if it is not a folder."""
+    root = Path(root).expanduser()
+    if not root.is_dir():
+        raise DatasetError(f"{what} root folder not found: {root}")
+    return root
+
+
+def select_sequences(available: list[str], requested: Iterable[str] | str | None, where: str,
+                     annotation_of: Mapping[str, Path] | None = None) -> list[str]:
+    """Names to load: all available, or the requested ones (case-insensitive match, each once).
+
+    ``requested`` may be one comma-separated string. ``annotation_of`` maps the benchmark's
+    other sequences (not available) to the annotation file that is missing, for a clearer error.
+    """
+    if requested is None:
+        return available
+    if isinstance(requested, str):
+        requested = [s for s in requested.split(",") if s.strip()]
+    if not requested:
+        raise DatasetError(f"no sequence names given for {where}")
+    by_lower: dict[str, list[str]] = {}
+    for name in available:
+        by_lower.setdefault(name.lower(), []).append(name)
+    missing = {name.lower(): path for name, path in (annotation_of or {}).items()}
+    chosen = []
+    for want in (w.strip() for w in requested):
+        if want in available:
+            chosen.append(want)
+        elif len(by_lower.get(want.lower(), [])) == 1:
+            chosen.append(by_lower[want.lower()][0])
+        else:
+            raise _not_found(want, available, where, missing.get(want.lower()))
+    return list(dict.fromkeys(chosen))
+
+
+def _not_found(want: str, available: list[str], where: str, missing_annotation: Path | None) -> DatasetError:
+    shown = ", ".join(available[:40]) + (" ..." if len(available) > 40 else "")
+    if missing_annotation is not None:
+        return DatasetError(f"sequence {want!r} of {where}: annotation file not found: "
+                            f"{missing_annotation}. Available ({len(available)}): {shown or 'none'}")
+    close = difflib.get_close_matches(want, available, n=1, cutoff=0.5)
+    hint = f" Did you mean {close[0]!r}?" if close else ""
+    return DatasetError(f"sequence {want!r} not found in {where}.{hint} "
+                        f"Available ({len(available)}): {shown or 'none'}")
+
+
+# --------------------------------------------------------------------------- the <seq>/img layout
+
+
+def image_sequence_folders(root: Path) -> list[Path]:
+    """Folders ``root/<seq>`` holding ``img/`` and a ``groundtruth_rect*.txt``: the layout that
+    DTB70 and OTB share (in listing order, as detection has always sampled them). None under a
+    root with ``data_seq/`` and ``anno/``: that is a UAV123 or UAVDT root, whatever else it holds."""
+    if (root / "data_seq").is_dir() and (root / "anno").is_dir():
+        return []
+    return [p for p in root.iterdir() if p.is_dir() and (p / "img").is_dir()
+            and any(p.glob("groundtruth_rect*.txt"))]
+
+
+def first_frame_digits(folders: list[Path], sample: int = 10) -> set[int]:
+    """Lengths of the first frame names (without extension) in the first ``sample`` ``img/``
+    folders: ``{5}`` for DTB70's ``00001.jpg``, ``{4}`` for OTB's ``0001.jpg``."""
+    return {len(os.path.splitext(f)[0]) for p in folders[:sample]
+            for f in sorted(os.listdir(p / "img"))[:1]}

@@ -1,0 +1,35 @@
+"""DTB70: ``ROOT/<seq>/img/%05d.jpg`` and ``ROOT/<seq>/groundtruth_rect.txt``."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from .base import (Sequence, annotated_frames, first_frame_digits, image_sequence_folders, read_boxes,
+                   require_root, select_sequences)
+from .registry import Evidence, register_layout
+
+
+def dtb70(root, sequences=None) -> list[Sequence]:
+    """DTB70: ``ROOT/<seq>/img/%05d.jpg`` and ``ROOT/<seq>/groundtruth_rect.txt``."""
+    root = require_root(root, "DTB70")
+    available = sorted(p.name for p in root.iterdir() if (p / "groundtruth_rect.txt").is_file())
+    out = []
+    for name in select_sequences(available, sequences, f"DTB70 at {root}"):
+        anno = root / name / "groundtruth_rect.txt"
+        boxes = read_boxes(anno)
+        frames = annotated_frames(root / name / "img", "%05d.jpg", boxes, anno, f"DTB70 {name}")
+        out.append(Sequence(name, frames, boxes, {}, "dtb70", anno))
+    return out
+
+
+def detect_dtb70(root: Path) -> Evidence:
+    """OTB's layout too, so told apart by the root's name, else by 5-digit frame names."""
+    folders = image_sequence_folders(root)
+    if not folders:
+        return Evidence.NONE
+    if "dtb" in root.name.lower():
+        return Evidence.NAME
+    return Evidence.FILES if first_frame_digits(folders) == {5} else Evidence.FOLDERS
+
+
+register_layout("dtb70", dtb70, "ROOT/<seq>/img/%05d.jpg, ROOT/<seq>/groundtruth_rect.txt",
+                detect=detect_dtb70)

@@ -1,0 +1,104 @@
+"""OTB-2013/2015 (OTB50, OTB100): ``ROOT/<seq>/img/*.jpg`` and ``ROOT/<seq>/groundtruth_rect.txt``,
+or ``groundtruth_rect.1.txt``, ``.2.txt`` … for the sequences with several targets."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .base import (DatasetError, Sequence, check_box_count, first_frame_digits, image_sequence_folders,
+                   read_boxes, read_text, require_root, select_sequences)
+from .registry import Evidence, register_layout
+
+# OTB sequences whose image folder holds more frames than are annotated (as in the
+# got10k and pysot toolkits): name -> first and last image number used.
+_TOOLKIT_FRAME_RANGES = {
+    "David": (300, 770),
+    "Football1": (1, 74),
+    "Freeman3": (1, 460),
+    "Freeman4": (1, 283),
+    "Diving": (1, 215),
+}
+
+
+def _targets(root: Path) -> dict[str, Path]:
+    """Sequence name -> annotation file; multi-target folders give ``Name-1``, ``Name-2``."""
+    targets = {}
+    for folder in sorted(p for p in root.iterdir() if p.is_dir()):
+        if (folder / "groundtruth_rect.txt").is_file():
+            targets[folder.name] = folder / "groundtruth_rect.txt"
+            continue
+        numbered = sorted(
+            (p for p in folder.glob("groundtruth_rect.*.txt") if read_text(p).strip()),  # OTB-100 has empty ones
+            key=lambda p: p.name)
+        if len(numbered) == 1:
+            targets[folder.name] = numbered[0]
+        else:
+            for p in numbered:
+                targets[f"{folder.name}-{p.name.split('.')[1]}"] = p
+    return targets
+
+
+def _numbered_jpgs(img: Path, name: str) -> dict[int, Path]:
+    """Frame number -> file of the ``.jpg`` files named by a number (``0001.jpg``, ``1.jpg``)."""
+    numbered: dict[int, Path] = {}
+    for f in os.listdir(img):
+        stem, ext = os.path.splitext(f)
+        if ext.lower() == ".jpg" and stem.isdigit():
+            if int(stem) in numbered:
+                raise DatasetError(f"OTB {name}: {numbered[int(stem)].name} and {f} in {img} are both "
+                                   f"frame {int(stem)}")
+            numbered[int(stem)] = img / f
+    return numbered
+
+
+def _frames(name: str, anno: Path, boxes: np.ndarray) -> tuple[Path, ...]:
+    """The annotated frames: the toolkit's range, else as many as there are boxes, from the first."""
+    img = anno.parent / "img"
+    if not img.is_dir():
+        raise DatasetError(f"OTB {name}: image folder not found: {img}")
+    numbered = _numbered_jpgs(img, name)
+    if anno.parent.name in _TOOLKIT_FRAME_RANGES:
+        first, last = _TOOLKIT_FRAME_RANGES[anno.parent.name]
+        check_box_count(boxes, last - first + 1, anno, f"frames {first}..{last}, as in the OTB toolkit")
+    else:
+        check_box_count(boxes, len(numbered), anno, f"{len(numbered)} numbered .jpg files in {img}")
+        first = min(numbered, default=1)
+        last = first + len(boxes) - 1
+    missing = [k for k in range(first, last + 1) if k not in numbered]
+    if missing:
+        raise DatasetError(
+            f"OTB {name}: frames {missing[:3]}{' ...' if len(missing) > 3 else ''} "
+            f"missing in {img} (expected frames {first}..{last})")
+    return tuple(numbered[k] for k in range(first, last + 1))
+
+
+def otb(root, sequences=None) -> list[Sequence]:
+    """OTB-2013/2015: ``ROOT/<seq>/img/*.jpg`` and ``ROOT/<seq>/groundtruth_rect.txt``.
+
+    Multi-target sequences (``groundtruth_rect.1.txt`` …) are named ``Jogging-1`` etc.;
+    David, Football1, Freeman3, Freeman4 and Diving use the frame ranges of the OTB toolkit.
+    """
+    root = require_root(root, "OTB")
+    targets = _targets(root)
+    out = []
+    for name in select_sequences(sorted(targets), sequences, f"OTB at {root}"):
+        anno = targets[name]
+        boxes = read_boxes(anno)
+        out.append(Sequence(name, _frames(name, anno, boxes), boxes, {}, "otb", anno))
+    return out
+
+
+def detect_otb(root: Path) -> Evidence:
+    """DTB70's layout too, so told apart by the root's name, else by 4-digit frame names."""
+    folders = image_sequence_folders(root)
+    if not folders:
+        return Evidence.NONE
+    if any(hint in root.name.lower() for hint in ("otb", "tb100", "tb50")):
+        return Evidence.NAME
+    return Evidence.FILES if first_frame_digits(folders) == {4} else Evidence.FOLDERS
+
+
+register_layout("otb", otb, "ROOT/<seq>/img/*.jpg, ROOT/<seq>/groundtruth_rect.txt (or .1.txt, .2.txt ...)",
+                detect=detect_otb, aliases=("otb100", "otb2015", "otb2013", "otb50"))
