@@ -29,6 +29,7 @@ import dcfkit  # noqa: E402
 from dcfkit.ablation import load_spec  # noqa: E402
 from dcfkit.datasets import load_dataset  # noqa: E402
 from dcfkit.metrics import iou, score_sequence  # noqa: E402
+from dcfkit.tracking import track  # noqa: E402
 
 LOST_TAIL = 10  # frames at the end of a segment that must all miss for it to count as lost
 
@@ -57,13 +58,8 @@ def run_segment(config: dict, seq, first: int) -> dict:
 
 
 def _track_segment(config: dict, seq, first: int) -> dict:
-    tracker = dcfkit.load_tracker(config)
     gt = seq.ground_truth[first:]
-    boxes = [np.asarray(gt[0], float)]
-    tracker.init(seq.frame(first), gt[0])
-    for i in range(first + 1, len(seq)):
-        boxes.append(np.asarray(tracker.update(seq.frame(i)), float))
-    boxes = np.array(boxes)
+    boxes = track(dcfkit.load_tracker(config), (seq.frame(i) for i in range(first, len(seq))), gt[0]).boxes
     scores = score_sequence(boxes, gt, protocol="otb")
     tail = iou(boxes[-LOST_TAIL:], gt[-LOST_TAIL:])
     lost = bool(np.all(np.nan_to_num(tail, nan=0.0) <= 0.0))

@@ -24,6 +24,7 @@ import numpy as np  # noqa: E402
 
 import dcfkit  # noqa: E402
 from dcfkit.synthetic import make_sequence  # noqa: E402
+from dcfkit.tracking import track  # noqa: E402
 
 cv2.setNumThreads(1)
 
@@ -40,9 +41,7 @@ def run_all(root: str, configs: list[str]) -> dict[str, np.ndarray]:
     boxes = {}
     for name, frames, box in seqs:
         for config in configs:
-            tracker = dcfkit.load_tracker(config)
-            tracker.init(frames[0], box)
-            boxes[f"{name}/{config}"] = np.array([box] + [tracker.update(f) for f in frames[1:]], float)
+            boxes[f"{name}/{config}"] = track(dcfkit.load_tracker(config), frames, box).boxes
             print(f"  {name:<14} {config}", flush=True)
     return boxes
 

@@ -19,7 +19,6 @@ import json  # noqa: E402
 import resource  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
-import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import cv2  # noqa: E402
@@ -27,6 +26,7 @@ import numpy as np  # noqa: E402
 
 import dcfkit  # noqa: E402
 from dcfkit.synthetic import make_sequence  # noqa: E402
+from dcfkit.tracking import track as run_track  # noqa: E402
 
 
 cv2.setNumThreads(1)
@@ -77,18 +77,8 @@ def first_frame_fresh(config: str, image: str, box) -> tuple[float, float]:
 
 def track(config: str, frame_at, n_frames: int, box) -> tuple[float, float]:
     """(fps of update over frames 2..n, seconds of init), decoding excluded."""
-    tracker = dcfkit.load_tracker(config)
-    frame = frame_at(0)
-    start = time.perf_counter()
-    tracker.init(frame, box)
-    first = time.perf_counter() - start
-    elapsed = 0.0
-    for i in range(1, n_frames):
-        frame = frame_at(i)  # decoding is not timed
-        start = time.perf_counter()
-        tracker.update(frame)
-        elapsed += time.perf_counter() - start
-    return (n_frames - 1) / elapsed, first
+    times = run_track(dcfkit.load_tracker(config), (frame_at(i) for i in range(n_frames)), box).times
+    return (n_frames - 1) / float(times[1:].sum()), float(times[0])
 
 
 def main():

@@ -25,6 +25,7 @@ import cv2  # noqa: E402
 import dcfkit  # noqa: E402
 import dcfkit.tracker as tracker_module  # noqa: E402
 from dcfkit.synthetic import make_sequence  # noqa: E402
+from dcfkit.tracking import track  # noqa: E402
 
 cv2.setNumThreads(1)
 TOTALS = collections.defaultdict(float)
@@ -76,12 +77,9 @@ def main():
         args.sequence = "synthetic_720p"
     tracker = dcfkit.load_tracker(args.config)
     instrument(tracker)
-    tracker.init(frames[0], box)
-    TOTALS.clear()
-    start = time.perf_counter()
-    for frame in frames[1:]:
-        tracker.update(frame)
-    total = time.perf_counter() - start
+    TOTALS.clear()  # the stages of the updates only: init is cleared at the first update
+    run = track(tracker, frames, box, lambda index, *_: TOTALS.clear() if index == 0 else None)
+    total = float(run.times[1:].sum())
     n = len(frames) - 1
     print(f"{args.config} on {args.sequence}: {n / total:.1f} fps, {1000 * total / n:.2f} ms/frame")
     rows = sorted(TOTALS.items(), key=lambda kv: -kv[1])

@@ -9,11 +9,11 @@ __all__ = ["__version__", "load_tracker", "load_config", "Tracker"]
 
 def __getattr__(name):  # lazy: importing dcfkit does no work
     if name in ("load_tracker", "Tracker"):
-        from . import tracker
+        from . import tracker  # lazy: importing dcfkit loads no tracker code
 
         return getattr(tracker, name)
     if name == "load_config":
-        from .config import load_config
+        from .config import load_config  # lazy, as above
 
         return load_config
     raise AttributeError(f"module 'dcfkit' has no attribute {name!r}")

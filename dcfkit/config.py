@@ -29,6 +29,7 @@ import yaml
 
 from .errors import ConfigError, DcfkitError
 from .params import closest, param, parse_params
+from .registry import get_registry
 
 SLOTS = ("features", "label", "regularizers", "solver", "search", "scale")
 TOP_LEVEL = ("name", "description", "base", "tracker") + SLOTS
@@ -301,8 +302,6 @@ def _component(registry, kind: str, spec: Any, where: str) -> dict:
 
 def resolve(data: Mapping, origin: str) -> dict:
     """Validate every key of ``data`` and return it with all defaults filled in."""
-    from .registry import get_registry
-
     registry = get_registry()
     unknown = [k for k in data if k not in TOP_LEVEL]
     if unknown:

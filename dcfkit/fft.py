@@ -16,7 +16,7 @@ class ScipyFFT:
     name = "scipy"
 
     def __init__(self):
-        import scipy.fft
+        import scipy.fft  # lazy: only the chosen backend is imported
 
         self._fft = scipy.fft
 
@@ -35,7 +35,7 @@ class PyFFTW:
     name = "pyfftw"
 
     def __init__(self):
-        import pyfftw
+        import pyfftw  # lazy: only the chosen backend is imported
 
         self._pyfftw = pyfftw
         self._plans: dict = {}

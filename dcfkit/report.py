@@ -95,33 +95,10 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
     weighting = weighting or proto.weighting
     keys = proto.score_keys
     sequences = list(sequences)
-    per_seq: dict[str, dict[str, dict]] = {}
-    fps: dict[str, dict[str, float | None]] = {}
-    missing: dict[str, list[str]] = {}
+    per_seq, fps, missing = {}, {}, {}
     for tracker, res in results.items():
-        per_seq[tracker], fps[tracker], missing[tracker] = {}, {}, []
-        for seq in sequences:
-            if seq.name in res:
-                boxes, seq_fps = _boxes_and_fps(res[seq.name])
-                if len(boxes) > len(seq):
-                    raise DatasetError(
-                        f"tracker {tracker!r}, sequence {seq.name!r}: {len(boxes)} boxes for "
-                        f"{len(seq)} frames")
-                if len(boxes) < len(seq):
-                    log.warning("tracker %r, sequence %r: %d boxes for %d frames; the last %d frames are "
-                                "scored as failures", tracker, seq.name, len(boxes), len(seq), len(seq) - len(boxes))
-            else:
-                boxes, seq_fps = np.empty((0, 4)), None
-                missing[tracker].append(seq.name)
-            per_seq[tracker][seq.name] = metrics.score_sequence(boxes, seq.ground_truth, include_first, proto)
-            fps[tracker][seq.name] = seq_fps
-        if missing[tracker]:
-            log.warning("tracker %r has no results for %d of %d sequences (scored as failures; "
-                        "report on the sequences that were run, e.g. with --sequences, to leave them out): %s",
-                        tracker, len(missing[tracker]), len(sequences), ", ".join(missing[tracker][:10]))
-
-    def rank(rows):
-        return sorted(rows, key=lambda r: _sort_key(r[proto.rank_key]))
+        per_seq[tracker], fps[tracker], missing[tracker] = _score_tracker(tracker, res, sequences, include_first,
+                                                                          proto)
 
     overall, curves = [], {}
     for tracker in results:
@@ -130,33 +107,14 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
         overall.append({"tracker": tracker, **{k: avg[k] for k in keys},
                         "fps": _mean_or_none(fps[tracker].values()),
                         "sequences": len(sequences), "missing": len(missing[tracker]), "frames": avg["frames"]})
-    overall = rank(overall)
+    overall = _rank(overall, proto)
     ranked = [r["tracker"] for r in overall]
-
     per_sequence = [
         {"tracker": t, "sequence": s.name, **{k: per_seq[t][s.name][k] for k in keys},
          "fps": fps[t][s.name], "frames": per_seq[t][s.name]["frames"]}
         for t in ranked for s in sequences]
-
-    attributes: dict[str, list[str]] = {}
-    for seq in sequences:
-        for attr, present in seq.attributes.items():
-            attributes.setdefault(attr, [])
-            if present:
-                attributes[attr].append(seq.name)
-    per_attribute, attribute_curves = [], {}
-    for attr, names in attributes.items():
-        if not names:
-            continue
-        attribute_curves[attr] = {}
-        rows = []
-        for tracker in ranked:
-            avg = metrics.average([per_seq[tracker][n] for n in names], weighting, proto)
-            attribute_curves[attr][tracker] = _curves(avg)
-            rows.append({"attribute": attr, "name": ATTRIBUTE_NAMES.get(attr, attr),
-                         "sequences": len(names), "tracker": tracker, **{k: avg[k] for k in keys}})
-        per_attribute += rank(rows)
-
+    attributes = _attribute_members(sequences)
+    per_attribute, attribute_curves = _per_attribute(attributes, per_seq, ranked, weighting, proto)
     return {
         "protocol": {"name": proto.name, "title": proto.title, "source": proto.source},
         "overall": overall,
@@ -164,10 +122,65 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
         "per_attribute": per_attribute,
         "curves": curves,
         "attribute_curves": attribute_curves,
-        "attributes": {a: len(n) for a, n in attributes.items() if n},
+        "attributes": {a: len(n) for a, n in attributes.items()},
         "thresholds": _thresholds(proto),
         "settings": {"protocol": proto.name, "include_first": include_first, "weighting": weighting},
     }
+
+
+def _score_tracker(tracker: str, res: Mapping, sequences: list[Sequence], include_first: bool,
+                   proto: Protocol) -> tuple[dict, dict, list]:
+    """(sequence -> scores, sequence -> fps, missing sequence names) of one tracker's results."""
+    scores, fps, missing = {}, {}, []
+    for seq in sequences:
+        if seq.name in res:
+            boxes, fps[seq.name] = _boxes_and_fps(res[seq.name])
+            if len(boxes) > len(seq):
+                raise DatasetError(f"tracker {tracker!r}, sequence {seq.name!r}: {len(boxes)} boxes for "
+                                   f"{len(seq)} frames")
+            if len(boxes) < len(seq):
+                log.warning("tracker %r, sequence %r: %d boxes for %d frames; the last %d frames are "
+                            "scored as failures", tracker, seq.name, len(boxes), len(seq), len(seq) - len(boxes))
+        else:
+            boxes, fps[seq.name] = np.empty((0, 4)), None
+            missing.append(seq.name)
+        scores[seq.name] = metrics.score_sequence(boxes, seq.ground_truth, include_first, proto)
+    if missing:
+        log.warning("tracker %r has no results for %d of %d sequences (scored as failures; "
+                    "report on the sequences that were run, e.g. with --sequences, to leave them out): %s",
+                    tracker, len(missing), len(sequences), ", ".join(missing[:10]))
+    return scores, fps, missing
+
+
+def _rank(rows: list[dict], proto: Protocol) -> list[dict]:
+    return sorted(rows, key=lambda r: _sort_key(r[proto.rank_key]))
+
+
+def _attribute_members(sequences: list[Sequence]) -> dict[str, list[str]]:
+    """attribute -> the sequences that have it (attributes no sequence has are left out)."""
+    members: dict[str, list[str]] = {}
+    for seq in sequences:
+        for attr, present in seq.attributes.items():
+            members.setdefault(attr, [])
+            if present:
+                members[attr].append(seq.name)
+    return {a: names for a, names in members.items() if names}
+
+
+def _per_attribute(attributes: dict, per_seq: dict, ranked: list[str], weighting: str,
+                   proto: Protocol) -> tuple[list[dict], dict]:
+    """Rows (per attribute, trackers ranked) and curves of the scores averaged per attribute."""
+    per_attribute, attribute_curves = [], {}
+    for attr, names in attributes.items():
+        attribute_curves[attr] = {}
+        rows = []
+        for tracker in ranked:
+            avg = metrics.average([per_seq[tracker][n] for n in names], weighting, proto)
+            attribute_curves[attr][tracker] = _curves(avg)
+            rows.append({"attribute": attr, "name": ATTRIBUTE_NAMES.get(attr, attr),
+                         "sequences": len(names), "tracker": tracker, **{k: avg[k] for k in proto.score_keys}})
+        per_attribute += _rank(rows, proto)
+    return per_attribute, attribute_curves
 
 
 def _thresholds(proto: Protocol) -> dict[str, np.ndarray]:
@@ -276,8 +289,8 @@ def plot_curves(curves: Mapping[str, Mapping], kind: str, path_stem, title: str 
     is ``"precision"`` (score at 20 px), ``"success"`` (AUC) or ``"norm_precision"``.
     Writes ``path_stem.png`` and ``path_stem.svg``; returns the paths.
     """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from matplotlib.backends.backend_agg import FigureCanvasAgg  # lazy: matplotlib is slow to import,
+    from matplotlib.figure import Figure  # and only plots need it
 
     proto = get_protocol(protocol)
     style = _PLOT_STYLE[kind]

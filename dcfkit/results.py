@@ -33,8 +33,11 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
+from . import __version__
+from .config import components
 from .datasets import DatasetError, Sequence, read_boxes
 from .errors import DcfkitError
+from .registry import get_registry
 
 log = logging.getLogger(__name__)
 
@@ -46,8 +49,6 @@ LABEL_KEYS = ("name", "description")  # config keys that never change a box
 
 def dcfkit_version() -> str:
     """``dcfkit.__version__`` (part of every run key)."""
-    from . import __version__  # the package imports nothing at import time: no cycle
-
     return __version__
 
 
@@ -66,9 +67,6 @@ def json_default(obj):
 
 def plugin_versions(config: Mapping) -> list[str]:
     """``"package version"`` of each installed plugin whose components ``config`` uses."""
-    from .config import components
-    from .registry import get_registry
-
     used = components(config)
     return get_registry().plugin_versions(used) if used else []  # e.g. an OpenCV baseline: no registry
 
@@ -156,7 +154,7 @@ def exclusive(lock: Path, command: str, what: str):
     exit). Where no lock can be taken (not POSIX, a file system without flock) the run goes
     on unlocked, with a warning."""
     try:
-        import fcntl
+        import fcntl  # POSIX only: elsewhere the run goes on unlocked
 
         handle = open(lock, "a+")
     except (ImportError, OSError) as exc:

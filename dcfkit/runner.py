@@ -21,6 +21,8 @@ from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import Any, Callable, Iterable, Mapping
 
+import cv2
+
 from .datasets import Sequence
 from .errors import DcfkitError
 from .registry import PluginWarning
@@ -139,10 +141,7 @@ def worker_init(parent_pid: int | None = None):
     stops its workers itself."""
     os.environ.update({k: "1" for k in _THREAD_VARS})
     warnings.simplefilter("ignore", PluginWarning)  # the parent said it
-    with contextlib.suppress(Exception):
-        import cv2
-
-        cv2.setNumThreads(1)
+    cv2.setNumThreads(1)
     if parent_pid is not None:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         _die_with_parent(parent_pid)
@@ -153,7 +152,7 @@ def _die_with_parent(parent_pid: int) -> None:
     (a pool worker would otherwise wait forever on its task queue)."""
     if sys.platform.startswith("linux"):
         with contextlib.suppress(Exception):
-            import ctypes
+            import ctypes  # Linux only
 
             ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
     if os.getppid() != parent_pid:  # the parent died before prctl
@@ -217,7 +216,7 @@ def run_pool(calls: Mapping[Any, tuple], jobs: int, on_result: Callable[[Any, An
 
 def _run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: str, on_result, on_crash) -> None:
     try:
-        from distributed import Client, LocalCluster, as_completed as dask_completed
+        from distributed import Client, LocalCluster, as_completed as dask_completed  # optional: dcfkit[dask]
     except ImportError:
         raise DcfkitError("--executor dask needs dask.distributed: pip install 'dcfkit[dask]'") from None
     with contextlib.ExitStack() as stack:

@@ -43,7 +43,7 @@ def sherman_morrison_solve(a: np.ndarray, b: np.ndarray, c: float) -> np.ndarray
     a, b: (C, ...) complex, solved in complex64 by the ADMM's compiled v-step; c > 0.
     Returns (C, ...) complex64.
     """
-    from . import solver_kernels as kernels
+    from . import solver_kernels as kernels  # lazy: numba, compiled on first use
 
     shape = np.shape(b)
     a = np.ascontiguousarray(a, np.complex64).reshape(shape[0], 1, -1)

@@ -9,6 +9,7 @@ from typing import Iterator
 import cv2
 import numpy as np
 
+from .datasets import read_frame
 from .errors import InputError
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff")
@@ -35,8 +36,6 @@ def frame_files(folder: str | Path) -> list[Path]:
 def iter_frames(video: str | None = None, frames: str | None = None) -> Iterator[np.ndarray]:
     """Yield BGR frames from a video file or an image folder."""
     if frames is not None:
-        from .datasets import read_frame
-
         for i, path in enumerate(frame_files(frames), start=1):
             yield read_frame(path, f"frame {i}")
         return

@@ -398,3 +398,21 @@ def test_a_second_run_on_the_same_folder_is_refused(tmp_path, data):
     (out / "jobs").write_text("")  # a file where the job folders go: refused before anything runs
     with pytest.raises(DcfkitError, match=r"cannot create the folder .*jobs"):
         run_ablation(spec, out, jobs=1, progress=False)
+
+
+def test_a_damaged_run_is_not_scored_and_is_recomputed(tmp_path, data):
+    spec = load_spec(write_spec(tmp_path / "spec.yaml", "dataset: {name: otb, root: data}\nsequences: [seqA, seqB]\n"
+                                                        "variants: {s: {config: strcf}}\n"))
+    out = tmp_path / "out"
+    first = run_ablation(spec, out, jobs=1, progress=False)
+    key = expand(spec)[0].key
+    txt = out / "jobs" / "otb" / key / "seqB.txt"
+    good = txt.read_bytes()
+    txt.write_bytes(good[:-6])  # truncate -s -6: the last height loses its decimals
+    summary = ablation.summarize(spec, out, spec.load_sequences())
+    rows = {r["sequence"]: r for r in summary["per_sequence"]}
+    assert rows["seqB"]["status"] == "damaged" and summary["overall"][0]["failed"] == 1
+    assert summary["overall"][0]["auc"] < first["summary"]["overall"][0]["auc"]  # scored as a failure, not as boxes
+    again = run_ablation(spec, out, jobs=1, progress=False)
+    assert again["done"] == [(key, "seqB")] and again["skipped"] == [(key, "seqA")]
+    assert txt.read_bytes() == good and again["summary"]["overall"][0]["failed"] == 0

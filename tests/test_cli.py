@@ -149,3 +149,38 @@ def test_video_writer_draws_points_in_the_colour_of_their_tracker(tmp_path):
     ring = out[27:34, 37:44].reshape(-1, 3)  # a circle of radius 3 around x=40, y=30
     assert any((px == COLOURS[1]).all() for px in ring) and not any((px == COLOURS[0]).all() for px in ring)
     assert not frame.any()  # the caller's frame is not drawn on
+
+
+TERMINATED_AT_FRAME_4 = """
+import os, signal, sys
+import dcfkit.cli.track as track_command
+real = track_command.iter_frames
+
+def frames(video, folder):  # the signal arrives while frame 4 is being read, as from `timeout`
+    for i, image in enumerate(real(video, folder)):
+        if i == 3:
+            os.kill(os.getpid(), getattr(signal, sys.argv[1]))
+        yield image
+
+track_command.iter_frames = frames
+from dcfkit.cli import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+@pytest.mark.parametrize("signame", ["SIGTERM", "SIGHUP"])
+def test_track_keeps_its_boxes_when_terminated(clip, tmp_path, signame):
+    import signal
+    import subprocess
+    import sys
+
+    seq, frames = clip
+    out = tmp_path / "partial.txt"
+    run = subprocess.run([sys.executable, "-c", TERMINATED_AT_FRAME_4, signame, "track", "strcf", "--frames",
+                          str(frames), "--box", box_arg(seq.ground_truth[0]), "--out", str(out)],
+                         capture_output=True, text=True, timeout=300)
+    assert run.returncode == 128 + getattr(signal, signame), run.stderr
+    assert f"dcfkit track: interrupted ({signame})" in run.stderr and "Traceback" not in run.stderr
+    boxes = np.loadtxt(out, delimiter=",")
+    assert boxes.shape == (3, 4)  # frames 1-3, tracked before the signal
+    np.testing.assert_allclose(boxes[0], seq.ground_truth[0], atol=1e-3)

@@ -248,7 +248,7 @@ def test_unreadable_frame_names_the_file(tmp_path):
     root, _ = dtb_root(tmp_path)
     (root / "Car2" / "img" / "00003.jpg").write_bytes(b"not a jpeg")
     (seq,) = load_dataset("dtb70", root, ["Car2"])
-    with pytest.raises(DatasetError, match=r"frame 2 of sequence 'Car2'.*00003\.jpg"):
+    with pytest.raises(DatasetError, match=r"frame 3 of sequence 'Car2'.*00003\.jpg"):  # numbered from 1
         seq.frame(2)
 
 

@@ -152,8 +152,8 @@ def plot_sensitivity(spec: AblationSpec, overall: list[dict], out, protocol: str
     over the other parameters' values, with their min-max as a band. The base value is a
     dotted vertical line. Writes ``OUT/sensitivity_<key>.png``; returns the paths.
     """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from matplotlib.backends.backend_agg import FigureCanvasAgg  # lazy: matplotlib is slow to import,
+    from matplotlib.figure import Figure  # and only plots need it
 
     grid = spec.grid
     rows = {r["variant"]: r for r in overall}

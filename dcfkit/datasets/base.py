@@ -80,8 +80,9 @@ class Sequence:
         return self.ground_truth[0].copy()
 
     def frame(self, i: int) -> np.ndarray:
-        """Frame ``i`` (0-based) as ``(H, W, 3) uint8`` BGR; :class:`DatasetError` if unreadable."""
-        return read_frame(self.frames[i], f"frame {i} of sequence {self.name!r}")
+        """Frame ``i`` (0-based index) as ``(H, W, 3) uint8`` BGR; a :class:`DatasetError` if
+        unreadable, which numbers the frame from 1 as the benchmarks' files do."""
+        return read_frame(self.frames[i], f"frame {i + 1} of sequence {self.name!r}")
 
 
 # --------------------------------------------------------------------------- images

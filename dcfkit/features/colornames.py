@@ -49,7 +49,7 @@ def _verify(table: np.ndarray, source: str) -> np.ndarray:
 
 def _from_opencv() -> np.ndarray:
     try:
-        import cv2
+        import cv2  # lazy: only when the table is read out of OpenCV
     except ImportError as exc:  # pragma: no cover - cv2 is a dependency
         raise ConfigError(f"cannot import cv2 to read the Color Names table: {exc}") from None
     folder = os.path.dirname(cv2.__file__)
@@ -73,7 +73,7 @@ def _from_file(path: str) -> np.ndarray:
     if p.suffix == ".npy":
         return _verify(np.load(p), str(p))
     if p.suffix == ".mat":
-        import scipy.io
+        import scipy.io  # lazy: only for a user-supplied .mat table
 
         arrays = [v for v in scipy.io.loadmat(str(p)).values() if isinstance(v, np.ndarray) and v.shape == SHAPE]
         if not arrays:

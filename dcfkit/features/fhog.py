@@ -111,7 +111,7 @@ def fhog(
         if soft_orientation:
             raise ValueError("fhog: arithmetic 'sse' (Piotr's gradientMex) bins orientations hard; "
                              "soft_orientation is not available with it")
-        from .fhog_sse import fhog_sse
+        from .fhog_sse import fhog_sse  # lazy: numba, compiled on first use
 
         out = fhog_sse(imgs, cell_size, n_orients, clip, channel_order == "rgb")
         return out if batch else out[0]
@@ -268,7 +268,7 @@ def _normalise(hist: np.ndarray, n_orients: int, clip: float, cell_size: int, ws
     Returns:
         ``(N, 3 * n_orients + 4, hb, wb)`` float32, C-contiguous, a new array.
     """
-    from . import kernels
+    from . import kernels  # lazy: numba, compiled on first use
 
     _, n, hb, wb = hist.shape
     no = 3 * n_orients  # orientation channels

@@ -120,7 +120,10 @@ def _grad_mag(img, reverse, table, mag, orient):  # pragma: no cover - compiled
 @numba.njit(cache=True, nogil=True)
 def _grad_hist(mag, orient, cell, n_bins, hist):  # pragma: no cover - compiled
     """gradHist with softBin = -1 (nearest orientation bin, bilinear over cells): hist is
-    (n_bins, wb, hb) float32, zeroed, summed pixel column by pixel column as Piotr's."""
+    (n_bins, wb, hb) float32, zeroed, summed pixel column by pixel column as Piotr's.
+
+    Not split: one compiled pass over the pixels, statement for statement the reference's loop (its
+    float32 rounding included); calls between numba functions would break that correspondence."""
     h, w = mag.shape
     hb, wb = h // cell, w // cell
     h0, w0 = hb * cell, wb * cell
@@ -193,7 +196,10 @@ def _grad_hist(mag, orient, cell, n_bins, hist):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True)
 def _fhog_channels(r1, n_orients, cell, clip, out):  # pragma: no cover - compiled
-    """hogNormMatrix and hogChannels of fhog: r1 (2n, wb, hb) -> out (3n + 4, hb, wb)."""
+    """hogNormMatrix and hogChannels of fhog: r1 (2n, wb, hb) -> out (3n + 4, hb, wb).
+
+    Not split: one compiled pass over the pixels, statement for statement the reference's loop (its
+    float32 rounding included); calls between numba functions would break that correspondence."""
     n2, wb, hb = r1.shape
     r2 = np.empty((n_orients, wb, hb), np.float32)
     for o in range(n_orients):

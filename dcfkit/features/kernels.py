@@ -116,6 +116,9 @@ def normalise(hist, clip, eps, orient, clipped):  # pragma: no cover - compiled
     3n orientation channels, which are clipped at ``clip``. Writes orient: (3n, N, hb, wb)
     float32, half the sum of the 4 clipped normalisations; clipped: (4, 2n, N, hb, wb) the
     clipped sensitive channels per normalisation (the texture channels sum them).
+
+    Not split: one compiled pass whose float32 operations keep the order of the vectorised
+    ``fhog._normalise`` it replaces bit for bit; its stages share the per-cell buffers.
     """
     n2, n, hb, wb = hist.shape
     no = n2 // 2

@@ -1,0 +1,90 @@
+"""The package's layout keeps showing its architecture: small functions, no import cycles, a
+library without argparse, and a reason on every import deferred into a function."""
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import grimp
+import mccabe
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "dcfkit"
+MAX_LINES = 60  # of a function's body, its docstring left out
+MAX_COMPLEXITY = 15  # McCabe, as flake8 counts it
+NOT_SPLIT = "Not split:"  # how a docstring gives the reason for a longer or more complex function
+
+
+def sources() -> list[Path]:
+    return sorted(PACKAGE.rglob("*.py"))
+
+
+def functions(tree: ast.AST):
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            yield node
+
+
+def body_lines(node) -> int:
+    body = node.body
+    if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) \
+            and isinstance(body[0].value.value, str):
+        body = body[1:]
+    return (body[-1].end_lineno - body[0].lineno + 1) if body else 0
+
+
+def complexities(tree: ast.AST) -> dict[int, int]:
+    """First line of each function -> its McCabe complexity (nested functions counted apart)."""
+    visitor = mccabe.PathGraphingAstVisitor()
+    visitor.preorder(tree, visitor)
+    return {graph.lineno: graph.complexity() for graph in visitor.graphs.values()}
+
+
+def test_functions_are_small_or_say_why_not():
+    offenders = []
+    for path in sources():
+        tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
+        cc = complexities(tree)
+        for node in functions(tree):
+            lines, complexity = body_lines(node), cc.get(node.lineno, 1)
+            if (lines > MAX_LINES or complexity > MAX_COMPLEXITY) and NOT_SPLIT not in (ast.get_docstring(node) or ""):
+                offenders.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno} {node.name}: "
+                                 f"{lines} lines, complexity {complexity}")
+    assert not offenders, "split these, or give the reason in a 'Not split:' paragraph:\n" + "\n".join(offenders)
+
+
+def test_the_checker_sees_a_long_and_a_complex_function(tmp_path):
+    branches = "\n".join(f"    if x == {i}:\n        return {i}" for i in range(20))
+    tree = ast.parse(f"def f(x):\n    '''Doc.'''\n{branches}\n    return -1\n")
+    (node,) = functions(tree)
+    assert body_lines(node) == 41 and complexities(tree)[1] == 21
+
+
+@pytest.fixture(scope="module")
+def graph():
+    return grimp.build_graph("dcfkit", include_external_packages=True, cache_dir=None)
+
+
+def test_no_import_cycles(graph):
+    cycles = sorted({tuple(sorted((m, i))) for m in graph.modules if m.startswith("dcfkit")
+                     for i in graph.find_modules_directly_imported_by(m)
+                     if i.startswith("dcfkit") and i != m and not m.startswith(i + ".") and not i.startswith(m + ".")
+                     and graph.chain_exists(importer=i, imported=m)})
+    assert not cycles, f"import cycles: {cycles}"
+
+
+def test_only_the_cli_parses_arguments(graph):
+    library = sorted(m for m in graph.find_modules_that_directly_import("argparse")
+                     if m.startswith("dcfkit") and not m.startswith("dcfkit.cli"))
+    assert not library, f"argparse outside dcfkit.cli: {library}"
+
+
+def test_imports_inside_functions_say_why():
+    silent = []
+    for path in sources():
+        lines = path.read_text(encoding="utf-8").splitlines()
+        for node in functions(ast.parse("\n".join(lines))):
+            for inner in ast.walk(node):
+                if isinstance(inner, (ast.Import, ast.ImportFrom)) and "#" not in lines[inner.lineno - 1]:
+                    silent.append(f"{path.relative_to(PACKAGE.parent)}:{inner.lineno}: {lines[inner.lineno - 1].strip()}")
+    assert not silent, "import at the top, or say on the line why it is deferred:\n" + "\n".join(silent)

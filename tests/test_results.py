@@ -1,0 +1,170 @@
+"""The results store: damaged results are detected, recomputed and never scored; folders that
+cannot take results fail before any tracking; one run key for eval and ablate."""
+from __future__ import annotations
+
+import contextlib
+import errno
+import json
+import os
+import tempfile
+
+import numpy as np
+import pytest
+
+from dcfkit import report, results
+from dcfkit.errors import DcfkitError
+from dcfkit.evaluation import run_one_pass
+from dcfkit.results import ResultStore, load_results, run_key
+
+from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixture)
+
+
+@contextlib.contextmanager
+def unwritable(monkeypatch, folder):
+    """``folder`` refuses new files: by its mode, or (as root, whom modes do not stop) by
+    making ``tempfile.mkstemp`` fail there as the kernel would."""
+    folder.mkdir(parents=True, exist_ok=True)
+    if os.geteuid() != 0:
+        folder.chmod(0o555)
+        try:
+            yield
+        finally:
+            folder.chmod(0o755)
+        return
+    real = tempfile.mkstemp
+
+    def mkstemp(*args, dir=None, **kwargs):
+        if dir is not None and os.path.realpath(dir) == os.path.realpath(folder):
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES))
+        return real(*args, dir=dir, **kwargs)
+
+    with monkeypatch.context() as m:
+        m.setattr(tempfile, "mkstemp", mkstemp)
+        yield
+
+
+def cut(path, n_bytes=6):
+    """``truncate -s -6 path``: a height 145.346 becomes 14, and the last line loses its end."""
+    data = path.read_bytes()
+    path.write_bytes(data[:-n_bytes])
+
+
+def test_a_result_file_cut_short_is_never_scored_and_is_recomputed(tmp_path, seqs, caplog):
+    run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    good = (tmp_path / "drift" / "a.txt").read_bytes()
+    cut(tmp_path / "drift" / "a.txt")
+    # not scored: load_results leaves it out and says why, so report counts it as missing
+    loaded = load_results(tmp_path, "drift", seqs)
+    assert sorted(loaded) == ["b", "c"]
+    assert "a.txt is not the file its run wrote" in caplog.text
+    scores = report.evaluate({"drift": loaded}, seqs)
+    assert scores["overall"][0]["missing"] == 1
+    # recomputed: the next run redoes exactly that sequence
+    counter = Counter()
+    summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=counter, progress=False)
+    assert summary["done"] == ["a"] and summary["skipped"] == ["b", "c"] and counter.made == 1
+    assert (tmp_path / "drift" / "a.txt").read_bytes() == good
+
+
+@pytest.mark.parametrize("damage", ["edited", "emptied", "sidecar_frames"])
+def test_other_damage_is_detected_too(tmp_path, seqs, damage):
+    run_one_pass(CONFIG, seqs[:1], tmp_path, make_tracker=Counter(), progress=False)
+    txt, side = tmp_path / "drift" / "a.txt", tmp_path / "drift" / "a.json"
+    if damage == "edited":  # same length, one digit changed
+        txt.write_text(txt.read_text().replace("4.000", "5.000", 1))
+    elif damage == "emptied":
+        txt.write_text("")
+    else:  # a sidecar that claims another frame count than the sequence has
+        meta = json.loads(side.read_text())
+        meta["frames"] += 1
+        side.write_text(json.dumps(meta))
+    store = ResultStore(tmp_path / "drift")
+    assert store.status(seqs[0], run_key(CONFIG)) == "damaged"
+    assert store.load(seqs[:1]) == {}
+
+
+def test_sidecars_without_a_checksum_are_recomputed(tmp_path, seqs):
+    """Results of dcfkit before 0.4 have no checksum: they cannot be shown intact, so they are
+    run again (docs/changes.md says so)."""
+    run_one_pass(CONFIG, seqs[:1], tmp_path, make_tracker=Counter(), progress=False)
+    side = tmp_path / "drift" / "a.json"
+    meta = json.loads(side.read_text())
+    del meta["sha256"]
+    side.write_text(json.dumps(meta))
+    assert run_one_pass(CONFIG, seqs[:1], tmp_path, make_tracker=Counter(), progress=False)["done"] == ["a"]
+
+
+def test_an_unwritable_results_folder_fails_before_any_tracking(tmp_path, seqs, monkeypatch):
+    counter = Counter()
+    with unwritable(monkeypatch, tmp_path / "drift"):
+        with pytest.raises(DcfkitError, match=r"cannot write drift's results to .*drift"):
+            run_one_pass(CONFIG, seqs, tmp_path, make_tracker=counter, progress=False)
+    assert counter.made == 0
+
+
+def test_a_folder_where_a_result_file_goes_fails_before_any_tracking(tmp_path, seqs):
+    (tmp_path / "drift" / "b.json").mkdir(parents=True)
+    counter = Counter()
+    with pytest.raises(DcfkitError, match=r"cannot write drift's results to .*drift: b\.json is a folder"):
+        run_one_pass(CONFIG, seqs, tmp_path, make_tracker=counter, progress=False)
+    assert counter.made == 0
+
+
+def test_a_write_that_fails_mid_run_is_a_clear_error_and_keeps_earlier_sequences(tmp_path, seqs, monkeypatch):
+    real = results.atomic_write
+
+    def full_disk(path, text):
+        if path.name.startswith("b."):
+            raise DcfkitError(f"cannot write {path}: No space left on device")
+        real(path, text)
+
+    monkeypatch.setattr(results, "atomic_write", full_disk)
+    with pytest.raises(DcfkitError, match=r"cannot write .*b\.txt: No space left"):
+        run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    assert sorted(load_results(tmp_path, "drift", seqs)) == ["a"]
+
+
+def test_atomic_write_names_the_file_it_cannot_write(tmp_path, monkeypatch):
+    with unwritable(monkeypatch, tmp_path / "ro"):
+        with pytest.raises(DcfkitError, match=r"cannot write .*ro/x\.txt: Permission denied"):
+            results.atomic_write(tmp_path / "ro" / "x.txt", "1\n")
+
+
+def test_report_into_an_unwritable_folder_is_a_clear_error(tmp_path, seqs, monkeypatch):
+    run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
+    with unwritable(monkeypatch, tmp_path / "out" / "report"):
+        with pytest.raises(DcfkitError, match=r"cannot write the report to .*report: Permission denied"):
+            report.write_report(tmp_path / "out", seqs)
+
+
+def test_a_tracker_named_report_is_not_shadowed_by_the_report_folder(tmp_path, seqs):
+    run_one_pass({**CONFIG, "name": "report"}, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
+    run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
+    with pytest.raises(DcfkitError, match=r"report holds a tracker's results; .*--report-dir"):
+        report.write_report(tmp_path / "out", seqs)  # would write into the tracker's folder
+    report.write_report(tmp_path / "out", seqs, report_dir=tmp_path / "tables")
+    data = json.loads((tmp_path / "tables" / "report.json").read_text())
+    assert sorted(r["tracker"] for r in data["overall"]) == ["drift", "report"]
+    # and a report folder of its own is still not taken for a tracker
+    report.write_report(tmp_path / "out", seqs, trackers=["drift"], report_dir=tmp_path / "out" / "tables")
+    assert sorted(report.gather_results(tmp_path / "out", seqs, exclude=[tmp_path / "out" / "tables"])) == \
+        ["drift", "report"]
+
+
+def test_eval_and_ablate_share_one_run_key():
+    """The key leaves out what names a run (name, description) and keeps what changes boxes."""
+    config = {"name": "a", "description": "x", "features": [{"name": "gray"}], "label": {"name": "gaussian"}}
+    assert run_key(config) == run_key({**config, "name": "b", "description": "y"})
+    assert run_key(config) != run_key({**config, "label": {"name": "dr2track"}})
+    assert run_key(config, "1.0") != run_key(config, "1.1")
+
+
+def test_the_sidecar_records_the_checksum_of_the_boxes_as_written(tmp_path, seqs):
+    run_one_pass(CONFIG, seqs[:1], tmp_path, make_tracker=Counter(), progress=False)
+    meta = json.loads((tmp_path / "drift" / "a.json").read_text())
+    import hashlib
+
+    assert meta["sha256"] == hashlib.sha256((tmp_path / "drift" / "a.txt").read_bytes()).hexdigest()
+    assert meta["frames"] == len(seqs[0]) and meta["config_hash"] == run_key(CONFIG)
+    np.testing.assert_array_equal(load_results(tmp_path, "drift", seqs[:1])["a"].boxes[:, 1:],
+                                  np.tile([3.0, 5.0, 6.0], (len(seqs[0]), 1)))
