@@ -314,9 +314,37 @@ def test_an_ambiguous_name_survives_a_plugin_failing_half_way_and_refuses_a_seco
         r.register(type("Flat", (Label,), {"name": "flat"}))
 
 
+def _reordered(value):
+    """``value`` with the keys of every mapping in it in reverse order."""
+    if isinstance(value, dict):
+        return {k: _reordered(value[k]) for k in reversed(list(value))}
+    return [_reordered(v) for v in value] if isinstance(value, list) else value
+
+
+def _each_value_changed(value):
+    """Copies of ``value``, one for each value in it (at any depth), with that value changed."""
+    if isinstance(value, dict):
+        for key, v in value.items():
+            yield from ({**value, key: changed} for changed in _each_value_changed(v))
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            yield from (value[:i] + [changed] + value[i + 1:] for changed in _each_value_changed(v))
+    else:
+        yield value + ("x" if isinstance(value, str) else 1)
+
+
 @pytest.mark.parametrize("config", [{"name": "csrt"}, {"name": "x", "regularizers": ["l2"]}, {"features": 3},
                                     {"features": [{"nome": "gray"}], "label": "gaussian"}])
 def test_configs_that_are_not_dcfkit_trackers_still_hash(config):
+    """Configs the registry cannot read (an OpenCV baseline, a typo) still key their results:
+    the hash is 16 hex digits, the same for the same config with its keys in another order,
+    and different when any value in it changes."""
+    import re
+
     from dcfkit.evaluation import config_hash
 
-    assert len(config_hash(config)) == 16
+    digest = config_hash(config)
+    assert re.fullmatch(r"[0-9a-f]{16}", digest)
+    assert config_hash(_reordered(config)) == digest
+    changed = list(_each_value_changed(config))
+    assert changed and all(config_hash(c) != digest for c in changed), changed
