@@ -314,9 +314,38 @@ def test_an_ambiguous_name_survives_a_plugin_failing_half_way_and_refuses_a_seco
         r.register(type("Flat", (Label,), {"name": "flat"}))
 
 
+def _reordered(value):
+    """``value`` with the keys of every mapping in it in reverse order."""
+    if isinstance(value, dict):
+        return {k: _reordered(value[k]) for k in reversed(list(value))}
+    return [_reordered(v) for v in value] if isinstance(value, list) else value
+
+
+def _each_value_changed(value):
+    """Copies of ``value``, one for each value in it (at any depth), with that value changed."""
+    if isinstance(value, dict):
+        for key, v in value.items():
+            yield from ({**value, key: changed} for changed in _each_value_changed(v))
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            yield from (value[:i] + [changed] + value[i + 1:] for changed in _each_value_changed(v))
+    else:
+        yield value + ("x" if isinstance(value, str) else 1)
+
+
 @pytest.mark.parametrize("config", [{"name": "csrt"}, {"name": "x", "regularizers": ["l2"]}, {"features": 3},
                                     {"features": [{"nome": "gray"}], "label": "gaussian"}])
 def test_configs_that_are_not_dcfkit_trackers_still_hash(config):
+    """Configs the registry cannot read (an OpenCV baseline, a typo) still key their results:
+    the key is 16 hex digits, the same for the same config with its keys in another order
+    or another name, and different when any other value in it changes."""
+    import re
+
     from dcfkit.results import run_key
 
-    assert len(run_key(config)) == 16
+    digest = run_key(config)
+    assert re.fullmatch(r"[0-9a-f]{16}", digest)
+    assert run_key(_reordered(config)) == digest
+    assert run_key({**config, "name": "renamed"}) == digest
+    changed = [c for c in _each_value_changed({k: v for k, v in config.items() if k != "name"})]
+    assert all(run_key({**c, "name": config.get("name")}) != digest for c in changed), changed

@@ -153,24 +153,54 @@ def test_labels_stay_finite_for_a_vanishing_sigma():
     assert np.all(np.isfinite(dsst.label_f))
 
 
+def sliding(image, n, dx, dy):
+    """``n`` frames of ``image`` moved by (dx, dy) px per frame, the image edge repeated."""
+    import cv2
+
+    return [cv2.warpAffine(image, np.float32([[1, 0, dx * k], [0, 1, dy * k]]), image.shape[1::-1],
+                           borderMode=cv2.BORDER_REPLICATE) for k in range(n)]
+
+
+def centres(boxes):
+    boxes = np.asarray(boxes, float)
+    return boxes[:, :2] + (boxes[:, 2:] - 1) / 2
+
+
 @pytest.mark.parametrize("config", ["strcf", "bacf", "dr2track"])
 @pytest.mark.parametrize("box", [(200, 150, 5, 4), (0, 0, 480, 360), (470, 350, 30, 30)],
                          ids=["tiny", "whole-image", "partly-outside"])
-def test_extreme_boxes_give_finite_boxes(config, box, sequence):
-    boxes = run(dcfkit.load_tracker(config), sequence.frames[:8], box)
+def test_extreme_boxes_follow_the_image_content(config, box, sequence):
+    """A 5x4 box, the whole image and a box mostly off the image, on a frame sliding by
+    (-2, -1.5) px a frame: the boxes stay finite, keep their size within a fifth (the content
+    does not change scale), and end near where the content under them went: within a third
+    of its 22.5 px journey, which a box left in place would miss. (The partly-outside box
+    starts with its centre off the image, clamped onto it, so only the end is checked.)"""
+    velocity = np.array([-2.0, -1.5])
+    boxes = np.array(run(dcfkit.load_tracker(config), sliding(sequence.frames[0], 10, *velocity), box))
     assert np.all(np.isfinite(boxes))
-    assert all(b[2] > 0 and b[3] > 0 for b in boxes)
+    assert np.all((boxes[:, 2:] > 0.8 * np.array(box[2:])) & (boxes[:, 2:] < 1.25 * np.array(box[2:])))
+    travel = 9 * velocity
+    assert np.hypot(*(centres(boxes)[-1] - centres([box])[0] - travel)) < np.hypot(*travel) / 3
 
 
-def test_target_leaving_the_image_keeps_boxes_finite():
-    frames = make_sequence(n_frames=40, seed=1).frames
-    import cv2
-
-    # the content slides out to the left; the image edge is replicated
-    shifted = [cv2.warpAffine(f, np.float32([[1, 0, -12 * k], [0, 1, 0]]), f.shape[1::-1],
-                              borderMode=cv2.BORDER_REPLICATE) for k, f in enumerate(frames)]
-    boxes = run(dcfkit.load_tracker("dr2track"), shifted, (20, 150, 30, 20))
-    assert np.all(np.isfinite(boxes))
+def test_target_leaving_the_image_is_followed_to_the_edge_and_kept_on_the_image():
+    """The content slides out to the left at 8 px a frame (the image edge repeated) until none
+    of it is left. While the target's centre is on the image the box moves with it; after
+    that the boxes stay finite with a positive size and the tracked centre on the image."""
+    box = (20, 150, 30, 20)
+    frames = sliding(make_sequence(n_frames=1, seed=1).frames[0], 61, -8, 0)
+    tracker = dcfkit.load_tracker("dr2track")
+    tracker.init(frames[0], box)
+    boxes, positions = [box], [tracker.position.copy()]
+    for frame in frames[1:]:
+        boxes.append(tracker.update(frame))
+        positions.append(tracker.position.copy())
+    expected = centres([box]) + np.outer(np.arange(len(frames)), [-8, 0])
+    visible = expected[:, 0] >= 0  # frames 1-5
+    assert visible.sum() == 5 and np.abs(centres(boxes)[visible] - expected[visible]).max() < 2
+    assert np.all(np.isfinite(boxes)) and all(b[2] > 0 and b[3] > 0 for b in boxes)
+    positions = np.array(positions)  # (y, x)
+    assert np.all((positions >= 0) & (positions <= np.array(frames[0].shape[:2]) - 1))
 
 
 def test_pyfftw_backend_tracks_like_scipy(sequence):
