@@ -22,6 +22,17 @@ def shared_data() -> Path:
     return SHARED_DATA
 
 
+def pytest_collection_modifyitems(config, items):
+    """Tiers: ``realdata`` (needs ../shared/data), ``install`` (pip-installs a copy), ``slow``
+    (marked by hand: spawns worker processes or a cluster). The fast tier is
+    ``python -m pytest -m "not realdata and not install and not slow"``."""
+    for item in items:
+        if "shared_data" in item.fixturenames:
+            item.add_marker(pytest.mark.realdata)
+        if "pip_install_copy" in item.fixturenames or item.path.name == "test_install.py":
+            item.add_marker(pytest.mark.install)
+
+
 @pytest.fixture(autouse=True)
 def _no_external_plugins_unless_asked(monkeypatch):
     monkeypatch.setenv("OMP_NUM_THREADS", os.environ.get("OMP_NUM_THREADS", "1"))

@@ -253,6 +253,7 @@ def alive(pid: int) -> bool:
 
 
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux /proc to watch the worker processes")
+@pytest.mark.slow
 def test_sigkill_then_rerun_loses_and_recomputes_nothing(tmp_path, data):
     spec = write_spec(tmp_path / "spec.yaml", """
 name: kill
@@ -352,6 +353,7 @@ variants: {s: {config: strcf, overrides: {scale.n_scales: 3}}}
     assert again["done"] == [] and len(again["skipped"]) == 2 and list(again["failed"]) == [(key, "seqB")]
 
 
+@pytest.mark.slow
 def test_local_pool_and_dask_give_identical_boxes(tmp_path, data):
     distributed = pytest.importorskip(
         "distributed", reason="dask.distributed not installed (pip install 'dcfkit[dask]')")
