@@ -418,3 +418,17 @@ def test_a_damaged_run_is_not_scored_and_is_recomputed(tmp_path, data):
     again = run_ablation(spec, out, jobs=1, progress=False)
     assert again["done"] == [(key, "seqB")] and again["skipped"] == [(key, "seqA")]
     assert txt.read_bytes() == good and again["summary"]["overall"][0]["failed"] == 0
+
+
+def test_eval_and_ablate_key_a_run_alike(tmp_path, data):
+    """One run identity: the same resolved config gets the same key from `dcfkit eval` (under
+    any name) as from `dcfkit ablate`."""
+    from dcfkit.evaluation import run_one_pass
+
+    spec = load_spec(write_spec(tmp_path / "spec.yaml", "dataset: {name: otb, root: data}\nsequences: [seqA]\n"
+                                                        "variants: {mine: {config: strcf, overrides: {regularizers.temporal.theta: 20}}}\n"))
+    (job,) = expand(spec)
+    config = {**load_config("strcf", {"regularizers.temporal.theta": 20}), "name": "my-strcf"}
+    summary = run_one_pass(config, spec.load_sequences(), tmp_path / "eval", progress=False)
+    assert summary["config_hash"] == job.key
+    assert json.loads((tmp_path / "eval" / "my-strcf" / "seqA.json").read_text())["config_hash"] == job.key

@@ -7,6 +7,7 @@ import warnings
 
 from ..errors import DcfkitError
 from ..registry import PluginWarning
+from ..tracking import interrupt_on_termination
 from .parser import build_parser
 
 __all__ = ["build_parser", "main"]
@@ -25,7 +26,7 @@ def _one_line_plugin_warnings(show):
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), interrupt_on_termination():  # SIGTERM/SIGHUP end a command as Ctrl-C does
         warnings.showwarning = _one_line_plugin_warnings(warnings.showwarning)
         try:
             return args.func(args) or 0

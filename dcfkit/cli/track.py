@@ -9,7 +9,7 @@ from ..config import parse_overrides
 from ..metrics import score_sequence
 from ..synthetic import make_sequence
 from ..tracker import load_tracker
-from ..tracking import Track, empty_track, interrupt_on_termination, track
+from ..tracking import Track, empty_track, track
 from ..video import VideoWriter, check_writable, iter_frames
 from .common import frame_count, parse_box
 
@@ -28,8 +28,9 @@ def add_track_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run_track(args: argparse.Namespace) -> int:
-    """Track and write the boxes; whatever ends the run (an error, Ctrl-C, SIGTERM, SIGHUP),
-    the boxes of the frames done are written."""
+    """Track and write the boxes; whatever ends the run (an error, Ctrl-C, or SIGTERM and
+    SIGHUP, which :func:`dcfkit.cli.main` turns into an interrupt), the boxes of the frames
+    done are written."""
     tracker = load_tracker(args.config, overrides=parse_overrides(args.set))
     out = check_writable(args.out, "--out") if args.out else None
     offset = 1.0 if args.one_based else 0.0
@@ -41,9 +42,8 @@ def run_track(args: argparse.Namespace) -> int:
 
     done = empty_track()
     try:
-        with interrupt_on_termination():
-            track(tracker, iter_frames(args.video, args.frames), (x - offset, y - offset, w, h),
-                  annotate if writer else None, partial=done)
+        track(tracker, iter_frames(args.video, args.frames), (x - offset, y - offset, w, h),
+              annotate if writer else None, partial=done)
     finally:  # an error on frame k keeps the boxes of frames 1..k-1
         if writer:
             writer.close()

@@ -1,0 +1,72 @@
+"""The one frame loop (dcfkit.tracking.track) and the termination signals."""
+from __future__ import annotations
+
+import os
+import signal
+
+import numpy as np
+import pytest
+
+from dcfkit.tracking import Interrupted, TrackerFailure, empty_track, interrupt_on_termination, track
+
+
+class Stepper:
+    """Moves the box 1 px right per update; raises on update ``fail_at`` (1-based frame)."""
+
+    def __init__(self, fail_at=None, out=None):
+        self.fail_at, self.out, self.frame = fail_at, out, 1
+
+    def init(self, image, box):
+        self.box = np.asarray(box, float)
+
+    def update(self, image):
+        self.frame += 1
+        if self.frame == self.fail_at:
+            raise ValueError("boom")
+        self.box = self.box + [1, 0, 0, 0]
+        return self.out if self.out is not None else self.box
+
+
+FRAMES = [np.zeros((8, 8), np.uint8)] * 5
+
+
+def test_track_collects_every_box_and_time():
+    seen = []
+    run = track(Stepper(), FRAMES, (1, 2, 3, 4), lambda i, image, box, t: seen.append((i, box[0])))
+    np.testing.assert_array_equal(run.boxes[:, 0], [1, 2, 3, 4, 5])
+    assert run.boxes.shape == (5, 4) and run.times.shape == (5,) and (run.times >= 0).all()
+    assert seen == [(0, 1.0), (1, 2.0), (2, 3.0), (3, 4.0), (4, 5.0)]
+    assert run.fps == pytest.approx(5 / run.times.sum())
+
+
+def test_a_failure_names_the_frame_from_1_and_keeps_the_frames_before():
+    done = empty_track()
+    with pytest.raises(TrackerFailure, match=r"^frame 4: update raised ValueError: boom$") as caught:
+        track(Stepper(fail_at=4), FRAMES, (1, 2, 3, 4), partial=done)
+    assert caught.value.frame == 4 and isinstance(caught.value.__cause__, ValueError)
+    np.testing.assert_array_equal(done.boxes[:, 0], [1, 2, 3])
+    assert done.times.shape == (3,)
+
+
+def test_a_non_box_is_a_failure_naming_the_frame():
+    with pytest.raises(TrackerFailure, match=r"frame 2: update\(\) returned 'lost', expected 4 numbers"):
+        track(Stepper(out="lost"), FRAMES, (1, 2, 3, 4))
+
+
+@pytest.mark.parametrize("signame", ["SIGTERM", "SIGHUP"])
+def test_termination_signals_interrupt_the_block_like_ctrl_c(signame):
+    signum = getattr(signal, signame)
+    before = signal.getsignal(signum)
+    done = empty_track()
+
+    def frames():
+        for i, image in enumerate(FRAMES):
+            if i == 2:
+                os.kill(os.getpid(), signum)
+            yield image
+
+    with pytest.raises(Interrupted) as caught:
+        with interrupt_on_termination():
+            track(Stepper(), frames(), (1, 2, 3, 4), partial=done)
+    assert isinstance(caught.value, KeyboardInterrupt) and caught.value.signum == signum
+    assert len(done.boxes) == 2 and signal.getsignal(signum) == before
