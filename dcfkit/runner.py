@@ -199,19 +199,25 @@ def run_pool(calls: Mapping[Any, tuple], jobs: int, on_result: Callable[[Any, An
                                    initializer=worker_init, initargs=(os.getpid(),))
         try:
             futures = {pool.submit(*call): key for key, call in calls.items()}
-            for future in as_completed(futures):
-                key = futures[future]
-                try:
-                    result = future.result()
-                except Exception as exc:
-                    result = on_crash(key, exc)
-                on_result(key, result)
+            _deliver(as_completed(futures), futures.__getitem__, on_result, on_crash)
         except BaseException:
             for process in list((getattr(pool, "_processes", None) or {}).values()):
                 process.terminate()  # results are written atomically: nothing half-written stays
             raise
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _deliver(finished: Iterable, key_of: Callable, on_result: Callable, on_crash: Callable) -> None:
+    """``on_result(key, result)`` for each future as it finishes; a future that raised gets
+    ``on_crash(key, exc)`` as its result."""
+    for future in finished:
+        key = key_of(future)
+        try:
+            result = future.result()
+        except Exception as exc:
+            result = on_crash(key, exc)
+        on_result(key, result)
 
 
 def _run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: str, on_result, on_crash) -> None:
@@ -232,13 +238,7 @@ def _run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: s
                                  key=f"dcfkit-{t.key}-{t.seq.dataset}-{t.seq.name}") for t in tasks]
         by_key = {f.key: t for f, t in zip(futures, tasks)}
         try:
-            for future in dask_completed(futures):
-                task = by_key[future.key]
-                try:
-                    result = future.result()
-                except Exception as exc:
-                    result = on_crash(task, exc)
-                on_result(task, result)
+            _deliver(dask_completed(futures), lambda future: by_key[future.key], on_result, on_crash)
         except BaseException:
             client.cancel(futures)
             raise
