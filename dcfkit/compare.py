@@ -15,11 +15,12 @@ given dataset, and returns one row per sequence:
   ``divergence_px`` apart (a box NaN in one file only counts as apart), or None.
 
 The ``mean`` row averages precision and AUC as the protocol averages sequences, and the
-per-sequence IoUs with equal weights. Sequences found in only one folder, or in both but
-not in the dataset, are listed in ``left_out``.
+per-sequence IoUs with equal weights. Sequences found in only one folder, in both but not
+in the dataset, or whose dcfkit sidecar says the file is damaged, are listed in ``left_out``.
 """
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 from typing import Iterable
 
@@ -27,13 +28,15 @@ import numpy as np
 
 from . import metrics
 from .datasets import DatasetError, Sequence, read_boxes
-from .results import result_files
+from .results import ResultStore, result_files
 from .protocols import DEFAULT, Protocol, get_protocol
 
 __all__ = ["COLUMNS", "compare_folders", "first_divergence", "series_iou"]
 
 COLUMNS = ("sequence", "frames", "precision", "precision_ref", "d_precision", "auc", "auc_ref", "d_auc",
            "iou", "diverges_at")
+
+log = logging.getLogger(__name__)
 
 
 def series_iou(a, b) -> np.ndarray:
@@ -68,7 +71,7 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     ``reference`` (the folders), ``rows`` (one per compared sequence, keys
     :data:`COLUMNS`), ``mean`` (the same keys, ``sequence`` "mean", ``frames`` the total,
     ``diverges_at`` None), ``diverged`` (how many sequences diverge) and ``left_out``
-    (``only_in_results``, ``only_in_reference``, ``not_in_dataset``: sequence names).
+    (``only_in_results``, ``only_in_reference``, ``not_in_dataset``, ``damaged``: sequence names).
     Raises :class:`DatasetError` for a missing folder, a malformed line (naming file and
     line), two files of one sequence with different line counts, or a line count that is
     not the sequence's frame count (naming the sequence).
@@ -76,13 +79,14 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     proto = get_protocol(protocol)
     if not divergence_px >= 0:
         raise DatasetError(f"divergence_px must be a number >= 0, got {divergence_px!r}")
-    ours, theirs = result_files(results), result_files(reference)
+    (ours, damaged), (theirs, damaged_ref) = _intact_files(results), _intact_files(reference)
     sequences = list(sequences)
     known = {s.name for s in sequences}
     both = [s for s in sequences if s.name in ours and s.name in theirs]
     left_out = {"only_in_results": sorted(set(ours) - set(theirs)),
                 "only_in_reference": sorted(set(theirs) - set(ours)),
-                "not_in_dataset": sorted((set(ours) & set(theirs)) - known)}
+                "not_in_dataset": sorted((set(ours) & set(theirs)) - known),
+                "damaged": sorted(set(damaged) | set(damaged_ref))}
     if not both:
         raise DatasetError(f"no sequence has results in both {results} ({len(ours)} files) and {reference} "
                            f"({len(theirs)} files) and ground truth in the dataset ({len(known)} sequences)")
@@ -99,6 +103,20 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     return {"protocol": proto.name, "divergence_px": float(divergence_px), "results": str(results),
             "reference": str(reference), "rows": rows, "mean": mean,
             "diverged": sum(r["diverges_at"] is not None for r in rows), "left_out": left_out}
+
+
+def _intact_files(folder) -> tuple[dict[str, Path], list[str]]:
+    """The result files of ``folder`` and, apart, the sequences whose dcfkit sidecar says the
+    file is damaged (never compared; each logged). Files without a sidecar are taken as they are."""
+    files, store = result_files(folder), ResultStore(folder)
+    damaged = []
+    for name in list(files):
+        meta = store.sidecar(name)
+        problem = store.problem(name, meta) if meta is not None else None
+        if problem is not None:
+            log.warning("%s: left out of the comparison", problem)
+            damaged.append(files.pop(name))
+    return files, [p.stem for p in damaged]
 
 
 def _boxes(seq: Sequence, path: Path, path_ref: Path) -> tuple[np.ndarray, np.ndarray]:

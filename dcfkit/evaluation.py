@@ -23,10 +23,11 @@ import numpy as np
 
 from .datasets import DatasetError, Sequence
 from .errors import ConfigError
-from .results import ResultStore, check_writable, dcfkit_version, exclusive, json_default, run_key
+from .results import (ResultStore, dcfkit_version, ensure_writable, exclusive, json_default, make_dir,
+                      remove_temporary_files, run_key)
 from .runner import RunTask, execute
 
-__all__ = ["run_one_pass", "tracker_name"]
+__all__ = ["check_one_pass", "run_one_pass", "tracker_name"]
 
 log = logging.getLogger(__name__)
 
@@ -59,15 +60,41 @@ def _check_same_dataset(store: ResultStore, metas: dict, todo: list[Sequence]) -
 
 
 def _warn_replaced(store: ResultStore, metas: dict, todo: list[Sequence], config: dict, key: str) -> None:
-    """Say so when results of another config (not merely another dcfkit version) are replaced."""
+    """Say so when results are recomputed because they are damaged, or replaced because they
+    are another config's (not merely another dcfkit version's)."""
     same = json.dumps(config, sort_keys=True, default=json_default)
+    damaged = [s.name for s in todo if store.status(s, key, metas[s.name]) == "damaged"]
     replaced = [s.name for s in todo
-                if (metas[s.name] or {}).get("config_hash") not in (None, key)
+                if (metas[s.name] or {}).get("run_key") not in (None, key)
                 and json.dumps(metas[s.name].get("config"), sort_keys=True, default=json_default) != same]
+    if damaged:
+        log.warning("%s: recomputing %d damaged result(s): %s", store.folder, len(damaged), ", ".join(damaged[:10]))
     if replaced:
         log.warning("%s: replacing the results of another config named %r for %d sequence(s): %s (give this "
                     "config another name to keep both)", store.folder, config["name"], len(replaced),
                     ", ".join(replaced[:10]))
+
+
+def _plan(config: dict, sequences: list[Sequence], out_dir) -> tuple[ResultStore, str, list[Sequence], dict]:
+    """(store, run key, sequences to run, their sidecars), after every check that needs no
+    tracking: the first boxes, the benchmark of the results there, and (when anything is to
+    run) that the folder takes the result files."""
+    name = tracker_name(config)
+    _check_first_boxes(sequences)
+    key = run_key(config)
+    store = ResultStore(Path(out_dir) / name)
+    metas = {s.name: store.sidecar(s.name) for s in sequences}  # each read once
+    todo = [s for s in sequences if store.status(s, key, metas[s.name]) != "done"]
+    _check_same_dataset(store, metas, todo)
+    if todo:
+        ensure_writable(store.folder, [f for s in todo for f in store.file_names(s.name)], f"{name}'s results")
+    return store, key, todo, metas
+
+
+def check_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir) -> None:
+    """Raise now what :func:`run_one_pass` would raise before tracking (``dcfkit eval`` checks
+    every config this way before it runs the first)."""
+    _plan(dict(config), list(sequences), out_dir)
 
 
 def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_tracker=None,
@@ -75,34 +102,32 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     """One-pass evaluation of the tracker described by ``config`` on ``sequences``.
 
     Each sequence starts from a fresh tracker initialised on frame 1's ground truth; results
-    go to ``out_dir/<config['name']>/``. The folder is checked to be writable before anything
-    runs. A tracker exception fails only its sequence. ``jobs > 1`` runs sequences in spawned
-    worker processes; ``make_tracker`` must then be picklable.
+    go to ``out_dir/<config['name']>/``. Sequences with intact results of the same run key
+    are skipped; before anything is tracked, the folder is checked to take the others. A
+    tracker exception fails only its sequence; a write failure (:class:`StoreError`) stops
+    the run. ``jobs > 1`` runs sequences in spawned worker processes; ``make_tracker`` must
+    then be picklable.
 
-    Returns a plain dict: ``tracker``, ``dir``, ``config_hash`` (the run key), ``done``
-    (computed now), ``skipped`` (already done), ``failed`` (sequence -> message).
+    Returns a plain dict: ``tracker``, ``dir``, ``run_key``, ``done`` (computed now),
+    ``skipped`` (already done), ``failed`` (sequence -> message).
     """
-    name = tracker_name(config)
     config, sequences = dict(config), list(sequences)
-    _check_first_boxes(sequences)
-    version = dcfkit_version()
-    key = run_key(config, version)
-    store = ResultStore(Path(out_dir) / name)
-    check_writable(store.folder, [f for s in sequences for f in store.file_names(s.name)], f"{name}'s results")
-
+    folder = Path(out_dir) / tracker_name(config)
+    if not folder.is_dir():
+        make_dir(folder)  # a first run: the locks need the folder
     with contextlib.ExitStack() as locks:  # a run on other sequences of this folder may go on alongside
-        lock_dir = store.folder / ".locks"
-        lock_dir.mkdir(exist_ok=True)
+        with contextlib.suppress(OSError):  # e.g. read-only results to score: exclusive() warns and goes on
+            (folder / ".locks").mkdir(exist_ok=True)
         for seq in sequences:
-            locks.enter_context(exclusive(lock_dir / f"{seq.name}.lock", "dcfkit eval",
-                                          f"{name}'s results of sequence {seq.name!r} to {store.folder}"))
-        metas = {s.name: store.sidecar(s.name) for s in sequences}  # each read once
-        todo = [s for s in sequences if store.status(s, key, metas[s.name]) != "done"]
-        _check_same_dataset(store, metas, todo)
+            locks.enter_context(exclusive(folder / ".locks" / f"{seq.name}.lock", "dcfkit eval",
+                                          f"{folder.name}'s results of sequence {seq.name!r} to {folder}"))
+        store, key, todo, metas = _plan(config, sequences, out_dir)
         _warn_replaced(store, metas, todo, config, key)
-        summary = {"tracker": name, "dir": store.folder, "config_hash": key,
+        remove_temporary_files(store.folder, [f for s in todo for f in store.file_names(s.name)])
+        summary = {"tracker": folder.name, "dir": store.folder, "run_key": key,
                    "done": [], "skipped": [s.name for s in sequences if s not in todo], "failed": {}}
-        _run(summary, [RunTask(config, s, store.folder, key, make_tracker) for s in todo], jobs, progress, version)
+        _run(summary, [RunTask(config, s, store.folder, key, make_tracker) for s in todo], jobs, progress,
+             dcfkit_version())
     order = {s.name: i for i, s in enumerate(sequences)}
     summary["done"].sort(key=order.get)
     return summary

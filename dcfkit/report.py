@@ -26,7 +26,7 @@ import numpy as np
 from . import metrics
 from .datasets import ATTRIBUTE_NAMES, DatasetError, Sequence
 from .protocols import DEFAULT, Protocol, get_protocol
-from .results import atomic_write, check_writable, import_results, load_results
+from .results import atomic_write, ensure_writable, import_results, load_results
 
 __all__ = [
     "columns",
@@ -82,7 +82,7 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
              protocol: str | Protocol = DEFAULT) -> dict:
     """Score ``results`` (tracker -> sequence name -> boxes) on ``sequences`` under ``protocol``.
 
-    A result is a :class:`dcfkit.evaluation.SequenceResult`, a dict with ``boxes`` (and
+    A result is a :class:`dcfkit.results.SequenceResult`, a dict with ``boxes`` (and
     optional ``fps``) or an ``(N, 4)`` array of 0-based boxes. ``weighting`` ``None`` averages
     as the protocol does. Returns a plain dict with ``overall``, ``per_sequence`` and
     ``per_attribute`` row lists (trackers best first by the protocol's ranking score: AO for
@@ -315,12 +315,17 @@ def plot_curves(curves: Mapping[str, Mapping], kind: str, path_stem, title: str 
     if order:
         ax.legend(loc=style["loc"], fontsize=8, framealpha=0.9)
     fig.tight_layout()
-    paths = []
-    for ext in formats:
-        path = Path(f"{path_stem}.{ext}")
-        fig.savefig(path, dpi=150)
-        paths.append(path)
+    paths = [Path(f"{path_stem}.{ext}") for ext in formats]
+    for path in paths:
+        save_figure(fig, path)
     return paths
+
+
+def save_figure(fig, path: Path) -> None:
+    """Render a matplotlib figure (format from the suffix) and write it atomically."""
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format=path.suffix[1:], dpi=150)
+    atomic_write(path, buffer.getvalue())
 
 
 # --------------------------------------------------------------------------- report
@@ -368,8 +373,8 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
 
 
 def _holds_results(folder: Path, names: set[str]) -> bool:
-    """Whether ``folder`` has the result sidecar of a sequence (a report folder has none)."""
-    return any((folder / f"{n}.json").is_file() for n in names)
+    """Whether ``folder`` has a result file or sidecar of a sequence (a report folder has none)."""
+    return any((folder / f"{n}.txt").is_file() or (folder / f"{n}.json").is_file() for n in names)
 
 
 def json_ready(obj):
@@ -385,6 +390,18 @@ def json_ready(obj):
     return obj
 
 
+REPORT_TABLES = ("overall", "per_sequence", "per_attribute")
+TABLE_FORMATS = (("table", "txt"), ("markdown", "md"), ("csv", "csv"))
+
+
+def report_file_names(sequences: Seq[Sequence]) -> list[str]:
+    """Every file a report on ``sequences`` may write."""
+    attributes = sorted({a for s in sequences for a, present in s.attributes.items() if present})
+    plots = ["precision", "success"] + [f"success_{a}" for a in attributes]
+    return ([f"{t}.{ext}" for t in REPORT_TABLES for _, ext in TABLE_FORMATS] + ["report.json"]
+            + [f"{p}.{ext}" for p in plots for ext in ("png", "svg")])
+
+
 def _write(evaluation: dict, report_dir: Path) -> list[Path]:
     paths = []
     protocol = evaluation["protocol"]["name"]
@@ -394,9 +411,9 @@ def _write(evaluation: dict, report_dir: Path) -> list[Path]:
         atomic_write(path, content)
         paths.append(path)
 
-    tables = ["overall", "per_sequence"] + (["per_attribute"] if evaluation["per_attribute"] else [])
+    tables = REPORT_TABLES if evaluation["per_attribute"] else REPORT_TABLES[:2]
     for stem in tables:
-        for fmt, ext in (("table", "txt"), ("markdown", "md"), ("csv", "csv")):
+        for fmt, ext in TABLE_FORMATS:
             text(f"{stem}.{ext}", format_table(evaluation[stem], fmt, columns(stem, protocol), protocol))
     text("report.json", json.dumps(json_ready(evaluation), indent=1) + "\n")
     for kind in ("precision", "success"):
@@ -434,6 +451,6 @@ def score_and_write(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] |
     results = gather_results(out_dir, sequences, trackers, exclude=[report_dir])
     if not results:
         raise DatasetError(f"no tracker results found under {out_dir}")
-    check_writable(report_dir, what="the report")  # before the scoring, which can take a while
+    ensure_writable(report_dir, report_file_names(sequences), "the report")  # before the scoring
     evaluation = evaluate(results, sequences, include_first, weighting, protocol)
     return evaluation, _write(evaluation, report_dir)

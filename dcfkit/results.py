@@ -12,19 +12,23 @@
     instead, when the tracker raised: frame (1-based), error, traceback.
 
 Every file is written to a temporary file in the same folder and moved into place with
-``os.replace``. A result counts only when its sidecar has the expected key and the ``.txt``
-still has the recorded checksum: a file cut short, edited or left by another config is
-recomputed by ``eval``/``ablate`` and never scored by ``report`` or the ablation summary.
+``os.replace``. A result is used only when its sidecar is well formed and its ``.txt``
+still has the recorded checksum (:meth:`ResultStore.problem`): a file cut short or edited
+is never scored by ``report``, ``compare`` or the ablation summary, and ``eval``/``ablate``
+recompute it (they also require the run key of the config they run). Every write failure
+is a :class:`StoreError` naming the file.
 """
 from __future__ import annotations
 
 import contextlib
 import dataclasses
 import functools
+import glob
 import hashlib
 import json
 import logging
 import os
+import re
 import tempfile
 import traceback
 from datetime import datetime, timezone
@@ -100,17 +104,21 @@ def _file_mode() -> int:
     return 0o666 & ~mask
 
 
-def atomic_write(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` via a temporary file in the same folder + ``os.replace``;
-    a :class:`DcfkitError` naming the file if it cannot be written."""
+class StoreError(DcfkitError):
+    """Results could not be written: the run stops (writing the next run would fail too)."""
+
+
+def atomic_write(path: Path, data: str | bytes) -> None:
+    """Write ``data`` to ``path`` via a temporary file in the same folder + ``os.replace``;
+    a :class:`StoreError` naming the file if it cannot be written."""
     try:
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     except OSError as exc:
-        raise DcfkitError(f"cannot write {path}: {exc.strerror}") from None
+        raise StoreError(f"cannot write {path}: {exc.strerror}") from None
     try:
         os.fchmod(fd, _file_mode())
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write(text)
+        with os.fdopen(fd, "wb") as f:
+            f.write(data.encode("utf-8") if isinstance(data, str) else data)
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
@@ -118,34 +126,42 @@ def atomic_write(path: Path, text: str) -> None:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         if isinstance(exc, OSError):
-            raise DcfkitError(f"cannot write {path}: {exc.strerror or exc}") from None
+            raise StoreError(f"cannot write {path}: {exc.strerror or exc}") from None
         raise
 
 
 def make_dir(folder: Path) -> Path:
-    """``mkdir -p``, with a :class:`DcfkitError` naming the folder (e.g. a file is in the way)."""
+    """``mkdir -p``, with a :class:`StoreError` naming the folder (e.g. a file is in the way)."""
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise DcfkitError(f"cannot create the folder {folder}: {exc.strerror}") from None
+        raise StoreError(f"cannot create the folder {folder}: {exc.strerror}") from None
     return folder
 
 
-def check_writable(folder: Path, names: Iterable[str] = (), what: str = "results") -> None:
-    """Raise a :class:`DcfkitError` now, before any tracking, if ``folder`` cannot take
-    ``what`` (created if needed; a probe file is written and removed) or if a file to be
-    written there, ``folder/<name>``, is a folder."""
+def ensure_writable(folder: Path, names: Iterable[str] = (), what: str = "results") -> None:
+    """Create ``folder`` if needed and raise a :class:`StoreError` now, before any work, if it
+    cannot take ``what`` (a probe file is written and removed) or if a file to be written
+    there, ``folder/<name>``, is a folder."""
     make_dir(folder)
     try:
         fd, probe = tempfile.mkstemp(dir=folder, prefix=".write-probe.")
         os.close(fd)
         os.unlink(probe)
     except OSError as exc:
-        raise DcfkitError(f"cannot write {what} to {folder}: {exc.strerror}") from None
+        raise StoreError(f"cannot write {what} to {folder}: {exc.strerror}") from None
     blocked = [name for name in names if (folder / name).is_dir()]
     if blocked:
-        raise DcfkitError(f"cannot write {what} to {folder}: {', '.join(blocked)} "
-                          f"{'is a folder' if len(blocked) == 1 else 'are folders'}; move it away")
+        raise StoreError(f"cannot write {what} to {folder}: {', '.join(blocked)} "
+                         f"{'is a folder; move it' if len(blocked) == 1 else 'are folders; move them'} away")
+
+
+def remove_temporary_files(folder: Path, names: Iterable[str]) -> None:
+    """Remove what a killed run left of writing ``folder/<name>`` (never read)."""
+    for name in names:
+        for stale in folder.glob(f".{glob.escape(name)}.*.tmp"):
+            with contextlib.suppress(OSError):
+                stale.unlink()
 
 
 @contextlib.contextmanager
@@ -167,7 +183,7 @@ def exclusive(lock: Path, command: str, what: str):
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             raise DcfkitError(f"another `{command}` is writing {what} (it holds {lock}); "
-                              f"wait for it or use another --out") from None
+                              f"wait for it or write elsewhere") from None
         except OSError as exc:
             log.warning("cannot lock %s (%s): running without the lock", lock, exc.strerror)
         yield
@@ -203,7 +219,7 @@ class SequenceResult:
     boxes: np.ndarray
     times: np.ndarray | None = None
     fps: float | None = None
-    config_hash: str | None = None
+    run_key: str | None = None
 
 
 class ResultStore:
@@ -229,25 +245,42 @@ class ResultStore:
 
     def status(self, seq: Sequence, key: str, meta: dict | None = None) -> str:
         """``done`` (complete, intact, from run ``key`` started at ``seq``'s current first
-        box), ``damaged`` (its sidecar is ``key``'s but the boxes file is not what was
-        written), ``failed`` (``key`` raised) or ``missing``. ``meta``: the sidecar, if read."""
+        box), ``damaged`` (its sidecar is ``key``'s but the sidecar or the boxes file is not
+        what was written), ``failed`` (``key`` raised) or ``missing``. ``meta``: the sidecar,
+        if read."""
         meta = self.sidecar(seq.name) if meta is None else meta
-        if meta is not None and meta.get("config_hash") == key:
+        if meta is not None and meta.get("run_key") == key:
             if meta.get("init_box") != [float(v) for v in seq.init_box]:
                 return "missing"  # a corrected annotation: run again
-            return "done" if self._intact(seq.name, meta, len(seq)) else "damaged"
+            return "done" if self.problem(seq.name, meta, len(seq)) is None else "damaged"
         error = read_json(self.error_path(seq.name))
-        return "failed" if error is not None and error.get("config_hash") == key else "missing"
+        return "failed" if error is not None and error.get("run_key") == key else "missing"
 
     def is_done(self, seq: Sequence, key: str) -> bool:
         return self.status(seq, key) == "done"
 
-    def _intact(self, name: str, meta: dict, frames: int) -> bool:
+    def problem(self, name: str, meta: dict, frames: int | None = None) -> str | None:
+        """Why the stored result of sequence ``name`` (sidecar ``meta``; ``frames`` long, if
+        known) cannot be used, or None. Results written by dcfkit < 0.4 have no checksum:
+        their lines are checked against the format dcfkit wrote instead."""
         try:
-            data = self.boxes_path(name).read_bytes()
-        except OSError:
-            return False
-        return meta.get("sha256") == checksum(data) and meta.get("frames") == frames
+            _check_sidecar(meta)
+        except (TypeError, ValueError) as exc:
+            return f"{self.sidecar_path(name)} is malformed ({exc})"
+        path = self.boxes_path(name)
+        try:
+            data = path.read_bytes()
+        except OSError as exc:
+            return f"cannot read {path} ({exc.strerror})"
+        frames = meta["frames"] if frames is None else frames
+        if "sha256" in meta:
+            if meta["sha256"] == checksum(data) and meta["frames"] == frames:
+                return None
+            return f"{path} is not the file its run wrote (cut short or edited)"
+        lines = data.splitlines(keepends=True)
+        if len(lines) == frames and all(_RESULT_LINE.fullmatch(line) for line in lines):
+            return None
+        return f"{path} (written by dcfkit < 0.4, without a checksum) is not as its run wrote it"
 
     def write(self, seq: Sequence, boxes: np.ndarray, meta: dict) -> None:
         """Store a finished run: boxes, then the sidecar (``meta`` plus the boxes' checksum)."""
@@ -261,53 +294,63 @@ class ResultStore:
             self.error_path(seq.name).unlink()
 
     def write_failure(self, seq: Sequence, record: dict, exc: BaseException) -> None:
-        """Store a failed run (removing any results, which another config may have left).
-        A failure that cannot be written is logged: the caller still reports it."""
+        """Store a failed run (removing any results, which another config may have left)."""
         record = {**record, "sequence": seq.name, "dataset": seq.dataset, "type": type(exc).__name__,
                   "traceback": "".join(traceback.format_exception(exc)), "time": now()}
         for stale in (self.sidecar_path(seq.name), self.boxes_path(seq.name)):
             with contextlib.suppress(FileNotFoundError):
                 stale.unlink()
-        try:
-            make_dir(self.folder)
-            atomic_write(self.error_path(seq.name), json.dumps(record, indent=1, default=json_default) + "\n")
-        except DcfkitError as write_error:
-            log.warning("%s", write_error)
+        make_dir(self.folder)
+        atomic_write(self.error_path(seq.name), json.dumps(record, indent=1, default=json_default) + "\n")
 
     def load(self, sequences: Iterable[Sequence | str]) -> dict[str, SequenceResult]:
         """Intact results for ``sequences`` (names or :class:`Sequence`); others (not run,
-        failed, damaged: each damaged file is logged) are left out. A :class:`DatasetError`
-        if the intact results come from different configs."""
-        results, hashes = {}, {}
+        failed, damaged, malformed: each of the last two is logged) are left out. A
+        :class:`DatasetError` if the intact results come from different configs."""
+        results, keys = {}, {}
         for seq in sequences:
             name = seq if isinstance(seq, str) else seq.name
             meta = self.sidecar(name)
             if meta is None or not self.boxes_path(name).is_file():
                 continue
-            if not self._intact(name, meta, meta.get("frames") if isinstance(seq, str) else len(seq)):
-                log.warning("%s is not the file its run wrote (cut short or edited): left out; run again "
-                            "to recompute %r", self.boxes_path(name), name)
+            problem = self.problem(name, meta, None if isinstance(seq, str) else len(seq))
+            if problem is not None:
+                log.warning("%s: left out; run it again to recompute %r", problem, name)
                 continue
-            results[name] = self._result(name, meta)
-            hashes.setdefault(meta.get("config_hash"), []).append(name)
-        if len(hashes) > 1:
-            detail = "; ".join(f"{h}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}" for h, v in hashes.items())
+            key = meta.get("run_key", meta.get("config_hash"))  # config_hash: dcfkit < 0.4
+            results[name] = SequenceResult(read_boxes(self.boxes_path(name)), _times(meta),
+                                           None if meta.get("fps") is None else float(meta["fps"]), key)
+            keys.setdefault(key, []).append(name)
+        if len(keys) > 1:
+            detail = "; ".join(f"{k}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}" for k, v in keys.items())
             raise DatasetError(
-                f"results in {self.folder} mix {len(hashes)} configurations ({detail}); rerun "
+                f"results in {self.folder} mix {len(keys)} configurations ({detail}); rerun "
                 f"`dcfkit eval` with one config, or give the other config a different 'name'")
         return results
 
-    def _result(self, name: str, meta: dict) -> SequenceResult:
-        try:
-            times = np.asarray(meta.get("times", []), dtype=np.float64).reshape(-1)
-            fps = float(meta["fps"]) if meta.get("fps") is not None else None
-            if not isinstance(meta.get("config_hash"), (str, type(None))):
-                raise TypeError(f"config_hash is {meta['config_hash']!r}")
-        except (TypeError, ValueError) as exc:
-            raise DatasetError(f"{self.sidecar_path(name)}: malformed results sidecar ({exc}); delete it and "
-                               f"run again to recompute {name!r}") from None
-        return SequenceResult(read_boxes(self.boxes_path(name)), times if times.size else None, fps,
-                              meta.get("config_hash"))
+
+_NUMBER = rb"(?:nan|-?\d+\.\d{3})"
+_RESULT_LINE = re.compile(_NUMBER + rb"(?:," + _NUMBER + rb"){3}\n")  # format_boxes's %.3f lines
+
+
+def _check_sidecar(meta: dict) -> None:
+    """A :class:`ValueError` or :class:`TypeError` naming the first field of a results
+    sidecar that has the wrong type."""
+    checks = {"frames": lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0,
+              "sha256": lambda v: isinstance(v, str),
+              "run_key": lambda v: isinstance(v, str), "config_hash": lambda v: isinstance(v, str),
+              "fps": lambda v: v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)),
+              "times": lambda v: isinstance(v, list) and all(isinstance(t, (int, float)) for t in v)}
+    if not isinstance(meta.get("frames"), int):
+        raise ValueError("no frame count")
+    for field, ok in checks.items():
+        if field in meta and not ok(meta[field]):
+            raise TypeError(f"{field} is {meta[field]!r:.60}")
+
+
+def _times(meta: dict) -> np.ndarray | None:
+    times = np.asarray(meta.get("times", []), dtype=np.float64).reshape(-1)
+    return times if times.size else None
 
 
 def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]) -> dict[str, SequenceResult]:

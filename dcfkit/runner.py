@@ -26,7 +26,7 @@ import cv2
 from .datasets import Sequence
 from .errors import DcfkitError
 from .registry import PluginWarning
-from .results import ResultStore, now, plugin_versions, run_key, dcfkit_version
+from .results import ResultStore, StoreError, dcfkit_version, now, plugin_versions, run_key
 from .tracking import TrackerFailure, track
 
 _THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS",
@@ -83,27 +83,30 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
             reading[0] = i + 1
             yield seq.frame(i)
 
+    tracker = None
     try:
         tracker = (task.make_tracker or load_dcfkit_tracker)(dict(task.config))
         run = track(tracker, frames(), seq.init_box, (lambda *_: on_frame()) if on_frame else None)
     except Exception as exc:
         frame = exc.frame if isinstance(exc, TrackerFailure) else reading[0] or None
-        return record_failure(task, version, _failure_message(seq, exc), exc, frame)
+        return record_failure(task, version, _failure_message(seq, exc, tracker is None, frame), exc, frame)
     meta = {"sequence": seq.name, "dataset": seq.dataset, "tracker": task.config.get("name"),
             "init_box": [float(v) for v in seq.init_box], "fps": run.fps, "total_time": float(run.times.sum()),
-            "config_hash": task.key, "dcfkit_version": version, "plugins": plugin_versions(task.config),
+            "run_key": task.key, "dcfkit_version": version, "plugins": plugin_versions(task.config),
             "time": now(), "config": task.config, "times": run.times.tolist()}
     store.write(seq, run.boxes, meta)
     return {"sequence": seq.name, "status": "done", "fps": run.fps, "frames": len(seq)}
 
 
-def _failure_message(seq: Sequence, exc: Exception) -> str:
-    if isinstance(exc, TrackerFailure):
-        name = seq.frames[exc.frame - 1].name if 0 < exc.frame <= len(seq.frames) else "?"
-        return f"sequence {seq.name!r}, frame {exc.frame} of {len(seq)} ({name}): {exc.detail}"
-    if isinstance(exc, DcfkitError):
-        return str(exc) if f"sequence {seq.name!r}" in str(exc) else f"sequence {seq.name!r}: {exc}"
-    return f"sequence {seq.name!r}: creating the tracker raised {type(exc).__name__}: {exc}"
+def _failure_message(seq: Sequence, exc: Exception, creating: bool, frame: int | None) -> str:
+    """What to say of a failed run, naming the sequence and the 1-based frame and its file."""
+    if isinstance(exc, DcfkitError) and not isinstance(exc, TrackerFailure) and f"sequence {seq.name!r}" in str(exc):
+        return str(exc)  # e.g. an unreadable frame: its message names the sequence and the frame
+    if creating:
+        return f"sequence {seq.name!r}: creating the tracker raised {type(exc).__name__}: {exc}"
+    where = f"frame {frame} of {len(seq)} ({seq.frames[frame - 1].name})" if frame else "before its first frame"
+    detail = exc.detail if isinstance(exc, TrackerFailure) else f"{type(exc).__name__}: {exc}"
+    return f"sequence {seq.name!r}, {where}: {detail}"
 
 
 def record_failure(task: RunTask, version: str, message: str, exc: BaseException, frame: int | None = None) -> dict:
@@ -112,7 +115,7 @@ def record_failure(task: RunTask, version: str, message: str, exc: BaseException
     ResultStore(task.folder).write_failure(task.seq, {
         "tracker": task.config.get("name"), "frame": frame,
         "frame_file": str(task.seq.frames[frame - 1]) if frame else None,
-        "error": message, "config_hash": task.key, "dcfkit_version": version}, cause)
+        "error": message, "run_key": task.key, "dcfkit_version": version}, cause)
     return {"sequence": task.seq.name, "status": "failed", "error": message, "frames": len(task.seq)}
 
 
@@ -264,9 +267,11 @@ def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None]
     if executor not in ("local", "dask"):
         raise DcfkitError(f"executor must be 'local' or 'dask', got {executor!r}")
     if jobs < 1:
-        raise DcfkitError(f"--jobs must be >= 1, got {jobs}")
+        raise DcfkitError(f"jobs must be >= 1, got {jobs}")
 
     def crashed(task: RunTask, exc: BaseException) -> dict:
+        if isinstance(exc, StoreError):  # as in this process: writing the next run would fail too
+            raise exc
         return record_failure(task, version, crash_message(task.seq, exc), exc)
 
     if not tasks:

@@ -1,7 +1,7 @@
 """The one frame loop: initialise on the first frame, update on the rest, time, collect boxes.
 
 Every run path uses :func:`track`: ``dcfkit eval`` and ``ablate`` (through
-:mod:`dcfkit.runner`), ``dcfkit track``, the demo, the benchmarks and the integrations. A
+:mod:`dcfkit.runner`), ``dcfkit track``, the demo and the benchmarks. A
 tracker is any object with ``init(image, box)`` and ``update(image) -> box``; boxes are
 ``(x, y, w, h)`` floats, **0-based**. Frame numbers in messages are **1-based**, as in the
 benchmarks' file names and annotations.
@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import os
 import signal
 import time
 from typing import Callable, Iterable
@@ -53,24 +54,56 @@ class Interrupted(KeyboardInterrupt):
         self.signum = signum
 
 
+TERMINATION = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name))
+
+
 @contextlib.contextmanager
 def interrupt_on_termination():
     """Turn SIGTERM and SIGHUP into :class:`Interrupted` while the block runs (e.g. a run under
-    ``timeout`` or a closed terminal keeps its boxes, as Ctrl-C does)."""
+    ``timeout`` or a closed terminal keeps its boxes, as Ctrl-C does). A signal that is
+    ignored when the block starts (``nohup`` ignores SIGHUP) stays ignored."""
     def handler(signum, frame):
         raise Interrupted(signum)
 
-    names = [s for s in ("SIGTERM", "SIGHUP") if hasattr(signal, s)]
     try:
-        saved = {name: signal.signal(getattr(signal, name), handler) for name in names}
+        saved = {s: signal.getsignal(s) for s in TERMINATION}
+        for s, previous in saved.items():
+            if previous is not signal.SIG_IGN:
+                signal.signal(s, handler)
     except ValueError:  # not the main thread: leave signals alone
         yield
         return
     try:
         yield
     finally:
-        for name, previous in saved.items():
-            signal.signal(getattr(signal, name), previous)
+        for s, previous in saved.items():
+            signal.signal(s, previous)
+
+
+@contextlib.contextmanager
+def termination_deferred():
+    """Hold SIGTERM and SIGHUP back while the block runs (a final write is never cut short);
+    one that arrived meanwhile is handled as it would have been, when the block ends."""
+    arrived = []
+    try:
+        saved = {s: signal.getsignal(s) for s in TERMINATION}
+        for s, previous in saved.items():
+            if previous is not signal.SIG_IGN:
+                signal.signal(s, lambda signum, frame: arrived.append(signum))
+    except ValueError:  # not the main thread: leave signals alone
+        yield
+        return
+    try:
+        yield
+    finally:
+        for s, previous in saved.items():
+            signal.signal(s, previous)
+        if arrived:
+            handler = saved[arrived[0]]
+            if callable(handler):
+                handler(arrived[0], None)
+            else:  # the default action: end the process, as the signal would have
+                os.kill(os.getpid(), arrived[0])
 
 
 def as_box(value, frame: int) -> np.ndarray:
@@ -103,7 +136,8 @@ def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | N
                     out = tracker.update(image)
             except Exception as exc:
                 call = "init" if index == 0 else "update"
-                raise TrackerFailure(index + 1, f"{call} raised {type(exc).__name__}: {exc}") from exc
+                said = str(exc).removeprefix(f"frame {index + 1}: ")  # the tracker's own errors name the frame
+                raise TrackerFailure(index + 1, f"{call} raised {type(exc).__name__}: {said}") from exc
             times.append(time.perf_counter() - start)
             boxes.append(as_box(out, index + 1))
             if on_frame is not None:

@@ -58,8 +58,9 @@ def iter_frames(video: str | None = None, frames: str | None = None) -> Iterator
         raise InputError(f"--video: {video} has no readable frames")
 
 
-def check_writable(path: str | Path, what: str) -> Path:
-    """Create ``path``'s folder and check it can be written, before any work is done."""
+def check_output_file(path: str | Path, what: str) -> Path:
+    """Create the folder of the file ``path`` and check the file can be written there, before
+    any work is done; ``what`` names the argument in the error."""
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -81,7 +82,7 @@ class VideoWriter:
         if Path(path).suffix.lower() not in VIDEO_SUFFIXES:
             raise InputError(f"--save-video: cannot write a video named {str(path)!r}: the name must end in "
                              f"{', '.join(VIDEO_SUFFIXES)}")
-        self.path = check_writable(path, "--save-video")
+        self.path = check_output_file(path, "--save-video")
         self.fps = fps
         self._writer = None
 

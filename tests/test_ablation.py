@@ -301,7 +301,7 @@ grid: {base: dr2, parameters: {label.mu: [0, 0.5]}}
         meta = json.loads(side.read_text())
         boxes = read_boxes(side.with_suffix(".txt"))
         assert meta["frames"] == len(boxes) == N_FRAMES and len(meta["times"]) == N_FRAMES
-        assert meta["config_hash"] == side.parent.name
+        assert meta["run_key"] == side.parent.name
     summary = json.loads((out / "summary.json").read_text())
     assert [r["variant"] for r in summary["overall"]] == ["dr2", "strcf", "label.mu=0", "label.mu=0.5"]
     assert all(r["failed"] == 0 and 0 <= r["precision"] <= 1 for r in summary["overall"])
@@ -430,5 +430,36 @@ def test_eval_and_ablate_key_a_run_alike(tmp_path, data):
     (job,) = expand(spec)
     config = {**load_config("strcf", {"regularizers.temporal.theta": 20}), "name": "my-strcf"}
     summary = run_one_pass(config, spec.load_sequences(), tmp_path / "eval", progress=False)
-    assert summary["config_hash"] == job.key
-    assert json.loads((tmp_path / "eval" / "my-strcf" / "seqA.json").read_text())["config_hash"] == job.key
+    assert summary["run_key"] == job.key
+    assert json.loads((tmp_path / "eval" / "my-strcf" / "seqA.json").read_text())["run_key"] == job.key
+
+
+@pytest.mark.parametrize("in_the_way", ["jobs/otb/{key}/seqB.json", "precision.png", "configs/{key}.json"])
+def test_a_folder_where_an_ablation_file_goes_is_refused_before_tracking(tmp_path, data, in_the_way, monkeypatch):
+    spec = load_spec(write_spec(tmp_path / "spec.yaml", "dataset: {name: otb, root: data}\nsequences: [seqA, seqB]\n"
+                                                        "variants: {s: {config: strcf}}\n"))
+    out = tmp_path / "out"
+    (out / in_the_way.format(key=expand(spec)[0].key)).mkdir(parents=True)
+    monkeypatch.setattr("dcfkit.runner.track", lambda *a, **k: pytest.fail("tracked before the check"))
+    with pytest.raises(DcfkitError, match=r"cannot write the ablation.*: [^ ]+ is a folder; move it away"):
+        run_ablation(spec, out, jobs=1, progress=False)
+
+
+def test_an_unwritable_job_folder_is_refused_before_tracking(tmp_path, data, monkeypatch):
+    import tempfile
+
+    spec = load_spec(write_spec(tmp_path / "spec.yaml", "dataset: {name: otb, root: data}\nsequences: [seqA]\n"
+                                                        "variants: {s: {config: strcf}}\n"))
+    folder = tmp_path / "out" / "jobs" / "otb" / expand(spec)[0].key
+    folder.mkdir(parents=True)
+    real = tempfile.mkstemp
+
+    def mkstemp(*args, dir=None, **kwargs):  # as a read-only folder refuses a new file (root ignores modes)
+        if dir is not None and Path(dir) == folder:
+            raise PermissionError(13, "Permission denied")
+        return real(*args, dir=dir, **kwargs)
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+    monkeypatch.setattr("dcfkit.runner.track", lambda *a, **k: pytest.fail("tracked before the check"))
+    with pytest.raises(DcfkitError, match=r"cannot write the ablation's results to .*: Permission denied"):
+        run_ablation(spec, tmp_path / "out", jobs=1, progress=False)

@@ -70,7 +70,7 @@ def test_hand_made_pair(folders):
     assert res["mean"]["auc"] == pytest.approx((75 / 105 + 20 / 21) / 2)
     assert res["mean"]["iou"] == pytest.approx((A_IOU + 1) / 2)
     assert res["left_out"] == {"only_in_results": ["only_ours"], "only_in_reference": ["only_theirs"],
-                               "not_in_dataset": ["c"]}
+                               "not_in_dataset": ["c"], "damaged": []}
     assert res["protocol"] == "otb"
     # a looser threshold: frame 4 is 3 px off, frame 5 is 5 px off
     assert compare_folders(ours, theirs, [sequence("a")], divergence_px=4)["rows"][0]["diverges_at"] == 5
@@ -170,3 +170,19 @@ def test_reference_results_against_themselves_and_another_tracker(shared_data, u
     other = compare_folders(bacf, refs / "ARCF-HC" / "UAV123_10fps", uav)
     assert other["diverged"] >= 1 and other["mean"]["iou"] < 1
     assert all(r["diverges_at"] is None or 2 <= r["diverges_at"] <= r["frames"] for r in other["rows"])
+
+
+def test_a_damaged_dcfkit_result_is_left_out_not_compared(tmp_path):
+    from dcfkit.results import ResultStore
+
+    seqs = [sequence("a"), sequence("b")]
+    ours, theirs = tmp_path / "ours", tmp_path / "theirs"
+    for seq in seqs:
+        ours.mkdir(exist_ok=True)
+        ResultStore(ours).write(seq, GT, {"run_key": "k"})  # as dcfkit eval stores them
+        write(theirs, seq.name, GT + [1, 1, 0, 0])
+    txt = ours / "b.txt"
+    txt.write_bytes(txt.read_bytes()[:-6])  # the last height loses its decimals
+    res = compare_folders(ours, theirs, seqs)
+    assert [r["sequence"] for r in res["rows"]] == ["a"] and res["left_out"]["damaged"] == ["b"]
+    assert res["rows"][0]["iou"] == 1.0

@@ -105,7 +105,7 @@ def test_result_files_are_one_based_with_sidecar(tmp_path, seqs):
     assert lines[0] == "3.000,4.000,5.000,6.000"  # 0-based (2, 3) written 1-based
     assert lines[5] == "8.000,4.000,5.000,6.000"
     meta = json.loads((d / "a.json").read_text())
-    assert meta["config_hash"] == run_key(CONFIG) == summary["config_hash"]
+    assert meta["run_key"] == run_key(CONFIG) == summary["run_key"]
     assert meta["dcfkit_version"] == results.dcfkit_version()
     assert len(meta["times"]) == N_FRAMES and meta["fps"] > 0 and meta["config"] == CONFIG
     res = load_results(tmp_path / "out", "drift", seqs)
@@ -158,7 +158,7 @@ def test_resume_recomputes_nothing(tmp_path, seqs, caplog, monkeypatch):
     assert "replacing the results of another config named 'drift' for 3 sequence(s): a, b, c" in caplog.text
     # the same config under another dcfkit version is recomputed without that warning
     caplog.clear()
-    monkeypatch.setattr(evaluation, "dcfkit_version", lambda: "99.0")
+    monkeypatch.setattr(results, "dcfkit_version", lambda: "99.0")
     with caplog.at_level("WARNING"):
         summary = run_one_pass({**CONFIG, "drift": 2.0}, seqs, tmp_path, make_tracker=Counter(), progress=False)
     assert summary["done"] == ["a", "b", "c"] and "replacing" not in caplog.text
@@ -189,13 +189,14 @@ def test_a_sidecar_that_is_not_an_object_means_not_done(tmp_path, seqs, content)
 
 
 @pytest.mark.parametrize("field,value", [("times", "abc"), ("times", [1, [2, 3]]), ("fps", "fast"),
-                                         ("fps", [1]), ("config_hash", [1])])
-def test_a_sidecar_with_wrong_types_is_named(tmp_path, seqs, field, value):
+                                         ("fps", [1]), ("run_key", [1])])
+def test_a_sidecar_with_wrong_types_is_named_left_out_and_recomputed(tmp_path, seqs, field, value, caplog):
     run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
     side = tmp_path / "drift" / "b.json"
     side.write_text(json.dumps({**json.loads(side.read_text()), field: value}))
-    with pytest.raises(DatasetError, match=r"b.json: malformed results sidecar .*delete it and run again"):
-        load_results(tmp_path, "drift", seqs)
+    assert sorted(load_results(tmp_path, "drift", seqs)) == ["a", "c"]
+    assert re.search(rf"b\.json is malformed \({field} is .*\): left out; run it again", caplog.text)
+    assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["done"] == ["b"]
 
 
 def test_a_second_eval_of_the_same_sequences_is_refused_and_of_others_not(tmp_path, seqs):
@@ -530,6 +531,13 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
     assert [line for line in printed if line.startswith("fast:")] == [
         f"fast: 1 run, 0 already done, 0 failed -> {tmp_path / 'out3' / 'fast'}"]
     assert printed[-1].startswith("  AO ") and printed[-1].endswith(" on 1 sequences (protocol got10k)")
+    # a second config's folder that cannot take its results stops the command before the first runs
+    (tmp_path / "out4" / "slow" / "c.json").mkdir(parents=True)
+    args = parser.parse_args(["fast.yaml", "slow.yaml", "--root", str(root), "--out", str(tmp_path / "out4"),
+                              "--no-progress"])
+    with pytest.raises(DcfkitError, match=r"slow's results to .*slow: c\.json is a folder"):
+        cli_evaluate.run_eval(args)
+    assert not list((tmp_path / "out4").rglob("*.txt"))  # nothing was tracked
 
     parser = argparse.ArgumentParser()
     cli_evaluate.add_report_arguments(parser)

@@ -6,6 +6,8 @@ import contextlib
 import errno
 import json
 import os
+import re
+import signal
 import tempfile
 
 import numpy as np
@@ -83,15 +85,20 @@ def test_other_damage_is_detected_too(tmp_path, seqs, damage):
     assert store.load(seqs[:1]) == {}
 
 
-def test_sidecars_without_a_checksum_are_recomputed(tmp_path, seqs):
-    """Results of dcfkit before 0.4 have no checksum: they cannot be shown intact, so they are
-    run again (docs/changes.md says so)."""
-    run_one_pass(CONFIG, seqs[:1], tmp_path, make_tracker=Counter(), progress=False)
-    side = tmp_path / "drift" / "a.json"
-    meta = json.loads(side.read_text())
-    del meta["sha256"]
-    side.write_text(json.dumps(meta))
-    assert run_one_pass(CONFIG, seqs[:1], tmp_path, make_tracker=Counter(), progress=False)["done"] == ["a"]
+def test_results_of_dcfkit_before_0_4_are_scored_if_intact_and_recomputed_by_eval(tmp_path, seqs, caplog):
+    """Sidecars of dcfkit < 0.4 have no checksum (and the key under ``config_hash``): report
+    checks their lines against the format dcfkit wrote; eval runs them again (another key)."""
+    run_one_pass(CONFIG, seqs[:2], tmp_path, make_tracker=Counter(), progress=False)
+    for name in ("a", "b"):
+        side = tmp_path / "drift" / f"{name}.json"
+        meta = json.loads(side.read_text())
+        meta["config_hash"] = meta.pop("run_key")
+        del meta["sha256"]
+        side.write_text(json.dumps(meta))
+    cut(tmp_path / "drift" / "b.txt")
+    loaded = load_results(tmp_path, "drift", seqs[:2])
+    assert sorted(loaded) == ["a"] and "b.txt (written by dcfkit < 0.4, without a checksum)" in caplog.text
+    assert run_one_pass(CONFIG, seqs[:2], tmp_path, make_tracker=Counter(), progress=False)["done"] == ["a", "b"]
 
 
 def test_an_unwritable_results_folder_fails_before_any_tracking(tmp_path, seqs, monkeypatch):
@@ -165,6 +172,86 @@ def test_the_sidecar_records_the_checksum_of_the_boxes_as_written(tmp_path, seqs
     import hashlib
 
     assert meta["sha256"] == hashlib.sha256((tmp_path / "drift" / "a.txt").read_bytes()).hexdigest()
-    assert meta["frames"] == len(seqs[0]) and meta["config_hash"] == run_key(CONFIG)
+    assert meta["frames"] == len(seqs[0]) and meta["run_key"] == run_key(CONFIG)
     np.testing.assert_array_equal(load_results(tmp_path, "drift", seqs[:1])["a"].boxes[:, 1:],
                                   np.tile([3.0, 5.0, 6.0], (len(seqs[0]), 1)))
+
+
+class Blocker:
+    """A picklable make_tracker that, when it builds the tracker of sequence b's run, puts a
+    folder where b's result file goes (a disk that fills up, a file system gone read-only)."""
+
+    def __init__(self, folder):
+        self.folder = folder
+
+    def __call__(self, config):
+        from test_evaluation import DriftTracker
+
+        tracker = DriftTracker(config)
+        real_init = tracker.init
+
+        def init(image, box):
+            if int(image[0, 0, 0]) == 10:  # sequence b's first frame
+                os.makedirs(os.path.join(self.folder, "b.txt"), exist_ok=True)
+            real_init(image, box)
+        tracker.init = init
+        return tracker
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_write_failure_mid_run_stops_the_run_whatever_the_jobs(tmp_path, seqs, jobs):
+    with pytest.raises(results.StoreError, match=r"cannot write .*b\.txt"):
+        run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Blocker(str(tmp_path / "drift")), jobs=jobs,
+                     progress=False)
+    assert "b" not in load_results(tmp_path, "drift", seqs)
+
+
+def test_a_terminated_eval_keeps_finished_sequences_and_leaves_no_partial_file(tmp_path, seqs):
+    from test_evaluation import DriftTracker
+
+    from dcfkit.tracking import Interrupted, interrupt_on_termination
+
+    class Terminated(DriftTracker):
+        def update(self, image):
+            if int(image[0, 0, 0]) == 12:  # sequence b, frame 3: as `kill -TERM` would
+                os.kill(os.getpid(), signal.SIGTERM)
+            return super().update(image)
+
+    with pytest.raises(Interrupted):
+        with interrupt_on_termination():
+            run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Terminated, progress=False)
+    assert sorted(load_results(tmp_path, "drift", seqs)) == ["a"]
+    assert sorted(p.name for p in (tmp_path / "drift").iterdir()) == [".locks", "a.json", "a.txt"]
+
+
+def test_finished_results_in_a_read_only_folder_are_still_scored(tmp_path, seqs, monkeypatch):
+    run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    with unwritable(monkeypatch, tmp_path / "drift"):
+        summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    assert summary["skipped"] == ["a", "b", "c"]
+
+
+def test_a_file_named_locks_only_costs_the_locks(tmp_path, seqs, caplog):
+    (tmp_path / "drift").mkdir()
+    (tmp_path / "drift" / ".locks").write_text("")
+    assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["done"] == ["a", "b", "c"]
+    assert "running without it" in caplog.text
+
+
+@pytest.mark.parametrize("blocked", ["precision.png", "overall.txt", "success_SV.svg"])
+def test_a_folder_where_a_report_file_goes_is_refused_before_scoring(tmp_path, seqs, blocked, monkeypatch):
+    run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
+    (tmp_path / "out" / "report" / blocked).mkdir(parents=True)
+    monkeypatch.setattr(report, "evaluate", lambda *a, **k: pytest.fail("scored before the check"))
+    with pytest.raises(DcfkitError, match=rf"cannot write the report to .*report: {re.escape(blocked)} is a folder"):
+        report.write_report(tmp_path / "out", seqs)
+
+
+def test_an_imported_tracker_folder_named_report_is_refused_as_report_folder(tmp_path, seqs):
+    run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
+    (tmp_path / "out" / "report").mkdir()
+    for s in seqs:
+        (tmp_path / "out" / "report" / f"{s.name}.txt").write_text((tmp_path / "out" / "drift" / f"{s.name}.txt")
+                                                                   .read_text())
+    with pytest.raises(DcfkitError, match=r"report holds a tracker's results"):
+        report.write_report(tmp_path / "out", seqs)

@@ -70,3 +70,26 @@ def test_termination_signals_interrupt_the_block_like_ctrl_c(signame):
             track(Stepper(), frames(), (1, 2, 3, 4), partial=done)
     assert isinstance(caught.value, KeyboardInterrupt) and caught.value.signum == signum
     assert len(done.boxes) == 2 and signal.getsignal(signum) == before
+
+
+def test_an_ignored_sighup_stays_ignored_as_under_nohup():
+    previous = signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    try:
+        with interrupt_on_termination():
+            os.kill(os.getpid(), signal.SIGHUP)  # nothing happens
+            assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
+        assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGHUP, previous)
+
+
+def test_termination_is_held_back_during_a_final_write():
+    from dcfkit.tracking import termination_deferred
+
+    written = []
+    with pytest.raises(Interrupted):
+        with interrupt_on_termination():
+            with termination_deferred():
+                os.kill(os.getpid(), signal.SIGTERM)
+                written.append("all of it")  # not cut short
+    assert written == ["all of it"]

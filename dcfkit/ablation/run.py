@@ -8,10 +8,10 @@ from pathlib import Path
 
 from ..errors import DcfkitError
 from ..protocols import DEFAULT
-from ..results import LABEL_KEYS, ResultStore, atomic_write, check_writable, dcfkit_version, exclusive, read_json
+from ..results import LABEL_KEYS, ResultStore, atomic_write, dcfkit_version, ensure_writable, exclusive, read_json
 from ..runner import RunTask, execute, usable_cores
 from .spec import AblationSpec, Job, expand, job_dir, variant_names
-from .summary import summarize
+from .summary import output_names, summarize
 
 
 def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str = "local",
@@ -31,7 +31,9 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     """
     jobs = jobs if jobs is not None else usable_cores()
     if jobs < 1:
-        raise DcfkitError(f"--jobs must be >= 1, got {jobs}")
+        raise DcfkitError(f"jobs must be >= 1, got {jobs}")
+    if executor not in ("local", "dask"):
+        raise DcfkitError(f"executor must be 'local' or 'dask', got {executor!r}")
     out = Path(out).expanduser().resolve()
     seqs = spec.load_sequences()
     version = dcfkit_version()
@@ -41,8 +43,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     for job in job_list:
         tasks.setdefault((job.key, job.sequence), RunTask(job.config, by_name[job.sequence],
                                                           job_dir(out, spec.dataset, job.key), job.key))
-    check_writable(out, ["summary.md", "summary.csv", "summary.json", "per_sequence.md", "per_sequence.csv"],
-                   "the ablation")
+    ensure_writable(out, output_names(spec), "the ablation")
     with exclusive(out / ".lock", "dcfkit ablate", f"to {out}"):
         _prepare(out, tasks.values(), job_list, version)
         todo = sorted((t for t in tasks.values() if not ResultStore(t.folder).is_done(t.seq, t.key)),
@@ -60,9 +61,12 @@ def _prepare(out: Path, tasks, job_list: list[Job], version: str) -> None:
     for stale in (out / "jobs").glob("*/*/.*.tmp"):  # left by a killed run; never read
         with contextlib.suppress(OSError):
             stale.unlink()
+    by_folder: dict[Path, list[str]] = {}
     for task in tasks:
-        check_writable(task.folder, ResultStore(task.folder).file_names(task.seq.name), "the ablation's results")
-    check_writable(out / "configs", [f"{j.key}.json" for j in job_list], "the ablation's configs")
+        by_folder.setdefault(task.folder, []).extend(ResultStore(task.folder).file_names(task.seq.name))
+    for folder, names in by_folder.items():
+        ensure_writable(folder, names, "the ablation's results")
+    ensure_writable(out / "configs", sorted({f"{j.key}.json" for j in job_list}), "the ablation's configs")
     for job in {j.key: j for j in job_list}.values():
         path = out / "configs" / f"{job.key}.json"
         if (read_json(path) or {}).get("key") != job.key:  # missing or damaged: (re)write the record

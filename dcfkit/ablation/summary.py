@@ -10,7 +10,7 @@ from typing import Any, Mapping
 
 from ..datasets import Sequence
 from ..protocols import DEFAULT, get_protocol
-from ..report import evaluate, format_table, json_ready, plot_curves
+from ..report import evaluate, format_table, json_ready, plot_curves, save_figure
 from ..results import ResultStore, atomic_write, read_json
 from .spec import AblationSpec, Job, expand, format_value, job_dir
 
@@ -195,10 +195,20 @@ def plot_sensitivity(spec: AblationSpec, overall: list[dict], out, protocol: str
         ax.grid(True, linestyle=":", linewidth=0.6)
         ax.legend(fontsize=8)
         fig.tight_layout()
-        safe = "".join(c if c.isalnum() or c in "._-" else "_" for c in key)
-        path = Path(out) / f"sensitivity_{safe}.png"
-        fig.savefig(path, dpi=150)
+        path = Path(out) / _sensitivity_file(key)
+        save_figure(fig, path)
         paths.append(path)
     return paths
+
+
+def _sensitivity_file(key: str) -> str:
+    return "sensitivity_" + "".join(c if c.isalnum() or c in "._-" else "_" for c in key) + ".png"
+
+
+def output_names(spec: AblationSpec) -> list[str]:
+    """Every file :func:`summarize` writes into the output folder."""
+    plots = ([_sensitivity_file(key) for key in spec.grid.parameters] if spec.grid is not None else
+             [f"{kind}.{ext}" for kind in ("precision", "success") for ext in ("png", "svg")])
+    return [f"{stem}.{ext}" for stem in ("summary", "per_sequence") for ext in ("md", "csv")] + ["summary.json"] + plots
 
 

@@ -13,7 +13,7 @@ from ..compare import COLUMNS, compare_folders
 from ..config import load_config, parse_overrides
 from ..datasets import load_dataset
 from ..errors import ConfigError
-from ..evaluation import run_one_pass, tracker_name
+from ..evaluation import check_one_pass, run_one_pass, tracker_name
 from ..report import columns, evaluate, format_table, json_ready, score_and_write, score_line
 from ..results import load_results
 from .common import add_dataset_arguments, add_protocol_argument, pixels
@@ -63,6 +63,8 @@ def run_eval(args: argparse.Namespace) -> int:
     sequences = load_dataset(args.dataset, args.root, args.sequences)
     overrides = parse_overrides(args.overrides)
     resolved = distinct_names(args.configs, [_resolve_config(spec, overrides) for spec in args.configs])
+    for config, _ in resolved:  # every config's folder and results checked before the first runs
+        check_one_pass(config, sequences, args.out)
     status = 0
     for config, factory in resolved:
         summary = run_one_pass(config, sequences, args.out, make_tracker=factory,

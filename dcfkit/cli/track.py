@@ -9,8 +9,9 @@ from ..config import parse_overrides
 from ..metrics import score_sequence
 from ..synthetic import make_sequence
 from ..tracker import load_tracker
-from ..tracking import Track, empty_track, track
-from ..video import VideoWriter, check_writable, iter_frames
+from ..results import atomic_write
+from ..tracking import Track, empty_track, termination_deferred, track
+from ..video import VideoWriter, check_output_file, iter_frames
 from .common import frame_count, parse_box
 
 
@@ -32,7 +33,7 @@ def run_track(args: argparse.Namespace) -> int:
     SIGHUP, which :func:`dcfkit.cli.main` turns into an interrupt), the boxes of the frames
     done are written."""
     tracker = load_tracker(args.config, overrides=parse_overrides(args.set))
-    out = check_writable(args.out, "--out") if args.out else None
+    out = check_output_file(args.out, "--out") if args.out else None
     offset = 1.0 if args.one_based else 0.0
     x, y, w, h = parse_box(args.box)
     writer = VideoWriter(args.save_video) if args.save_video else None
@@ -56,7 +57,8 @@ def _write_boxes(done: Track, out, offset: float, name: str) -> None:
         return
     lines = "".join("%.3f,%.3f,%.3f,%.3f\n" % tuple(b) for b in done.boxes + [offset, offset, 0, 0])
     if out:
-        out.write_text(lines)
+        with termination_deferred():
+            atomic_write(out, lines)
     else:
         print(lines, end="")
     seconds = float(done.times.sum())

@@ -76,7 +76,7 @@ class Sequence:
 
     @property
     def init_box(self) -> np.ndarray:
-        """Frame 0's ground truth box, ``(4,) float64`` 0-based (may contain NaN)."""
+        """Frame 1's ground-truth box, ``(4,) float64`` 0-based (may contain NaN)."""
         return self.ground_truth[0].copy()
 
     def frame(self, i: int) -> np.ndarray:
