@@ -58,26 +58,33 @@ TERMINATION = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if h
 
 
 @contextlib.contextmanager
-def interrupt_on_termination():
-    """Turn SIGTERM and SIGHUP into :class:`Interrupted` while the block runs (e.g. a run under
-    ``timeout`` or a closed terminal keeps its boxes, as Ctrl-C does). A signal that is
-    ignored when the block starts (``nohup`` ignores SIGHUP) stays ignored."""
-    def handler(signum, frame):
-        raise Interrupted(signum)
-
+def _termination_handled_by(handler):
+    """Handle SIGTERM and SIGHUP with ``handler`` in the block, except a signal ignored when
+    it starts (``nohup`` ignores SIGHUP); yields the handlers it replaced (None off the main
+    thread, where signals are left alone)."""
     try:
         saved = {s: signal.getsignal(s) for s in TERMINATION}
         for s, previous in saved.items():
             if previous is not signal.SIG_IGN:
                 signal.signal(s, handler)
-    except ValueError:  # not the main thread: leave signals alone
-        yield
+    except ValueError:  # not the main thread
+        yield None
         return
     try:
-        yield
+        yield saved
     finally:
         for s, previous in saved.items():
             signal.signal(s, previous)
+
+
+def _interrupt(signum, frame):
+    raise Interrupted(signum)
+
+
+def interrupt_on_termination():
+    """Turn SIGTERM and SIGHUP into :class:`Interrupted` while the block runs (e.g. a run under
+    ``timeout`` or a closed terminal keeps its boxes, as Ctrl-C does)."""
+    return _termination_handled_by(_interrupt)
 
 
 @contextlib.contextmanager
@@ -85,25 +92,14 @@ def termination_deferred():
     """Hold SIGTERM and SIGHUP back while the block runs (a final write is never cut short);
     one that arrived meanwhile is handled as it would have been, when the block ends."""
     arrived = []
-    try:
-        saved = {s: signal.getsignal(s) for s in TERMINATION}
-        for s, previous in saved.items():
-            if previous is not signal.SIG_IGN:
-                signal.signal(s, lambda signum, frame: arrived.append(signum))
-    except ValueError:  # not the main thread: leave signals alone
+    with _termination_handled_by(lambda signum, frame: arrived.append(signum)) as saved:
         yield
-        return
-    try:
-        yield
-    finally:
-        for s, previous in saved.items():
-            signal.signal(s, previous)
-        if arrived:
-            handler = saved[arrived[0]]
-            if callable(handler):
-                handler(arrived[0], None)
-            else:  # the default action: end the process, as the signal would have
-                os.kill(os.getpid(), arrived[0])
+    if arrived and saved is not None:
+        handler = saved[arrived[0]]
+        if callable(handler):
+            handler(arrived[0], None)
+        else:  # the default action: end the process, as the signal would have
+            os.kill(os.getpid(), arrived[0])
 
 
 def as_box(value, frame: int) -> np.ndarray:
