@@ -59,7 +59,7 @@ def _check_same_dataset(store: ResultStore, metas: dict, todo: list[Sequence]) -
                                f"is on {seq.dataset!r}: use a separate --out for each benchmark")
 
 
-def _warn_replaced(store: ResultStore, metas: dict, todo: list[Sequence], config: dict, key: str) -> None:
+def _say_what_is_recomputed(store: ResultStore, metas: dict, todo: list[Sequence], config: dict, key: str) -> None:
     """Say so when results are recomputed because they are damaged, or replaced because they
     are another config's (not merely another dcfkit version's)."""
     same = json.dumps(config, sort_keys=True, default=json_default)
@@ -122,7 +122,7 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
             locks.enter_context(exclusive(folder / ".locks" / f"{seq.name}.lock", "dcfkit eval",
                                           f"{folder.name}'s results of sequence {seq.name!r} to {folder}"))
         store, key, todo, metas = _plan(config, sequences, out_dir)
-        _warn_replaced(store, metas, todo, config, key)
+        _say_what_is_recomputed(store, metas, todo, config, key)
         remove_temporary_files(store.folder, [f for s in todo for f in store.file_names(s.name)])
         summary = {"tracker": folder.name, "dir": store.folder, "run_key": key,
                    "done": [], "skipped": [s.name for s in sequences if s not in todo], "failed": {}}
