@@ -8,6 +8,13 @@ import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, settings
+
+# Property tests run a fixed, derandomized example budget: the same examples on every run
+# (a CI failure reproduces locally), and within the minute the fuzz tests may take in all.
+settings.register_profile("dcfkit", max_examples=40, deadline=None, derandomize=True, print_blob=True,
+                          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "dcfkit"))
 
 # the real development sequences: ../shared/data next to the checkout, or $DCFKIT_TEST_DATA
 SHARED_DATA = Path(os.environ.get("DCFKIT_TEST_DATA") or Path(__file__).resolve().parents[2] / "shared" / "data")
