@@ -5,10 +5,38 @@ Coordinates are 0-based pixel indices, (y, x) order for centres and (h, w) for s
 """
 from __future__ import annotations
 
+import math
+import os
 from typing import Callable
 
 import cv2
 import numpy as np
+
+from .errors import ConfigError, InputError
+
+IMAGE_PIXELS_VARIABLE = "DCFKIT_MAX_IMAGE_PIXELS"
+DEFAULT_MAX_IMAGE_PIXELS = 10**8  # 300 MB as BGR; an 8K video frame has 33 million
+
+
+def pixel_budget(variable: str, default: int) -> int:
+    """A limit in pixels: the environment variable ``variable`` if set (``1e9`` is fine), else
+    ``default``; read when used, so a program may set it before tracking."""
+    text = os.environ.get(variable, "").strip()
+    if not text:
+        return default
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (1 <= value < math.inf):
+        raise ConfigError(f"${variable} must be a number of pixels >= 1, got {text!r}")
+    return int(value)
+
+
+def max_image_pixels() -> int:
+    """The most pixels dcfkit holds in one image: a frame it reads from a file, or a region it
+    copies from a frame for one sample (``$DCFKIT_MAX_IMAGE_PIXELS``, default 10^8)."""
+    return pixel_budget(IMAGE_PIXELS_VARIABLE, DEFAULT_MAX_IMAGE_PIXELS)
 
 
 def box_to_centre_size(box) -> tuple[np.ndarray, np.ndarray]:
@@ -44,6 +72,7 @@ def _cropper_at(shape, y0: int, x0: int, rh: int, rw: int) -> Callable[[np.ndarr
     height, width = shape[:2]
     if y0 >= 0 and x0 >= 0 and y0 + rh <= height and x0 + rw <= width:
         return lambda image: image[y0:y0 + rh, x0:x0 + rw]
+    _check_copy(rh, rw, width, height)  # checked here, where the geometry is built: before any copy
     # the part inside the image (at least its nearest edge pixel), then replicate its borders
     ya, xa = min(max(y0, 0), height - 1), min(max(x0, 0), width - 1)
     yb, xb = max(min(y0 + rh, height), ya + 1), max(min(x0 + rw, width), xa + 1)
@@ -54,6 +83,15 @@ def _cropper_at(shape, y0: int, x0: int, rh: int, rw: int) -> Callable[[np.ndarr
         cols = np.clip(np.arange(x0, x0 + rw), 0, width - 1)[None, :]
         return lambda image: image[rows, cols]
     return lambda image: cv2.copyMakeBorder(image[ya:yb, xa:xb], top, bottom, left, right, cv2.BORDER_REPLICATE)
+
+
+def _check_copy(rh: int, rw: int, width: int, height: int) -> None:
+    """InputError if a ``rw`` x ``rh`` copy (a region partly outside the image, its edges
+    replicated) would hold more than :func:`max_image_pixels`."""
+    limit = max_image_pixels()
+    if rh * rw > limit:
+        raise InputError(f"the {rw}x{rh} px region to copy from the {width}x{height} image holds {rh * rw:.3g} "
+                         f"pixels, over the limit of {limit:.3g} (${IMAGE_PIXELS_VARIABLE})")
 
 
 def resize(patch: np.ndarray, out) -> np.ndarray:
@@ -120,10 +158,15 @@ def whole_pixel_crop(image: np.ndarray, centre, size) -> np.ndarray:
     """The authors' crop (``get_pixels``, DSST's ``get_scale_sample``): ``size`` (h, w) whole pixels,
     1-based ``floor(pos) + (1:h) - floor(h/2)``, edges replicated. The pixel ``floor(centre)``
     sits at index h // 2 - 1: half a pixel above and left of the middle when h, w are even."""
+    return whole_pixel_cropper(image.shape, centre, size)(image)
+
+
+def whole_pixel_cropper(shape, centre, size) -> Callable[[np.ndarray], np.ndarray]:
+    """:func:`whole_pixel_crop` with its geometry worked out once, for images of ``shape``."""
     h, w = int(size[0]), int(size[1])
     y0 = int(np.floor(centre[0])) + 1 - h // 2
     x0 = int(np.floor(centre[1])) + 1 - w // 2
-    return _cropper_at(image.shape, y0, x0, h, w)(image)
+    return _cropper_at(shape, y0, x0, h, w)
 
 
 def resize_auto(patch: np.ndarray, out) -> np.ndarray:
@@ -138,8 +181,14 @@ def whole_pixel_sample(image: np.ndarray, centre, region, out) -> np.ndarray:
     """The search patch as the authors' code samples it (STRCF's and DR²Track's ``get_pixels``):
     :func:`whole_pixel_crop` of ``round(region)`` pixels (a side below 1 becomes 2), then
     :func:`resize_auto` to ``out``."""
+    return whole_pixel_sampler(image.shape, centre, region, out)(image)
+
+
+def whole_pixel_sampler(shape, centre, region, out) -> Callable[[np.ndarray], np.ndarray]:
+    """:func:`whole_pixel_sample` with its geometry worked out once, for images of ``shape``."""
     size = [int(v) if v >= 1 else 2 for v in round_half_away(region)]
-    return resize_auto(whole_pixel_crop(image, centre, size), out)
+    cut = whole_pixel_cropper(shape, centre, size)
+    return lambda image: resize_auto(cut(image), out)
 
 
 def _blocks_outside(start: int, n: int, k: int, size: int) -> tuple[int, int]:

@@ -15,20 +15,36 @@ Images are (H, W, 3) uint8 BGR or (H, W) uint8 gray; boxes are (x, y, w, h) floa
 from __future__ import annotations
 
 import dataclasses
+import reprlib
 from typing import Any, Mapping
 
 import cv2
 import numpy as np
 
 from .config import TrackerParams, load_config
-from .errors import InputError, TrackingError, blamed_on
+from .errors import ConfigError, InputError, TrackingError, blamed_on
 from .features import extract_stack
 from .fft import make_fft
 from .labels import Detection, gaussian_label
-from .patches import box_to_centre_size, centre_size_to_box, round_half_away, sample, whole_pixel_sample
+from .patches import (box_to_centre_size, centre_size_to_box, cropper, pixel_budget, round_half_away, sampler,
+                      whole_pixel_sampler)
 from .registry import get_registry
 from .response import newton_peak, response, shift_spectrum, subpixel_peak
-from .scale import scale_limits
+from .scale import DSST, scale_limits
+
+MAX_BOX_TO_IMAGE = 10  # an initial box is at most this many times the image's width and height
+SAMPLE_PIXELS_VARIABLE = "DCFKIT_MAX_SAMPLE_PIXELS"
+DEFAULT_MAX_SAMPLE_PIXELS = 2048**2  # 20 times the shipped configs' 5 x 200² (STRCF, BACF)
+CELL_AREA = 16  # the cell budget: as many cells as the pixel budget has 4x4-pixel cells
+
+
+def sample_budget() -> tuple[int, int]:
+    """(pixels, cells) one frame's samples may have: the search samples at every search scale,
+    in pixels and in feature cells, and the scale filter's samples (``$DCFKIT_MAX_SAMPLE_PIXELS``,
+    default 2048²; cells: a sixteenth of it). Beyond them memory and time per frame grow without
+    bound (features are ``channels x cells`` floats)."""
+    pixels = pixel_budget(SAMPLE_PIXELS_VARIABLE, DEFAULT_MAX_SAMPLE_PIXELS)
+    return pixels, max(pixels // CELL_AREA, 1)
 
 
 def check_image(image: Any, frame: int) -> np.ndarray:
@@ -47,20 +63,27 @@ def check_image(image: Any, frame: int) -> np.ndarray:
 
 
 def check_box(box: Any, image_shape: tuple[int, ...]) -> np.ndarray:
-    """A finite (x, y, w, h) with positive size that overlaps the image."""
+    """A finite (x, y, w, h) that overlaps the image, each side at least a pixel and at most
+    ``MAX_BOX_TO_IMAGE`` times the image's."""
     try:
         raw = np.asarray(box)
         if raw.dtype.kind not in "iuf":  # not booleans, complex numbers, strings or objects
             raise TypeError
         b = raw.astype(float).reshape(-1)
     except (TypeError, ValueError):
-        raise InputError(f"initial box must be 4 numbers (x, y, w, h), got {box!r}") from None
+        raise InputError(f"initial box must be 4 numbers (x, y, w, h), got {reprlib.repr(box)}") from None
     if b.size != 4 or not np.all(np.isfinite(b)):
-        raise InputError(f"initial box must be 4 finite numbers (x, y, w, h), got {box!r}")
+        raise InputError(f"initial box must be 4 finite numbers (x, y, w, h), got {reprlib.repr(box)}")
     x, y, w, h = (float(v) for v in b)
     if w <= 0 or h <= 0:
         raise InputError(f"initial box {(x, y, w, h)} has non-positive size (w={w:g}, h={h:g})")
+    if w < 1 or h < 1:  # nothing to track, and a size that underflows the geometry's areas
+        raise InputError(f"initial box {(x, y, w, h)} is under a pixel wide or tall (w={w:g}, h={h:g}); "
+                         f"boxes are in pixels, not fractions of the image")
     height, width = image_shape[:2]
+    if w > MAX_BOX_TO_IMAGE * width or h > MAX_BOX_TO_IMAGE * height:
+        raise InputError(f"initial box {(x, y, w, h)} is more than {MAX_BOX_TO_IMAGE} times as wide or as tall "
+                         f"as the {width}x{height} image")
     if x + w <= 0 or y + h <= 0 or x >= width or y >= height:
         raise InputError(f"initial box {(x, y, w, h)} lies outside the {width}x{height} image")
     return b
@@ -110,6 +133,34 @@ class Tracker:
         self.last_search_box: tuple[float, float, float, float] | None = None
         self.last_distractors = np.zeros((0, 2))
         self.held_frames: list[int] = []  # 1-based numbers of frames held as blank
+        self._check_config_budget()
+
+    # -- budgets: memory and time per frame stay bounded (docs/architecture.md) -------------
+    def _search_scales(self) -> np.ndarray:
+        """The relative scales of the search samples (one sample each per frame)."""
+        try:
+            return np.asarray(self.scale_estimator.search_factors(), dtype=float).reshape(-1)
+        except Exception:  # an estimator that needs init first: budgeted as one scale, copies checked anyway
+            return np.ones(1)
+
+    def _check_config_budget(self) -> None:
+        """ConfigError naming the keys whose samples would be over :func:`sample_budget` for any box."""
+        p, n = self.params, len(self._search_scales())
+        pixels, cells = sample_budget()
+        area = p.max_image_sample_size
+        if n * area > pixels or n * area / p.cell_size**2 > cells:
+            raise ConfigError(f"{self.name}: {n} search scales (scale.n_scales) of tracker.max_image_sample_size "
+                              f"{area:g} px (tracker.cell_size {p.cell_size}) are {n * area:.3g} px and "
+                              f"{n * area / p.cell_size**2:.3g} cells a frame, over the limit of {pixels:.3g} px and "
+                              f"{cells:.3g} cells (${SAMPLE_PIXELS_VARIABLE})")
+        if isinstance(self.scale_estimator, DSST):
+            d = self.scale_estimator.params
+            model = max(d.model_max_area, (2 * d.cell_size) ** 2)  # a sample has at least 2x2 cells
+            work = model * (d.n_scales + d.step ** (2 * (d.n_scales - 1)))  # the samples and their working patch
+            if work > pixels:
+                raise ConfigError(f"{self.name}: scale.n_scales {d.n_scales} samples of scale.model_max_area "
+                                  f"{d.model_max_area} px, and their working patch (scale.step {d.step:g}), are "
+                                  f"{work:.3g} px a frame, over the limit of {pixels:.3g} (${SAMPLE_PIXELS_VARIABLE})")
 
     # -- geometry ---------------------------------------------------------------------------
     def _geometry(self, target: np.ndarray) -> tuple[Geometry, float]:
@@ -137,10 +188,19 @@ class Tracker:
 
     def _patch(self, image: np.ndarray, centre: np.ndarray, scale: float, g: Geometry | None = None) -> np.ndarray:
         """The search patch at ``centre``, resampled to the sample size (``tracker.sampling``)."""
+        try:
+            cut = self._sampler(image.shape, centre, scale, g)
+        except InputError as exc:  # a copy over the image budget: the target has grown beyond it
+            raise InputError(f"frame {self.frame}: the search region at scale {scale:g}: {exc}") from None
+        return cut(image)
+
+    def _sampler(self, shape, centre: np.ndarray, scale: float, g: Geometry | None = None):
+        """:meth:`_patch`'s geometry, built without touching an image (an InputError if its copy
+        would be over the image budget)."""
         g = g or self.geometry
         if self.params.sampling == "whole_pixel":
-            return whole_pixel_sample(image, round_half_away(centre), g.sample_size * scale, g.sample_size)
-        return sample(image, centre, g.sample_size * scale, g.sample_size)
+            return whole_pixel_sampler(shape, round_half_away(centre), g.sample_size * scale, g.sample_size)
+        return sampler(shape, centre, g.sample_size * scale, g.sample_size)
 
     def _spectrum(self, patch: np.ndarray) -> np.ndarray:
         """(C, H, Wr) complex64 spectrum of the windowed features of a search patch."""
@@ -168,6 +228,7 @@ class Tracker:
         g, scale = self._geometry(target)
         limits = scale_limits(g.base_target, g.sample_size, image.shape, initial=scale)
         scale = float(np.clip(scale, *limits))
+        self._check_first_frame(image.shape, centre, g, scale, box)
         patch = self._patch(image, centre, scale, g)
         std = self._blank(patch)
         if std is not None:  # checked before any state changes: a failed init leaves the tracker as it was
@@ -193,6 +254,28 @@ class Tracker:
         self.last_distractors = np.zeros((0, 2))
         self.held_frames = []
         self._train(image, None, self._spectrum(patch))  # m^1: the patch checked above
+
+    def _check_first_frame(self, shape, centre: np.ndarray, g: Geometry, scale: float, box: np.ndarray) -> None:
+        """InputError naming the initial box if its samples would be over a budget: the search
+        samples' pixels and cells (:func:`sample_budget`; an extreme aspect ratio can inflate
+        them), or a region copied from the image at the largest search scale or by the DSST
+        (``$DCFKIT_MAX_IMAGE_PIXELS``). Checked before any state changes."""
+        what = f"frame 1: initial box {tuple(float(v) for v in box)}"
+        factors = self._search_scales()
+        pixels, cells = sample_budget()
+        n, area, n_cells = len(factors), int(np.prod(g.sample_size)), int(np.prod(g.filter_size))
+        if n * area > pixels or n * n_cells > cells:
+            raise InputError(f"{what}: {n} search samples of {g.sample_size[1]}x{g.sample_size[0]} px "
+                             f"({g.filter_size[1]}x{g.filter_size[0]} cells) a frame, over the limit of {pixels:.3g} px "
+                             f"and {cells:.3g} cells (${SAMPLE_PIXELS_VARIABLE})")
+        largest = float(factors.max(initial=1.0))
+        try:
+            self._sampler(shape, centre, scale * largest, g)  # the geometry only: nothing is copied
+            if isinstance(self.scale_estimator, DSST):  # its largest scale sample, cut around the target
+                d = self.scale_estimator.params
+                cropper(shape, centre, np.floor(g.base_target * scale * d.step ** ((d.n_scales - 1) / 2)))
+        except InputError as exc:
+            raise InputError(f"{what}: {exc}") from None
 
     def update(self, image: np.ndarray) -> tuple[float, float, float, float]:
         """Frame t > 1: locate the target, return its box (x, y, w, h), and learn from it."""

@@ -90,6 +90,8 @@ def test_grayscale_frames_are_tracked(sequence):
     ((10, 10, 0, 20), "non-positive size"),
     ((10, 10, 20, -3), "non-positive size"),
     ((900, 10, 20, 20), "outside the 480x360 image"),
+    ((10, 10, 0.5, 20), "under a pixel wide or tall"),
+    ((10, 10, 20, 3601), "more than 10 times as wide or as tall as the 480x360 image"),
     ((1, 2, 3), "4 finite numbers"),
     ((np.nan, 2, 3, 4), "4 finite numbers"),
 ])
