@@ -200,3 +200,138 @@ def test_a_region_that_grows_over_the_image_budget_names_the_frame(monkeypatch):
                                          r"\(\$DCFKIT_MAX_IMAGE_PIXELS\)"):
         t.update(SEQUENCE.frames[1])
     assert t.box == before
+
+
+# --------------------------------------------------------------------------- image files
+
+def png_declaring(width: int, height: int) -> bytes:
+    """A valid 8x8 PNG whose IHDR chunk claims ``width`` x ``height`` (its CRC fixed)."""
+    data = bytearray(cv2.imencode(".png", SEQUENCE.frames[0][:8, :8])[1].tobytes())
+    data[16:24] = struct.pack(">II", width, height)
+    data[29:33] = struct.pack(">I", zlib.crc32(bytes(data[12:29])))
+    return bytes(data)
+
+
+def jpeg_declaring(width: int, height: int) -> bytes:
+    """A valid 8x8 baseline JPEG whose frame header (SOF0) claims ``width`` x ``height``."""
+    data = bytearray(cv2.imencode(".jpg", SEQUENCE.frames[0][:8, :8])[1].tobytes())
+    sof = data.index(b"\xff\xc0")
+    data[sof + 5:sof + 9] = struct.pack(">HH", height, width)
+    return bytes(data)
+
+
+@pytest.fixture
+def decodes(monkeypatch):
+    """The calls made to cv2.imdecode (read_frame's decoder) while the test runs."""
+    calls = []
+    real = cv2.imdecode
+
+    def counted(*args, **kwargs):
+        calls.append(args)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(cv2, "imdecode", counted)
+    return calls
+
+
+@given(kind=st.sampled_from(["png", "jpeg"]), width=st.integers(1, 65535), height=st.integers(1, 65535))
+@example(kind="png", width=30000, height=30000)  # the 876 KB PNG that needed 5.3 GB
+@example(kind="jpeg", width=2000, height=2000)
+def test_an_image_larger_than_the_limit_is_refused_from_its_header(kind, width, height, tmp_path, monkeypatch,
+                                                                   decodes):
+    """With the limit lowered to a million pixels, a header over it is refused naming the file,
+    its size and the variable, without decoding anything; one under it is decoded or refused
+    as unreadable (its data is an 8x8 image's)."""
+    monkeypatch.setenv("DCFKIT_MAX_IMAGE_PIXELS", "1e6")
+    path = tmp_path / f"frame.{kind}"
+    path.write_bytes((png_declaring if kind == "png" else jpeg_declaring)(width, height))
+    decodes.clear()
+    if width * height > 10**6:
+        said = (rf"{width}x{height} = .* pixels, over the limit of 1e\+06: \$DCFKIT_MAX_IMAGE_PIXELS\)"
+                if width * height <= 2 * Image.MAX_IMAGE_PIXELS else "more pixels than Pillow reads")
+        with pytest.raises(DatasetError, match=rf"cannot read frame 4: .*frame\.{kind} \(its header declares {said}"):
+            read_frame(path, "frame 4")
+        assert not decodes
+        return
+    try:
+        read_frame(path)
+    except DatasetError:
+        pass
+
+
+def test_pillows_own_bomb_limit_is_a_dataset_error_too(tmp_path, monkeypatch, decodes):
+    """Pillow refuses headers over twice PIL.Image.MAX_IMAGE_PIXELS (1.79e8) itself, even when
+    dcfkit's limit is raised past it."""
+    monkeypatch.setenv("DCFKIT_MAX_IMAGE_PIXELS", "1e12")
+    path = tmp_path / "bomb.png"
+    path.write_bytes(png_declaring(30000, 30000))
+    with pytest.raises(DatasetError, match=r"bomb\.png \(its header declares more pixels than Pillow reads: "
+                                           r"1\.79e\+08, twice PIL.Image.MAX_IMAGE_PIXELS\)"):
+        read_frame(path)
+    assert not decodes
+
+
+def libjpeg_verdict(data: bytes, capfd) -> tuple[np.ndarray | None, str]:
+    """OpenCV's decode of ``data`` and what its libjpeg printed (warnings of corrupt data)."""
+    capfd.readouterr()
+    image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+    return image, capfd.readouterr().err
+
+
+TEXTURE = make_sequence(n_frames=1, size=(96, 128), target=(10, 14), distractor=False).frames[0]
+JPEG = cv2.imencode(".jpg", TEXTURE, [cv2.IMWRITE_JPEG_QUALITY, 90])[1].tobytes()
+SCAN = JPEG.index(b"\xff\xda") + 14  # the entropy-coded data (the scan header is 12 bytes + marker)
+
+
+@given(flips=st.lists(st.tuples(st.integers(SCAN, len(JPEG) - 3), st.integers(1, 255)), min_size=1, max_size=200))
+def test_a_jpeg_whose_data_libjpeg_reports_corrupt_is_refused(flips, tmp_path, capfd):
+    """Bytes of the coded data changed, the end-of-image marker kept (as the fault-injection
+    pass did): whenever OpenCV's libjpeg warns about the data, read_frame refuses the file,
+    naming it; otherwise it returns OpenCV's decode unchanged. (A change libjpeg cannot see is
+    indistinguishable from a different picture.)"""
+    data = bytearray(JPEG)
+    for position, xor in flips:
+        data[position] ^= xor
+    path = tmp_path / "frame.jpg"
+    path.write_bytes(bytes(data))
+    expected, warnings = libjpeg_verdict(bytes(data), capfd)
+    event("libjpeg warns" if expected is None or warnings.strip() else "libjpeg silent")
+    if expected is None or warnings.strip():
+        with pytest.raises(DatasetError, match=r"cannot read frame 9: .*frame\.jpg \((corrupt JPEG data|truncated "
+                                               r"JPEG|not a readable image)"):
+            read_frame(path, "frame 9")
+    else:
+        np.testing.assert_array_equal(read_frame(path, "frame 9"), expected)
+
+
+def test_valid_jpegs_decode_as_opencv_decodes_them(tmp_path):
+    """The strict check changes no pixel: the same array as cv2.imdecode, for baseline,
+    progressive, gray and 4:4:4 JPEGs."""
+    variants = {"baseline": [], "progressive": [cv2.IMWRITE_JPEG_PROGRESSIVE, 1],
+                "444": [cv2.IMWRITE_JPEG_SAMPLING_FACTOR, cv2.IMWRITE_JPEG_SAMPLING_FACTOR_444]}
+    for name, params in variants.items():
+        for image in (TEXTURE, cv2.cvtColor(TEXTURE, cv2.COLOR_BGR2GRAY)):
+            data = cv2.imencode(".jpg", image, params)[1].tobytes()
+            path = tmp_path / f"{name}.jpg"
+            path.write_bytes(data)
+            np.testing.assert_array_equal(read_frame(path), cv2.imdecode(np.frombuffer(data, np.uint8),
+                                                                         cv2.IMREAD_COLOR))
+
+
+def test_a_corrupt_frame_ends_the_run_naming_it_and_keeps_the_boxes_before(tmp_path, capsys):
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    frames = make_sequence(n_frames=4, size=(96, 128), target=(10, 14), distractor=False)
+    for i, frame in enumerate(frames.frames, start=1):
+        cv2.imwrite(str(folder / f"{i}.jpg"), frame)
+    data = bytearray((folder / "3.jpg").read_bytes())
+    scan = data.index(b"\xff\xda") + 14
+    for position in np.random.default_rng(0).integers(scan, len(data) - 2, 200):  # the pass's 200 flipped bytes
+        data[position] ^= 0xFF
+    (folder / "3.jpg").write_bytes(bytes(data))
+    out = tmp_path / "boxes.txt"
+    box = ",".join(str(v) for v in frames.ground_truth[0])
+    assert cli.main(["track", "strcf", "--frames", str(folder), f"--box={box}", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "error: cannot read frame 3: " in err and "3.jpg (corrupt JPEG data: " in err
+    assert len(out.read_text().splitlines()) == 2  # frames 1 and 2

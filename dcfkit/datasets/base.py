@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import io
 import os
 import re
+import warnings
 from pathlib import Path
 from typing import Iterable, Mapping
 
@@ -89,28 +91,78 @@ class Sequence:
 
 
 def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
-    """A BGR image; :class:`DatasetError` naming the file when it is missing, not an image, or
-    a truncated JPEG (``cv2.imread`` would return one grey below the cut, with a warning only).
-    A JPEG that lacks just its end-of-image marker, a common defect, is read as imread would."""
+    """A BGR image; :class:`DatasetError` naming the file when it is missing, not an image, larger
+    than :func:`~dcfkit.patches.max_image_pixels` (read from its header, before decoding), a
+    truncated JPEG (``cv2.imread`` would return one grey below the cut, with a warning only), or
+    a JPEG whose data libjpeg reports corrupt (``cv2.imread`` would return it with a warning, part
+    of it grey or wrong). A JPEG that lacks just its end-of-image marker, a common defect, is read
+    as imread would. Decoding is OpenCV's, unchanged."""
     import cv2  # deferred: listing sequences needs no OpenCV
 
     try:
-        data = np.fromfile(os.fspath(path), np.uint8)
+        with open(path, "rb") as file:
+            data = file.read()
     except OSError as exc:
         reason = "file does not exist" if not os.path.exists(path) else exc.strerror
         raise DatasetError(f"cannot read {what}: {path} ({reason})") from None
-    image = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
-    if image is None and _missing_end_marker(data.tobytes()):
-        image = cv2.imdecode(np.concatenate([data, _JPEG_END]), cv2.IMREAD_COLOR)
+    _check_size(data, path, what)
+    image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+    if image is None and _missing_end_marker(data):
+        data += _JPEG_END
+        image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
         if image is not None and (image[-8:, -8:] == 128).all():  # libjpeg's fill for missing data
             raise DatasetError(f"cannot read {what}: {path} (truncated JPEG: the image data stops "
                                f"before its end)")
     if image is None:
         raise DatasetError(f"cannot read {what}: {path} (not a readable image)")
+    if data.startswith(b"\xff\xd8"):
+        _check_jpeg_data(data, path, what)
     return image
 
 
-_JPEG_END = np.array([0xFF, 0xD9], np.uint8)
+def _check_size(data: bytes, path, what: str) -> None:
+    """DatasetError unless the image header declares at most ``max_image_pixels()`` pixels: a
+    small file can declare billions (a 876 KB PNG of 30000x30000 decodes to 2.7 GB). Pillow reads
+    the header only (JPEG, PNG, BMP, TIFF, WebP and more); a file whose header it cannot read is
+    refused, as its size is unknown."""
+    from PIL import Image  # deferred, as OpenCV: listing sequences reads no image
+
+    from ..patches import IMAGE_PIXELS_VARIABLE, max_image_pixels  # deferred with OpenCV, which patches imports
+
+    limit = max_image_pixels()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", Image.DecompressionBombWarning)  # dcfkit's limit is the one that applies
+        try:
+            with Image.open(io.BytesIO(data)) as header:
+                width, height = header.size
+        except Image.DecompressionBombError:  # Pillow's own limit, which it checks first: its size is not said
+            raise DatasetError(f"cannot read {what}: {path} (its header declares more pixels than Pillow reads: "
+                               f"{2 * Image.MAX_IMAGE_PIXELS:.3g}, twice PIL.Image.MAX_IMAGE_PIXELS)") from None
+        except Exception:  # Pillow's plugins raise several types for a header they cannot read
+            raise DatasetError(f"cannot read {what}: {path} (not a readable image)") from None
+    if width * height > limit:
+        raise DatasetError(f"cannot read {what}: {path} (its header declares {width}x{height} = "
+                           f"{width * height:.3g} pixels, over the limit of {limit:.3g}: ${IMAGE_PIXELS_VARIABLE})")
+
+
+def _check_jpeg_data(data: bytes, path, what: str) -> None:
+    """DatasetError if libjpeg reports the JPEG's data corrupt. OpenCV's decoder only prints
+    such a warning and returns the image, grey or garbled from the damage on; simplejpeg (the
+    same libjpeg-turbo) raises instead. Its decode at 1/8 scale reads every coded coefficient,
+    so it sees the same errors, at a third of a full decode's time."""
+    import simplejpeg  # deferred, as OpenCV
+
+    try:
+        simplejpeg.decode_jpeg(data, colorspace="BGR", min_height=1, min_width=1, strict=True)
+    except ValueError as exc:
+        try:  # a JPEG that simplejpeg cannot decode at all (CMYK, say) has nothing to say about corruption
+            simplejpeg.decode_jpeg(data, colorspace="BGR", min_height=1, min_width=1, strict=False)
+        except ValueError:
+            return
+        raise DatasetError(f"cannot read {what}: {path} (corrupt JPEG data: {exc})") from None
+
+
+_JPEG_END = b"\xff\xd9"
 
 
 def _missing_end_marker(data: bytes) -> bool:
