@@ -1,6 +1,7 @@
 """Reading frames (video file or image folder) and writing annotated videos."""
 from __future__ import annotations
 
+import math
 import os
 import re
 from pathlib import Path
@@ -11,6 +12,7 @@ import numpy as np
 
 from .datasets import read_frame
 from .errors import InputError
+from .patches import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff")
 COLOURS = ((0, 0, 255), (0, 255, 255), (255, 160, 0), (255, 0, 255), (255, 255, 255))  # BGR
@@ -34,28 +36,54 @@ def frame_files(folder: str | Path) -> list[Path]:
 
 
 def iter_frames(video: str | None = None, frames: str | None = None) -> Iterator[np.ndarray]:
-    """Yield BGR frames from a video file or an image folder."""
+    """Yield BGR frames from a video file or an image folder (:func:`read_frame`'s checks for
+    each file; :func:`video_frames`' for a video)."""
     if frames is not None:
         for i, path in enumerate(frame_files(frames), start=1):
             yield read_frame(path, f"frame {i}")
         return
+    yield from video_frames(video)
+
+
+def video_frames(video: str | os.PathLike) -> Iterator[np.ndarray]:
+    """Yield a video's frames; an InputError before reading if its frames are larger than
+    ``max_image_pixels()``, and one naming the frame where it stops short of the frame count its
+    header declares: a truncated file, whose last frame read is partly lost (OpenCV's decoder
+    fills in the rest) and is not yielded. Frames are read one ahead to know which is the last."""
+    cap = _open_video(video)
+    declared = cap.get(cv2.CAP_PROP_FRAME_COUNT)
+    declared = int(declared) if 0 < declared < math.inf else 0  # 0 (or -1): the container does not say
+    count = 0
+    try:
+        ok, image = cap.read()
+        while ok:
+            ok, following = cap.read()
+            if not ok and count + 1 < declared:
+                raise InputError(f"--video: {video} stops at frame {count + 1} of the {declared} its header declares "
+                                 f"(a truncated file?); frame {count + 1}, where its data ends, is not tracked")
+            count += 1
+            yield image
+            image = following
+    finally:
+        cap.release()
+    if count == 0:
+        raise InputError(f"--video: {video} has no readable frames")
+
+
+def _open_video(video) -> cv2.VideoCapture:
+    """An opened capture whose frame size is within ``max_image_pixels()``."""
     if not Path(video).is_file():
         raise InputError(f"--video: file not found: {video}")
     cap = cv2.VideoCapture(str(video))
     if not cap.isOpened():
         raise InputError(f"--video: OpenCV cannot open {video}")
-    count = 0
-    try:
-        while True:
-            ok, image = cap.read()
-            if not ok:
-                break
-            count += 1
-            yield image
-    finally:
+    width, height = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
+    limit = max_image_pixels()
+    if width * height > limit:
         cap.release()
-    if count == 0:
-        raise InputError(f"--video: {video} has no readable frames")
+        raise InputError(f"--video: {video} has {width}x{height} = {width * height:.3g} pixel frames, over the "
+                         f"limit of {limit:.3g} (${IMAGE_PIXELS_VARIABLE})")
+    return cap
 
 
 def check_output_file(path: str | Path, what: str) -> Path:

@@ -335,3 +335,47 @@ def test_a_corrupt_frame_ends_the_run_naming_it_and_keeps_the_boxes_before(tmp_p
     err = capsys.readouterr().err
     assert "error: cannot read frame 3: " in err and "3.jpg (corrupt JPEG data: " in err
     assert len(out.read_text().splitlines()) == 2  # frames 1 and 2
+
+
+# --------------------------------------------------------------------------- videos
+
+def write_video(path, frames) -> bytes:
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 10, frames[0].shape[1::-1])
+    for frame in frames:
+        writer.write(frame)
+    writer.release()
+    return path.read_bytes()
+
+
+VIDEO_FRAMES = make_sequence(n_frames=8, size=(96, 128), target=(10, 14), distractor=False)
+
+
+@pytest.mark.parametrize("kept", [0.3, 0.5, 0.8])
+def test_a_truncated_video_ends_with_an_error_naming_the_frame_where_it_stops(kept, tmp_path, capsys):
+    """An MJPG .avi cut short: the frames before the last one read are the complete video's,
+    the last one (partly lost, filled in by FFmpeg) is not given, and the error names it and
+    the count the header declares; `dcfkit track` exits 2 with the boxes of the frames before."""
+    full = tmp_path / "full.avi"
+    data = write_video(full, VIDEO_FRAMES.frames)
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(data[:int(len(data) * kept)])
+    complete = list(iter_frames(video=str(full)))
+    got = []
+    with pytest.raises(InputError, match=r"--video: .*cut\.avi stops at frame (\d) of the 8 its header declares") as e:
+        got.extend(iter_frames(video=str(cut)))
+    stop = int(e.value.args[0].split("stops at frame ")[1].split()[0])
+    assert len(got) == stop - 1 and all(np.array_equal(a, b) for a, b in zip(got, complete))
+    out = tmp_path / "boxes.txt"
+    box = ",".join(str(v) for v in VIDEO_FRAMES.ground_truth[0])
+    assert cli.main(["track", "strcf", "--video", str(cut), f"--box={box}", "--out", str(out)]) == 2
+    assert f"stops at frame {stop} of the 8" in capsys.readouterr().err
+    assert len(out.read_text().splitlines() if out.exists() else []) == stop - 1  # none: no file
+
+
+def test_video_frames_over_the_image_limit_are_refused_before_reading(tmp_path, monkeypatch):
+    path = tmp_path / "v.avi"
+    write_video(path, VIDEO_FRAMES.frames)
+    monkeypatch.setenv("DCFKIT_MAX_IMAGE_PIXELS", "10000")
+    with pytest.raises(InputError, match=r"v\.avi has 128x96 = 1\.23e\+04 pixel frames, over the limit of 1e\+04 "
+                                         r"\(\$DCFKIT_MAX_IMAGE_PIXELS\)"):
+        next(iter_frames(video=str(path)))
