@@ -379,3 +379,19 @@ def test_video_frames_over_the_image_limit_are_refused_before_reading(tmp_path, 
     with pytest.raises(InputError, match=r"v\.avi has 128x96 = 1\.23e\+04 pixel frames, over the limit of 1e\+04 "
                                          r"\(\$DCFKIT_MAX_IMAGE_PIXELS\)"):
         next(iter_frames(video=str(path)))
+
+
+# --------------------------------------------------------------------------- the demo
+
+@pytest.mark.parametrize("args,said", [
+    (["--frames", "251"], "expected a whole number of frames from 2 to 250, got '251'"),
+    (["--frames", "100000000"], "expected a whole number of frames from 2 to 250"),
+    (["--seed", "-1"], "expected a whole number >= 0, got '-1'"),
+    (["--seed", "1.5"], "expected a whole number >= 0, got '1.5'"),
+])
+def test_demo_arguments_out_of_range_are_usage_errors(args, said, capsys):
+    """--frames beyond the generated world (the camera drifts off it near frame 265: frames
+    shrank and tracking failed) and negative seeds (numpy raised) are refused by argparse."""
+    with pytest.raises(SystemExit) as e:
+        cli.main(["demo", "--save-video", "", *args])
+    assert e.value.code == 2 and said in capsys.readouterr().err

@@ -30,14 +30,29 @@ def pixels(text: str) -> float:
     return value
 
 
+# the demo's generated world is twice the frame; its camera drifts off it after some 265 frames
+MAX_DEMO_FRAMES = 250
+
+
 def frame_count(text: str) -> int:
-    """An argparse type: a whole number of frames >= 2."""
+    """An argparse type: a whole number of frames from 2 to MAX_DEMO_FRAMES."""
     try:
         value = int(text)
     except ValueError:
         value = 0
-    if value < 2:
-        raise argparse.ArgumentTypeError(f"expected a whole number of frames >= 2, got {text!r}")
+    if not 2 <= value <= MAX_DEMO_FRAMES:
+        raise argparse.ArgumentTypeError(f"expected a whole number of frames from 2 to {MAX_DEMO_FRAMES}, got {text!r}")
+    return value
+
+
+def seed(text: str) -> int:
+    """An argparse type: a random seed, a whole number >= 0 (numpy refuses negative ones)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}")
     return value
 
 

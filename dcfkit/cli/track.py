@@ -12,7 +12,7 @@ from ..tracker import load_tracker
 from ..results import atomic_write
 from ..tracking import Track, empty_track, termination_deferred, track
 from ..video import VideoWriter, check_output_file, iter_frames
-from .common import frame_count, parse_box
+from .common import MAX_DEMO_FRAMES, frame_count, parse_box, seed
 
 
 def add_track_arguments(p: argparse.ArgumentParser) -> None:
@@ -67,8 +67,8 @@ def _write_boxes(done: Track, out, offset: float, name: str) -> None:
 
 def add_demo_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--trackers", default="strcf,dr2track", help="comma-separated configs")
-    p.add_argument("--frames", type=frame_count, default=120, help="sequence length (at least 2)")
-    p.add_argument("--seed", type=int, default=0, help="random seed of the generated sequence")
+    p.add_argument("--frames", type=frame_count, default=120, help=f"sequence length (2 to {MAX_DEMO_FRAMES})")
+    p.add_argument("--seed", type=seed, default=0, help="random seed of the generated sequence (a whole number >= 0)")
     p.add_argument("--save-video", default="dcfkit_demo.mp4", help="annotated video ('' to skip)")
 
 
