@@ -271,11 +271,25 @@ class Tracker:
         largest = float(factors.max(initial=1.0))
         try:
             self._sampler(shape, centre, scale * largest, g)  # the geometry only: nothing is copied
-            if isinstance(self.scale_estimator, DSST):  # its largest scale sample, cut around the target
-                d = self.scale_estimator.params
-                cropper(shape, centre, np.floor(g.base_target * scale * d.step ** ((d.n_scales - 1) / 2)))
+            if isinstance(self.scale_estimator, DSST):
+                self._check_dsst_copies(shape, centre, g.base_target * scale)
         except InputError as exc:
             raise InputError(f"{what}: {exc}") from None
+
+    def _check_dsst_copies(self, shape, centre: np.ndarray, target: np.ndarray) -> None:
+        """The geometry of the DSST's largest copy at its first frame (an InputError if it would
+        be over the image budget): its largest scale sample, cut whole ('whole_pixel'), or cut
+        for the working patch, which is at least 2 cells times the span a side: the most a
+        sampler can copy for it (the more it shrinks, the wider its blocks of edge pixels; one
+        that shrinks less than 2 times copies the region itself, which is then under 4 working
+        patches: within the DSST's sample budget)."""
+        d = self.scale_estimator.params
+        span = d.step ** (d.n_scales - 1)
+        region = np.maximum(np.floor(target * span ** 0.5), 2)
+        if d.sampling == "whole_pixel":
+            cropper(shape, centre, region)
+        else:
+            sampler(shape, centre, region, np.full(2, np.ceil(2 * d.cell_size * span)))
 
     def update(self, image: np.ndarray) -> tuple[float, float, float, float]:
         """Frame t > 1: locate the target, return its box (x, y, w, h), and learn from it."""

@@ -202,6 +202,21 @@ def test_a_region_that_grows_over_the_image_budget_names_the_frame(monkeypatch):
     assert t.box == before
 
 
+def test_a_dsst_copy_over_the_image_budget_refuses_init_before_any_state_changes(monkeypatch):
+    """DR²Track's scale samples are whole-pixel crops of up to 1.6 times the target: for a box
+    ten times the image they hold 1.6 million pixels, far more than its search sample copies.
+    The refusal comes before anything changes: the tracker goes on as if init had not been
+    called."""
+    tracking, reference = dcfkit.load_tracker("dr2track"), dcfkit.load_tracker("dr2track")
+    for t in (tracking, reference):
+        t.init(SEQUENCE.frames[0], SEQUENCE.ground_truth[0])
+    monkeypatch.setenv("DCFKIT_MAX_IMAGE_PIXELS", "1e6")
+    with pytest.raises(InputError, match=r"frame 1: initial box \(0.0, 0.0, 900.0, 700.0\): the 1444x1123 px region "
+                                         r"to copy from the 96x72 image holds 1.62e\+06 pixels, over the limit of 1e\+06"):
+        tracking.init(SEQUENCE.frames[0], (0, 0, 900, 700))
+    assert tracking.update(SEQUENCE.frames[1]) == reference.update(SEQUENCE.frames[1])
+
+
 # --------------------------------------------------------------------------- image files
 
 def png_declaring(width: int, height: int) -> bytes:
