@@ -18,7 +18,7 @@ from typing import Any, Mapping
 
 import pluggy
 
-from .errors import ConfigError, DcfkitError, RegistryError, describe_error
+from .errors import ConfigError, DcfkitError, RegistryError, clip, describe_error, shown
 from .params import NoParams, check_schema, closest, parse_params
 
 PROJECT = "dcfkit"
@@ -115,7 +115,7 @@ class Registry:
                                 f"uninstall all but one of them")
         if name not in entries:
             skipped = f"; skipped plugins: {' | '.join(self.failures)}" if self.failures else ""
-            raise RegistryError(f"unknown {kind} '{name}'{closest(name, entries)}; "
+            raise RegistryError(f"unknown {kind} '{clip(name)}'{closest(name, entries)}; "
                                 f"registered {kind}s: {', '.join(sorted(entries)) or 'none'}{skipped}")
         return entries[name]
 
@@ -123,9 +123,9 @@ class Registry:
         """Instantiate a component from ``{'name': ..., **params}`` (or a bare name)."""
         if isinstance(spec, str):
             spec = {"name": spec}
-        if not isinstance(spec, Mapping) or not isinstance(spec.get("name"), str):
-            raise RegistryError(f"{where}: expected a mapping with a 'name' key "
-                                f"(one of {', '.join(self.names(kind))}), got {spec!r}")
+        if not isinstance(spec, Mapping) or not isinstance(spec.get("name"), str):  # a config's mistake
+            raise ConfigError(f"{where}: expected a mapping with a 'name' key "
+                              f"(one of {', '.join(self.names(kind))}), got {shown(spec)}")
         values = dict(spec)
         name = values.pop("name")
         try:
