@@ -27,13 +27,25 @@ from typing import Any, Mapping
 
 import yaml
 
-from .errors import ConfigError, DcfkitError
+from .errors import ConfigError, DcfkitError, clip, shown
 from .params import closest, param, parse_params
 from .registry import get_registry
 
 SLOTS = ("features", "label", "regularizers", "solver", "search", "scale")
 TOP_LEVEL = ("name", "description", "base", "tracker") + SLOTS
 REGULARIZER_ROLES = ("spatial", "temporal")
+
+# Bounds on what a config, an ablation spec or a --set value may be, far beyond any real one
+# (the shipped configs and specs: at most 6.4 KB, 409 values, 5 levels). Read when used: a
+# program that needs more sets e.g. ``dcfkit.config.MAX_VALUES = 10**6`` before loading.
+MAX_YAML_BYTES = 256 * 1024  # a YAML file or --set value (PyYAML takes up to 0.3 s to read that here)
+MAX_VALUES = 10_000  # mappings, lists, keys and scalars in one document or value, an alias counted at each use
+MAX_TEXT = 1024 * 1024  # characters of the scalars in one document or value, an alias counted at each use
+MAX_DEPTH = 32  # levels of mappings and lists nested in one another
+MAX_BASE_CHAIN = 32  # files in one 'base:' chain
+DEEP = "nested more than {} levels deep (dcfkit.config.MAX_DEPTH)"
+LARGE = "more than {} values, each alias counted as the values it stands for (dcfkit.config.MAX_VALUES)"
+LONG = "more than {} characters, each alias counted as the text it stands for (dcfkit.config.MAX_TEXT)"
 
 
 def shipped_config_dir() -> Path:
@@ -105,36 +117,185 @@ class TrackerParams:
             return "cell_selection_thresh must be in [0, 1]"
 
 
-class _StrictLoader(yaml.SafeLoader):
-    """safe_load that refuses a key given twice in one mapping (YAML keeps the last silently)."""
+class _OverLimit(Exception):
+    """A value over one of the bounds above: ``problem`` says which, ``path`` lists the keys
+    down to the part refused, ``at`` is that part (a YAML node while loading)."""
+
+    def __init__(self, problem: str, path: list, at: Any = None):
+        super().__init__(problem)
+        self.problem, self.path, self.at = problem, list(path), at
+
+    def describe(self) -> str:
+        """``dotted.key: problem`` (the problem alone for the whole value)."""
+        key = clip(".".join(clip(str(p)) for p in self.path))
+        return f"{key}: {self.problem}" if key else self.problem
+
+
+def _measure(root: Any, items) -> None:
+    """Raise :class:`_OverLimit` if ``root`` nests deeper than MAX_DEPTH, holds more than
+    MAX_VALUES values or MAX_TEXT characters with a shared part counted at each use, or
+    contains itself.
+
+    ``items(x)`` lists a container's ``(key, child)`` pairs, or gives a scalar's length in
+    characters. A shared part is walked once (memoised by identity), so an alias bomb costs the
+    time of its source, not of its expansion, and the recursion is never deeper than MAX_DEPTH.
+    """
+    known: dict[int, tuple[int, int, int] | None] = {}  # id -> (values, characters, height); None while inside
+    path: list = []
+
+    def visit(item: Any) -> tuple[int, int, int]:
+        if id(item) not in known:  # the structure keeps its parts alive: an id is not reused meanwhile
+            children = items(item)
+            if isinstance(children, int):
+                return 1, children, 0
+            known[id(item)] = None
+            known[id(item)] = add_up(item, children)
+        if known[id(item)] is None:
+            raise _OverLimit("contains itself (an alias inside its own anchor)", path, item)
+        values, characters, height = known[id(item)]
+        if len(path) + height > MAX_DEPTH:
+            raise _OverLimit(DEEP.format(MAX_DEPTH), path, item)
+        return values, characters, height
+
+    def add_up(item: Any, children: list) -> tuple[int, int, int]:
+        if len(path) >= MAX_DEPTH:
+            raise _OverLimit(DEEP.format(MAX_DEPTH), path, item)
+        values, characters, height = 1, 0, 0
+        for key, child in children:
+            path.append(key)
+            more, longer, below = visit(child)
+            path.pop()
+            values, characters, height = values + more, characters + longer, max(height, below + 1)
+            if values > MAX_VALUES:
+                raise _OverLimit(LARGE.format(MAX_VALUES), path, item)
+            if characters > MAX_TEXT:
+                raise _OverLimit(LONG.format(MAX_TEXT), path, item)
+        return values, characters, height
+
+    visit(root)
+
+
+def _node_items(node: yaml.Node) -> list | int:
+    """A YAML node's ``(key, child)`` pairs (a mapping's keys are children too), or a scalar's length."""
+    if isinstance(node, yaml.SequenceNode):
+        return list(enumerate(node.value))
+    if isinstance(node, yaml.MappingNode):
+        pairs = [(k.value if isinstance(k, yaml.ScalarNode) else "?", k, v) for k, v in node.value]
+        return [item for key, k, v in pairs for item in ((key, k), (key, v))]
+    return len(node.value)
+
+
+def _python_items(value: Any) -> list | int:
+    """A config value's ``(key, child)`` pairs if a mapping, list or tuple; else its length if
+    text, 1 for anything else."""
+    if isinstance(value, Mapping):
+        return [item for k, v in value.items() for item in ((k, k), (k, v))]
+    if isinstance(value, (list, tuple)):
+        return list(enumerate(value))
+    return len(value) if isinstance(value, (str, bytes)) else 1
+
+
+def check_value(value: Any, where: str) -> None:
+    """A ConfigError naming ``where`` and the key if ``value`` (a config dict, an override) is
+    nested too deeply, too large or contains itself: checked before anything walks it."""
+    try:
+        _measure(value, _python_items)
+    except _OverLimit as exc:
+        raise ConfigError(f"{where}: {exc.describe()}") from None
+
+
+class _BoundedLoader(yaml.SafeLoader):
+    """safe_load within the bounds above; it also refuses a key given twice in one mapping (YAML
+    keeps the last silently). The document is composed with nesting and node count bounded as it
+    goes (the composer recurses), measured with its aliases expanded, and only then built:
+    PyYAML copies what a merge key (``<<``) brings in while it builds, so a bomb is refused first."""
+
+    def __init__(self, stream):
+        super().__init__(stream)
+        self._depth = self._nodes = 0
+
+    def compose_node(self, parent, index):
+        self._depth, self._nodes = self._depth + 1, self._nodes + 1
+        try:
+            if self._depth > MAX_DEPTH + 1:  # + 1: the scalars in the deepest list
+                raise _OverLimit(DEEP.format(MAX_DEPTH), [], self.peek_event())
+            if self._nodes > MAX_VALUES:
+                raise _OverLimit(LARGE.format(MAX_VALUES), [], self.peek_event())
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+    def get_single_data(self):
+        node = self.get_single_node()
+        if node is None:
+            return None
+        _measure(node, _node_items)
+        return _tree(self.construct_document(node))
+
+    def construct_object(self, node, deep=False):
+        try:
+            return super().construct_object(node, deep)
+        except (ValueError, OverflowError) as exc:  # an int over 4300 digits, a date such as 2001-13-45
+            raise yaml.constructor.ConstructorError(None, None, f"cannot read this value: {exc}",
+                                                    node.start_mark) from None
 
     def construct_mapping(self, node, deep=False):
         seen = set()
-        for key_node, _ in node.value:  # the mapping's own scalar keys; merge keys (<<) may be overridden
+        pairs = node.value if isinstance(node, yaml.MappingNode) else ()  # not a mapping: PyYAML's error below
+        for key_node, _ in pairs:  # the mapping's own scalar keys; merge keys (<<) may be overridden
             if not isinstance(key_node, yaml.ScalarNode) or key_node.tag == "tag:yaml.org,2002:merge":
                 continue
             key = (key_node.tag, key_node.value)
             if key in seen:
                 raise yaml.constructor.ConstructorError(
-                    None, None, f"key '{key_node.value}' is given twice in this mapping", key_node.start_mark)
+                    None, None, f"key {shown(key_node.value)} is given twice in this mapping", key_node.start_mark)
             seen.add(key)
         return super().construct_mapping(node, deep)
 
 
+def _tree(value: Any) -> Any:
+    """``value`` with its mappings and lists unshared: an alias is a copy, so that an override
+    changes the one place it names (called on measured values only: bounded depth and size)."""
+    if isinstance(value, dict):
+        return {k: _tree(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_tree(v) for v in value]
+    return value
+
+
+def _load_yaml(text: str) -> Any:
+    """``text`` read by :class:`_BoundedLoader`: raises yaml.YAMLError (not YAML) or :class:`_OverLimit`."""
+    if len(text) > MAX_YAML_BYTES:
+        raise _OverLimit(f"longer than {MAX_YAML_BYTES} characters (dcfkit.config.MAX_YAML_BYTES)", [])
+    return yaml.load(text, Loader=_BoundedLoader)
+
+
+def _at(where: str, mark) -> str:
+    """``where:line:column`` of a YAML mark (None: ``where``)."""
+    return f"{where}:{mark.line + 1}:{mark.column + 1}" if mark is not None else where
+
+
 def read_yaml(path: Path) -> dict:
+    """A config or spec file as a dict; a ConfigError names the file (and line) when it is
+    unreadable, not UTF-8, not YAML, over a bound or not a mapping."""
     try:
-        text = path.read_text(encoding="utf-8")
+        with open(path, "rb") as file:
+            raw = file.read(MAX_YAML_BYTES + 1)
     except OSError as exc:
         raise ConfigError(f"cannot read config {path}: {exc.strerror}") from None
+    if len(raw) > MAX_YAML_BYTES:
+        raise ConfigError(f"{path}: larger than {MAX_YAML_BYTES} bytes (dcfkit.config.MAX_YAML_BYTES); "
+                          f"is it a config?")
+    try:
+        data = _load_yaml(raw.decode("utf-8"))
     except UnicodeDecodeError as exc:
         raise ConfigError(f"{path}: not a UTF-8 text file (byte {exc.start} is not UTF-8)") from None
-    try:
-        data = yaml.load(text, Loader=_StrictLoader)
+    except _OverLimit as exc:
+        mark = getattr(exc.at, "start_mark", None)
+        raise ConfigError(f"{_at(str(path), mark)}: {exc.describe()}") from None
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
         problem = getattr(exc, "problem", None) or str(exc)
-        raise ConfigError(f"{where}: YAML error: {problem}") from None
+        raise ConfigError(f"{_at(str(path), getattr(exc, 'problem_mark', None))}: YAML error: {problem}") from None
     if data is None:
         return {}
     if not isinstance(data, dict):
@@ -162,27 +323,33 @@ def _load_file(path: Path, chain: tuple[Path, ...] = ()) -> tuple[dict, tuple[Pa
     path = path.resolve()
     if path in chain:
         raise ConfigError(f"{path}: circular 'base' chain: {' -> '.join(map(str, chain + (path,)))}")
+    if len(chain) >= MAX_BASE_CHAIN:  # each file is a level of recursion here and in merge()
+        raise ConfigError(f"{chain[0]}: the 'base' chain is longer than {MAX_BASE_CHAIN} files "
+                          f"(dcfkit.config.MAX_BASE_CHAIN): {chain[0]} -> {chain[1]} -> ... -> {path}")
     data = read_yaml(path)
     base = data.pop("base", None)
     if base is None:
         return data, (path,)
     if not isinstance(base, str):
-        raise ConfigError(f"{path}: 'base' must be a file name, got {base!r}")
+        raise ConfigError(f"{path}: 'base' must be a file name, got {shown(base)}")
     base_path = path.parent / base
     if not base_path.is_file():  # a shipped config by name ('dr2track' or 'dr2track.yaml')
         shipped = shipped_config(base) if Path(base).name == base else None
         if shipped is None:
-            raise ConfigError(f"{path}: base config '{base}' not found (looked for {base_path} "
+            raise ConfigError(f"{path}: base config '{clip(base)}' not found (looked for {clip(str(base_path))} "
                               f"and for a shipped config of that name)")
         base_path = shipped
     inherited, files = _load_file(base_path, chain + (path,))
     return merge(inherited, data), (path,) + files
 
 
-def parse_value(text: str) -> Any:
-    """A CLI override value: YAML scalars/lists ('0.3', 'true', '[1, 2]', 'null')."""
+def parse_value(text: str, where: str = "--set value") -> Any:
+    """A CLI override value: YAML scalars/lists ('0.3', 'true', '[1, 2]', 'null'); text that is
+    not YAML stays text. A value over the bounds of a config is a ConfigError naming ``where``."""
     try:
-        return yaml.safe_load(text)
+        return _load_yaml(text)
+    except _OverLimit as exc:
+        raise ConfigError(f"{where}: {exc.describe()}") from None
     except yaml.YAMLError:
         return text
 
@@ -193,8 +360,8 @@ def parse_overrides(items) -> dict:
     for item in items or ():
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
-            raise ConfigError(f"--set expects KEY=VALUE (e.g. label.mu=0.3), got {item!r}")
-        out[key.strip()] = parse_value(value) if value.strip() else ""
+            raise ConfigError(f"--set expects KEY=VALUE (e.g. label.mu=0.3), got {shown(item)}")
+        out[key.strip()] = parse_value(value, f"--set {clip(key.strip())}") if value.strip() else ""
     return out
 
 
@@ -211,7 +378,7 @@ def set_dotted(config: dict, key: str, value: Any) -> None:
                 node[part] = {}
             node = node[part]
         else:
-            raise ConfigError(f"override '{key}': '{where}' is not a mapping")
+            raise ConfigError(f"override '{clip(key)}': '{clip(where)}' is not a mapping")
     last = parts[-1]
     if isinstance(node, list):
         node[_index(node, last, key)] = value
@@ -225,9 +392,9 @@ def _index(items: list, part: str, where: str) -> int:
     try:
         i = int(part)
     except ValueError:
-        raise ConfigError(f"override '{where}': this is a list; use an index 0..{len(items) - 1}") from None
+        raise ConfigError(f"override '{clip(where)}': this is a list; use an index 0..{len(items) - 1}") from None
     if not -len(items) <= i < len(items):
-        raise ConfigError(f"override '{where}': index {i} out of range 0..{len(items) - 1}")
+        raise ConfigError(f"override '{clip(where)}': index {shown(i)} out of range 0..{len(items) - 1}")
     return i
 
 
@@ -242,9 +409,13 @@ def load_config(source: str | Path | Mapping, overrides: Mapping[str, Any] | Non
     if not isinstance(source, (str, os.PathLike, Mapping)):
         raise ConfigError(f"a config is a file path, a shipped config name or a mapping, got {type(source).__name__}")
     if isinstance(source, Mapping):
-        data, origin = copy.deepcopy(dict(source)), "<config dict>"
+        origin = "<config dict>"
+        check_value(source, origin)  # before deepcopy and merge walk it
+        data = _tree(copy.deepcopy(dict(source)))
         base = data.pop("base", None)
         if base is not None:
+            if not isinstance(base, (str, os.PathLike)):
+                raise ConfigError(f"{origin}: 'base' must be a file name, got {shown(base)}")
             inherited, files = _load_file(_find(base))
             data = merge(inherited, data)
     else:
@@ -253,8 +424,10 @@ def load_config(source: str | Path | Mapping, overrides: Mapping[str, Any] | Non
         origin = str(path)
     for key, value in (overrides or {}).items():
         if not isinstance(key, str):
-            raise ConfigError(f"override keys are dotted strings such as 'label.mu', got {key!r}")
+            raise ConfigError(f"override keys are dotted strings such as 'label.mu', got {shown(key)}")
+        check_value(value, f"override '{clip(key)}'")
         set_dotted(data, key, value)
+    check_value(data, origin)  # dotted keys nest values deeper; merged files add up
     try:
         return resolve(data, origin)
     except DcfkitError as exc:
@@ -292,7 +465,8 @@ def _find(source: str | Path) -> Path:
         return found
     folder = shipped_config_dir()
     shipped = sorted(p.stem for p in folder.glob("*.yaml")) if folder.is_dir() else []
-    raise ConfigError(f"config not found: {source}" + (f"; shipped configs: {', '.join(shipped)}" if shipped else ""))
+    raise ConfigError(f"config not found: {clip(str(source))}"
+                      + (f"; shipped configs: {', '.join(shipped)}" if shipped else ""))
 
 
 def _component(registry, kind: str, spec: Any, where: str) -> dict:
@@ -305,14 +479,14 @@ def resolve(data: Mapping, origin: str) -> dict:
     registry = get_registry()
     unknown = [k for k in data if k not in TOP_LEVEL]
     if unknown:
-        raise ConfigError(f"{origin}: unknown key '{unknown[0]}'{closest(unknown[0], TOP_LEVEL)}; "
+        raise ConfigError(f"{origin}: unknown key {shown(unknown[0])}{closest(unknown[0], TOP_LEVEL)}; "
                           f"valid keys: {', '.join(TOP_LEVEL)}")
     missing = [k for k in ("features", "label", "solver") if k not in data]
     if missing:
         raise ConfigError(f"{origin}: missing required key '{missing[0]}'")
     for key in ("name", "description"):
         if data.get(key) is not None and not isinstance(data[key], str):
-            raise ConfigError(f"{origin}: {key}: expected a string, got {data[key]!r}")
+            raise ConfigError(f"{origin}: {key}: expected a string, got {shown(data[key])}")
     out: dict[str, Any] = {"name": data.get("name") or Path(origin).stem}
     if data.get("description"):
         out["description"] = str(data["description"])
@@ -329,8 +503,8 @@ def resolve(data: Mapping, origin: str) -> dict:
     out["regularizers"] = {}
     for role in regs:
         if role not in REGULARIZER_ROLES:
-            raise ConfigError(f"{origin}: regularizers.{role}: unknown role{closest(role, REGULARIZER_ROLES)}; "
-                              f"valid: {', '.join(REGULARIZER_ROLES)}")
+            raise ConfigError(f"{origin}: regularizers.{clip(str(role))}: unknown role"
+                              f"{closest(role, REGULARIZER_ROLES)}; valid: {', '.join(REGULARIZER_ROLES)}")
     for role in REGULARIZER_ROLES:
         spec = regs.get(role)
         if spec is None:

@@ -1,6 +1,10 @@
 """Exceptions raised by dcfkit. Each names what was wrong and where."""
 import contextlib
+import reprlib
 import traceback
+from typing import Any
+
+SHOWN_CHARS = 200  # the most of a value or key an error message shows: a config value may be megabytes
 
 
 class DcfkitError(Exception):
@@ -21,6 +25,22 @@ class InputError(DcfkitError, ValueError):
 
 class TrackingError(DcfkitError, RuntimeError):
     """Tracking could not continue on a frame (the message names the frame)."""
+
+
+def shown(value: Any) -> str:
+    """``repr(value)`` in at most :data:`SHOWN_CHARS` characters, whatever the value's size or depth."""
+    short = reprlib.Repr()  # its limits are per level: a few items, a few levels, a few characters each
+    short.maxlevel, short.maxstring, short.maxother = 3, SHOWN_CHARS, SHOWN_CHARS
+    try:
+        text = short.repr(value)
+    except Exception:  # a repr that fails: an int over Python's 4300 digits, a broken object
+        text = f"<{type(value).__name__}>"
+    return clip(text)
+
+
+def clip(text: str) -> str:
+    """``text`` cut to at most :data:`SHOWN_CHARS` characters (a key or path from a config, for a message)."""
+    return text if len(text) <= SHOWN_CHARS else text[:SHOWN_CHARS - 3] + "..."
 
 
 def describe_error(exc: BaseException) -> str:

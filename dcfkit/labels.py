@@ -28,9 +28,13 @@ import numpy as np
 
 from .params import param
 from .patches import round_half_away
-from .registry import Component
+from .registry import Component, Contract
 from .regularizers import target_mask
 from .response import local_maxima, wrap
+
+
+MAX_MU = 1e6
+MAX_NEIGHBOURHOOD = 101
 
 
 @dataclasses.dataclass
@@ -57,7 +61,11 @@ def gaussian_label(shape: tuple[int, int], sigma: float) -> np.ndarray:
 
 
 class Label(Component):
+    """Makes each frame's training label. The tracker calls ``reset()`` at every ``init`` (a new
+    target), then ``make`` once per training frame: ``detection`` None on the first."""
+
     kind = "label"
+    contract = Contract(required={"make": ("g", "detection")}, optional={"reset": ()})
 
     def make(self, g: np.ndarray, detection: Detection | None) -> tuple[np.ndarray, np.ndarray]:
         """Training label from the base Gaussian ``g`` and the last detection.
@@ -66,6 +74,9 @@ class Label(Component):
         offsets in cells from the target of the repressed peaks (empty for fixed labels).
         """
         raise NotImplementedError
+
+    def reset(self) -> None:
+        """Forget what earlier targets left (the built-in labels keep nothing)."""
 
 
 class Gaussian(Label):
@@ -103,8 +114,12 @@ class DistractorRepressed(Label):
                 return "top_n must be >= 0"
             if self.mu < 0:
                 return "mu must be >= 0"
+            if self.mu > MAX_MU:  # y = g - μR̃ is float32, and so are the filter and response it trains
+                return f"mu must be <= {MAX_MU:g}"
             if self.neighbourhood < 3 or self.neighbourhood % 2 == 0:
                 return "neighbourhood must be an odd number >= 3"
+            if self.neighbourhood > MAX_NEIGHBOURHOOD:  # the map is padded by half of it on every side
+                return f"neighbourhood must be <= {MAX_NEIGHBOURHOOD}"
             if self.exclusion < 0:
                 return "exclusion must be >= 0"
 

@@ -14,7 +14,7 @@ import types
 import typing
 from typing import Any, Mapping
 
-from .errors import ConfigError
+from .errors import ConfigError, clip, shown
 
 
 def param(default: Any, help: str, choices: tuple | None = None) -> Any:
@@ -54,11 +54,11 @@ def _coerce(value: Any, kind: Any, where: str) -> Any:
 
 def _coerce_sequence(value: Any, kind: Any, where: str) -> tuple:
     if not isinstance(value, (list, tuple)):
-        raise ConfigError(f"{where}: expected a list, got {value!r}")
+        raise ConfigError(f"{where}: expected a list, got {shown(value)}")
     args = typing.get_args(kind)
     if typing.get_origin(kind) is tuple and args and Ellipsis not in args:  # tuple[X, Y]: exactly these items
         if len(value) != len(args):
-            raise ConfigError(f"{where}: expected a list of {len(args)} values, got {value!r}")
+            raise ConfigError(f"{where}: expected a list of {len(args)} values, got {shown(value)}")
         return tuple(_coerce(v, a, f"{where}[{i}]") for i, (v, a) in enumerate(zip(value, args)))
     item = args[0] if args else Any
     return tuple(_coerce(v, item, f"{where}[{i}]") for i, v in enumerate(value))
@@ -67,7 +67,7 @@ def _coerce_sequence(value: Any, kind: Any, where: str) -> tuple:
 def _coerce_bool(value: Any, where: str) -> bool:
     if isinstance(value, bool):
         return value
-    raise ConfigError(f"{where}: expected true or false, got {value!r}")
+    raise ConfigError(f"{where}: expected true or false, got {shown(value)}")
 
 
 def _coerce_int(value: Any, where: str) -> int:
@@ -75,7 +75,7 @@ def _coerce_int(value: Any, where: str) -> int:
         return value
     if isinstance(value, float) and value.is_integer():
         return int(value)
-    raise ConfigError(f"{where}: expected an integer, got {value!r}")
+    raise ConfigError(f"{where}: expected an integer, got {shown(value)}")
 
 
 def _coerce_float(value: Any, where: str) -> float:
@@ -86,16 +86,16 @@ def _coerce_float(value: Any, where: str) -> float:
         with contextlib.suppress(ValueError):
             number = float(value)
     if number is None:
-        raise ConfigError(f"{where}: expected a number, got {value!r}")
+        raise ConfigError(f"{where}: expected a number, got {shown(value)}")
     if not math.isfinite(number):
-        raise ConfigError(f"{where}: expected a finite number, got {value!r}")
+        raise ConfigError(f"{where}: expected a finite number, got {shown(value)}")
     return number
 
 
 def _coerce_str(value: Any, where: str) -> str:
     if isinstance(value, str):
         return value
-    raise ConfigError(f"{where}: expected a string, got {value!r}")
+    raise ConfigError(f"{where}: expected a string, got {shown(value)}")
 
 
 _SCALAR_COERCERS = {bool: _coerce_bool, int: _coerce_int, float: _coerce_float, str: _coerce_str}
@@ -153,7 +153,7 @@ def fields(schema: type) -> list[dict]:
 def parse_params(schema: type, values: Mapping[str, Any] | None, where: str) -> Any:
     """Build ``schema`` from ``values``; ``where`` (e.g. 'dr2track.yaml: label') prefixes errors."""
     if values is not None and not isinstance(values, Mapping):
-        raise ConfigError(f"{where}: expected a mapping of parameters, got {values!r}")
+        raise ConfigError(f"{where}: expected a mapping of parameters, got {shown(values)}")
     values = dict(values or {})
     hints = typing.get_type_hints(schema)
     known = {f.name: f for f in dataclasses.fields(schema)}
@@ -161,14 +161,14 @@ def parse_params(schema: type, values: Mapping[str, Any] | None, where: str) -> 
     if unknown:
         k = unknown[0]
         valid = ", ".join(known) or "none"
-        raise ConfigError(f"{where}: unknown parameter '{k}'{closest(k, known)}; valid parameters: {valid}")
+        raise ConfigError(f"{where}: unknown parameter {shown(k)}{closest(k, known)}; valid parameters: {valid}")
     kwargs = {}
     for name, value in values.items():
-        key = f"{where}.{name}"
+        key = f"{where}.{clip(str(name))}"
         kwargs[name] = _coerce(value, hints[name], key)
         choices = known[name].metadata.get("choices")
         if choices is not None and kwargs[name] not in choices:
-            raise ConfigError(f"{key}: {kwargs[name]!r} is not one of {', '.join(map(str, choices))}"
+            raise ConfigError(f"{key}: {shown(kwargs[name])} is not one of {', '.join(map(str, choices))}"
                               f"{closest(kwargs[name], choices)}")
     try:
         instance = schema(**kwargs)

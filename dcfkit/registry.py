@@ -9,21 +9,31 @@ the registry is built on first use of :func:`get_registry`.
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import importlib
 import importlib.metadata
+import inspect
 import os
+import signal
+import typing
 import warnings
 from typing import Any, Mapping
 
 import pluggy
 
-from .errors import ConfigError, DcfkitError, RegistryError, describe_error
+from .errors import ConfigError, DcfkitError, RegistryError, clip, describe_error, shown
 from .params import NoParams, check_schema, closest, parse_params
 
 PROJECT = "dcfkit"
 KINDS = ("feature", "label", "regularizer", "solver", "search", "scale")
 DISABLE_ENV = "DCFKIT_DISABLE_PLUGINS"
+# The base classes of each kind (a regularizer's: one per role), whose ``contract`` a component
+# must meet. Named, not imported: their modules import this one.
+BASES = {"feature": ("dcfkit.features", "Feature"), "label": ("dcfkit.labels", "Label"),
+         "regularizer": ("dcfkit.regularizers", "SpatialRegularizer", "TemporalRegularizer"),
+         "solver": ("dcfkit.solvers", "Solver"), "search": ("dcfkit.search", "Search"),
+         "scale": ("dcfkit.scale", "ScaleEstimator")}
 
 hookspec = pluggy.HookspecMarker(PROJECT)
 hookimpl = pluggy.HookimplMarker(PROJECT)
@@ -49,6 +59,127 @@ class Component:
         return f"{type(self).__name__}({self.params})"
 
 
+@dataclasses.dataclass(frozen=True)
+class Contract:
+    """What the tracker needs of one kind of component (or regularizer role): set as ``contract``
+    on the kind's base class, checked by :meth:`Registry.register` (docs/plugins.md, section 5).
+
+    ``required``: methods the component must implement, name -> the arguments the tracker
+    passes after ``self``; ``optional``: the same for methods the base class implements.
+    ``params``: ``Params`` fields the tracker reads, name -> (type, lowest, highest): the field
+    must exist with that annotation, and a value outside the range is a ConfigError whenever
+    the component is built (the arithmetic that receives it needs the range).
+    """
+
+    required: Mapping[str, tuple[str, ...]] = dataclasses.field(default_factory=dict)
+    optional: Mapping[str, tuple[str, ...]] = dataclasses.field(default_factory=dict)
+    params: Mapping[str, tuple[type, float, float]] = dataclasses.field(default_factory=dict)
+
+
+def base_classes(kind: str) -> tuple[type, ...]:
+    """The base classes of ``kind`` (:data:`BASES`)."""
+    module, *names = BASES[kind]
+    loaded = importlib.import_module(module)  # by name: the base modules import this one
+    return tuple(getattr(loaded, n) for n in names)
+
+
+def _signature_problem(cls: type, method: str, args: tuple[str, ...]) -> str | None:
+    """Why ``cls().method(*args)`` cannot be called as the tracker calls it, or None."""
+    found = getattr(cls, method, None)
+    if not callable(found):
+        return f"{method} is {'missing' if found is None else 'not a method'}"
+    try:
+        signature = inspect.signature(found)
+    except (TypeError, ValueError):  # a callable without a signature (a builtin): take it on trust
+        return None
+    takes_self = inspect.isfunction(inspect.getattr_static(cls, method))  # not a static/class method
+    try:
+        signature.bind(*([None] * (takes_self + len(args))))
+    except TypeError:
+        return (f"{method}{signature} cannot be called as {method}({', '.join(('self',) * takes_self + args)}) "
+                f"(the tracker passes {len(args)} argument{'s' * (len(args) != 1)})")
+    return None
+
+
+def contract_problems(cls: type, base: type) -> list[str]:
+    """What ``cls`` lacks of ``base.contract`` (an empty list: it meets it)."""
+    contract: Contract = base.__dict__["contract"]
+    problems = []
+    for method, args in {**contract.required, **contract.optional}.items():
+        if method in contract.required and getattr(cls, method, None) is getattr(base, method, None):
+            problems.append(f"it does not implement {method}({', '.join(args)})")
+        elif problem := _signature_problem(cls, method, args):
+            problems.append(problem)
+    hints = typing.get_type_hints(cls.Params)
+    for field, (kind, lowest, highest) in contract.params.items():
+        if hints.get(field) is not kind:
+            problems.append(f"its Params has no {kind.__name__} field '{field}' (the tracker reads "
+                            f"params.{field}, in [{lowest:g}, {highest:g}])")
+        elif not lowest <= (default := getattr(cls.Params(), field)) <= highest:
+            problems.append(f"its default {field}={default!r} is outside [{lowest:g}, {highest:g}]")
+    return problems
+
+
+def base_of(cls: type, kind: str, where: str) -> type:
+    """The base class of ``kind`` that ``cls`` subclasses (a RegistryError if none)."""
+    bases = [b for b in base_classes(kind) if issubclass(cls, b)]
+    if not bases:
+        names = " or ".join(f"{BASES[kind][0]}.{n}" for n in BASES[kind][1:])
+        raise RegistryError(f"{where}: a {kind} must subclass {names}")
+    base = bases[-1]  # the most specific, should a class subclass both roles' bases
+    if hasattr(base, "role") and getattr(cls, "role", None) != base.role:
+        raise RegistryError(f"{where}: role {getattr(cls, 'role', None)!r} is not its base class "
+                            f"{base.__name__}'s ({base.role!r})")
+    return base
+
+
+def check_contract_values(contract: Contract, params: Any, where: str) -> None:
+    """A ConfigError if a parameter the tracker reads is outside its contract's range."""
+    for field, (_, lowest, highest) in contract.params.items():
+        value = getattr(params, field)
+        if not lowest <= value <= highest:
+            raise ConfigError(f"{where}.{field}: {value!r} is outside [{lowest:g}, {highest:g}]")
+
+
+# What a plugin may raise at import or registration and be skipped for: any exception, and
+# SystemExit and KeyboardInterrupt that it raises itself (sys.exit(), raise KeyboardInterrupt);
+# an interrupt that a signal raised while it ran (Ctrl-C; SIGTERM, see dcfkit.tracking) goes on.
+PLUGIN_FAULTS = (Exception, SystemExit, KeyboardInterrupt)
+INTERRUPTS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
+
+
+@contextlib.contextmanager
+def signals_noted():
+    """Yields a list to which every SIGINT, SIGTERM or SIGHUP arriving in the block is added
+    before its handler runs. Off the main thread, where Python runs no handlers, it stays empty."""
+    arrived: list[int] = []
+    saved = {}
+
+    def noted(handler):
+        def note(signum, frame):
+            arrived.append(signum)
+            return handler(signum, frame)
+        return note
+
+    with contextlib.suppress(ValueError):  # not the main thread
+        for s in INTERRUPTS:
+            if callable(handler := signal.getsignal(s)):  # SIG_DFL and SIG_IGN raise nothing
+                saved[s] = handler
+                signal.signal(s, noted(handler))
+    try:
+        yield arrived
+    finally:
+        for s, handler in saved.items():
+            signal.signal(s, handler)
+
+
+def _raise_if_signalled(exc: BaseException, signalled: list) -> None:
+    """Re-raise an interrupt (not an Exception) that followed a signal: it is the user's, not
+    the plugin's."""
+    if signalled and not isinstance(exc, Exception):
+        raise exc
+
+
 class PluginWarning(RuntimeWarning):
     """A plugin was skipped, or a name it registers withdrawn (also in ``Registry.failures``)."""
 
@@ -58,6 +189,7 @@ class Entry:
     cls: type
     provider: str
     distribution: str | None = None  # "name version" of the plugin's package; None for built-ins
+    contract: Contract = dataclasses.field(default_factory=Contract, compare=False)  # its kind's (or role's)
 
 
 class Registry:
@@ -70,7 +202,8 @@ class Registry:
         self.failures: list[str] = []
 
     def register(self, cls: type) -> type:
-        """Register a component class; its ``kind`` and ``name`` must be set and new.
+        """Register a component class; its ``kind`` and ``name`` must be set and new, and it must
+        subclass its kind's base class and meet that class's :class:`Contract`.
 
         A name that two plugins both register is withdrawn: which one a config got would
         depend on the order of installation, so using it is an error naming both.
@@ -81,12 +214,17 @@ class Registry:
                                 f"{', '.join(KINDS)}")
         if not name or not isinstance(name, str):
             raise RegistryError(f"{cls.__qualname__} (from {self._provider}): component has no name")
+        where = f"{kind} '{name}' (from {self._provider})"
+        base = base_of(cls, kind, where)
         if not dataclasses.is_dataclass(cls.Params):
-            raise RegistryError(f"{kind} '{name}' (from {self._provider}): Params must be a dataclass")
+            raise RegistryError(f"{where}: Params must be a dataclass")
         try:
             check_schema(cls.Params)
         except ConfigError as exc:
-            raise RegistryError(f"{kind} '{name}' (from {self._provider}): {exc}") from None
+            raise RegistryError(f"{where}: {exc}") from None
+        problems = contract_problems(cls, base)
+        if problems:
+            raise RegistryError(f"{where}: {'; '.join(problems)}")
         if name in self._ambiguous[kind]:
             if self._distribution is None or self._provider in self._ambiguous[kind][name]:
                 raise RegistryError(f"{kind} '{name}' from {self._provider} is already registered by "
@@ -101,7 +239,7 @@ class Registry:
             del self._entries[kind][name]
             self._ambiguous[kind][name] = [existing.provider, self._provider]
             return cls
-        self._entries[kind][name] = Entry(cls, self._provider, self._distribution)
+        self._entries[kind][name] = Entry(cls, self._provider, self._distribution, base.__dict__["contract"])
         return cls
 
     def names(self, kind: str) -> list[str]:
@@ -115,7 +253,7 @@ class Registry:
                                 f"uninstall all but one of them")
         if name not in entries:
             skipped = f"; skipped plugins: {' | '.join(self.failures)}" if self.failures else ""
-            raise RegistryError(f"unknown {kind} '{name}'{closest(name, entries)}; "
+            raise RegistryError(f"unknown {kind} '{clip(name)}'{closest(name, entries)}; "
                                 f"registered {kind}s: {', '.join(sorted(entries)) or 'none'}{skipped}")
         return entries[name]
 
@@ -123,16 +261,19 @@ class Registry:
         """Instantiate a component from ``{'name': ..., **params}`` (or a bare name)."""
         if isinstance(spec, str):
             spec = {"name": spec}
-        if not isinstance(spec, Mapping) or not isinstance(spec.get("name"), str):
-            raise RegistryError(f"{where}: expected a mapping with a 'name' key "
-                                f"(one of {', '.join(self.names(kind))}), got {spec!r}")
+        if not isinstance(spec, Mapping) or not isinstance(spec.get("name"), str):  # a config's mistake
+            raise ConfigError(f"{where}: expected a mapping with a 'name' key "
+                              f"(one of {', '.join(self.names(kind))}), got {shown(spec)}")
         values = dict(spec)
         name = values.pop("name")
         try:
-            cls = self.entry(kind, name).cls
+            entry = self.entry(kind, name)
         except RegistryError as exc:
             raise RegistryError(f"{where}.name: {exc}") from None
-        return cls(parse_params(cls.Params, values, f"{where} ({kind} '{name}')"))
+        where = f"{where} ({kind} '{name}')"
+        params = parse_params(entry.cls.Params, values, where)
+        check_contract_values(entry.contract, params, where)
+        return entry.cls(params)
 
     def _check_kind(self, kind: str) -> dict[str, Entry]:
         if kind not in self._entries:
@@ -150,8 +291,9 @@ class Registry:
         warnings.warn(message, PluginWarning, stacklevel=3)
 
     def _run_plugin(self, pm: pluggy.PluginManager, plugin: Any, provider: str,
-                    distribution: str | None = None) -> None:
-        """Register one plugin's components; on failure undo them and remember why."""
+                    distribution: str | None = None, signalled: list = ()) -> None:
+        """Register one plugin's components; on failure undo them and remember why
+        (``signalled``: the signals that arrived meanwhile, :func:`signals_noted`)."""
         before = {k: dict(v) for k, v in self._entries.items()}
         ambiguous = {k: {n: list(p) for n, p in v.items()} for k, v in self._ambiguous.items()}
         self._provider, self._distribution = provider, distribution
@@ -165,7 +307,8 @@ class Registry:
                        if callable(plugin) else ""))
             others = [p for p in pm.get_plugins() if p is not plugin]
             pm.subset_hook_caller("dcfkit_register_components", remove_plugins=others)(registry=self)
-        except (Exception, SystemExit) as exc:  # a broken plugin must not break dcfkit
+        except PLUGIN_FAULTS as exc:  # a broken plugin must not break dcfkit
+            _raise_if_signalled(exc, signalled)
             self._entries, self._ambiguous = before, ambiguous
             if pm.is_registered(plugin):
                 pm.unregister(plugin)
@@ -200,9 +343,9 @@ def build_registry(external: bool = True) -> Registry:
     pm = pluggy.PluginManager(PROJECT)
     pm.add_hookspecs(HookSpecs)
     registry = Registry()
-    registry._run_plugin(pm, importlib.import_module("dcfkit.builtin"), "dcfkit")
-    if external:
-        for ep in sorted(importlib.metadata.entry_points(group=PROJECT), key=lambda e: e.name):
+    with signals_noted() as signalled:
+        registry._run_plugin(pm, importlib.import_module("dcfkit.builtin"), "dcfkit", signalled=signalled)
+        for ep in sorted(importlib.metadata.entry_points(group=PROJECT), key=lambda e: e.name) if external else ():
             if ep.value.split(":")[0] == "dcfkit.builtin":
                 continue
             provider = f"{ep.name} ({ep.value})"
@@ -210,9 +353,10 @@ def build_registry(external: bool = True) -> Registry:
             distribution = f"{dist.name} {dist.version}" if dist is not None else provider
             try:
                 plugin = ep.load()
-            except (Exception, SystemExit) as exc:
+            except PLUGIN_FAULTS as exc:
+                _raise_if_signalled(exc, signalled)
                 registry._fail(f"dcfkit plugin '{provider}' could not be imported and was skipped: "
                                f"{describe_error(exc)}")
                 continue
-            registry._run_plugin(pm, plugin, provider, distribution)
+            registry._run_plugin(pm, plugin, provider, distribution, signalled)
     return registry

@@ -13,7 +13,7 @@ import dataclasses
 import numpy as np
 
 from .params import param
-from .registry import Component
+from .registry import Component, Contract
 
 
 PLACEMENTS = ("centred", "authors")
@@ -40,13 +40,31 @@ def target_mask(shape: tuple[int, int], target_cells: tuple[float, float], place
     return mask
 
 
+MAX_WEIGHT = 1e10  # of w: w² (and a crop's λ, up to MAX_WEIGHT²) stays far inside float32
+MAX_THETA = 1e10  # θ: the solver adds it to its penalty γ and multiplies last frame's filter by it
+MAX_POWER = 10.0  # smooth's exponent: the window's float64 distances to it stay finite
+
+
 class SpatialRegularizer(Component):
+    """The spatial weight w of Eqs. (1), (2), (10) (``regularizers.spatial``). The tracker calls
+    ``weights_squared`` once per ``init`` (a new target) and gives the result to the solver."""
+
     kind = "regularizer"
     role = "spatial"
+    contract = Contract(required={"weights_squared": ("shape", "target_cells")})
 
     def weights_squared(self, shape: tuple[int, int], target_cells: tuple[float, float]) -> np.ndarray:
-        """w² over the (H, W) filter grid, centred layout."""
+        """w² over the (H, W) filter grid, centred layout: (H, W) float32, >= 0, ``inf`` where h must be 0."""
         raise NotImplementedError
+
+
+class TemporalRegularizer(Component):
+    """The temporal term θ/2 ‖h - h_prev‖² of Eq. (1) (``regularizers.temporal``): it has no
+    methods; the tracker reads ``params.theta`` every training frame and passes it to the solver."""
+
+    kind = "regularizer"
+    role = "temporal"
+    contract = Contract(params={"theta": (float, 0.0, MAX_THETA)})
 
 
 class BoxWindow(SpatialRegularizer):
@@ -64,6 +82,8 @@ class BoxWindow(SpatialRegularizer):
         def validate(self):
             if not 0 <= self.inside <= self.outside:
                 return "need 0 <= inside <= outside"
+            if self.outside > MAX_WEIGHT:
+                return f"outside must be <= {MAX_WEIGHT:g}"
 
     def weights_squared(self, shape, target_cells):
         mask = target_mask(shape, target_cells, self.params.placement)
@@ -85,6 +105,10 @@ class SmoothWindow(SpatialRegularizer):
         def validate(self):
             if not 0 <= self.minimum <= self.edge:
                 return "need 0 <= minimum <= edge"
+            if self.edge > MAX_WEIGHT:
+                return f"edge must be <= {MAX_WEIGHT:g}"
+            if not 0 < self.power <= MAX_POWER:  # <= 0: an infinite weight at the centre
+                return f"power must be in (0, {MAX_POWER:g}]"
 
     def weights_squared(self, shape, target_cells):
         ys = (np.arange(shape[0]) - (shape[0] - 1) / 2) / max(target_cells[0] / 2, 0.5)
@@ -92,7 +116,8 @@ class SmoothWindow(SpatialRegularizer):
         p = self.params.power
         w = self.params.minimum + (self.params.edge - self.params.minimum) * (
             np.abs(ys)[:, None] ** p + np.abs(xs)[None, :] ** p)
-        return (w**2).astype(np.float32)
+        with np.errstate(over="ignore"):  # w² beyond float32 far from the target: inf, i.e. h = 0 there
+            return (w**2).astype(np.float32)
 
 
 class Crop(SpatialRegularizer):
@@ -109,17 +134,17 @@ class Crop(SpatialRegularizer):
         def validate(self):
             if self.lam < 0:
                 return "lam must be >= 0"
+            if self.lam > MAX_WEIGHT**2:  # λ is w² inside the box
+                return f"lam must be <= {MAX_WEIGHT**2:g}"
 
     def weights_squared(self, shape, target_cells):
         return np.where(target_mask(shape, target_cells, self.params.placement), self.params.lam,
                         np.inf).astype(np.float32)
 
 
-class Temporal(Component):
+class Temporal(TemporalRegularizer):
     """θ/2 ‖h - h_prev‖² of Eq. (1) (STRCF's temporal regularization)."""
 
-    kind = "regularizer"
-    role = "temporal"
     name = "temporal"
 
     @dataclasses.dataclass(frozen=True)
@@ -129,6 +154,8 @@ class Temporal(Component):
         def validate(self):
             if self.theta < 0:
                 return "theta must be >= 0"
+            if self.theta > MAX_THETA:
+                return f"theta must be <= {MAX_THETA:g}"
 
 
 BUILTIN = (BoxWindow, SmoothWindow, Crop, Temporal)

@@ -16,11 +16,17 @@ import numpy as np
 from .features.fhog import fhog
 from .params import param
 from .patches import resize_auto, sample, sampler, whole_pixel_crop
-from .registry import Component
+from .registry import Component, Contract
 
 
 class ScaleEstimator(Component):
+    """The target's scale. The tracker calls ``init`` at every ``init`` (a new target),
+    ``search_factors()`` at the start of every later frame, and ``update`` once the target is
+    found on it (not on a held blank frame), which returns the new scale within ``limits``."""
+
     kind = "scale"
+    contract = Contract(optional={"init": ("image", "centre", "base_target", "scale", "limits"),
+                                  "search_factors": (), "update": ("image", "centre", "scale")})
 
     def init(self, image: np.ndarray, centre: np.ndarray, base_target: np.ndarray, scale: float,
              limits: tuple[float, float]) -> None:
@@ -69,6 +75,9 @@ class Pyramid(ScaleEstimator):
         return _factors(self.params.n_scales, self.params.step)
 
 
+MAX_WORKING_AREA = 2000**2  # pixels, as the largest search patch (tracker.max_image_sample_size)
+
+
 class DSST(ScaleEstimator):
     """Discriminative scale filter: fHOG of S target-sized samples, a 1-D filter over scale."""
 
@@ -103,13 +112,25 @@ class DSST(ScaleEstimator):
         def validate(self):
             if self.sigma_factor <= 0:
                 return "sigma_factor must be > 0"
+            if self.sigma_factor > 10:  # σ beyond 1.7 n_scales: a flat label, every scale alike
+                return "sigma_factor must be <= 10"
+            if not 0 < self.lam <= 1e10:  # the scale filter divides by Σ|x̂|² + λ, which may be λ alone
+                return "lam must be in (0, 1e10]"
             if not 0 < self.learning_rate <= 1:
                 return "learning_rate must be in (0, 1]"
             if not 1 <= self.model_max_area <= 10000:
                 return "model_max_area must be in [1, 10000]"
             if not 1 <= self.cell_size <= 16:
                 return "cell_size must be in [1, 16]"
-            return _check_span(self.n_scales, self.step, least=3)
+            return _check_span(self.n_scales, self.step, least=3) or self._working_patch_problem()
+
+        def _working_patch_problem(self):
+            """The working patch holds the largest scale's sample at the smallest's resolution."""
+            area = max(self.model_max_area, (2 * self.cell_size) ** 2) * (self.step ** (self.n_scales - 1)) ** 2
+            if area > MAX_WORKING_AREA:
+                return (f"model_max_area={self.model_max_area}, cell_size={self.cell_size}, step={self.step:g} and "
+                        f"n_scales={self.n_scales}: the scale samples' working patch would have {area:.3g} pixels, "
+                        f"over {MAX_WORKING_AREA:.3g} (2000²; lower model_max_area, n_scales or step)")
 
     def init(self, image, centre, base_target, scale, limits):
         super().init(image, centre, base_target, scale, limits)

@@ -6,11 +6,16 @@ import dataclasses
 import numpy as np
 
 from .params import param
-from .registry import Component
+from .registry import Component, Contract
 
 
 class Search(Component):
+    """Where the next search area is centred. The tracker calls ``reset`` at every ``init`` (a
+    new target), ``centre()`` at the start of every later frame, and ``observe`` once the target
+    is found on it (not on a held blank frame). Positions are (y, x) image pixels, finite."""
+
     kind = "search"
+    contract = Contract(optional={"reset": ("position",), "centre": (), "observe": ("position",)})
 
     def reset(self, position: np.ndarray) -> None:
         """Start at the first frame's target centre (y, x)."""
@@ -31,6 +36,9 @@ class Fixed(Search):
     name = "fixed"
 
 
+MAX_GAIN = 10.0
+
+
 class MotionAware(Search):
     """Eqs. (13)-(14): V^t = p^t - p^{t-1}; the next search centre is p^t + gain · V^t."""
 
@@ -39,6 +47,12 @@ class MotionAware(Search):
     @dataclasses.dataclass(frozen=True)
     class Params:
         gain: float = param(1.0, "multiplier of the last displacement (1 = Eq. 14)")
+
+        def validate(self):
+            # 0: the last position; beyond MAX_GAIN the predicted centre leaves any image (with
+            # tracker.clamp_position false, 1e30 px away: the sampling broke); < 0: against the motion
+            if not 0 <= self.gain <= MAX_GAIN:
+                return f"gain must be in [0, {MAX_GAIN:g}]"
 
     def reset(self, position):
         super().reset(position)

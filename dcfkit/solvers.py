@@ -25,11 +25,12 @@ spectrum is exact.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
 from .params import param
-from .registry import Component
+from .registry import Component, Contract
 
 
 def _floats(z: np.ndarray) -> np.ndarray:
@@ -69,6 +70,42 @@ class ADMMParams:
             return "iterations must be in [1, 10000]"
         if self.gamma0 <= 0 or self.gamma_max <= 0 or self.beta <= 0:
             return "gamma0, beta and gamma_max must be > 0"
+        return schedule_problem(self)
+
+
+# Every penalty γ the ADMM uses: it divides by γ and by θ + γ, and multiplies by γK, in float32
+PENALTY_RANGE = (1e-10, 1e10)
+# h_step 'authors' adds the unscaled multiplier u = γz to v (Eq. 10 reads z): inside the target
+# box each iteration multiplies the multiplier's error by |1 - γ|; beyond this the filter is noise
+AUTHORS_GROWTH_MAX = 1e10
+
+
+def penalties(p: ADMMParams) -> list[float]:
+    """γ of each of the E iterations: γ⁰, then γ ← min(γ_max, βγ) (Eq. 11)."""
+    gammas = [p.gamma0]
+    for _ in range(p.iterations - 1):
+        gammas.append(min(p.gamma_max, p.beta * gammas[-1]))
+    return gammas
+
+
+def schedule_problem(p: ADMMParams) -> str | None:
+    """Why the penalties of ``p`` cannot work in float32 (:data:`PENALTY_RANGE`,
+    :data:`AUTHORS_GROWTH_MAX`), or None."""
+    low, high = PENALTY_RANGE
+    for key, value in (("gamma0", p.gamma0), ("gamma_max", p.gamma_max)):
+        if not low <= value <= high:
+            return f"{key} must be in [{low:g}, {high:g}]"
+    schedule = penalties(p)
+    worst = min(range(len(schedule)), key=schedule.__getitem__)
+    if schedule[worst] < low:
+        return (f"beta={p.beta:g} takes γ from gamma0={p.gamma0:g} down to {schedule[worst]:g} in iteration "
+                f"{worst + 1} of {p.iterations} (γ ← min(gamma_max, beta·γ)); it must stay >= {low:g}")
+    growth = math.prod(max(1.0, g - 1) for g in schedule[1:-1])  # the h-steps whose multiplier is used
+    if p.h_step == "authors" and growth > AUTHORS_GROWTH_MAX:
+        return (f"h_step 'authors' with iterations={p.iterations} and γ up to {max(schedule):g}: its multiplier's "
+                f"error grows by |1 - γ| per iteration, {growth:.3g}-fold here, over {AUTHORS_GROWTH_MAX:g} "
+                f"(fewer iterations, a smaller gamma_max, or h_step 'standard')")
+    return None
 
 
 def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: np.ndarray | None,
@@ -99,8 +136,7 @@ def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: n
     t = np.empty(xf.shape[1:], np.complex64)
     vf, uf, g = (np.empty_like(xf) for _ in range(3))
     hf = uf  # h = u = 0 at first (Remark 1): the first v-step reads neither
-    gamma = p.gamma0
-    for e in range(p.iterations):
+    for e, gamma in enumerate(penalties(p)):
         first = e == 0
         # v-step (Eq. 9): Sherman-Morrison per frequency, b = a conj(ŷ) + θ v̂ˡ + γ ĥ - û
         kernels.v_step(_floats(xf), _floats(rhs0), _floats(hf), _floats(uf), gamma, theta + gamma, aa, first,
@@ -115,15 +151,19 @@ def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: n
         hf = np.ascontiguousarray(fft.rfft2(h.astype(np.float32, copy=False)), np.complex64)
         # multiplier (Eq. 11) and penalty schedule
         kernels.multiplier(_floats(vf), _floats(hf), gamma, first, _floats(uf))
-        gamma = min(p.gamma_max, p.beta * gamma)
     return vf, hf
 
 
 class Solver(Component):
-    """Trains the filter of one frame. State between frames lives in the solver instance."""
+    """Trains the filter of one frame. State between frames lives in the solver instance.
+
+    The tracker calls ``reset()`` at every ``init`` (a new target; also once on construction),
+    then ``train`` once per training frame. A solver declares its own ``Params`` (none by
+    default); the ADMM solvers' are :class:`ADMMParams`.
+    """
 
     kind = "solver"
-    Params = ADMMParams
+    contract = Contract(required={"reset": (), "train": ("xf", "yf", "w2", "theta", "fft")})
 
     def __init__(self, params=None):
         super().__init__(params)
@@ -142,6 +182,7 @@ class ADMMStrcf(Solver):
     """STRCF/DR²Track: current sample, temporal term towards the previous filter (Eqs. 4–11)."""
 
     name = "admm_strcf"
+    Params = ADMMParams
 
     def reset(self):
         self.v_prev = None

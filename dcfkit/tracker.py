@@ -246,7 +246,8 @@ class Tracker:
         self.base_label.setflags(write=False)  # every frame's label starts from it
         self.w2 = (self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
                    else np.zeros(g.filter_size, np.float32))
-        self.solver.reset()
+        for component in (*self.features, self.label, self.solver):  # a new target: nothing kept from the last
+            component.reset()
         self.search.reset(centre)
         self.scale_estimator.init(image, centre, g.base_target, self.scale, self.limits)
         self.position = centre

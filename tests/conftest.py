@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, settings
 
 # Property tests run a fixed, derandomized example budget: the same examples on every run
 # (a CI failure reproduces locally), and within the minute the fuzz tests may take in all.
-settings.register_profile("dcfkit", max_examples=40, deadline=None, derandomize=True, print_blob=True,
+settings.register_profile("dcfkit", max_examples=40, deadline=None, derandomize=True, database=None, print_blob=True,
                           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "dcfkit"))
 

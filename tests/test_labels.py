@@ -2,7 +2,12 @@
 import numpy as np
 import pytest
 
-from dcfkit.labels import Detection, DistractorRepressed, Gaussian, gaussian_label
+import dcfkit
+from dcfkit.errors import ConfigError
+from dcfkit.labels import Detection, DistractorRepressed, Gaussian, Label, gaussian_label
+from dcfkit.params import parse_params
+from dcfkit.response import local_maxima
+from dcfkit.synthetic import make_sequence
 
 
 def test_gaussian_label_peaks_at_origin_and_is_symmetric():
@@ -70,3 +75,44 @@ def test_exclusion_zone_and_wrapped_offsets_of_the_distractors():
     offsets, values = DistractorRepressed().distractors(det)
     assert offsets.tolist() == [[0, -4], [-3, 0], [7, 9]]
     np.testing.assert_allclose(values, [0.6, 0.5, 0.3])
+
+
+@pytest.mark.parametrize("values, message", [
+    ({"mu": 1e300}, r"label: mu must be <= 1e\+06"),                        # y = g - μR̃ was -inf in float32
+    ({"neighbourhood": 10**6 + 1}, r"label: neighbourhood must be <= 101"),  # a wrap-padded 10^6-wide copy
+])
+def test_repression_values_beyond_float32_or_memory_are_refused(values, message):
+    with pytest.raises(ConfigError, match=message):
+        parse_params(DistractorRepressed.Params, values, "label")
+
+
+def test_the_widest_neighbourhood_works_on_a_map_smaller_than_it():
+    """101 cells on an 8x8 circular map: every cell is in every other's neighbourhood, so the one
+    maximum is the map's."""
+    r = np.zeros((8, 8), np.float32)
+    r[2, 3], r[6, 6] = 1.0, 0.5
+    rows, cols = local_maxima(r, 101)
+    assert (rows.tolist(), cols.tolist()) == ([2], [3])
+
+
+def test_init_resets_the_label_before_the_first_frame_of_a_target():
+    """The tracker calls reset() on every init: a label keeping per-target state starts afresh."""
+    calls = []
+
+    class Recording(Label):
+        name = "recording"
+
+        def reset(self):
+            calls.append("reset")
+
+        def make(self, g, detection):
+            calls.append("first" if detection is None else "later")
+            return g, np.zeros((0, 2), int)
+
+    seq = make_sequence(n_frames=3, seed=2)
+    tracker = dcfkit.load_tracker("strcf", overrides={"scale.n_scales": 1})
+    tracker.label = Recording()
+    for _ in range(2):
+        tracker.init(seq.frames[0], seq.ground_truth[0])
+        tracker.update(seq.frames[1])
+    assert calls == ["reset", "first", "later"] * 2

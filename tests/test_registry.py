@@ -237,6 +237,9 @@ def test_params_schemas_are_checked_when_the_component_registers(field, message)
         name = "checked"
         Params = namespace["Params"]
 
+        def make(self, g, detection):
+            return g, np.zeros((0, 2), int)
+
     r = reg.Registry()
     if message is None:
         r.register(Checked)
@@ -311,7 +314,7 @@ def test_an_ambiguous_name_survives_a_plugin_failing_half_way_and_refuses_a_seco
                                             r"and dcfkit_test_a2 \(dcfkit_test_a2\)\)"):  # the failed ones undone
         r.entry("label", "flat")
     with pytest.raises(RegistryError, match="already registered"):  # outside plugin loading
-        r.register(type("Flat", (Label,), {"name": "flat"}))
+        r.register(type("Flat", (Label,), {"name": "flat", "make": lambda self, g, detection: (g, None)}))
 
 
 def _reordered(value):
@@ -349,3 +352,73 @@ def test_configs_that_are_not_dcfkit_trackers_still_hash(config):
     assert run_key({**config, "name": "renamed"}) == digest
     changed = [c for c in _each_value_changed({k: v for k, v in config.items() if k != "name"})]
     assert all(run_key({**c, "name": config.get("name")}) != digest for c in changed), changed
+
+
+def _entry_point(monkeypatch, name, source):
+    """An entry point whose module runs ``source`` (as file '<string>') when it is loaded."""
+    ep = install_plugin(monkeypatch, name, "")
+
+    def load():
+        module = types.ModuleType(name)
+        exec(compile(source, "<string>", "exec"), module.__dict__)
+        return module
+    ep.load = load
+    return ep
+
+
+def _build_or_fail():
+    """build_registry, with an escaping KeyboardInterrupt a test failure (not the end of the run)."""
+    try:
+        return reg.build_registry()
+    except KeyboardInterrupt as exc:
+        pytest.fail(f"{exc!r} escaped the registry")
+
+
+@pytest.mark.parametrize("source, message", [
+    ("raise KeyboardInterrupt", r"'dcfkit_test_ctrl_c \(dcfkit_test_ctrl_c\)' could not be imported and was "
+                                r"skipped: KeyboardInterrupt \(at <string>:1\)"),
+    ("raise SystemExit('bye')", r"could not be imported and was skipped: SystemExit: bye \(at <string>:1\)"),
+    (PLUGIN.replace("registry.register(Flat)", "registry.register(Flat)\n    raise KeyboardInterrupt('in the hook')"),
+     r"'dcfkit_test_ctrl_c \(dcfkit_test_ctrl_c\)' failed and was skipped: KeyboardInterrupt: in the hook "
+     r"\(at <string>:\d+\)"),
+])
+def test_a_plugin_raising_keyboard_interrupt_is_named_and_skipped(monkeypatch, source, message):
+    """It used to escape the registry: every command printed 'interrupted' and nothing named the plugin."""
+    ep = _entry_point(monkeypatch, "dcfkit_test_ctrl_c", source)
+    with_entry_points(monkeypatch, [ep, install_plugin(monkeypatch, "dcfkit_test_good2", PLUGIN)])
+    with pytest.warns(reg.PluginWarning, match=message):
+        r = _build_or_fail()
+    assert "flat" in r.names("label") and "gaussian" in r.names("label")  # the other plugin's, undone ones' not
+
+
+def test_every_command_names_a_plugin_that_raises_keyboard_interrupt(monkeypatch, capsys):
+    from dcfkit import cli
+
+    with_entry_points(monkeypatch, [install_plugin(monkeypatch, "dcfkit_test_ctrl_c2", PLUGIN.replace(
+        "registry.register(Flat)", "raise KeyboardInterrupt"))])
+    monkeypatch.setattr(reg, "_REGISTRY", None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        status = cli.main(["components", "--kind", "label"])
+    err = capsys.readouterr().err
+    assert status == 1 and "interrupted" not in err
+    assert "warning: dcfkit plugin 'dcfkit_test_ctrl_c2 (dcfkit_test_ctrl_c2)' failed and was skipped: " \
+           "KeyboardInterrupt (at " in err
+    monkeypatch.setattr(reg, "_REGISTRY", None)
+
+
+@pytest.mark.parametrize("signal_name", ["SIGINT", "SIGTERM"])
+def test_a_real_interrupt_while_a_plugin_loads_still_interrupts(monkeypatch, signal_name):
+    """Ctrl-C (or SIGTERM, which the commands turn into an interrupt) arriving while a plugin is
+    imported is the user's: it ends the command, and is not blamed on the plugin."""
+    import signal
+
+    from dcfkit.tracking import Interrupted, interrupt_on_termination
+
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        pytest.skip("Ctrl-C is not Python's default KeyboardInterrupt here")
+    source = f"import os, signal, time\nos.kill(os.getpid(), signal.{signal_name})\ntime.sleep(5)\n"
+    with_entry_points(monkeypatch, [_entry_point(monkeypatch, "dcfkit_test_signalled", source)])
+    with interrupt_on_termination(), pytest.raises(KeyboardInterrupt) as raised:
+        reg.build_registry()
+    assert isinstance(raised.value, Interrupted) == (signal_name == "SIGTERM")

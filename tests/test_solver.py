@@ -1,8 +1,14 @@
 """The ADMM solver (Eqs. 4-11) against independent dense references."""
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
+from dcfkit.config import load_config
+from dcfkit.errors import ConfigError
 from dcfkit.fft import make_fft
+from dcfkit.params import parse_params
+from dcfkit.regularizers import Temporal
 from dcfkit.solvers import ADMMParams, admm, sherman_morrison_solve
 
 
@@ -179,3 +185,44 @@ def test_the_few_iterations_trackers_run_follow_the_penalty_schedule(p):
     vf, _ = admm(fft.rfft2(m).astype(np.complex64), fft.rfft2(y).astype(np.complex64), w2.astype(np.float32),
                  theta, fft.rfft2(h_prev).astype(np.complex64), p, fft)
     np.testing.assert_allclose(vf, expected, rtol=0, atol=2e-4 * np.abs(expected).max())
+
+
+# -- what validation must cover: every accepted penalty schedule runs in float32 ----------------------------
+EXTREMES = [5e-324, 7.8e-307, 1e-300, 1e-30, 1e-10, 1e-3, 0.5, 1.0, 2.0, 10.0, 1e4, 1e10, 1e30, 1e300]
+
+
+@pytest.mark.parametrize("beta, iterations", [(1e-300, 3), (7.8e-307, 3), (1e-300, 4), (0.5, 10000)])
+def test_a_penalty_that_underflows_is_refused_naming_beta(beta, iterations):
+    """γ ← βγ reached 0 and the v-step divided by it (ZeroDivisionError in the compiled kernel)."""
+    with pytest.raises(ConfigError, match=r"solver \(solver 'admm_strcf'\): beta=.* takes γ from gamma0=1 down to "
+                                          r"\S+ in iteration \d+ of \d+"):
+        load_config("strcf", {"solver.beta": beta, "solver.iterations": iterations})
+
+
+@given(values=st.fixed_dictionaries({}, optional={
+    "iterations": st.one_of(st.integers(1, 40), st.sampled_from([0, -1, 10000, 10**9])),
+    "gamma0": st.one_of(st.sampled_from(EXTREMES), st.floats(1e-12, 1e12)),
+    "beta": st.one_of(st.sampled_from(EXTREMES), st.floats(1e-3, 1e3)),
+    "gamma_max": st.one_of(st.sampled_from(EXTREMES), st.floats(1e-12, 1e12)),
+    "h_step": st.sampled_from(["standard", "authors"])}),
+    theta=st.one_of(st.sampled_from([0.0, 1e-300] + EXTREMES), st.floats(0, 1e12)))
+def test_every_accepted_schedule_gives_a_finite_filter(values, theta):
+    """Either the parameters (and θ) are refused when read, or three frames of ADMM on a
+    BACF-like problem (w² = inf outside the box) and an STRCF-like one give finite filters."""
+    try:
+        p = parse_params(ADMMParams, values, "solver")
+        theta = parse_params(Temporal.Params, {"theta": theta}, "temporal").theta
+    except ConfigError:
+        return
+    rng = np.random.default_rng(9)
+    fft = make_fft("scipy")
+    shape, C = (8, 10), 3
+    box = np.full(shape, 1e10, np.float32)
+    box[3:5, 3:7] = 1e-6
+    for w2 in (box, np.where(box > 1, np.inf, 0.01).astype(np.float32)):
+        v_prev = None
+        for _ in range(3):
+            xf = fft.rfft2(rng.standard_normal((C, *shape)).astype(np.float32)).astype(np.complex64)
+            yf = fft.rfft2(rng.standard_normal(shape).astype(np.float32)).astype(np.complex64)
+            v_prev, _ = admm(xf, yf, w2, theta, v_prev, p, fft)
+            assert np.isfinite(v_prev).all(), (values, theta)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import itertools
+import math
 import os
 from pathlib import Path
 from typing import Any, Iterable, Mapping
@@ -13,7 +14,7 @@ import yaml
 
 from ..config import load_config, read_yaml, shipped_config, shipped_config_dir
 from ..datasets import DatasetError, canonical_name, load_dataset
-from ..errors import ConfigError, DcfkitError
+from ..errors import ConfigError, DcfkitError, clip, shown
 from ..params import closest
 from ..results import dcfkit_version, run_key
 
@@ -21,6 +22,7 @@ SPEC_KEYS = ("name", "description", "dataset", "sequences", "variants", "grid")
 VARIANT_KEYS = ("config", "overrides", "description")
 GRID_KEYS = ("base", "overrides", "mode", "parameters")
 GRID_MODES = ("sweep", "product")
+MAX_VARIANTS = 1000  # named and grid variants in one spec: each is resolved (some 4 ms) when the spec is read
 
 
 @dataclasses.dataclass(frozen=True)
@@ -67,7 +69,8 @@ class AblationSpec:
                               f"(the {self.dataset} benchmark folder)")
         if not self.root.is_dir():
             hint = "" if self.root_origin == "--root" else f"; pass --root DIR (the {self.dataset} benchmark folder)"
-            raise ConfigError(f"{self.path}: dataset root {self.root} ({self.root_origin}) is not a folder{hint}")
+            raise ConfigError(f"{self.path}: dataset root {clip(str(self.root))} ({self.root_origin}) "
+                              f"is not a folder{hint}")
         return load_dataset(self.dataset, self.root, list(self.sequences) if self.sequences is not None else None)
 
 
@@ -100,14 +103,14 @@ def _find_spec(source: str | os.PathLike) -> Path:
         if candidate.is_file() and candidate.suffix in (".yaml", ".yml"):
             return candidate.resolve()
     shipped = [p.stem for p in sorted(folder.glob("*.yaml")) if _is_spec_file(p)] if folder.is_dir() else []
-    raise ConfigError(f"ablation spec not found: {source}"
+    raise ConfigError(f"ablation spec not found: {clip(str(source))}"
                       + (f"; shipped specs: {', '.join(shipped)}" if shipped else ""))
 
 
 def _is_spec_file(path: Path) -> bool:
-    with contextlib.suppress(OSError, yaml.YAMLError):
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-        return isinstance(data, dict) and ("variants" in data or "grid" in data)
+    with contextlib.suppress(ConfigError):
+        data = read_yaml(path)
+        return "variants" in data or "grid" in data
     return False
 
 
@@ -115,21 +118,21 @@ def _mapping(value: Any, where: str, what: str) -> dict:
     if value is None:
         return {}
     if not isinstance(value, Mapping):
-        raise ConfigError(f"{where}: expected {what}, got {type(value).__name__} {value!r}")
+        raise ConfigError(f"{where}: expected {what}, got {type(value).__name__} {shown(value)}")
     return dict(value)
 
 
 def _check_keys(data: Mapping, valid: tuple, where: str) -> None:
     for key in data:
         if key not in valid:
-            raise ConfigError(f"{where}: unknown key '{key}'{closest(key, valid)}; valid keys: {', '.join(valid)}")
+            raise ConfigError(f"{where}: unknown key {shown(key)}{closest(key, valid)}; valid keys: {', '.join(valid)}")
 
 
 def _overrides(value: Any, where: str) -> dict:
     out = _mapping(value, where, "a mapping of dotted keys to values, e.g. {label.mu: 0.3}")
     for key in out:
         if not isinstance(key, str) or not key.strip():
-            raise ConfigError(f"{where}: keys must be dotted config keys such as label.mu, got {key!r}")
+            raise ConfigError(f"{where}: keys must be dotted config keys such as label.mu, got {shown(key)}")
     return out
 
 
@@ -139,12 +142,12 @@ def _load(spec_path: Path, config: Any, overrides: Mapping, where: str, key: str
     ``where`` names the spec entry in errors, ``key`` the spec key holding ``config``."""
     if not isinstance(config, str) or not config.strip():
         raise ConfigError(f"{spec_path}: {key}: expected a config file or shipped name "
-                          f"(e.g. ../dr2track.yaml or dr2track), got {config!r}")
+                          f"(e.g. ../dr2track.yaml or dr2track), got {shown(config)}")
     local = spec_path.parent / config
     found = local if local.is_file() else shipped_config(config)  # never the working directory
     if found is None:
-        raise ConfigError(f"{spec_path}: {where}: config '{config}' not found (looked for {local} and for "
-                          f"a shipped config of that name)")
+        raise ConfigError(f"{spec_path}: {where}: config '{clip(config)}' not found (looked for "
+                          f"{clip(str(local))} and for a shipped config of that name)")
     source = str(found)
     try:
         return load_config(source, overrides), source
@@ -153,7 +156,7 @@ def _load(spec_path: Path, config: Any, overrides: Mapping, where: str, key: str
             load_config(source)
         except DcfkitError:
             raise ConfigError(f"{spec_path}: {where}: {exc}") from None
-        raise ConfigError(f"{spec_path}: {where} overrides ({', '.join(overrides)}): {exc}") from None
+        raise ConfigError(f"{spec_path}: {where} overrides ({clip(', '.join(overrides))}): {exc}") from None
 
 
 def format_value(value: Any) -> str:
@@ -168,7 +171,7 @@ def _parse_grid(spec_path: Path, data: Any, named: dict[str, Variant]) -> tuple[
     _check_keys(grid, GRID_KEYS, f"{spec_path}: grid")
     mode = grid.get("mode", "sweep")
     if mode not in GRID_MODES:
-        raise ConfigError(f"{spec_path}: grid.mode: expected one of {', '.join(GRID_MODES)}, got {mode!r}")
+        raise ConfigError(f"{spec_path}: grid.mode: expected one of {', '.join(GRID_MODES)}, got {shown(mode)}")
     base = grid.get("base")
     if base is None:
         raise ConfigError(f"{spec_path}: grid.base: missing; name a variant or a config (e.g. dr2track)")
@@ -184,9 +187,21 @@ def _parse_grid(spec_path: Path, data: Any, named: dict[str, Variant]) -> tuple[
                       "a mapping of dotted keys to value lists, e.g. {label.mu: [0, 0.1, 0.25]}")
     if not params:
         raise ConfigError(f"{spec_path}: grid.parameters: empty; give at least one dotted key with a list of values")
+    parsed = _parse_parameters(spec_path, params)
+    variants = []
+    for point in _grid_points(spec_path, parsed, mode, len(named)):
+        name = ", ".join(f"{parsed[k][0]}={format_value(v)}" for k, v in point.items())
+        where = clip("grid (" + ", ".join(f"{k}={format_value(v)}" for k, v in point.items()) + ")")
+        config, _ = _load(spec_path, base_source, {**base_overrides, **point}, where, "grid.base")
+        variants.append(Variant(name, config, base_source, {**base_overrides, **point}, dict(point)))
+    return Grid(str(base), mode, parsed, base_config), variants
+
+
+def _parse_parameters(spec_path: Path, params: Mapping) -> dict[str, tuple[str, list]]:
+    """``grid.parameters`` as dotted key -> (label, values), each value and label once."""
     parsed: dict[str, tuple[str, list]] = {}
     for key, entry in params.items():
-        where = f"{spec_path}: grid.parameters.{key}"
+        where = f"{spec_path}: grid.parameters.{clip(str(key))}"
         label = key
         if isinstance(entry, Mapping):
             _check_keys(entry, ("values", "label"), where)
@@ -194,29 +209,39 @@ def _parse_grid(spec_path: Path, data: Any, named: dict[str, Variant]) -> tuple[
             entry = entry.get("values")
         if not isinstance(entry, list) or not entry:
             raise ConfigError(f"{where}: expected a non-empty list of values (or {{label: ..., values: [...]}}), "
-                              f"got {entry!r}")
-        names = [format_value(v) for v in entry]
-        dup = next((n for n in names if names.count(n) > 1), None)
+                              f"got {shown(entry)}")
+        dup = _first_repeat(format_value(v) for v in entry)
         if dup is not None:
-            raise ConfigError(f"{where}: value {dup} is listed twice")
+            raise ConfigError(f"{where}: value {clip(dup)} is listed twice")
         parsed[str(key)] = (label, list(entry))
-    labels = [label for label, _ in parsed.values()]
-    dup = next((lab for lab in labels if labels.count(lab) > 1), None)
+    dup = _first_repeat(label for label, _ in parsed.values())
     if dup is not None:
-        raise ConfigError(f"{spec_path}: grid.parameters: two parameters share the label {dup!r}")
+        raise ConfigError(f"{spec_path}: grid.parameters: two parameters share the label {shown(dup)}")
+    return parsed
 
+
+def _first_repeat(items: Iterable) -> Any:
+    """The first item seen a second time, or None (in linear time: a grid may list many values)."""
+    seen = set()
+    for item in items:
+        if item in seen:
+            return item
+        seen.add(item)
+    return None
+
+
+def _grid_points(spec_path: Path, parsed: Mapping, mode: str, named: int) -> list[dict]:
+    """The grid's points (dotted key -> value), counted before they are made: a product of a few
+    long lists is more variants than can be resolved, or held."""
+    lengths = [len(values) for _, values in parsed.values()]
+    count = sum(lengths) if mode == "sweep" else math.prod(lengths)
+    if named + count > MAX_VARIANTS:
+        raise ConfigError(f"{spec_path}: grid.parameters: {count} grid points ({mode}) and {named} named variants; "
+                          f"a spec has at most {MAX_VARIANTS} variants (dcfkit.ablation.spec.MAX_VARIANTS)")
     if mode == "sweep":
-        points = [{key: value} for key, (_, values) in parsed.items() for value in values]
-    else:
-        keys = list(parsed)
-        points = [dict(zip(keys, combo)) for combo in itertools.product(*(parsed[k][1] for k in keys))]
-    variants = []
-    for point in points:
-        name = ", ".join(f"{parsed[k][0]}={format_value(v)}" for k, v in point.items())
-        where = "grid (" + ", ".join(f"{k}={format_value(v)}" for k, v in point.items()) + ")"
-        config, _ = _load(spec_path, base_source, {**base_overrides, **point}, where, "grid.base")
-        variants.append(Variant(name, config, base_source, {**base_overrides, **point}, dict(point)))
-    return Grid(str(base), mode, parsed, base_config), variants
+        return [{key: value} for key, (_, values) in parsed.items() for value in values]
+    keys = list(parsed)
+    return [dict(zip(keys, combo)) for combo in itertools.product(*(parsed[k][1] for k in keys))]
 
 
 def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
@@ -232,6 +257,9 @@ def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
     path = _find_spec(source)
     data = read_yaml(path)
     _check_keys(data, SPEC_KEYS, str(path))
+    for key in ("name", "description"):
+        if data.get(key) is not None and not isinstance(data[key], str):
+            raise ConfigError(f"{path}: {key}: expected a string, got {shown(data[key])}")
     dataset_name, root_path, origin = _parse_dataset(path, data.get("dataset"), root)
     named = _parse_variants(path, data.get("variants"))
     grid, grid_variants = None, []
@@ -239,7 +267,7 @@ def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
         grid, grid_variants = _parse_grid(path, data["grid"], named)
     for v in grid_variants:
         if v.name in named:
-            raise ConfigError(f"{path}: grid point {v.name!r} has the same name as variants.{v.name}; "
+            raise ConfigError(f"{path}: grid point {shown(v.name)} has the same name as variants.{clip(v.name)}; "
                               f"rename the variant")
     if not named and not grid_variants:
         raise ConfigError(f"{path}: no variants and no grid: nothing to run")
@@ -257,15 +285,17 @@ def _parse_dataset(path: Path, dataset: Any, root) -> tuple[str, Path | None, st
     _check_keys(dataset, ("name", "root"), f"{path}: dataset")
     if not dataset.get("name"):
         raise ConfigError(f"{path}: dataset.name: missing (e.g. uav123_10fps, dtb70, uavdt, otb)")
+    if not isinstance(dataset["name"], str):
+        raise ConfigError(f"{path}: dataset.name: expected a name such as uav123_10fps, got {shown(dataset['name'])}")
     try:
-        name = canonical_name(str(dataset["name"]))
+        name = canonical_name(dataset["name"])
     except DatasetError as exc:
         raise ConfigError(f"{path}: dataset.name: {exc}") from None
     if root is not None:
         return name, Path(root).expanduser().resolve(), "--root"
     if dataset.get("root"):
         return (name, (path.parent / Path(str(dataset["root"])).expanduser()).resolve(),
-                f"dataset.root {dataset['root']!r} relative to the spec")
+                f"dataset.root {shown(dataset['root'])} relative to the spec")
     return name, None, "not given"
 
 
@@ -282,18 +312,21 @@ def _parse_sequences(path: Path, data: Mapping, sequences) -> tuple | None:
         return None
     if not isinstance(sequences, (list, tuple)) or not sequences or \
             not all(isinstance(s, str) and s for s in sequences):
-        raise ConfigError(f"{where}: expected a non-empty list of sequence names, got {sequences!r}")
+        raise ConfigError(f"{where}: expected a non-empty list of sequence names, got {shown(sequences)}")
     return tuple(dict.fromkeys(sequences))
 
 
 def _parse_variants(path: Path, raw: Any) -> dict[str, Variant]:
     """The named variants, each config resolved with its overrides."""
     raw_variants = _mapping(raw, f"{path}: variants", "a mapping of variant names to {config: ..., overrides: {...}}")
+    if len(raw_variants) > MAX_VARIANTS:
+        raise ConfigError(f"{path}: variants: {len(raw_variants)} variants; a spec has at most {MAX_VARIANTS} "
+                          f"(dcfkit.ablation.spec.MAX_VARIANTS)")
     named: dict[str, Variant] = {}
     for name, entry in raw_variants.items():
-        where = f"variants.{name}"
+        where = f"variants.{clip(str(name))}"
         if str(name) in named:  # YAML keys 1 and "1" (or true and "True") are one name here
-            raise ConfigError(f"{path}: {where}: variant names must be unique, and {name!r} is given twice")
+            raise ConfigError(f"{path}: {where}: variant names must be unique, and {shown(name)} is given twice")
         if isinstance(entry, str):
             entry = {"config": entry}
         entry = _mapping(entry, f"{path}: {where}", "{config: path-or-name, overrides: {dotted.key: value}}")

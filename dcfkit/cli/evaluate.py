@@ -12,7 +12,7 @@ from ..baselines import opencv_tracker
 from ..compare import COLUMNS, compare_folders
 from ..config import load_config, parse_overrides
 from ..datasets import load_dataset
-from ..errors import ConfigError
+from ..errors import ConfigError, shown
 from ..evaluation import check_one_pass, run_one_pass, tracker_name
 from ..report import columns, evaluate, format_table, json_ready, score_and_write, score_line
 from ..results import load_results
@@ -53,7 +53,7 @@ def distinct_names(specs: list[str], resolved: list[tuple[dict, Callable | None]
             out.append((config, factory))
         elif seen[name][1] != config:
             raise ConfigError(
-                f"configs {seen[name][0]!r} and {spec!r} are both named {name!r} and would write to the "
+                f"configs {shown(seen[name][0])} and {shown(spec)} are both named {shown(name)} and would write to the "
                 f"same results folder; give one of them another 'name:' (--set name=... renames every CONFIG)")
     return out
 

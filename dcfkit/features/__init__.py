@@ -15,8 +15,8 @@ import numpy as np
 
 from ..errors import TrackingError, blamed_on
 from ..params import param
-from ..registry import Component
-from .colornames import load_table
+from ..registry import Component, Contract
+from .colornames import load_table, table_path_problem
 from .fhog import fhog
 
 
@@ -30,15 +30,26 @@ def cell_average(x: np.ndarray, cell_size: int) -> np.ndarray:
 
 
 class Feature(Component):
+    """Maps search patches to feature maps. The tracker calls ``reset()`` at every ``init``
+    (a new target), then ``extract`` on each patch; ``channels()`` whenever it checks a map."""
+
     kind = "feature"
+    contract = Contract(required={"channels": (), "extract": ("patch", "cell_size")}, optional={"reset": ()})
 
     def channels(self) -> int:
+        """C, the number of channels ``extract`` returns (at least 1)."""
         raise NotImplementedError
 
     def extract(self, patch: np.ndarray, cell_size: int) -> np.ndarray:
-        """(H, W, 3) uint8 BGR -> (C, H/cell, W/cell) float32."""
+        """(H, W, 3) uint8 BGR, sides multiples of ``cell_size`` -> (C, H/cell, W/cell) float32, finite."""
         raise NotImplementedError
 
+    def reset(self) -> None:
+        """Forget what earlier targets left (the built-in features keep nothing)."""
+
+
+MAX_ORIENTS = 36  # fhog's bins of 5 degrees
+MIN_CLIP = 1e-6
 
 # rgb2gray's weights of R, G, B in MATLAB and Octave, applied to the unrounded colour values
 MATLAB_GRAY_WEIGHTS = (0.298936, 0.587043, 0.114021)
@@ -90,8 +101,12 @@ class FHOG(Feature):
         def validate(self):
             if self.n_orients < 2:
                 return "n_orients must be at least 2"
+            if self.n_orients > MAX_ORIENTS:  # 3 channels each: the size of the maps, the solver's time
+                return f"n_orients must be at most {MAX_ORIENTS}"
             if not 0 < self.clip <= 1:
                 return "clip must be in (0, 1]"
+            if self.clip < MIN_CLIP:  # a smaller one keeps only which bins are empty, or rounds to float32's 0
+                return f"clip must be at least {MIN_CLIP:g}"
             if self.arithmetic == "sse" and self.soft_orientation:
                 return "arithmetic 'sse' (Piotr's gradientMex) bins orientations hard: set soft_orientation false"
 
@@ -112,6 +127,9 @@ class ColorNames(Feature):
     @dataclasses.dataclass(frozen=True)
     class Params:
         table_path: str = param("", "a .npy/.mat CN table; empty: read it from the installed OpenCV")
+
+        def validate(self):
+            return table_path_problem(self.table_path) if self.table_path else None
 
     def channels(self) -> int:
         return 10

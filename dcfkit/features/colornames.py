@@ -66,20 +66,58 @@ def _from_opencv() -> np.ndarray:
         + "); install opencv-contrib-python-headless, or set colornames.table_path to a .npy/.mat file")
 
 
-def _from_file(path: str) -> np.ndarray:
-    p = Path(path).expanduser()
-    if not p.is_file():
-        raise ConfigError(f"colornames.table_path: file not found: {p}")
-    if p.suffix == ".npy":
-        return _verify(np.load(p), str(p))
-    if p.suffix == ".mat":
-        import scipy.io  # lazy: only for a user-supplied .mat table
+def _expanded(path: str) -> Path | None:
+    """``path`` with ``~`` expanded, or None if it names an unknown user's home."""
+    try:
+        return Path(path).expanduser()
+    except RuntimeError:  # pathlib: "Could not determine home directory"
+        return None
 
-        arrays = [v for v in scipy.io.loadmat(str(p)).values() if isinstance(v, np.ndarray) and v.shape == SHAPE]
-        if not arrays:
-            raise ConfigError(f"colornames.table_path: {p} holds no {SHAPE[0]}x{SHAPE[1]} array")
-        return _verify(arrays[0], str(p))
-    raise ConfigError(f"colornames.table_path: {p} must be a .npy or .mat file")
+
+def _is_file(p: Path | None) -> bool:
+    try:
+        return p is not None and p.is_file()
+    except OSError:  # e.g. a name too long for the file system: no such file
+        return False
+
+
+def table_path_problem(path: str) -> str | None:
+    """Why ``path`` cannot name a table (checked when a config is read), or None."""
+    p = _expanded(path)
+    shown = path if len(path) <= 200 else f"{path[:200]}..."
+    if not path.endswith((".npy", ".mat")):
+        return f"table_path: {shown!r} must be a .npy or .mat file"
+    if not _is_file(p):
+        return f"table_path: file not found: {shown}"
+    return None
+
+
+def _read(p: Path) -> np.ndarray | None:
+    """The array of a .npy file, or the first (32768, 10) one of a .mat file (None: none there)."""
+    if p.suffix == ".npy":
+        return np.load(p)
+    import scipy.io  # lazy: only for a user-supplied .mat table
+
+    try:
+        data = scipy.io.loadmat(str(p))
+    except scipy.io.matlab.MatReadError as exc:  # said as numpy says an unreadable file
+        raise ValueError(str(exc)) from None
+    return next((v for v in data.values() if isinstance(v, np.ndarray) and v.shape == SHAPE), None)
+
+
+def _from_file(path: str) -> np.ndarray:
+    p = _expanded(path)
+    if not _is_file(p):
+        raise ConfigError(f"colornames.table_path: file not found: {p or path}")
+    if p.suffix not in (".npy", ".mat"):
+        raise ConfigError(f"colornames.table_path: {p} must be a .npy or .mat file")
+    try:
+        table = _read(p)
+    except (OSError, ValueError, EOFError) as exc:  # not an array file
+        raise ConfigError(f"colornames.table_path: {p} cannot be read ({type(exc).__name__}: {exc})") from None
+    if table is None:
+        raise ConfigError(f"colornames.table_path: {p} holds no {SHAPE[0]}x{SHAPE[1]} array")
+    return _verify(table, str(p))
 
 
 @functools.lru_cache(maxsize=4)
