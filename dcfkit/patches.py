@@ -5,39 +5,13 @@ Coordinates are 0-based pixel indices, (y, x) order for centres and (h, w) for s
 """
 from __future__ import annotations
 
-import math
-import os
 from typing import Callable
 
 import cv2
 import numpy as np
 
-from .errors import ConfigError, InputError
-
-IMAGE_PIXELS_VARIABLE = "DCFKIT_MAX_IMAGE_PIXELS"
-DEFAULT_MAX_IMAGE_PIXELS = 10**8  # 300 MB as BGR; an 8K video frame has 33 million
-
-
-def pixel_budget(variable: str, default: int) -> int:
-    """A limit in pixels: the environment variable ``variable`` if set (``1e9`` is fine), else
-    ``default``; read when used, so a program may set it before tracking."""
-    text = os.environ.get(variable, "").strip()
-    if not text:
-        return default
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (1 <= value < math.inf):
-        raise ConfigError(f"${variable} must be a number of pixels >= 1, got {text!r}")
-    return int(value)
-
-
-def max_image_pixels() -> int:
-    """The most pixels dcfkit holds in one image: a frame it reads from a file, or a region it
-    copies from a frame for one sample (``$DCFKIT_MAX_IMAGE_PIXELS``, default 10^8)."""
-    return pixel_budget(IMAGE_PIXELS_VARIABLE, DEFAULT_MAX_IMAGE_PIXELS)
-
+from .errors import InputError
+from .limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 def box_to_centre_size(box) -> tuple[np.ndarray, np.ndarray]:
     """(x, y, w, h) -> centre (y, x) and size (h, w), float64."""

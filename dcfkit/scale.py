@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from .features.fhog import fhog
+from .limits import SAMPLE_PIXELS_VARIABLE, sample_budget
 from .params import param
 from .patches import resize_auto, sample, sampler, whole_pixel_crop
 from .registry import Component, Contract
@@ -75,9 +76,6 @@ class Pyramid(ScaleEstimator):
         return _factors(self.params.n_scales, self.params.step)
 
 
-MAX_WORKING_AREA = 2000**2  # pixels, as the largest search patch (tracker.max_image_sample_size)
-
-
 class DSST(ScaleEstimator):
     """Discriminative scale filter: fHOG of S target-sized samples, a 1-D filter over scale."""
 
@@ -127,10 +125,12 @@ class DSST(ScaleEstimator):
         def _working_patch_problem(self):
             """The working patch holds the largest scale's sample at the smallest's resolution."""
             area = max(self.model_max_area, (2 * self.cell_size) ** 2) * (self.step ** (self.n_scales - 1)) ** 2
-            if area > MAX_WORKING_AREA:
+            limit = sample_budget()[0]
+            if area > limit:
                 return (f"model_max_area={self.model_max_area}, cell_size={self.cell_size}, step={self.step:g} and "
                         f"n_scales={self.n_scales}: the scale samples' working patch would have {area:.3g} pixels, "
-                        f"over {MAX_WORKING_AREA:.3g} (2000²; lower model_max_area, n_scales or step)")
+                        f"over the limit of {limit:.3g} (${SAMPLE_PIXELS_VARIABLE}; or lower model_max_area, "
+                        f"n_scales or step)")
 
     def init(self, image, centre, base_target, scale, limits):
         super().init(image, centre, base_target, scale, limits)

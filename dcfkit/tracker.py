@@ -26,27 +26,13 @@ from .errors import ConfigError, InputError, TrackingError, blamed_on
 from .features import extract_stack
 from .fft import make_fft
 from .labels import Detection, gaussian_label
-from .patches import (box_to_centre_size, centre_size_to_box, cropper, pixel_budget, round_half_away, sampler,
-                      whole_pixel_sampler)
+from .limits import SAMPLE_PIXELS_VARIABLE, sample_budget
+from .patches import box_to_centre_size, centre_size_to_box, cropper, round_half_away, sampler, whole_pixel_sampler
 from .registry import get_registry
 from .response import newton_peak, response, shift_spectrum, subpixel_peak
 from .scale import DSST, scale_limits
 
 MAX_BOX_TO_IMAGE = 10  # an initial box is at most this many times the image's width and height
-SAMPLE_PIXELS_VARIABLE = "DCFKIT_MAX_SAMPLE_PIXELS"
-DEFAULT_MAX_SAMPLE_PIXELS = 2048**2  # 20 times the shipped configs' 5 x 200² (STRCF, BACF)
-CELL_AREA = 16  # the cell budget: as many cells as the pixel budget has 4x4-pixel cells
-
-
-def sample_budget() -> tuple[int, int]:
-    """(pixels, cells) one frame's samples may have: the search samples at every search scale,
-    in pixels and in feature cells, and the scale filter's samples (``$DCFKIT_MAX_SAMPLE_PIXELS``,
-    default 2048²; cells: a sixteenth of it). Beyond them memory and time per frame grow without
-    bound (features are ``channels x cells`` floats)."""
-    pixels = pixel_budget(SAMPLE_PIXELS_VARIABLE, DEFAULT_MAX_SAMPLE_PIXELS)
-    return pixels, max(pixels // CELL_AREA, 1)
-
-
 def check_image(image: Any, frame: int) -> np.ndarray:
     """Reject anything but a non-empty (H, W) or (H, W, 3) uint8 array, naming the frame."""
     if not isinstance(image, np.ndarray):

@@ -17,7 +17,7 @@ from typing import Callable, Iterable
 
 import numpy as np
 
-from .errors import DcfkitError
+from .errors import DcfkitError, shown
 
 OnFrame = Callable[[int, np.ndarray, np.ndarray, object], None]
 
@@ -107,7 +107,8 @@ def as_box(value, frame: int) -> np.ndarray:
     try:
         return np.asarray(value, dtype=np.float64).reshape(4)
     except (TypeError, ValueError):
-        raise TrackerFailure(frame, f"update() returned {value!r}, expected 4 numbers (x, y, w, h)") from None
+        what = "the initial box is" if frame == 1 else "update() returned"
+        raise TrackerFailure(frame, f"{what} {shown(value)}, expected 4 numbers (x, y, w, h)") from None
 
 
 def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | None = None,
@@ -120,7 +121,6 @@ def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | N
     done so far, so a caller can keep them. A tracker exception becomes a
     :class:`TrackerFailure` naming the frame and the call."""
     boxes, times = [], []
-    init_box = np.asarray(init_box, dtype=np.float64).reshape(4)
     try:
         for index, image in enumerate(frames):  # decoding happens here: not timed
             start = time.perf_counter()

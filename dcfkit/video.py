@@ -12,7 +12,7 @@ import numpy as np
 
 from .datasets import read_frame
 from .errors import InputError
-from .patches import IMAGE_PIXELS_VARIABLE, max_image_pixels
+from .limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff")
 COLOURS = ((0, 0, 255), (0, 255, 255), (255, 160, 0), (255, 0, 255), (255, 255, 255))  # BGR

@@ -93,3 +93,9 @@ def test_termination_is_held_back_during_a_final_write():
                 os.kill(os.getpid(), signal.SIGTERM)
                 written.append("all of it")  # not cut short
     assert written == ["all of it"]
+
+
+@pytest.mark.parametrize("box", [(1, 2, 3), "abc", None])
+def test_a_malformed_initial_box_is_a_failure_of_frame_1(box):
+    with pytest.raises(TrackerFailure, match=r"^frame 1: "):
+        track(Stepper(), FRAMES, box)

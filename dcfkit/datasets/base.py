@@ -15,6 +15,7 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from ..errors import DcfkitError
+from ..limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 
 class DatasetError(DcfkitError, ValueError):
@@ -92,7 +93,7 @@ class Sequence:
 
 def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
     """A BGR image; :class:`DatasetError` naming the file when it is missing, not an image, larger
-    than :func:`~dcfkit.patches.max_image_pixels` (read from its header, before decoding), a
+    than :func:`~dcfkit.limits.max_image_pixels` (read from its header, before decoding), a
     truncated JPEG (``cv2.imread`` would return one grey below the cut, with a warning only), or
     a JPEG whose data libjpeg reports corrupt (``cv2.imread`` would return it with a warning, part
     of it grey or wrong). A JPEG that lacks just its end-of-image marker, a common defect, is read
@@ -127,7 +128,6 @@ def _check_size(data: bytes, path, what: str) -> None:
     refused, as its size is unknown."""
     from PIL import Image  # deferred, as OpenCV: listing sequences reads no image
 
-    from ..patches import IMAGE_PIXELS_VARIABLE, max_image_pixels  # deferred with OpenCV, which patches imports
 
     limit = max_image_pixels()
     with warnings.catch_warnings():
