@@ -16,6 +16,7 @@ import importlib.metadata
 import inspect
 import os
 import signal
+import threading
 import typing
 import warnings
 from typing import Any, Mapping
@@ -161,11 +162,11 @@ def signals_noted():
             return handler(signum, frame)
         return note
 
-    with contextlib.suppress(ValueError):  # not the main thread
+    if threading.current_thread() is threading.main_thread():  # elsewhere signal.signal raises
         for s in INTERRUPTS:
             if callable(handler := signal.getsignal(s)):  # SIG_DFL and SIG_IGN raise nothing
-                saved[s] = handler
                 signal.signal(s, noted(handler))
+                saved[s] = handler
     try:
         yield arrived
     finally:

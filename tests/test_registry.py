@@ -422,3 +422,23 @@ def test_a_real_interrupt_while_a_plugin_loads_still_interrupts(monkeypatch, sig
     with interrupt_on_termination(), pytest.raises(KeyboardInterrupt) as raised:
         reg.build_registry()
     assert isinstance(raised.value, Interrupted) == (signal_name == "SIGTERM")
+
+
+def test_plugins_load_off_the_main_thread_as_a_dask_worker_does():
+    """Dask runs tasks in worker threads, where signal handlers cannot be set: loading the
+    registry there must not try."""
+    import threading
+
+    outcome = []
+
+    def load():
+        try:
+            outcome.append(sorted(reg.build_registry(external=False).names("label")))
+        except Exception as exc:  # noqa: BLE001 - the test reports it
+            outcome.append(exc)
+
+    worker = threading.Thread(target=load)
+    worker.start()
+    worker.join()
+    assert outcome and not isinstance(outcome[0], Exception), outcome
+    assert "gaussian" in outcome[0]
