@@ -370,15 +370,14 @@ def set_dotted(config: dict, key: str, value: Any) -> None:
     parts = key.split(".")
     node: Any = config
     for i, part in enumerate(parts[:-1]):
-        where = ".".join(parts[: i + 1])
         if isinstance(node, list):
-            node = node[_index(node, part, where)]
+            node = node[_index(node, part, ".".join(parts[: i + 1]))]
         elif isinstance(node, dict):
             if not isinstance(node.get(part), (dict, list)):
                 node[part] = {}
             node = node[part]
         else:
-            raise ConfigError(f"override '{clip(key)}': '{clip(where)}' is not a mapping")
+            raise ConfigError(f"override '{clip(key)}': '{clip('.'.join(parts[: i + 1]))}' is not a mapping")
     last = parts[-1]
     if isinstance(node, list):
         node[_index(node, last, key)] = value

@@ -81,7 +81,10 @@ def _coerce_int(value: Any, where: str) -> int:
 def _coerce_float(value: Any, where: str) -> float:
     number = None
     if isinstance(value, (int, float)) and not isinstance(value, bool):
-        number = float(value)
+        with contextlib.suppress(OverflowError):  # an int beyond float's range: not finite
+            number = float(value)
+        if number is None:
+            number = math.inf
     elif isinstance(value, str):  # YAML 1.1 reads '1e-3' as a string
         with contextlib.suppress(ValueError):
             number = float(value)

@@ -14,7 +14,6 @@ import math
 import numpy as np
 
 from .features.fhog import fhog
-from .limits import SAMPLE_PIXELS_VARIABLE, sample_budget
 from .params import param
 from .patches import resize_auto, sample, sampler, whole_pixel_crop
 from .registry import Component, Contract
@@ -120,17 +119,7 @@ class DSST(ScaleEstimator):
                 return "model_max_area must be in [1, 10000]"
             if not 1 <= self.cell_size <= 16:
                 return "cell_size must be in [1, 16]"
-            return _check_span(self.n_scales, self.step, least=3) or self._working_patch_problem()
-
-        def _working_patch_problem(self):
-            """The working patch holds the largest scale's sample at the smallest's resolution."""
-            area = max(self.model_max_area, (2 * self.cell_size) ** 2) * (self.step ** (self.n_scales - 1)) ** 2
-            limit = sample_budget()[0]
-            if area > limit:
-                return (f"model_max_area={self.model_max_area}, cell_size={self.cell_size}, step={self.step:g} and "
-                        f"n_scales={self.n_scales}: the scale samples' working patch would have {area:.3g} pixels, "
-                        f"over the limit of {limit:.3g} (${SAMPLE_PIXELS_VARIABLE}; or lower model_max_area, "
-                        f"n_scales or step)")
+            return _check_span(self.n_scales, self.step, least=3)
 
     def init(self, image, centre, base_target, scale, limits):
         super().init(image, centre, base_target, scale, limits)

@@ -32,6 +32,7 @@ from .registry import get_registry
 from .response import newton_peak, response, shift_spectrum, subpixel_peak
 from .scale import DSST, scale_limits
 
+MAX_CHANNELS = 256  # feature channels in all: 6 times the shipped configs' 42 (gray, fhog, colornames)
 MAX_BOX_TO_IMAGE = 10  # an initial box is at most this many times the image's width and height
 def check_image(image: Any, frame: int) -> np.ndarray:
     """Reject anything but a non-empty (H, W) or (H, W, 3) uint8 array, naming the frame."""
@@ -130,9 +131,14 @@ class Tracker:
             return np.ones(1)
 
     def _check_config_budget(self) -> None:
-        """ConfigError naming the keys whose samples would be over :func:`sample_budget` for any box."""
+        """ConfigError naming the keys whose samples would be over :func:`sample_budget` for any box
+        (features hold channels x cells floats, so the channels count too)."""
         p, n = self.params, len(self._search_scales())
         pixels, cells = sample_budget()
+        channels = sum(f.channels() for f in self.features)
+        if channels > MAX_CHANNELS:
+            raise ConfigError(f"{self.name}: the features have {channels} channels together, over the limit of "
+                              f"{MAX_CHANNELS} (dcfkit.tracker.MAX_CHANNELS; the shipped configs have 42)")
         area = p.max_image_sample_size
         if n * area > pixels or n * area / p.cell_size**2 > cells:
             raise ConfigError(f"{self.name}: {n} search scales (scale.n_scales) of tracker.max_image_sample_size "

@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import warnings
 from pathlib import Path
 from typing import Iterator
 
@@ -45,11 +46,25 @@ def iter_frames(video: str | None = None, frames: str | None = None) -> Iterator
     yield from video_frames(video)
 
 
+# containers whose frame count is an index of the frames; elsewhere (MKV, WebM, ...) OpenCV
+# estimates it from the duration, and a complete file may fall short of it
+INDEXED_CONTAINERS = (".avi", ".mp4", ".m4v", ".mov")
+
+
+def _stopped_short(video, frame: int, declared: int) -> None:
+    """A video ends at ``frame`` of the ``declared``: an InputError for an indexed container (a
+    truncated file, whose last frame read is partly lost and is not tracked), else a warning."""
+    said = f"--video: {video} stops at frame {frame} of the {declared} its header declares"
+    if Path(video).suffix.lower() in INDEXED_CONTAINERS:
+        raise InputError(f"{said} (a truncated file?); frame {frame}, where its data ends, is not tracked")
+    warnings.warn(f"{said}; the count of this container is an estimate, so frame {frame} is tracked as the last "
+                  f"(if the file is truncated, that frame is partly lost)", RuntimeWarning, stacklevel=3)
+
+
 def video_frames(video: str | os.PathLike) -> Iterator[np.ndarray]:
     """Yield a video's frames; an InputError before reading if its frames are larger than
-    ``max_image_pixels()``, and one naming the frame where it stops short of the frame count its
-    header declares: a truncated file, whose last frame read is partly lost (OpenCV's decoder
-    fills in the rest) and is not yielded. Frames are read one ahead to know which is the last."""
+    ``max_image_pixels()``, and at the frame where it stops short of the frame count its header
+    declares (:func:`_stopped_short`). Frames are read one ahead to know which is the last."""
     cap = _open_video(video)
     declared = cap.get(cv2.CAP_PROP_FRAME_COUNT)
     declared = int(declared) if 0 < declared < math.inf else 0  # 0 (or -1): the container does not say
@@ -59,8 +74,7 @@ def video_frames(video: str | os.PathLike) -> Iterator[np.ndarray]:
         while ok:
             ok, following = cap.read()
             if not ok and count + 1 < declared:
-                raise InputError(f"--video: {video} stops at frame {count + 1} of the {declared} its header declares "
-                                 f"(a truncated file?); frame {count + 1}, where its data ends, is not tracked")
+                _stopped_short(video, count + 1, declared)
             count += 1
             yield image
             image = following

@@ -134,12 +134,19 @@ def test_every_accepted_parameter_value_tracks(kind, cls, data):
     ("search", "motion_aware", {"gain": 1e30}, "gain"),           # IndexError with clamp_position false
     ("scale", "dsst", {"lam": 0.0}, "lam"),                       # 0/0 on a featureless scale sample
     ("scale", "dsst", {"sigma_factor": 1e300}, "sigma_factor"),   # a flat scale label
-    ("scale", "dsst", {"model_max_area": 10000, "n_scales": 101, "step": 1.047}, "model_max_area"),
 ])
 def test_values_that_cannot_work_are_refused_at_load_naming_the_key(kind, cls, params, key):
     cls = reg.build_registry(external=False).entry(kind, cls).cls
     with pytest.raises(ConfigError, match=rf"\({kind} '{cls.name}'\): .*{key}"):
         dcfkit.load_tracker(TINY, overrides=slot_override(kind, cls, params))
+
+
+def test_a_dsst_working_patch_over_the_sample_budget_is_refused_naming_its_keys():
+    """The budget is the tracker's (``$DCFKIT_MAX_SAMPLE_PIXELS``): registering the built-ins
+    never depends on the environment."""
+    with pytest.raises(ConfigError, match=r"scale.n_scales 101 samples of scale.model_max_area .*DCFKIT_MAX_SAMPLE"):
+        dcfkit.load_tracker(TINY, overrides={"scale": {"name": "dsst", "model_max_area": 10000, "n_scales": 101,
+                                                       "step": 1.047}})
 
 
 @pytest.mark.parametrize("kind, cls", builtins(), ids=lambda v: getattr(v, "name", v))

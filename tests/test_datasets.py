@@ -270,7 +270,7 @@ def test_truncated_jpeg_is_refused_and_complete_ones_are_not(tmp_path):
         read_frame(cut, "frame 7")
     with pytest.raises(DatasetError, match=r"missing\.jpg \(file does not exist\)"):
         read_frame(missing)
-    with pytest.raises(DatasetError, match=r"Is a directory"):
+    with pytest.raises(DatasetError, match=r"not a regular file"):
         read_frame(tmp_path)
 
 

@@ -458,3 +458,10 @@ def test_any_set_value_is_parsed_or_a_config_error(text, key):
         if "--set" in str(exc):
             assert f"--set {key}" in str(exc)
     assert time.perf_counter() - start < SECONDS
+
+
+def test_a_400_digit_integer_for_a_float_parameter_is_a_config_error():
+    import dcfkit
+
+    with pytest.raises(ConfigError, match=r"solver.*beta.*expected a finite number"):
+        dcfkit.load_tracker("strcf", overrides={"solver.beta": int("9" * 400)})

@@ -413,3 +413,41 @@ def test_demo_arguments_out_of_range_are_usage_errors(args, said, capsys):
     with pytest.raises(SystemExit) as e:
         cli.main(["demo", "--save-video", "", *args])
     assert e.value.code == 2 and said in capsys.readouterr().err
+
+
+def test_only_regular_frame_files_of_bounded_size_are_read(tmp_path, monkeypatch):
+    import os
+
+    """A FIFO would block, /dev/zero never end, a sparse 6 GB file fill memory: refused unread."""
+    from dcfkit.datasets import DatasetError, read_frame
+
+    fifo = tmp_path / "00001.jpg"
+    os.mkfifo(fifo)
+    with pytest.raises(DatasetError, match=r"00001\.jpg \(not a regular file\)"):
+        read_frame(fifo)
+    monkeypatch.setenv("DCFKIT_MAX_IMAGE_PIXELS", "1000")
+    big = tmp_path / "00002.png"
+    with open(big, "wb") as f:
+        f.truncate(10**7)  # sparse
+    with pytest.raises(DatasetError, match=r"00002\.png \(1e\+07 bytes, more than an image of the limit"):
+        read_frame(big)
+
+
+def test_many_feature_channels_are_refused_at_load():
+    import dcfkit
+    from dcfkit.errors import ConfigError
+
+    features = [{"name": "fhog", "n_orients": 36}] * 10
+    with pytest.raises(ConfigError, match=r"1120 channels together, over the limit of 256"):
+        dcfkit.load_tracker("strcf", overrides={"features": features})
+
+
+def test_a_short_video_is_an_error_only_where_the_frame_count_is_an_index():
+    """MKV and WebM counts are duration x fps estimates: a complete file may fall short of them."""
+    from dcfkit.errors import InputError
+    from dcfkit.video import _stopped_short
+
+    with pytest.raises(InputError, match=r"cut\.avi stops at frame 8 of the 10 .*not tracked"):
+        _stopped_short("cut.avi", 8, 10)
+    with pytest.warns(RuntimeWarning, match=r"long\.mkv stops at frame 8 of the 10 .*tracked as the last"):
+        _stopped_short("long.mkv", 8, 10)

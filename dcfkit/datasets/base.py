@@ -8,6 +8,7 @@ import difflib
 import io
 import os
 import re
+import stat
 import warnings
 from pathlib import Path
 from typing import Iterable, Mapping
@@ -91,6 +92,24 @@ class Sequence:
 # --------------------------------------------------------------------------- images
 
 
+def _read_image_bytes(path, what: str) -> bytes:
+    """The bytes of an image file: a regular file (a FIFO would block, /dev/zero never end) no
+    larger than an uncompressed image of the pixel limit could be."""
+    limit = 6 * max_image_pixels() + 2**20  # 16-bit BGR, plus headers
+    try:
+        info = os.stat(path)
+        if not stat.S_ISREG(info.st_mode):
+            raise DatasetError(f"cannot read {what}: {path} (not a regular file)")
+        if info.st_size > limit:
+            raise DatasetError(f"cannot read {what}: {path} ({info.st_size:.3g} bytes, more than an image of the "
+                               f"limit of {max_image_pixels():.3g} pixels can take: ${IMAGE_PIXELS_VARIABLE})")
+        with open(path, "rb") as file:
+            return file.read(info.st_size + 1)  # a file growing meanwhile is cut: its size was checked
+    except OSError as exc:
+        reason = "file does not exist" if not os.path.exists(path) else exc.strerror
+        raise DatasetError(f"cannot read {what}: {path} ({reason})") from None
+
+
 def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
     """A BGR image; :class:`DatasetError` naming the file when it is missing, not an image, larger
     than :func:`~dcfkit.limits.max_image_pixels` (read from its header, before decoding), a
@@ -100,12 +119,7 @@ def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
     as imread would. Decoding is OpenCV's, unchanged."""
     import cv2  # deferred: listing sequences needs no OpenCV
 
-    try:
-        with open(path, "rb") as file:
-            data = file.read()
-    except OSError as exc:
-        reason = "file does not exist" if not os.path.exists(path) else exc.strerror
-        raise DatasetError(f"cannot read {what}: {path} ({reason})") from None
+    data = _read_image_bytes(path, what)
     _check_size(data, path, what)
     image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
     if image is None and _missing_end_marker(data):
