@@ -19,41 +19,27 @@ def parse_box(text: str) -> tuple[float, ...]:
     return box
 
 
-def pixels(text: str) -> float:
-    """An argparse type: a distance in pixels >= 0."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not value >= 0:
-        raise argparse.ArgumentTypeError(f"expected a distance in pixels >= 0, got {text!r}")
-    return value
+def _argument_type(convert, accept, expected: str):
+    """An argparse type: ``convert(text)`` if it converts and ``accept`` takes the value, else an
+    error saying it ``expected`` something else."""
+    def parse(text: str):
+        try:
+            value = convert(text)
+        except ValueError:
+            value = None
+        if value is None or not accept(value):
+            raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}")
+        return value
+    return parse
 
 
 # the demo's generated world is twice the frame; its camera drifts off it after some 265 frames
 MAX_DEMO_FRAMES = 250
 
-
-def frame_count(text: str) -> int:
-    """An argparse type: a whole number of frames from 2 to MAX_DEMO_FRAMES."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if not 2 <= value <= MAX_DEMO_FRAMES:
-        raise argparse.ArgumentTypeError(f"expected a whole number of frames from 2 to {MAX_DEMO_FRAMES}, got {text!r}")
-    return value
-
-
-def seed(text: str) -> int:
-    """An argparse type: a random seed, a whole number >= 0 (numpy refuses negative ones)."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}")
-    return value
+pixels = _argument_type(float, lambda v: v >= 0, "a distance in pixels >= 0")  # NaN fails v >= 0 too
+frame_count = _argument_type(int, lambda v: 2 <= v <= MAX_DEMO_FRAMES,
+                             f"a whole number of frames from 2 to {MAX_DEMO_FRAMES}")
+seed = _argument_type(int, lambda v: v >= 0, "a whole number >= 0")  # numpy refuses negative seeds
 
 
 def add_protocol_argument(parser: argparse.ArgumentParser) -> None:
