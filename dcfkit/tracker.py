@@ -15,14 +15,13 @@ Images are (H, W, 3) uint8 BGR or (H, W) uint8 gray; boxes are (x, y, w, h) floa
 from __future__ import annotations
 
 import dataclasses
-import reprlib
 from typing import Any, Mapping
 
 import cv2
 import numpy as np
 
 from .config import TrackerParams, load_config
-from .errors import ConfigError, InputError, TrackingError, blamed_on
+from .errors import ConfigError, InputError, TrackingError, blamed_on, shown
 from .features import extract_stack
 from .fft import make_fft
 from .labels import Detection, gaussian_label
@@ -34,6 +33,8 @@ from .scale import DSST, scale_limits
 
 MAX_CHANNELS = 256  # feature channels in all: 6 times the shipped configs' 42 (gray, fhog, colornames)
 MAX_BOX_TO_IMAGE = 10  # an initial box is at most this many times the image's width and height
+
+
 def check_image(image: Any, frame: int) -> np.ndarray:
     """Reject anything but a non-empty (H, W) or (H, W, 3) uint8 array, naming the frame."""
     if not isinstance(image, np.ndarray):
@@ -58,9 +59,9 @@ def check_box(box: Any, image_shape: tuple[int, ...]) -> np.ndarray:
             raise TypeError
         b = raw.astype(float).reshape(-1)
     except (TypeError, ValueError):
-        raise InputError(f"initial box must be 4 numbers (x, y, w, h), got {reprlib.repr(box)}") from None
+        raise InputError(f"initial box must be 4 numbers (x, y, w, h), got {shown(box)}") from None
     if b.size != 4 or not np.all(np.isfinite(b)):
-        raise InputError(f"initial box must be 4 finite numbers (x, y, w, h), got {reprlib.repr(box)}")
+        raise InputError(f"initial box must be 4 finite numbers (x, y, w, h), got {shown(box)}")
     x, y, w, h = (float(v) for v in b)
     if w <= 0 or h <= 0:
         raise InputError(f"initial box {(x, y, w, h)} has non-positive size (w={w:g}, h={h:g})")

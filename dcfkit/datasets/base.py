@@ -142,7 +142,6 @@ def _check_size(data: bytes, path, what: str) -> None:
     refused, as its size is unknown."""
     from PIL import Image  # deferred, as OpenCV: listing sequences reads no image
 
-
     limit = max_image_pixels()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", Image.DecompressionBombWarning)  # dcfkit's limit is the one that applies
