@@ -16,7 +16,6 @@ import importlib.metadata
 import inspect
 import os
 import signal
-import threading
 import typing
 import warnings
 from typing import Any, Mapping
@@ -25,6 +24,7 @@ import pluggy
 
 from .errors import ConfigError, DcfkitError, RegistryError, clip, describe_error, shown
 from .params import NoParams, check_schema, closest, parse_params
+from .signals import handlers_replaced
 
 PROJECT = "dcfkit"
 KINDS = ("feature", "label", "regularizer", "solver", "search", "scale")
@@ -154,24 +154,18 @@ def signals_noted():
     """Yields a list to which every SIGINT, SIGTERM or SIGHUP arriving in the block is added
     before its handler runs. Off the main thread, where Python runs no handlers, it stays empty."""
     arrived: list[int] = []
-    saved = {}
 
     def noted(handler):
+        if not callable(handler):  # SIG_DFL and SIG_IGN raise nothing
+            return None
+
         def note(signum, frame):
             arrived.append(signum)
             return handler(signum, frame)
         return note
 
-    if threading.current_thread() is threading.main_thread():  # elsewhere signal.signal raises
-        for s in INTERRUPTS:
-            if callable(handler := signal.getsignal(s)):  # SIG_DFL and SIG_IGN raise nothing
-                signal.signal(s, noted(handler))
-                saved[s] = handler
-    try:
+    with handlers_replaced(INTERRUPTS, noted):
         yield arrived
-    finally:
-        for s, handler in saved.items():
-            signal.signal(s, handler)
 
 
 def _raise_if_signalled(exc: BaseException, signalled: list) -> None:

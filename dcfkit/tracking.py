@@ -18,6 +18,7 @@ from typing import Callable, Iterable
 import numpy as np
 
 from .errors import DcfkitError, shown
+from .signals import handlers_replaced
 
 OnFrame = Callable[[int, np.ndarray, np.ndarray, object], None]
 
@@ -57,24 +58,11 @@ class Interrupted(KeyboardInterrupt):
 TERMINATION = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name))
 
 
-@contextlib.contextmanager
 def _termination_handled_by(handler):
     """Handle SIGTERM and SIGHUP with ``handler`` in the block, except a signal ignored when
     it starts (``nohup`` ignores SIGHUP); yields the handlers it replaced (None off the main
     thread, where signals are left alone)."""
-    try:
-        saved = {s: signal.getsignal(s) for s in TERMINATION}
-        for s, previous in saved.items():
-            if previous is not signal.SIG_IGN:
-                signal.signal(s, handler)
-    except ValueError:  # not the main thread
-        yield None
-        return
-    try:
-        yield saved
-    finally:
-        for s, previous in saved.items():
-            signal.signal(s, previous)
+    return handlers_replaced(TERMINATION, lambda previous: None if previous is signal.SIG_IGN else handler)
 
 
 def _interrupt(signum, frame):
