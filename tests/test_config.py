@@ -141,6 +141,11 @@ def test_error_in_an_inherited_file_lists_the_files_merged(tmp_path):
     ("base: strcf\nsolver: {iterations: 3, iterations: 4}\n", r"bad.yaml:2:\d+: .*key 'iterations' is given twice"),
     ("base: strcf\nlabel: {name: gaussian}\nlabel: {name: gaussian}\n", r"bad.yaml:3:1: .*key 'label' is given twice"),
     ("base: strcf\n? [a, b]\n: 1\n", r"bad.yaml:\d+:\d+: YAML error: found unhashable key"),
+    # values PyYAML cannot build: a ConfigError naming the line, not PyYAML's ValueError
+    ("base: strcf\nname: 1" + "0" * 5000 + "\n",
+     r"bad.yaml:2:7: YAML error: cannot read this value: Exceeds the limit"),
+    ("base: strcf\nname: 2001-13-45\n", r"bad.yaml:2:7: YAML error: cannot read this value: month must be in 1..12"),
+    ("base: strcf\nname: \x00\n", r"bad.yaml: YAML error: .*unacceptable character"),
 ])
 def test_bad_yaml_files_name_file_line_and_key(tmp_path, text, match):
     bad = tmp_path / "bad.yaml"

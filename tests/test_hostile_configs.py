@@ -321,19 +321,6 @@ def test_long_values_are_shown_short_in_messages(tmp_path):
     assert "name: expected a string, got <int>" in str(info.value)
 
 
-@pytest.mark.parametrize("text,match", [
-    ("base: strcf\nname: 1" + "0" * 5000 + "\n",
-     r"bad.yaml:2:7: YAML error: cannot read this value: Exceeds the limit"),
-    ("base: strcf\nname: 2001-13-45\n", r"bad.yaml:2:7: YAML error: cannot read this value: month must be in 1..12"),
-    ("base: strcf\nname: \x00\n", r"bad.yaml: YAML error: .*unacceptable character"),
-])
-def test_values_pyyaml_cannot_build_are_config_errors(tmp_path, text, match):
-    path = tmp_path / "bad.yaml"
-    path.write_text(text)
-    with pytest.raises(ConfigError, match=match):
-        load_config(path)
-
-
 # --------------------------------------------------------------------------- 7a. a null section
 
 
