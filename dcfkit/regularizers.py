@@ -47,24 +47,46 @@ MAX_POWER = 10.0  # smooth's exponent: the window's float64 distances to it stay
 
 class SpatialRegularizer(Component):
     """The spatial weight w of Eqs. (1), (2), (10) (``regularizers.spatial``). The tracker calls
-    ``weights_squared`` once per ``init`` (a new target) and gives the result to the solver."""
+    ``reset()`` and ``weights_squared`` once per ``init`` (a new target), then ``adapt`` after
+    every detection, and gives the w² in force to the solver. A fixed window (all the built-ins
+    but AutoTrack's) keeps w² as it is; an adaptive one keeps its state, explicit and small."""
 
     kind = "regularizer"
     role = "spatial"
-    contract = Contract(required={"weights_squared": ("shape", "target_cells")})
+    contract = Contract(required={"weights_squared": ("shape", "target_cells")},
+                        optional={"reset": (), "adapt": ("w2", "detection")})
 
     def weights_squared(self, shape: tuple[int, int], target_cells: tuple[float, float]) -> np.ndarray:
         """w² over the (H, W) filter grid, centred layout: (H, W) float32, >= 0, ``inf`` where h must be 0."""
         raise NotImplementedError
 
+    def reset(self) -> None:
+        """Forget what earlier targets left (the fixed windows keep nothing)."""
+
+    def adapt(self, w2: np.ndarray, detection) -> np.ndarray:
+        """The w² for this frame's training, given the one in force and the frame's
+        :class:`dcfkit.labels.Detection`: (H, W) float32 as ``weights_squared``'s. Fixed: ``w2``."""
+        return w2
+
 
 class TemporalRegularizer(Component):
-    """The temporal term θ/2 ‖h - h_prev‖² of Eq. (1) (``regularizers.temporal``): it has no
-    methods; the tracker reads ``params.theta`` every training frame and passes it to the solver."""
+    """The temporal term θ/2 ‖h - h_prev‖² of Eq. (1) (``regularizers.temporal``). The tracker
+    calls ``reset()`` at every ``init`` and ``weight(detection)`` every training frame
+    (``detection`` None on the first), and passes the θ it returns to the solver. The fixed
+    term returns ``params.theta``; an adaptive one may return ``inf``, the limit in which the
+    filter cannot change: the tracker then keeps the last filter and does not train."""
 
     kind = "regularizer"
     role = "temporal"
-    contract = Contract(params={"theta": (float, 0.0, MAX_THETA)})
+    contract = Contract(params={"theta": (float, 0.0, MAX_THETA)},
+                        optional={"reset": (), "weight": ("detection",)})
+
+    def reset(self) -> None:
+        """Forget what earlier targets left (the fixed term keeps nothing)."""
+
+    def weight(self, detection) -> float:
+        """θ for this frame's training: in [0, MAX_THETA], or ``inf`` to keep the last filter."""
+        return self.params.theta
 
 
 class BoxWindow(SpatialRegularizer):

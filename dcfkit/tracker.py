@@ -28,7 +28,8 @@ from .labels import Detection, gaussian_label
 from .limits import SAMPLE_PIXELS_VARIABLE, sample_budget
 from .patches import box_to_centre_size, centre_size_to_box, cropper, round_half_away, sampler, whole_pixel_sampler
 from .registry import get_registry
-from .response import newton_peak, response, shift_spectrum, subpixel_peak
+from .regularizers import MAX_THETA
+from .response import newton_peak, shift_spectrum, subpixel_peak
 from .scale import DSST, scale_limits
 
 MAX_CHANNELS = 256  # feature channels in all: 6 times the shipped configs' 42 (gray, fhog, colornames)
@@ -239,7 +240,8 @@ class Tracker:
         self.base_label.setflags(write=False)  # every frame's label starts from it
         self.w2 = (self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
                    else np.zeros(g.filter_size, np.float32))
-        for component in (*self.features, self.label, self.solver):  # a new target: nothing kept from the last
+        regularizers = [r for r in (self.spatial, self.temporal) if r is not None]
+        for component in (*self.features, self.label, self.solver, *regularizers):  # a new target: nothing kept
             component.reset()
         self.search.reset(centre)
         self.scale_estimator.init(image, centre, g.base_target, self.scale, self.limits)
@@ -305,7 +307,7 @@ class Tracker:
             return self.box
         patches = [self._patch(image, centre, self.scale * f) for f in factors]
         samples = np.stack([self._spectrum(patch) for patch in patches])
-        maps = response(self.hf, samples, g.filter_size, self.fft)  # Eq. (12)
+        maps = self._response(samples)  # Eq. (12)
         if not np.all(np.isfinite(maps)):
             raise TrackingError(f"frame {self.frame}: the response map is not finite (the filter overflowed: "
                                 f"look for extreme solver, regularizer or label values in the config)")
@@ -325,8 +327,45 @@ class Tracker:
             sy, sx = (self.position - centre) / (g.cell_size * self.scale)
             xf = shift_spectrum(samples[best], sy, sx, g.filter_size)
         detection = Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells, (dy, dx))
+        self._observe(detection)
         self._train(image, detection, xf)
         return self.box
+
+    def _response(self, samples: np.ndarray) -> np.ndarray:
+        """The solver's (S, H, W) response maps of the (S, C, H, Wr) search samples, checked."""
+        expected = (len(samples), *self.geometry.filter_size)
+        with blamed_on(f"frame {self.frame}: solver '{self.solver.name}'"):
+            maps = np.asarray(self.solver.response(self.hf, samples, self.geometry.filter_size, self.fft))
+        if maps.shape != expected:
+            raise TrackingError(f"frame {self.frame}: solver '{self.solver.name}' response() returned shape "
+                                f"{maps.shape}, expected {expected}")
+        return maps
+
+    def _observe(self, detection: Detection) -> None:
+        """Give the detection to the components that adapt to it: the solver, and the spatial
+        regularizer, whose w² it returns is used from this frame on."""
+        with blamed_on(f"frame {self.frame}: solver '{self.solver.name}'"):
+            self.solver.observe(detection)
+        if self.spatial is None:
+            return
+        what = f"frame {self.frame}: spatial regularizer '{self.spatial.name}'"
+        with blamed_on(what):
+            w2 = np.asarray(self.spatial.adapt(self.w2, detection))
+        if w2.shape != self.w2.shape or np.isnan(w2).any() or (w2 < 0).any():
+            raise TrackingError(f"{what}: adapt() must return w² of shape {self.w2.shape}, >= 0 (inf allowed), "
+                                f"got shape {w2.shape}")
+        self.w2 = w2.astype(np.float32, copy=False)
+
+    def _theta(self, detection: Detection | None) -> float:
+        """θ of this frame's training (0 without a temporal term; ``inf``: keep the last filter)."""
+        if self.temporal is None:
+            return 0.0
+        what = f"frame {self.frame}: temporal regularizer '{self.temporal.name}'"
+        with blamed_on(what):
+            theta = float(self.temporal.weight(detection))
+        if not (0 <= theta <= MAX_THETA or theta == np.inf):
+            raise TrackingError(f"{what}: weight() returned θ = {theta!r}, expected [0, {MAX_THETA:g}] or inf")
+        return theta
 
     def _peak(self, maps: np.ndarray) -> tuple[int, float, float]:
         """The search scale whose response is best and its peak as a (dy, dx) offset in cells."""
@@ -342,8 +381,12 @@ class Tracker:
             xf = self._sample(image, self.position, self.scale)  # m^t at p^t
         y, offsets = self._label(detection)  # Eq. (3)
         yf = self.fft.rfft2(y).astype(np.complex64, copy=False)
-        theta = self.temporal.params.theta if self.temporal is not None else 0.0
-        self.hf = self.solver.train(xf, yf, self.w2, theta, self.fft)  # Eqs. (9)-(11)
+        theta = self._theta(detection)
+        if theta == np.inf and detection is None:
+            raise TrackingError(f"frame {self.frame}: temporal regularizer '{self.temporal.name}' returned θ = inf "
+                                f"on the first frame, where there is no filter to keep")
+        if theta != np.inf:  # inf: the temporal term holds the filter where it is
+            self.hf = self.solver.train(xf, yf, self.w2, theta, self.fft)  # Eqs. (9)-(11)
         step = self.geometry.cell_size * self.scale
         self.last_distractors = (self.position[None, ::-1] + offsets[:, ::-1] * step) if len(offsets) else \
             np.zeros((0, 2))
