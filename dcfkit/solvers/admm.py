@@ -29,9 +29,8 @@ import math
 
 import numpy as np
 
-from .params import param
-from .registry import Component, Contract
-from .response import response as linear_response
+from ..params import param
+from .base import Solver
 
 
 def _floats(z: np.ndarray) -> np.ndarray:
@@ -45,7 +44,7 @@ def sherman_morrison_solve(a: np.ndarray, b: np.ndarray, c: float) -> np.ndarray
     a, b: (C, ...) complex, solved in complex64 by the ADMM's compiled v-step; c > 0.
     Returns (C, ...) complex64.
     """
-    from . import solver_kernels as kernels  # lazy: numba, compiled on first use
+    from . import kernels  # lazy: numba, compiled on first use
 
     shape = np.shape(b)
     a = np.ascontiguousarray(a, np.complex64).reshape(shape[0], 1, -1)
@@ -119,7 +118,7 @@ def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: n
     Returns (v̂, ĥ), each (C, H, Wr) complex64. The trackers use v̂ only, so the last h-step
     and multiplier update, which cannot change it, run only when ``need_h``.
     """
-    from . import solver_kernels as kernels  # numba: compiled, or loaded from disk, on first use
+    from . import kernels  # numba: compiled, or loaded from disk, on first use
 
     shape = w2.shape
     K = float(shape[0] * shape[1])
@@ -153,44 +152,6 @@ def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: n
         # multiplier (Eq. 11) and penalty schedule
         kernels.multiplier(_floats(vf), _floats(hf), gamma, first, _floats(uf))
     return vf, hf
-
-
-class Solver(Component):
-    """Trains the filter of one frame and, optionally, detects with it. State between frames
-    lives in the solver instance.
-
-    The tracker calls ``reset()`` at every ``init`` (a new target; also once on construction),
-    then ``train`` once per training frame; on every later frame it calls ``response`` for the
-    response maps of the search samples (Eq. 12) and ``observe`` with what the detection saw,
-    before training. A solver declares its own ``Params`` (none by default); the ADMM
-    solvers' are :class:`ADMMParams`.
-    """
-
-    kind = "solver"
-    contract = Contract(required={"reset": (), "train": ("xf", "yf", "w2", "theta", "fft")},
-                        optional={"response": ("hf", "samples", "shape", "fft"), "observe": ("detection",)})
-
-    def __init__(self, params=None):
-        super().__init__(params)
-        self.reset()
-
-    def reset(self) -> None:
-        """Forget everything learnt (called by the tracker's init)."""
-        raise NotImplementedError
-
-    def train(self, xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, fft) -> np.ndarray:
-        """One frame: sample (C, H, Wr), label spectrum (H, Wr), w² (H, W), θ -> filter (C, H, Wr)."""
-        raise NotImplementedError
-
-    def response(self, hf: np.ndarray, samples: np.ndarray, shape: tuple[int, int], fft) -> np.ndarray:
-        """Eq. (12): the last ``train``'s filter and (S, C, H, Wr) search samples -> (S, H, W)
-        float32 response maps (circular layout). The linear correlation unless overridden (KCF's
-        kernel)."""
-        return linear_response(hf, samples, shape, fft)
-
-    def observe(self, detection) -> None:
-        """What the detection of this frame saw (a :class:`dcfkit.labels.Detection`), before the
-        frame's ``train``; the built-in ADMM solvers keep nothing of it (ARCF's keeps the map)."""
 
 
 class ADMMStrcf(Solver):
@@ -237,5 +198,3 @@ class ADMMBacf(Solver):
         self.v_prev = vf
         return vf
 
-
-BUILTIN = (ADMMStrcf, ADMMBacf)

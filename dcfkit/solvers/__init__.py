@@ -1,0 +1,17 @@
+"""Filter solvers (``solver:`` in a config): train each frame's filter and detect with it.
+
+* :mod:`.base` -- the :class:`Solver` contract;
+* :mod:`.admm` -- ADMM for the spatially and temporally regularized objective (Eqs. 4–11):
+  ``admm_strcf`` (STRCF, DR²Track) and ``admm_bacf`` (BACF's running sample model);
+* :mod:`.kernels` -- the ADMM's per-frequency arithmetic, compiled (numba) on first use.
+"""
+from __future__ import annotations
+
+from .admm import ADMMBacf, ADMMParams, ADMMStrcf, BACFParams, admm, penalties, schedule_problem, \
+    sherman_morrison_solve
+from .base import Solver
+
+BUILTIN = (ADMMStrcf, ADMMBacf)
+
+__all__ = ["ADMMBacf", "ADMMParams", "ADMMStrcf", "BACFParams", "BUILTIN", "Solver", "admm", "penalties",
+           "schedule_problem", "sherman_morrison_solve"]

@@ -1,0 +1,45 @@
+"""The solver's contract: what the tracker gives a solver and what it gets back."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..registry import Component, Contract
+from ..response import response as linear_response
+
+
+class Solver(Component):
+    """Trains the filter of one frame and, optionally, detects with it. State between frames
+    lives in the solver instance.
+
+    The tracker calls ``reset()`` at every ``init`` (a new target; also once on construction),
+    then ``train`` once per training frame; on every later frame it calls ``response`` for the
+    response maps of the search samples (Eq. 12) and ``observe`` with what the detection saw,
+    before training. A solver declares its own ``Params`` (none by default); the ADMM
+    solvers' are :class:`ADMMParams`.
+    """
+
+    kind = "solver"
+    contract = Contract(required={"reset": (), "train": ("xf", "yf", "w2", "theta", "fft")},
+                        optional={"response": ("hf", "samples", "shape", "fft"), "observe": ("detection",)})
+
+    def __init__(self, params=None):
+        super().__init__(params)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget everything learnt (called by the tracker's init)."""
+        raise NotImplementedError
+
+    def train(self, xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, fft) -> np.ndarray:
+        """One frame: sample (C, H, Wr), label spectrum (H, Wr), w² (H, W), θ -> filter (C, H, Wr)."""
+        raise NotImplementedError
+
+    def response(self, hf: np.ndarray, samples: np.ndarray, shape: tuple[int, int], fft) -> np.ndarray:
+        """Eq. (12): the last ``train``'s filter and (S, C, H, Wr) search samples -> (S, H, W)
+        float32 response maps (circular layout). The linear correlation unless overridden (KCF's
+        kernel)."""
+        return linear_response(hf, samples, shape, fft)
+
+    def observe(self, detection) -> None:
+        """What the detection of this frame saw (a :class:`dcfkit.labels.Detection`), before the
+        frame's ``train``; the built-in ADMM solvers keep nothing of it (ARCF's keeps the map)."""
