@@ -238,11 +238,11 @@ class Tracker:
         sigma = np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * self.params.output_sigma_factor
         self.base_label = gaussian_label(g.filter_size, sigma)
         self.base_label.setflags(write=False)  # every frame's label starts from it
-        self.w2 = (self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
-                   else np.zeros(g.filter_size, np.float32))
         regularizers = [r for r in (self.spatial, self.temporal) if r is not None]
         for component in (*self.features, self.label, self.solver, *regularizers):  # a new target: nothing kept
             component.reset()
+        self.w2 = (self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
+                   else np.zeros(g.filter_size, np.float32))
         self.search.reset(centre)
         self.scale_estimator.init(image, centre, g.base_target, self.scale, self.limits)
         self.position = centre

@@ -4,6 +4,7 @@
 * :mod:`.admm` -- ADMM for the spatially and temporally regularized objective (Eqs. 4–11):
   ``admm_strcf`` (STRCF, DR²Track) and ``admm_bacf`` (BACF's running sample model);
 * :mod:`.arcf` -- ``admm_arcf``, BACF's with ARCF's aberrance repression term;
+* :mod:`.autotrack` -- ``admm_autotrack``, STRCF's with AutoTrack's θ-step;
 * :mod:`.kernels` -- the ADMM's per-frequency arithmetic, compiled (numba) on first use.
 """
 from __future__ import annotations
@@ -11,9 +12,10 @@ from __future__ import annotations
 from .admm import ADMMBacf, ADMMParams, ADMMStrcf, BACFParams, admm, penalties, schedule_problem, \
     sherman_morrison_solve
 from .arcf import ADMMArcf, ARCFParams
+from .autotrack import ADMMAutoTrack, AutoTrackParams
 from .base import Solver
 
-BUILTIN = (ADMMStrcf, ADMMBacf, ADMMArcf)
+BUILTIN = (ADMMStrcf, ADMMBacf, ADMMArcf, ADMMAutoTrack)
 
-__all__ = ["ADMMArcf", "ARCFParams", "ADMMBacf", "ADMMParams", "ADMMStrcf", "BACFParams", "BUILTIN", "Solver", "admm", "penalties",
+__all__ = ["ADMMArcf", "ADMMAutoTrack", "ARCFParams", "AutoTrackParams", "ADMMBacf", "ADMMParams", "ADMMStrcf", "BACFParams", "BUILTIN", "Solver", "admm", "penalties",
            "schedule_problem", "sherman_morrison_solve"]

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Callable
 
 import numpy as np
 
@@ -109,14 +110,17 @@ def schedule_problem(p: ADMMParams) -> str | None:
 
 
 def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: np.ndarray | None,
-         p: ADMMParams, fft, need_h: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
+         p: ADMMParams, fft, need_h: bool = False,
+         theta_step: Callable[[np.ndarray], float] | None = None) -> tuple[np.ndarray, np.ndarray | None]:
     """Run E iterations of Eqs. (9)-(11).
 
     xf: (C, H, Wr) complex64 training sample; yf: (H, Wr) label spectrum; w2: (H, W) float32 w²
     in the patch layout, target centred like h itself (may hold inf); theta: temporal weight
     (ignored when v_prev is None); v_prev: (C, H, Wr) last frame's filter.
     Returns (v̂, ĥ), each (C, H, Wr) complex64. The trackers use v̂ only, so the last h-step
-    and multiplier update, which cannot change it, run only when ``need_h``.
+    and multiplier update, which cannot change it, run only when ``need_h``. ``theta_step``
+    (AutoTrack's θ-subproblem) gives θ for the next iteration from this one's v̂, after every
+    iteration but the last.
     """
     from . import kernels  # numba: compiled, or loaded from disk, on first use
 
@@ -143,6 +147,9 @@ def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: n
                        _floats(t), _floats(vf))
         if e == p.iterations - 1 and not need_h:
             return vf, None
+        if theta_step is not None and e < p.iterations - 1:
+            theta = theta_step(vf)
+            kernels.prepare(_floats(xf), _floats(yf), _floats(v_prev), theta, aa, _floats(rhs0))
         # h-step (Eq. 10) in the spatial domain
         if not first:
             kernels.h_input(_floats(vf), _floats(uf), 1.0 if p.h_step == "authors" else gamma, _floats(g))

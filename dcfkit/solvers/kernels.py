@@ -41,8 +41,8 @@ def _mul(ar, ai, br, bi):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True)
 def prepare(xf, yf, v_prev, theta, aa, rhs0):  # pragma: no cover - compiled
-    """aa = Σ_c |x̂_c|² (H, Wr); rhs0 = x̂ ⊙ conj(ŷ) + θ v̂ˡ, the frame-constant part of Eq. (9)'s
-    right-hand side (θ = 0: no v_prev)."""
+    """aa = Σ_c |x̂_c|² (H, Wr); rhs0 = x̂ ⊙ conj(ŷ) + θ v̂ˡ, the part of Eq. (9)'s right-hand
+    side constant over the iterations while θ is (θ = 0: no v_prev)."""
     n, h, w2 = xf.shape
     m = h * w2 // 2
     th = np.float32(theta)
@@ -54,7 +54,7 @@ def prepare(xf, yf, v_prev, theta, aa, rhs0):  # pragma: no cover - compiled
             xr, xi = X[2 * p], X[2 * p + 1]
             A[p] = A[p] + (xr * xr - (-xi) * xi)
             re, im = _mul(xr, xi, Y[2 * p], -Y[2 * p + 1])
-            if theta > 0:
+            if theta != 0:  # AutoTrack's θ-step may take θ below 0
                 re = re + V[2 * p] * th
                 im = im + V[2 * p + 1] * th
             R[2 * p], R[2 * p + 1] = re, im

@@ -1,0 +1,126 @@
+"""AutoTrack's regularizers (Li et al., CVPR 2020), set every frame from the response's variation.
+
+The local response variation Π (their Eq. 3) compares this frame's response R with the
+last one's, each shifted so its peak sits at the origin:
+Π = |(R[ψ] - R_prev[ψ_prev]) / R_prev[ψ_prev]| element-wise. From it:
+
+* ``local_variation`` (spatial): inside the target box, w = δ log(Π + 1) (their Eq. 4),
+  where the response is reliable the filter is regularized less; outside it w stays large;
+* ``global_variation`` (temporal): θ̃ = ζ / (1 + log(ν ‖Π‖₂ + 1)) (their Eq. 5), the
+  reference the ADMM's θ-step starts from (``admm_autotrack``); when ‖Π‖₂ crosses a
+  threshold the frame is taken as an occlusion and the filter is kept (θ = ∞).
+
+As in the authors' AutoTrack_optimized.m: the first detection only records the response;
+the peak shift uses floor of the sub-cell peak; ‖Π‖₂ is the spectral norm (MATLAB's
+``norm`` of a matrix) divided by 10⁴; w inside the box keeps its last value between frames.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..params import param
+from .base import MAX_THETA, MAX_WEIGHT, PLACEMENTS, SpatialRegularizer, TemporalRegularizer, target_mask
+
+
+def response_variation(previous: tuple[np.ndarray, tuple[float, float]], detection) -> np.ndarray:
+    """Π: (H, W) float32, circular layout, of the last (response, (dy, dx)) and this detection.
+    Where the last shifted response is 0, Π is inf (or NaN where both are)."""
+    def centred(response, offset):
+        return np.roll(response, (-int(np.floor(offset[0])), -int(np.floor(offset[1]))), axis=(0, 1))
+
+    now = centred(detection.response, detection.offset or (0.0, 0.0))
+    before = centred(*previous)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.abs(np.abs(now - before) / before).astype(np.float32)
+
+
+def _record(detection) -> tuple[np.ndarray, tuple[float, float]]:
+    return np.array(detection.response, np.float32), tuple(detection.offset or (0.0, 0.0))
+
+
+class LocalVariation(SpatialRegularizer):
+    """AutoTrack's spatial window: ``outside`` beyond the target box; inside, ``inside`` until
+    the second detection, then δ log(Π + 1) of the latest (module doc). State: the last
+    response and its peak."""
+
+    name = "local_variation"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        inside: float = param(1e-3, "w inside the target box before the response varies (reg_window_min)")
+        outside: float = param(1e5, "w outside the target box (reg_window_max)")
+        delta: float = param(0.2, "δ: w inside the box is δ log(Π + 1)")
+        placement: str = param("authors", "where an odd box sits in an even patch: 'centred' or 'authors' "
+                               "(init_regwindow's, a cell lower and to the right)", choices=PLACEMENTS)
+
+        def validate(self):
+            if not 0 <= self.inside <= self.outside:
+                return "need 0 <= inside <= outside"
+            if self.outside > MAX_WEIGHT:
+                return f"outside must be <= {MAX_WEIGHT:g}"
+            if not 0 <= self.delta <= MAX_WEIGHT:
+                return f"delta must be in [0, {MAX_WEIGHT:g}]"
+
+    def reset(self):
+        self.previous = None
+        self.mask = None
+
+    def weights_squared(self, shape, target_cells):
+        self.mask = target_mask(shape, target_cells, self.params.placement)
+        w = np.where(self.mask, self.params.inside, self.params.outside)
+        return (w ** 2).astype(np.float32)
+
+    def adapt(self, w2, detection):
+        previous, self.previous = self.previous, _record(detection)
+        if previous is None:
+            return w2
+        variation = np.fft.fftshift(response_variation(previous, detection))  # circshift(floor(size / 2))
+        w2 = w2.copy()
+        with np.errstate(over="ignore"):  # Π = inf (a zero in the last response): w = inf, h = 0 there
+            w2[self.mask] = (self.params.delta * np.log(variation[self.mask] + 1)) ** 2
+        return w2
+
+
+class GlobalVariation(TemporalRegularizer):
+    """AutoTrack's temporal weight: the reference θ̃ = ζ / (1 + log(ν η + 1)), η = ‖Π‖₂ / 10⁴,
+    or ∞ (keep the filter) when η ≥ φ (module doc). ``theta`` is ζ, used until the second
+    detection. State: the last response and its peak."""
+
+    name = "global_variation"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        theta: float = param(13.0, "ζ: the reference θ before any variation, and its scale (zeta)")
+        nu: float = param(0.2, "ν: how fast θ̃ falls as the response varies")
+        occlusion: float = param(0.3, "φ: from this η on the frame is an occlusion and the filter is kept "
+                                 "(inf: never)")
+        norm_scale: float = param(1e4, "η = ‖Π‖₂ / norm_scale (the authors' 1e4)")
+
+        def validate(self):
+            if not 0 <= self.theta <= MAX_THETA:
+                return f"theta must be in [0, {MAX_THETA:g}]"
+            if not 0 <= self.nu <= 1e6:
+                return "nu must be in [0, 1e6]"
+            if not self.occlusion > 0:
+                return "occlusion must be > 0"
+            if not 1e-6 <= self.norm_scale <= 1e12:
+                return "norm_scale must be in [1e-6, 1e12]"
+
+    def reset(self):
+        self.previous = None
+
+    def weight(self, detection):
+        if detection is None:
+            return self.params.theta
+        previous, self.previous = self.previous, _record(detection)
+        if previous is None:
+            return self.params.theta
+        variation = response_variation(previous, detection)
+        if not np.all(np.isfinite(variation)):  # a zero in the last response: no sensible η
+            return np.inf
+        eta = float(np.linalg.norm(variation.astype(np.float64), 2)) / self.params.norm_scale
+        if eta >= self.params.occlusion:
+            return np.inf
+        return self.params.theta / (1 + np.log(self.params.nu * eta + 1))

@@ -1,0 +1,61 @@
+"""AutoTrack's solver (Li et al., CVPR 2020): STRCF's ADMM with θ one of the unknowns.
+
+AutoTrack adds (θ - θ̃)²/2 to STRCF's objective, θ̃ the reference that the temporal
+regularizer ``global_variation`` sets each frame; the ADMM gains a θ-step (their Eq. 11),
+θ = θ̃ - ‖ĝ - ĝ_prev‖² / (2ε), between its iterations. As the authors' AutoTrack_optimized.m
+runs it: from the third frame on (before, θ is fixed), after every iteration but the last,
+with ‖·‖ the spectral norm (MATLAB's ``norm`` of a matrix) of the last feature channel's
+full unnormalised spectrum (their loop over channels keeps only the last one's).
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..params import param
+from .admm import ADMMParams, ADMMStrcf, admm
+
+
+@dataclasses.dataclass(frozen=True)
+class AutoTrackParams(ADMMParams):
+    epsilon: float = param(1.0, "ε of the θ-step θ = θ̃ - ‖ĝ - ĝ_prev‖² / (2ε)")
+
+    def validate(self):
+        if not 1e-10 <= self.epsilon <= 1e10:
+            return "epsilon must be in [1e-10, 1e10]"
+        return super().validate()
+
+
+def full_spectrum(half: np.ndarray, width: int) -> np.ndarray:
+    """The (H, W) spectrum of a real map from its (H, W//2+1) half: F(k, l) = conj(F(-k, -l))."""
+    rows = -np.arange(half.shape[0]) % half.shape[0]
+    cols = width - np.arange(half.shape[1], width)
+    return np.concatenate([half, np.conj(half[rows][:, cols])], axis=1)
+
+
+class ADMMAutoTrack(ADMMStrcf):
+    """AutoTrack: :class:`ADMMStrcf` with the θ-step (module doc). The tracker's θ is the
+    reference θ̃. State between frames: the last filter and how many frames were trained."""
+
+    name = "admm_autotrack"
+    Params = AutoTrackParams
+
+    def reset(self):
+        super().reset()
+        self.trained = 0
+
+    def train(self, xf, yf, w2, theta, fft):
+        step = None
+        if self.trained >= 2:  # the authors' ``frame > 2``: frames 1 and 2 are trained with θ fixed
+            last = full_spectrum(self.v_prev[-1].astype(np.complex128), w2.shape[1])
+            scale = 2 * self.params.epsilon
+
+            def step(vf):
+                change = full_spectrum(vf[-1].astype(np.complex128), w2.shape[1]) - last
+                return theta - float(np.linalg.norm(change, 2)) ** 2 / scale
+
+        vf, _ = admm(xf, yf, w2, theta, self.v_prev, self.params, fft, theta_step=step)
+        self.v_prev = vf
+        self.trained += 1
+        return vf
