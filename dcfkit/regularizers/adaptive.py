@@ -1,12 +1,12 @@
 """AutoTrack's regularizers (Li et al., CVPR 2020), set every frame from the response's variation.
 
-The local response variation Π (their Eq. 3) compares this frame's response R with the
+The local response variation Π compares this frame's response R with the
 last one's, each shifted so its peak sits at the origin:
 Π = |(R[ψ] - R_prev[ψ_prev]) / R_prev[ψ_prev]| element-wise. From it:
 
-* ``local_variation`` (spatial): inside the target box, w = δ log(Π + 1) (their Eq. 4),
+* ``local_variation`` (spatial): inside the target box, w = δ log(Π + 1),
   where the response is reliable the filter is regularized less; outside it w stays large;
-* ``global_variation`` (temporal): θ̃ = ζ / (1 + log(ν ‖Π‖₂ + 1)) (their Eq. 5), the
+* ``global_variation`` (temporal): θ̃ = ζ / (1 + log(ν ‖Π‖₂ + 1)), the
   reference the ADMM's θ-step starts from (``admm_autotrack``); when ‖Π‖₂ crosses a
   threshold the frame is taken as an occlusion and the filter is kept (θ = ∞).
 

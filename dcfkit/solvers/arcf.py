@@ -2,7 +2,7 @@
 
 ARCF adds γ/2 ‖M^{t-1}[ψ] - Σ_c x_c ⋆ h_c‖² to BACF's objective: the response on the
 training sample is pulled towards the last frame's response map M^{t-1}, shifted ([ψ]) so
-its peak moves as the target's did between the two frames (their Eq. 3). The authors' code
+its peak moves as the target's did between the two frames. The authors' code
 (tracker_HOGCN.m, as ARCF-HC) adds the term in the Fourier domain as ``γ M_prev .* model_xf``
 with ``M_prev`` the *spatial* map (fftshift-ed, shifted by the change of its peak's index)
 standing for the spectrum, and the term's data weight (1 + γ) on ``S_xx``. Per frequency the

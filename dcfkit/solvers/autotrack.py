@@ -1,7 +1,7 @@
 """AutoTrack's solver (Li et al., CVPR 2020): STRCF's ADMM with θ one of the unknowns.
 
 AutoTrack adds (θ - θ̃)²/2 to STRCF's objective, θ̃ the reference that the temporal
-regularizer ``global_variation`` sets each frame; the ADMM gains a θ-step (their Eq. 11),
+regularizer ``global_variation`` sets each frame; the ADMM gains a θ-step,
 θ = θ̃ - ‖ĝ - ĝ_prev‖² / (2ε), between its iterations. As the authors' AutoTrack_optimized.m
 runs it: from the third frame on (before, θ is fixed), after every iteration but the last,
 with ‖·‖ the spectral norm (MATLAB's ``norm`` of a matrix) of the last feature channel's
