@@ -132,7 +132,9 @@ class DSST(ScaleEstimator):
             self.label_f = np.fft.fft(np.exp(-0.5 * offsets**2 / max(sigma**2, np.finfo(float).tiny)))
         self.window = np.hanning(n + 2)[1:-1] if p.window == "hann_interior" else np.hanning(n)
         authors = p.model_size == "image_target"  # init_scale: the target in image pixels, floored
-        target = self.base_target * scale if authors else self.base_target
+        # the authors' target_sz is whole pixels; base_target * scale rebuilds it up to rounding
+        # (10.999999999999998 for 11), which the floor below must not see
+        target = np.round(self.base_target * scale, 9) if authors else self.base_target
         area = float(np.prod(target))
         shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
         # at least 2 cells, which fhog needs (init_scale allows 2 px: a side under 8 px differs)
