@@ -336,6 +336,48 @@ def test_valid_jpegs_decode_as_opencv_decodes_them(tmp_path):
                                                                          cv2.IMREAD_COLOR))
 
 
+def with_padding(data: bytes, padding: bytes) -> bytes:
+    """``data`` with ``padding`` between its last scan and its end-of-image marker."""
+    assert data.endswith(b"\xff\xd9")
+    return data[:-2] + padding + data[-2:]
+
+
+def early_finish(capfd) -> bytes:
+    """JPEG with one byte changed so that the decoder finishes early, leaving coded data before
+    the end-of-image marker: libjpeg warns as it does for padding there."""
+    for offset in range(SCAN, len(JPEG) - 2):
+        damaged = bytearray(JPEG)
+        damaged[offset] ^= 0xFF
+        image, warned = libjpeg_verdict(bytes(damaged), capfd)
+        if image is not None and "extraneous bytes before marker 0xd9" in warned:
+            return bytes(damaged)
+    pytest.fail("no changed byte makes the decoder finish early")
+
+
+def test_zero_padding_before_the_end_marker_is_read_and_damage_warned_alike_is_not(tmp_path, capfd):
+    """Zero bytes some writers put before the end-of-image marker: libjpeg warns ("extraneous
+    bytes before marker 0xd9") and OpenCV decodes the same pixels; read_frame returns them,
+    baseline and progressive. The same warning for a damaged JPEG (the decoder finished early),
+    zero padding added to it, or nonzero bytes there, is still a refusal naming the frame."""
+    path = tmp_path / "frame.jpg"
+    for params in ([], [cv2.IMWRITE_JPEG_PROGRESSIVE, 1]):
+        plain = cv2.imencode(".jpg", TEXTURE, params)[1].tobytes()
+        for count in (16, 1000):  # the few bytes libjpeg-turbo has read ahead go unreported
+            data = with_padding(plain, bytes(count))
+            image, warned = libjpeg_verdict(data, capfd)
+            assert "extraneous bytes before marker 0xd9" in warned
+            path.write_bytes(data)
+            np.testing.assert_array_equal(read_frame(path), image)
+            np.testing.assert_array_equal(image, cv2.imdecode(np.frombuffer(plain, np.uint8), cv2.IMREAD_COLOR))
+    damaged = early_finish(capfd)
+    for data in (damaged, with_padding(damaged, bytes(8)), with_padding(JPEG, b"\x12\x34"),
+                 with_padding(JPEG, b"\0\0\x01\0\0")):
+        path.write_bytes(data)
+        with pytest.raises(DatasetError, match=r"cannot read frame 5: .*frame\.jpg \(corrupt JPEG data: Corrupt JPEG "
+                                               r"data: \d+ extraneous bytes before marker 0xd9\)"):
+            read_frame(path, "frame 5")
+
+
 def test_a_corrupt_frame_ends_the_run_naming_it_and_keeps_the_boxes_before(tmp_path, capsys):
     folder = tmp_path / "frames"
     folder.mkdir()

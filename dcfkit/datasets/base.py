@@ -115,8 +115,8 @@ def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
     than :func:`~dcfkit.limits.max_image_pixels` (read from its header, before decoding), a
     truncated JPEG (``cv2.imread`` would return one grey below the cut, with a warning only), or
     a JPEG whose data libjpeg reports corrupt (``cv2.imread`` would return it with a warning, part
-    of it grey or wrong). A JPEG that lacks just its end-of-image marker, a common defect, is read
-    as imread would. Decoding is OpenCV's, unchanged."""
+    of it grey or wrong). A JPEG that lacks just its end-of-image marker, or has zero bytes
+    before it, common defects, is read as imread would. Decoding is OpenCV's, unchanged."""
     import cv2  # deferred: listing sequences needs no OpenCV
 
     data = _read_image_bytes(path, what)
@@ -159,20 +159,56 @@ def _check_size(data: bytes, path, what: str) -> None:
 
 
 def _check_jpeg_data(data: bytes, path, what: str) -> None:
-    """DatasetError if libjpeg reports the JPEG's data corrupt. OpenCV's decoder only prints
+    """DatasetError if libjpeg reports the JPEG's data corrupt (:func:`jpeg_damage`)."""
+    damage = jpeg_damage(data)
+    if damage is not None:
+        raise DatasetError(f"cannot read {what}: {path} (corrupt JPEG data: {damage})")
+
+
+def jpeg_damage(data: bytes) -> str | None:
+    """What libjpeg reports wrong with a JPEG's data, or None. OpenCV's decoder only prints
     such a warning and returns the image, grey or garbled from the damage on; simplejpeg (the
     same libjpeg-turbo) raises instead. Its decode at 1/8 scale reads every coded coefficient,
-    so it sees the same errors, at a third of a full decode's time."""
+    so it sees the same errors, at a third of a full decode's time. None too for a JPEG
+    simplejpeg cannot decode at all (CMYK, say), which has nothing to say about corruption, and
+    for one with zero padding before its end-of-image marker (:func:`_without_zero_padding`)."""
+    complaint = _libjpeg_complaint(data)
+    if complaint is None or _libjpeg_complaint(data, strict=False) is not None:
+        return None
+    unpadded = _without_zero_padding(data, complaint)
+    if unpadded is not None and _libjpeg_complaint(unpadded) is None:
+        return None
+    return complaint
+
+
+def _libjpeg_complaint(data: bytes, strict: bool = True) -> str | None:
+    """libjpeg's first warning (``strict``) or error decoding ``data`` at 1/8 scale, or None."""
     import simplejpeg  # deferred, as OpenCV
 
     try:
-        simplejpeg.decode_jpeg(data, colorspace="BGR", min_height=1, min_width=1, strict=True)
+        simplejpeg.decode_jpeg(data, colorspace="BGR", min_height=1, min_width=1, strict=strict)
     except ValueError as exc:
-        try:  # a JPEG that simplejpeg cannot decode at all (CMYK, say) has nothing to say about corruption
-            simplejpeg.decode_jpeg(data, colorspace="BGR", min_height=1, min_width=1, strict=False)
-        except ValueError:
-            return
-        raise DatasetError(f"cannot read {what}: {path} (corrupt JPEG data: {exc})") from None
+        return str(exc)
+    return None
+
+
+# libjpeg's JWRN_EXTRANEOUS_DATA for the end-of-image marker (its wording since libjpeg 6)
+_EXTRANEOUS_BEFORE_END = re.compile(r"\d+ extraneous bytes before marker 0xd9")
+
+
+def _without_zero_padding(data: bytes, complaint: str) -> bytes | None:
+    """``data`` without the zero bytes just before its end-of-image marker, if libjpeg's
+    ``complaint`` is about bytes there: padding some writers add. The caller checks that the
+    rest decodes cleanly, all its blocks from its own data; then the padding was never read
+    and OpenCV's decode is the same with it. Other bytes there are refused: damage that makes
+    the decoder reach the last block early leaves coded data there and gets the same warning
+    (47% of JPEGs with 1 to 5 random bytes of coded data changed did), and damage that makes
+    it run past the end reads the padding as data."""
+    end = data.find(_JPEG_END, data.rfind(b"\xff\xda"))  # markers cannot occur in coded data
+    if not _EXTRANEOUS_BEFORE_END.search(complaint) or end < 0:
+        return None
+    start = len(data[:end].rstrip(b"\0"))
+    return data[:start] + data[end:] if start < end else None
 
 
 _JPEG_END = b"\xff\xd9"
