@@ -289,6 +289,44 @@ def test_pillows_own_bomb_limit_is_a_dataset_error_too(tmp_path, monkeypatch, de
     assert not decodes
 
 
+def png_chunk(kind: bytes, body: bytes, crc: int | None = None) -> bytes:
+    """One PNG chunk; its CRC is ``crc`` if given, else the right one."""
+    crc = zlib.crc32(kind + body) if crc is None else crc
+    return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", crc)
+
+
+def with_bad_text_chunk(png: bytes) -> bytes:
+    """``png`` with a tEXt chunk whose CRC is wrong, after its IHDR (8 + 25 bytes)."""
+    return png[:33] + png_chunk(b"tEXt", b"Comment\0made by a camera", crc=0) + png[33:]
+
+
+def test_a_bad_crc_in_an_ancillary_png_chunk_is_read_as_libpng_reads_it(tmp_path, monkeypatch, capfd, decodes):
+    """A tEXt chunk with a bad CRC: libpng (OpenCV's decoder) warns and decodes the image, Pillow
+    refused its header; read_frame returns OpenCV's pixels, and still refuses such a PNG whose
+    IDAT data is damaged too (libpng's error: OpenCV returns nothing), naming the frame, and
+    one whose IHDR declares over the limit, from the header, decoding nothing."""
+    png = with_bad_text_chunk(cv2.imencode(".png", TEXTURE)[1].tobytes())
+    capfd.readouterr()
+    expected = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_COLOR)
+    assert "tEXt: CRC error" in capfd.readouterr().err
+    np.testing.assert_array_equal(expected, TEXTURE)
+    path = tmp_path / "frame.png"
+    path.write_bytes(png)
+    np.testing.assert_array_equal(read_frame(path, "frame 2"), expected)
+    idat = png.index(b"IDAT") + 4
+    damaged = bytearray(png)
+    damaged[idat + 100] ^= 0x55
+    path.write_bytes(bytes(damaged))
+    with pytest.raises(DatasetError, match=r"cannot read frame 2: .*frame\.png \(not a readable image\)"):
+        read_frame(path, "frame 2")
+    monkeypatch.setenv("DCFKIT_MAX_IMAGE_PIXELS", "1e6")
+    path.write_bytes(with_bad_text_chunk(png_declaring(2000, 2000)))
+    decodes.clear()
+    with pytest.raises(DatasetError, match=r"cannot read frame 2: .*frame\.png \(its header declares 2000x2000 = "):
+        read_frame(path, "frame 2")
+    assert not decodes
+
+
 def libjpeg_verdict(data: bytes, capfd) -> tuple[np.ndarray | None, str]:
     """OpenCV's decode of ``data`` and what its libjpeg printed (warnings of corrupt data)."""
     capfd.readouterr()

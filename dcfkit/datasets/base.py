@@ -9,7 +9,9 @@ import io
 import os
 import re
 import stat
+import struct
 import warnings
+import zlib
 from pathlib import Path
 from typing import Iterable, Mapping
 
@@ -139,7 +141,7 @@ def _check_size(data: bytes, path, what: str) -> None:
     """DatasetError unless the image header declares at most ``max_image_pixels()`` pixels: a
     small file can declare billions (a 876 KB PNG of 30000x30000 decodes to 2.7 GB). Pillow reads
     the header only (JPEG, PNG, BMP, TIFF, WebP and more); a file whose header it cannot read is
-    refused, as its size is unknown."""
+    refused, as its size is unknown, unless it is a PNG with an intact IHDR (:func:`_png_size`)."""
     from PIL import Image  # deferred, as OpenCV: listing sequences reads no image
 
     limit = max_image_pixels()
@@ -152,10 +154,29 @@ def _check_size(data: bytes, path, what: str) -> None:
             raise DatasetError(f"cannot read {what}: {path} (its header declares more pixels than Pillow reads: "
                                f"{2 * Image.MAX_IMAGE_PIXELS:.3g}, twice PIL.Image.MAX_IMAGE_PIXELS)") from None
         except Exception:  # Pillow's plugins raise several types for a header they cannot read
-            raise DatasetError(f"cannot read {what}: {path} (not a readable image)") from None
+            size = _png_size(data)
+            if size is None:
+                raise DatasetError(f"cannot read {what}: {path} (not a readable image)") from None
+            width, height = size
     if width * height > limit:
         raise DatasetError(f"cannot read {what}: {path} (its header declares {width}x{height} = "
                            f"{width * height:.3g} pixels, over the limit of {limit:.3g}: ${IMAGE_PIXELS_VARIABLE})")
+
+
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def _png_size(data: bytes) -> tuple[int, int] | None:
+    """Width and height from a PNG's IHDR chunk, if it is intact; else None. Pillow reads the
+    chunks up to the image data and refuses a bad CRC in any, while libpng (OpenCV's decoder)
+    only warns about one in an ancillary chunk (tEXt, say) and decodes the image; it refuses
+    damage to the critical ones (IHDR, IDAT), so ``cv2.imdecode`` returns None for those."""
+    if not data.startswith(_PNG_SIGNATURE) or len(data) < 33:
+        return None
+    length, kind, width, height = struct.unpack(">I4sII", data[8:24])
+    if length != 13 or kind != b"IHDR" or zlib.crc32(data[12:29]) != int.from_bytes(data[29:33], "big"):
+        return None
+    return width, height
 
 
 def _check_jpeg_data(data: bytes, path, what: str) -> None:
