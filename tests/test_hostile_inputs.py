@@ -416,6 +416,27 @@ def test_zero_padding_before_the_end_marker_is_read_and_damage_warned_alike_is_n
             read_frame(path, "frame 5")
 
 
+@pytest.mark.parametrize("compression,name", [(5, "tiff_lzw"), (8, "tiff_adobe_deflate")])
+def test_a_tiff_whose_data_libtiff_cannot_decode_is_refused(compression, name, tmp_path, capfd):
+    """LZW and Deflate TIFFs with bytes of their strip overwritten: OpenCV's libtiff prints an
+    error and returns the image, a fifth of it wrong; read_frame refuses the file naming the
+    frame. Intact, they are read as OpenCV reads them."""
+    data = cv2.imencode(".tiff", TEXTURE, [cv2.IMWRITE_TIFF_COMPRESSION, compression])[1].tobytes()
+    path = tmp_path / "frame.tif"
+    path.write_bytes(data)
+    np.testing.assert_array_equal(read_frame(path, "frame 6"), TEXTURE)
+    damaged = bytearray(data)
+    damaged[200:240] = b"\xff" * 40  # the strip starts at byte 8
+    capfd.readouterr()
+    image = cv2.imdecode(np.frombuffer(bytes(damaged), np.uint8), cv2.IMREAD_COLOR)
+    assert image.shape == TEXTURE.shape and "TIFF_Error" in capfd.readouterr().err
+    assert (image != TEXTURE).any()
+    path.write_bytes(bytes(damaged))
+    with pytest.raises(DatasetError, match=rf"cannot read frame 6: .*frame\.tif \(corrupt TIFF data: libtiff cannot "
+                                           rf"decode its {name} data\)"):
+        read_frame(path, "frame 6")
+
+
 def test_a_corrupt_frame_ends_the_run_naming_it_and_keeps_the_boxes_before(tmp_path, capsys):
     folder = tmp_path / "frames"
     folder.mkdir()

@@ -117,12 +117,14 @@ def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
     than :func:`~dcfkit.limits.max_image_pixels` (read from its header, before decoding), a
     truncated JPEG (``cv2.imread`` would return one grey below the cut, with a warning only), or
     a JPEG whose data libjpeg reports corrupt (``cv2.imread`` would return it with a warning, part
-    of it grey or wrong). A JPEG that lacks just its end-of-image marker, or has zero bytes
+    of it grey or wrong), or a TIFF whose data libtiff cannot decode (likewise). A JPEG that lacks just its end-of-image marker, or has zero bytes
     before it, common defects, is read as imread would. Decoding is OpenCV's, unchanged."""
     import cv2  # deferred: listing sequences needs no OpenCV
 
     data = _read_image_bytes(path, what)
     _check_size(data, path, what)
+    if data.startswith(_TIFF_SIGNATURES):
+        _check_tiff_data(data, path, what)
     image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
     if image is None and _missing_end_marker(data):
         data += _JPEG_END
@@ -177,6 +179,34 @@ def _png_size(data: bytes) -> tuple[int, int] | None:
     if length != 13 or kind != b"IHDR" or zlib.crc32(data[12:29]) != int.from_bytes(data[29:33], "big"):
         return None
     return width, height
+
+
+_TIFF_SIGNATURES = (b"II*\0", b"MM\0*", b"II+\0", b"MM\0+")  # TIFF and BigTIFF, either byte order
+# Pillow's names of the TIFF compressions whose data any bytes are: nothing for a decode to find
+_TIFF_UNCHECKABLE = ("raw", "packbits")
+_TIFF_DAMAGE = ("decoder error", "image file is truncated")  # how Pillow's decoders say the data is broken
+
+
+def _check_tiff_data(data: bytes, path, what: str) -> None:
+    """DatasetError if libtiff cannot decode a compressed TIFF's image data (a broken LZW or
+    Deflate stream). OpenCV's decoder (its own libtiff) prints the error and returns the image,
+    wrong or blank from the damage on; Pillow's raises. So Pillow decodes it too, first (the two
+    images are not held at once): twice the decoding time, for compressed TIFF frames only,
+    which no benchmark uses. Pillow's other failures (a layout it does not read) say nothing
+    about damage and leave the file to OpenCV."""
+    from PIL import Image  # deferred, as OpenCV
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # metadata warnings: the header was checked, the verdict is the decode's
+        try:
+            with Image.open(io.BytesIO(data)) as image:
+                compression = image.info.get("compression", "unknown")
+                if compression not in _TIFF_UNCHECKABLE:
+                    image.load()
+        except Exception as exc:  # as in _check_size, several types
+            if str(exc).startswith(_TIFF_DAMAGE):
+                raise DatasetError(f"cannot read {what}: {path} (corrupt TIFF data: libtiff cannot decode its "
+                                   f"{compression} data)") from None
 
 
 def _check_jpeg_data(data: bytes, path, what: str) -> None:
