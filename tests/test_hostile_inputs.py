@@ -491,6 +491,57 @@ def test_a_truncated_video_ends_with_an_error_naming_the_frame_where_it_stops(ke
     assert len(out.read_text().splitlines() if out.exists() else []) == stop - 1  # none: no file
 
 
+def damage_frame(data: bytes, frame: int) -> bytes:
+    """The MJPG video ``data`` with bytes of frame ``frame``'s (1-based) coded data inverted."""
+    start = -1
+    for _ in range(frame):
+        start = data.index(b"\xff\xd8", start + 1)  # each frame's start-of-image marker
+    scan = data.index(b"\xff\xda", start) + 14
+    damaged = bytearray(data)
+    for position in np.random.default_rng(0).integers(scan, scan + 600, 50):
+        damaged[position] ^= 0xFF
+    return bytes(damaged)
+
+
+def test_a_damaged_frame_of_a_motion_jpeg_video_ends_the_run_naming_it(tmp_path, capsys):
+    """Frame 3 of an MJPG .avi damaged: FFmpeg decodes all 8 frames, patching over the damage,
+    so it was tracked. Now the frames before it are given as before and the error names it;
+    `dcfkit track` exits 2 with the boxes of frames 1 and 2."""
+    full = tmp_path / "full.avi"
+    data = write_video(full, VIDEO_FRAMES.frames)
+    damaged = tmp_path / "damaged.avi"
+    damaged.write_bytes(damage_frame(data, 3))
+    complete = list(iter_frames(video=str(full)))
+    cap = cv2.VideoCapture(str(damaged))
+    concealed = [cap.read()[1] for _ in range(8)]
+    assert all(image is not None for image in concealed) and not np.array_equal(concealed[2], complete[2])
+    got = []
+    with pytest.raises(InputError, match=r"--video: .*damaged\.avi: frame 3 is damaged \(corrupt JPEG data: "):
+        got.extend(iter_frames(video=str(damaged)))
+    assert len(got) == 2 and all(np.array_equal(a, b) for a, b in zip(got, complete))
+    out = tmp_path / "boxes.txt"
+    box = ",".join(str(v) for v in VIDEO_FRAMES.ground_truth[0])
+    assert cli.main(["track", "strcf", "--video", str(damaged), f"--box={box}", "--out", str(out)]) == 2
+    assert "damaged.avi: frame 3 is damaged" in capsys.readouterr().err
+    assert len(out.read_text().splitlines()) == 2
+
+
+def test_a_motion_jpeg_video_cut_inside_its_last_frame_is_refused_there(tmp_path):
+    """A cut inside the last frame's data leaves the count the header declares: FFmpeg fills
+    the rest of the frame in, and it was tracked. Now the first 7 frames are given and the
+    error names frame 8."""
+    full = tmp_path / "full.avi"
+    data = write_video(full, VIDEO_FRAMES.frames)
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(data[:data.rindex(b"\xff\xd8") + 600])
+    cap = cv2.VideoCapture(str(cut))
+    assert cap.get(cv2.CAP_PROP_FRAME_COUNT) == 8 and all(cap.read()[0] for _ in range(8))
+    got = []
+    with pytest.raises(InputError, match=r"cut\.avi: frame 8 is damaged \(corrupt JPEG data: Premature end of JPEG"):
+        got.extend(iter_frames(video=str(cut)))
+    assert len(got) == 7 and all(np.array_equal(a, b) for a, b in zip(got, iter_frames(video=str(full))))
+
+
 def test_video_frames_over_the_image_limit_are_refused_before_reading(tmp_path, monkeypatch):
     path = tmp_path / "v.avi"
     write_video(path, VIDEO_FRAMES.frames)

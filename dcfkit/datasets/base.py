@@ -216,20 +216,26 @@ def _check_jpeg_data(data: bytes, path, what: str) -> None:
         raise DatasetError(f"cannot read {what}: {path} (corrupt JPEG data: {damage})")
 
 
-def jpeg_damage(data: bytes) -> str | None:
+def jpeg_damage(data: bytes, decodable: bool = False) -> str | None:
     """What libjpeg reports wrong with a JPEG's data, or None. OpenCV's decoder only prints
     such a warning and returns the image, grey or garbled from the damage on; simplejpeg (the
     same libjpeg-turbo) raises instead. Its decode at 1/8 scale reads every coded coefficient,
     so it sees the same errors, at a third of a full decode's time. None too for a JPEG
-    simplejpeg cannot decode at all (CMYK, say), which has nothing to say about corruption, and
-    for one with zero padding before its end-of-image marker (:func:`_without_zero_padding`)."""
+    simplejpeg cannot decode at all (CMYK, say), which has nothing to say about corruption,
+    unless it is known to be ``decodable`` (a video frame, whose first frame libjpeg decoded);
+    and for one with zero padding before its end-of-image marker (:func:`_without_zero_padding`)."""
     complaint = _libjpeg_complaint(data)
-    if complaint is None or _libjpeg_complaint(data, strict=False) is not None:
+    if complaint is None or (not decodable and not jpeg_decodable(data)):
         return None
     unpadded = _without_zero_padding(data, complaint)
     if unpadded is not None and _libjpeg_complaint(unpadded) is None:
         return None
     return complaint
+
+
+def jpeg_decodable(data: bytes) -> bool:
+    """Whether libjpeg (simplejpeg's) decodes ``data``, warnings or not."""
+    return _libjpeg_complaint(data, strict=False) is None
 
 
 def _libjpeg_complaint(data: bytes, strict: bool = True) -> str | None:
