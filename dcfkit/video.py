@@ -70,9 +70,9 @@ def video_frames(video: str | os.PathLike) -> Iterator[np.ndarray]:
     cap = _open_video(video)
     declared = cap.get(cv2.CAP_PROP_FRAME_COUNT)
     declared = int(declared) if 0 < declared < math.inf else 0  # 0 (or -1): the container does not say
-    packets = _JpegPackets.of(video, cap)
-    count = 0
+    packets, count = None, 0
     try:
+        packets = _JpegPackets.of(video, cap)
         ok, image = cap.read()
         while ok:
             ok, following = cap.read()
@@ -101,7 +101,7 @@ class _JpegPackets:
     as read_frame checks a JPEG file (:func:`~dcfkit.datasets.base.jpeg_damage`). FFmpeg's
     decoder conceals damage (it patches over the blocks it cannot decode) and OpenCV reports
     none. Each frame is one packet, so the two captures stay in step. The check is libjpeg's
-    decode at 1/8 scale, about half of FFmpeg's full decode."""
+    decode at 1/8 scale, about 40% more time than FFmpeg's full decode alone."""
 
     def __init__(self, video, raw: cv2.VideoCapture, first: bytes):
         self.video, self._raw, self._next = video, raw, first
@@ -116,8 +116,9 @@ class _JpegPackets:
             return None
         raw = cv2.VideoCapture(str(video), cv2.CAP_FFMPEG, [cv2.CAP_PROP_FORMAT, -1])
         ok, packet = raw.read() if raw.isOpened() and raw.get(cv2.CAP_PROP_FORMAT) == -1 else (False, None)
-        if ok and packet.tobytes().startswith(b"\xff\xd8") and jpeg_decodable(packet.tobytes()):
-            return cls(video, raw, packet.tobytes())
+        first = packet.tobytes() if ok else b""
+        if first.startswith(b"\xff\xd8") and jpeg_decodable(first):
+            return cls(video, raw, first)
         raw.release()
         return None
 
@@ -126,7 +127,7 @@ class _JpegPackets:
         data, self._next = self._next, None
         if data is None:
             ok, packet = self._raw.read()
-            if not ok:  # the decoder returned a frame the demuxer does not have: no verdict
+            if not ok:  # no packet for a frame the decoder gave: the captures disagree, so no verdict
                 return
             data = packet.tobytes()
         damage = jpeg_damage(data, decodable=True)
