@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 
 from .datasets import read_frame
+from .datasets.base import jpeg_damage, jpeg_decodable
 from .errors import InputError
 from .limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
@@ -63,25 +64,79 @@ def _stopped_short(video, frame: int, declared: int) -> None:
 
 def video_frames(video: str | os.PathLike) -> Iterator[np.ndarray]:
     """Yield a video's frames; an InputError before reading if its frames are larger than
-    ``max_image_pixels()``, and at the frame where it stops short of the frame count its header
-    declares (:func:`_stopped_short`). Frames are read one ahead to know which is the last."""
+    ``max_image_pixels()``, at the frame where it stops short of the frame count its header
+    declares (:func:`_stopped_short`), and at a damaged frame of a Motion JPEG video
+    (:class:`_JpegPackets`). Frames are read one ahead to know which is the last."""
     cap = _open_video(video)
     declared = cap.get(cv2.CAP_PROP_FRAME_COUNT)
     declared = int(declared) if 0 < declared < math.inf else 0  # 0 (or -1): the container does not say
-    count = 0
+    packets, count = None, 0
     try:
+        packets = _JpegPackets.of(video, cap)
         ok, image = cap.read()
         while ok:
             ok, following = cap.read()
             if not ok and count + 1 < declared:
                 _stopped_short(video, count + 1, declared)
             count += 1
+            if packets is not None:
+                packets.check(count)
             yield image
             image = following
     finally:
         cap.release()
+        if packets is not None:
+            packets.release()
     if count == 0:
         raise InputError(f"--video: {video} has no readable frames")
+
+
+# OpenCV's names (CAP_PROP_FOURCC) of codecs whose frames are each a JPEG
+JPEG_FOURCCS = ("MJPG", "JPEG", "AVRN", "AVDJ", "DMB1")
+
+
+class _JpegPackets:
+    """The coded frames of a Motion JPEG video, read beside the decoded ones by a second
+    capture in OpenCV's raw mode (``CAP_PROP_FORMAT`` -1: the packet, not decoded), and checked
+    as read_frame checks a JPEG file (:func:`~dcfkit.datasets.base.jpeg_damage`). FFmpeg's
+    decoder conceals damage (it patches over the blocks it cannot decode) and OpenCV reports
+    none. Each frame is one packet, so the two captures stay in step. The check is libjpeg's
+    decode at 1/8 scale, about 40% more time than FFmpeg's full decode alone."""
+
+    def __init__(self, video, raw: cv2.VideoCapture, first: bytes):
+        self.video, self._raw, self._next = video, raw, first
+
+    @classmethod
+    def of(cls, video, cap: cv2.VideoCapture) -> _JpegPackets | None:
+        """The packets of ``video`` if ``cap`` decodes it with FFmpeg from JPEG frames that
+        libjpeg decodes (judged by the first one: a variant it does not read, lossless say, is
+        not checked); else None."""
+        fourcc = int(cap.get(cv2.CAP_PROP_FOURCC)).to_bytes(4, "little").decode("latin-1").upper()
+        if cap.getBackendName() != "FFMPEG" or fourcc not in JPEG_FOURCCS:
+            return None
+        raw = cv2.VideoCapture(str(video), cv2.CAP_FFMPEG, [cv2.CAP_PROP_FORMAT, -1])
+        ok, packet = raw.read() if raw.isOpened() and raw.get(cv2.CAP_PROP_FORMAT) == -1 else (False, None)
+        first = packet.tobytes() if ok else b""
+        if first.startswith(b"\xff\xd8") and jpeg_decodable(first):
+            return cls(video, raw, first)
+        raw.release()
+        return None
+
+    def check(self, frame: int) -> None:
+        """InputError if the coded data of ``frame`` (1-based, the next one) is damaged."""
+        data, self._next = self._next, None
+        if data is None:
+            ok, packet = self._raw.read()
+            if not ok:  # no packet for a frame the decoder gave: the captures disagree, so no verdict
+                return
+            data = packet.tobytes()
+        damage = jpeg_damage(data, decodable=True)
+        if damage is not None:
+            raise InputError(f"--video: {self.video}: frame {frame} is damaged (corrupt JPEG data: {damage}), so "
+                             f"it is not tracked: FFmpeg would show it patched over")
+
+    def release(self) -> None:
+        self._raw.release()
 
 
 def _open_video(video) -> cv2.VideoCapture:

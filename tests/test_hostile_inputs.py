@@ -289,6 +289,44 @@ def test_pillows_own_bomb_limit_is_a_dataset_error_too(tmp_path, monkeypatch, de
     assert not decodes
 
 
+def png_chunk(kind: bytes, body: bytes, crc: int | None = None) -> bytes:
+    """One PNG chunk; its CRC is ``crc`` if given, else the right one."""
+    crc = zlib.crc32(kind + body) if crc is None else crc
+    return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", crc)
+
+
+def with_bad_text_chunk(png: bytes) -> bytes:
+    """``png`` with a tEXt chunk whose CRC is wrong, after its IHDR (8 + 25 bytes)."""
+    return png[:33] + png_chunk(b"tEXt", b"Comment\0made by a camera", crc=0) + png[33:]
+
+
+def test_a_bad_crc_in_an_ancillary_png_chunk_is_read_as_libpng_reads_it(tmp_path, monkeypatch, capfd, decodes):
+    """A tEXt chunk with a bad CRC: libpng (OpenCV's decoder) warns and decodes the image, Pillow
+    refused its header; read_frame returns OpenCV's pixels, and still refuses such a PNG whose
+    IDAT data is damaged too (libpng's error: OpenCV returns nothing), naming the frame, and
+    one whose IHDR declares over the limit, from the header, decoding nothing."""
+    png = with_bad_text_chunk(cv2.imencode(".png", TEXTURE)[1].tobytes())
+    capfd.readouterr()
+    expected = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_COLOR)
+    assert "tEXt: CRC error" in capfd.readouterr().err
+    np.testing.assert_array_equal(expected, TEXTURE)
+    path = tmp_path / "frame.png"
+    path.write_bytes(png)
+    np.testing.assert_array_equal(read_frame(path, "frame 2"), expected)
+    idat = png.index(b"IDAT") + 4
+    damaged = bytearray(png)
+    damaged[idat + 100] ^= 0x55
+    path.write_bytes(bytes(damaged))
+    with pytest.raises(DatasetError, match=r"cannot read frame 2: .*frame\.png \(not a readable image\)"):
+        read_frame(path, "frame 2")
+    monkeypatch.setenv("DCFKIT_MAX_IMAGE_PIXELS", "1e6")
+    path.write_bytes(with_bad_text_chunk(png_declaring(2000, 2000)))
+    decodes.clear()
+    with pytest.raises(DatasetError, match=r"cannot read frame 2: .*frame\.png \(its header declares 2000x2000 = "):
+        read_frame(path, "frame 2")
+    assert not decodes
+
+
 def libjpeg_verdict(data: bytes, capfd) -> tuple[np.ndarray | None, str]:
     """OpenCV's decode of ``data`` and what its libjpeg printed (warnings of corrupt data)."""
     capfd.readouterr()
@@ -334,6 +372,69 @@ def test_valid_jpegs_decode_as_opencv_decodes_them(tmp_path):
             path.write_bytes(data)
             np.testing.assert_array_equal(read_frame(path), cv2.imdecode(np.frombuffer(data, np.uint8),
                                                                          cv2.IMREAD_COLOR))
+
+
+def with_padding(data: bytes, padding: bytes) -> bytes:
+    """``data`` with ``padding`` between its last scan and its end-of-image marker."""
+    assert data.endswith(b"\xff\xd9")
+    return data[:-2] + padding + data[-2:]
+
+
+def early_finish(capfd) -> bytes:
+    """JPEG with one byte changed so that the decoder finishes early, leaving coded data before
+    the end-of-image marker: libjpeg warns as it does for padding there."""
+    for offset in range(SCAN, len(JPEG) - 2):
+        damaged = bytearray(JPEG)
+        damaged[offset] ^= 0xFF
+        image, warned = libjpeg_verdict(bytes(damaged), capfd)
+        if image is not None and "extraneous bytes before marker 0xd9" in warned:
+            return bytes(damaged)
+    pytest.fail("no changed byte makes the decoder finish early")
+
+
+def test_zero_padding_before_the_end_marker_is_read_and_damage_warned_alike_is_not(tmp_path, capfd):
+    """Zero bytes some writers put before the end-of-image marker: libjpeg warns ("extraneous
+    bytes before marker 0xd9") and OpenCV decodes the same pixels; read_frame returns them,
+    baseline and progressive. The same warning for a damaged JPEG (the decoder finished early),
+    zero padding added to it, or nonzero bytes there, is still a refusal naming the frame."""
+    path = tmp_path / "frame.jpg"
+    for params in ([], [cv2.IMWRITE_JPEG_PROGRESSIVE, 1]):
+        plain = cv2.imencode(".jpg", TEXTURE, params)[1].tobytes()
+        for count in (16, 1000):  # the few bytes libjpeg-turbo has read ahead go unreported
+            data = with_padding(plain, bytes(count))
+            image, warned = libjpeg_verdict(data, capfd)
+            assert "extraneous bytes before marker 0xd9" in warned
+            path.write_bytes(data)
+            np.testing.assert_array_equal(read_frame(path), image)
+            np.testing.assert_array_equal(image, cv2.imdecode(np.frombuffer(plain, np.uint8), cv2.IMREAD_COLOR))
+    damaged = early_finish(capfd)
+    for data in (damaged, with_padding(damaged, bytes(8)), with_padding(JPEG, b"\x12\x34"),
+                 with_padding(JPEG, b"\0\0\x01\0\0")):
+        path.write_bytes(data)
+        with pytest.raises(DatasetError, match=r"cannot read frame 5: .*frame\.jpg \(corrupt JPEG data: Corrupt JPEG "
+                                               r"data: \d+ extraneous bytes before marker 0xd9\)"):
+            read_frame(path, "frame 5")
+
+
+@pytest.mark.parametrize("compression,name", [(5, "tiff_lzw"), (8, "tiff_adobe_deflate")])
+def test_a_tiff_whose_data_libtiff_cannot_decode_is_refused(compression, name, tmp_path, capfd):
+    """LZW and Deflate TIFFs with bytes of their strip overwritten: OpenCV's libtiff prints an
+    error and returns the image, a fifth of it wrong; read_frame refuses the file naming the
+    frame. Intact, they are read as OpenCV reads them."""
+    data = cv2.imencode(".tiff", TEXTURE, [cv2.IMWRITE_TIFF_COMPRESSION, compression])[1].tobytes()
+    path = tmp_path / "frame.tif"
+    path.write_bytes(data)
+    np.testing.assert_array_equal(read_frame(path, "frame 6"), TEXTURE)
+    damaged = bytearray(data)
+    damaged[200:240] = b"\xff" * 40  # the strip starts at byte 8
+    capfd.readouterr()
+    image = cv2.imdecode(np.frombuffer(bytes(damaged), np.uint8), cv2.IMREAD_COLOR)
+    assert image.shape == TEXTURE.shape and "TIFF_Error" in capfd.readouterr().err
+    assert (image != TEXTURE).any()
+    path.write_bytes(bytes(damaged))
+    with pytest.raises(DatasetError, match=rf"cannot read frame 6: .*frame\.tif \(corrupt TIFF data: libtiff cannot "
+                                           rf"decode its {name} data\)"):
+        read_frame(path, "frame 6")
 
 
 def test_a_corrupt_frame_ends_the_run_naming_it_and_keeps_the_boxes_before(tmp_path, capsys):
@@ -388,6 +489,57 @@ def test_a_truncated_video_ends_with_an_error_naming_the_frame_where_it_stops(ke
     assert cli.main(["track", "strcf", "--video", str(cut), f"--box={box}", "--out", str(out)]) == 2
     assert f"stops at frame {stop} of the 8" in capsys.readouterr().err
     assert len(out.read_text().splitlines() if out.exists() else []) == stop - 1  # none: no file
+
+
+def damage_frame(data: bytes, frame: int) -> bytes:
+    """The MJPG video ``data`` with bytes of frame ``frame``'s (1-based) coded data inverted."""
+    start = -1
+    for _ in range(frame):
+        start = data.index(b"\xff\xd8", start + 1)  # each frame's start-of-image marker
+    scan = data.index(b"\xff\xda", start) + 14
+    damaged = bytearray(data)
+    for position in np.random.default_rng(0).integers(scan, scan + 600, 50):
+        damaged[position] ^= 0xFF
+    return bytes(damaged)
+
+
+def test_a_damaged_frame_of_a_motion_jpeg_video_ends_the_run_naming_it(tmp_path, capsys):
+    """Frame 3 of an MJPG .avi damaged: FFmpeg decodes all 8 frames, patching over the damage,
+    so it was tracked. Now the frames before it are given as before and the error names it;
+    `dcfkit track` exits 2 with the boxes of frames 1 and 2."""
+    full = tmp_path / "full.avi"
+    data = write_video(full, VIDEO_FRAMES.frames)
+    damaged = tmp_path / "damaged.avi"
+    damaged.write_bytes(damage_frame(data, 3))
+    complete = list(iter_frames(video=str(full)))
+    cap = cv2.VideoCapture(str(damaged))
+    concealed = [cap.read()[1] for _ in range(8)]
+    assert all(image is not None for image in concealed) and not np.array_equal(concealed[2], complete[2])
+    got = []
+    with pytest.raises(InputError, match=r"--video: .*damaged\.avi: frame 3 is damaged \(corrupt JPEG data: "):
+        got.extend(iter_frames(video=str(damaged)))
+    assert len(got) == 2 and all(np.array_equal(a, b) for a, b in zip(got, complete))
+    out = tmp_path / "boxes.txt"
+    box = ",".join(str(v) for v in VIDEO_FRAMES.ground_truth[0])
+    assert cli.main(["track", "strcf", "--video", str(damaged), f"--box={box}", "--out", str(out)]) == 2
+    assert "damaged.avi: frame 3 is damaged" in capsys.readouterr().err
+    assert len(out.read_text().splitlines()) == 2
+
+
+def test_a_motion_jpeg_video_cut_inside_its_last_frame_is_refused_there(tmp_path):
+    """A cut inside the last frame's data leaves the count the header declares: FFmpeg fills
+    the rest of the frame in, and it was tracked. Now the first 7 frames are given and the
+    error names frame 8."""
+    full = tmp_path / "full.avi"
+    data = write_video(full, VIDEO_FRAMES.frames)
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(data[:data.rindex(b"\xff\xd8") + 600])
+    cap = cv2.VideoCapture(str(cut))
+    assert cap.get(cv2.CAP_PROP_FRAME_COUNT) == 8 and all(cap.read()[0] for _ in range(8))
+    got = []
+    with pytest.raises(InputError, match=r"cut\.avi: frame 8 is damaged \(corrupt JPEG data: Premature end of JPEG"):
+        got.extend(iter_frames(video=str(cut)))
+    assert len(got) == 7 and all(np.array_equal(a, b) for a, b in zip(got, iter_frames(video=str(full))))
 
 
 def test_video_frames_over_the_image_limit_are_refused_before_reading(tmp_path, monkeypatch):

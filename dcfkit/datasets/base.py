@@ -9,7 +9,9 @@ import io
 import os
 import re
 import stat
+import struct
 import warnings
+import zlib
 from pathlib import Path
 from typing import Iterable, Mapping
 
@@ -115,12 +117,14 @@ def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
     than :func:`~dcfkit.limits.max_image_pixels` (read from its header, before decoding), a
     truncated JPEG (``cv2.imread`` would return one grey below the cut, with a warning only), or
     a JPEG whose data libjpeg reports corrupt (``cv2.imread`` would return it with a warning, part
-    of it grey or wrong). A JPEG that lacks just its end-of-image marker, a common defect, is read
-    as imread would. Decoding is OpenCV's, unchanged."""
+    of it grey or wrong), or a TIFF whose data libtiff cannot decode (likewise). A JPEG that lacks just its end-of-image marker, or has zero bytes
+    before it, common defects, is read as imread would. Decoding is OpenCV's, unchanged."""
     import cv2  # deferred: listing sequences needs no OpenCV
 
     data = _read_image_bytes(path, what)
     _check_size(data, path, what)
+    if data.startswith(_TIFF_SIGNATURES):
+        _check_tiff_data(data, path, what)
     image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
     if image is None and _missing_end_marker(data):
         data += _JPEG_END
@@ -139,7 +143,7 @@ def _check_size(data: bytes, path, what: str) -> None:
     """DatasetError unless the image header declares at most ``max_image_pixels()`` pixels: a
     small file can declare billions (a 876 KB PNG of 30000x30000 decodes to 2.7 GB). Pillow reads
     the header only (JPEG, PNG, BMP, TIFF, WebP and more); a file whose header it cannot read is
-    refused, as its size is unknown."""
+    refused, as its size is unknown, unless it is a PNG with an intact IHDR (:func:`_png_size`)."""
     from PIL import Image  # deferred, as OpenCV: listing sequences reads no image
 
     limit = max_image_pixels()
@@ -152,27 +156,116 @@ def _check_size(data: bytes, path, what: str) -> None:
             raise DatasetError(f"cannot read {what}: {path} (its header declares more pixels than Pillow reads: "
                                f"{2 * Image.MAX_IMAGE_PIXELS:.3g}, twice PIL.Image.MAX_IMAGE_PIXELS)") from None
         except Exception:  # Pillow's plugins raise several types for a header they cannot read
-            raise DatasetError(f"cannot read {what}: {path} (not a readable image)") from None
+            size = _png_size(data)
+            if size is None:
+                raise DatasetError(f"cannot read {what}: {path} (not a readable image)") from None
+            width, height = size
     if width * height > limit:
         raise DatasetError(f"cannot read {what}: {path} (its header declares {width}x{height} = "
                            f"{width * height:.3g} pixels, over the limit of {limit:.3g}: ${IMAGE_PIXELS_VARIABLE})")
 
 
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def _png_size(data: bytes) -> tuple[int, int] | None:
+    """Width and height from a PNG's IHDR chunk, if it is intact; else None. Pillow reads the
+    chunks up to the image data and refuses a bad CRC in any, while libpng (OpenCV's decoder)
+    only warns about one in an ancillary chunk (tEXt, say) and decodes the image; it refuses
+    damage to the critical ones (IHDR, IDAT), so ``cv2.imdecode`` returns None for those."""
+    if not data.startswith(_PNG_SIGNATURE) or len(data) < 33:
+        return None
+    length, kind, width, height = struct.unpack(">I4sII", data[8:24])
+    if length != 13 or kind != b"IHDR" or zlib.crc32(data[12:29]) != int.from_bytes(data[29:33], "big"):
+        return None
+    return width, height
+
+
+_TIFF_SIGNATURES = (b"II*\0", b"MM\0*", b"II+\0", b"MM\0+")  # TIFF and BigTIFF, either byte order
+# Pillow's names of the TIFF compressions whose data any bytes are: nothing for a decode to find
+_TIFF_UNCHECKABLE = ("raw", "packbits")
+_TIFF_DAMAGE = ("decoder error", "image file is truncated")  # how Pillow's decoders say the data is broken
+
+
+def _check_tiff_data(data: bytes, path, what: str) -> None:
+    """DatasetError if libtiff cannot decode a compressed TIFF's image data (a broken LZW or
+    Deflate stream). OpenCV's decoder (its own libtiff) prints the error and returns the image,
+    wrong or blank from the damage on; Pillow's raises. So Pillow decodes it too, first (the two
+    images are not held at once): twice the decoding time, for compressed TIFF frames only,
+    which no benchmark uses. Pillow's other failures (a layout it does not read) say nothing
+    about damage and leave the file to OpenCV."""
+    from PIL import Image  # deferred, as OpenCV
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # metadata warnings: the header was checked, the verdict is the decode's
+        try:
+            with Image.open(io.BytesIO(data)) as image:
+                compression = image.info.get("compression", "unknown")
+                if compression not in _TIFF_UNCHECKABLE:
+                    image.load()
+        except Exception as exc:  # as in _check_size, several types
+            if str(exc).startswith(_TIFF_DAMAGE):
+                raise DatasetError(f"cannot read {what}: {path} (corrupt TIFF data: libtiff cannot decode its "
+                                   f"{compression} data)") from None
+
+
 def _check_jpeg_data(data: bytes, path, what: str) -> None:
-    """DatasetError if libjpeg reports the JPEG's data corrupt. OpenCV's decoder only prints
+    """DatasetError if libjpeg reports the JPEG's data corrupt (:func:`jpeg_damage`)."""
+    damage = jpeg_damage(data)
+    if damage is not None:
+        raise DatasetError(f"cannot read {what}: {path} (corrupt JPEG data: {damage})")
+
+
+def jpeg_damage(data: bytes, decodable: bool = False) -> str | None:
+    """What libjpeg reports wrong with a JPEG's data, or None. OpenCV's decoder only prints
     such a warning and returns the image, grey or garbled from the damage on; simplejpeg (the
     same libjpeg-turbo) raises instead. Its decode at 1/8 scale reads every coded coefficient,
-    so it sees the same errors, at a third of a full decode's time."""
+    so it sees the same errors, at a third of a full decode's time. None too for a JPEG
+    simplejpeg cannot decode at all (CMYK, say), which has nothing to say about corruption,
+    unless it is known to be ``decodable`` (a video frame, whose first frame libjpeg decoded);
+    and for one with zero padding before its end-of-image marker (:func:`_without_zero_padding`)."""
+    complaint = _libjpeg_complaint(data)
+    if complaint is None or (not decodable and not jpeg_decodable(data)):
+        return None
+    unpadded = _without_zero_padding(data, complaint)
+    if unpadded is not None and _libjpeg_complaint(unpadded) is None:
+        return None
+    return complaint
+
+
+def jpeg_decodable(data: bytes) -> bool:
+    """Whether libjpeg (simplejpeg's) decodes ``data``, warnings or not."""
+    return _libjpeg_complaint(data, strict=False) is None
+
+
+def _libjpeg_complaint(data: bytes, strict: bool = True) -> str | None:
+    """libjpeg's first warning (``strict``) or error decoding ``data`` at 1/8 scale, or None."""
     import simplejpeg  # deferred, as OpenCV
 
     try:
-        simplejpeg.decode_jpeg(data, colorspace="BGR", min_height=1, min_width=1, strict=True)
+        simplejpeg.decode_jpeg(data, colorspace="BGR", min_height=1, min_width=1, strict=strict)
     except ValueError as exc:
-        try:  # a JPEG that simplejpeg cannot decode at all (CMYK, say) has nothing to say about corruption
-            simplejpeg.decode_jpeg(data, colorspace="BGR", min_height=1, min_width=1, strict=False)
-        except ValueError:
-            return
-        raise DatasetError(f"cannot read {what}: {path} (corrupt JPEG data: {exc})") from None
+        return str(exc)
+    return None
+
+
+# libjpeg's JWRN_EXTRANEOUS_DATA for the end-of-image marker (its wording since libjpeg 6)
+_EXTRANEOUS_BEFORE_END = re.compile(r"\d+ extraneous bytes before marker 0xd9")
+
+
+def _without_zero_padding(data: bytes, complaint: str) -> bytes | None:
+    """``data`` without the zero bytes just before its end-of-image marker, if libjpeg's
+    ``complaint`` is about bytes there: padding some writers add. The caller checks that the
+    rest decodes cleanly, all its blocks from its own data; then the padding was never read
+    and OpenCV's decode is the same with it. Other bytes there are refused: damage that makes
+    the decoder reach the last block early leaves coded data there and gets the same warning
+    (47% of JPEGs with 1 to 5 random bytes of coded data changed did), and damage that makes
+    it run past the end reads the padding as data."""
+    end = data.find(_JPEG_END, data.rfind(b"\xff\xda"))  # markers cannot occur in coded data
+    if not _EXTRANEOUS_BEFORE_END.search(complaint) or end < 0:
+        return None
+    start = len(data[:end].rstrip(b"\0"))
+    return data[:start] + data[end:] if start < end else None
 
 
 _JPEG_END = b"\xff\xd9"
