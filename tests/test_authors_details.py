@@ -99,18 +99,15 @@ def test_resize_auto_on_square_patches(old, new, interpolation):
     assert np.array_equal(resize_auto(patch, new), expected)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "BUG: the authors' mexResize 'auto' compares the NEW WIDTH with the OLD HEIGHT, not the old width. "
-    "mexResize.cpp:34-49 builds newSize = Size(s.height, s.width) (= new width, new height) and tests "
-    "newSize.width > oldSize.height, its comment assuming the Mat is transposed; but MxArray::toMat "
-    "(MxArray.cpp:348-373, transpose=true by default, MxArray.hpp:322) returns the image un-transposed, so "
-    "oldSize.height is the old number of rows. Compiled under Octave from the shipped sources (STRCF/"
-    "external_libs/mexResize, identical to DR2Track1/utils/mexResize.cpp): [40 10] -> [20 15] gives "
-    "cv2's INTER_AREA and [10 20] -> [15 20] INTER_LINEAR, bit for bit; resize_auto gives the opposite. "
-    "Only non-square patches differ: the DSST's scale samples (whole_pixel sampling)."))
 @pytest.mark.parametrize("old, new", [((40, 10), (20, 15)), ((10, 20), (15, 20)), ((10, 40), (30, 20)),
                                       ((30, 12), (20, 16))])
 def test_resize_auto_compares_the_new_width_with_the_old_height_as_the_compiled_mex(old, new):
+    """mexResize.cpp:34-49 builds newSize = Size(s.height, s.width) (new width, new height) and
+    tests newSize.width > oldSize.height, its comment assuming a transposed Mat; MxArray::toMat
+    (MxArray.cpp:348-373, transpose=true by default, MxArray.hpp:322) returns the image
+    untransposed, so oldSize.height is the old number of rows. Compiled under Octave from the
+    shipped sources (STRCF/external_libs/mexResize, identical to DR2Track1/utils/mexResize.cpp):
+    [40 10] -> [20 15] gives cv2's INTER_AREA and [10 20] -> [15 20] INTER_LINEAR, bit for bit."""
     patch = np.random.default_rng(2).integers(0, 256, (*old, 3), dtype=np.uint8)
     interpolation = cv2.INTER_LINEAR if new[1] > old[0] else cv2.INTER_AREA
     assert np.array_equal(resize_auto(patch, new), cv2.resize(patch, (new[1], new[0]), interpolation=interpolation))
