@@ -1,10 +1,11 @@
 #!/bin/bash
 # Optional parity tool: runs the authors' own MATLAB code, STRCF (run_STRCF.m, hand-crafted:
-# gray + fHOG + CN), DR²Track (IROS version, DR2Track1) or BACF (the ARCF repository's
-# tracker_HOG.m with its aberrance term off, which is BACF_optimized.m), under GNU Octave on
-# one dataset's sequences, and writes their boxes for comparison with dcfkit.
+# gray + fHOG + CN), DR²Track (IROS version, DR2Track1), BACF (the ARCF repository's
+# tracker_HOG.m with its aberrance term off, which is BACF_optimized.m), ARCF-HC (run_ARCF.m:
+# gray + fHOG + CN, tracker_HOGCN.m) or AutoTrack (run_AutoTrack.m, AutoTrack_optimized.m),
+# under GNU Octave on one dataset's sequences, and writes their boxes for comparison with dcfkit.
 #
-#   bash benchmarks/authors_octave.sh {strcf|dr2track|bacf} DATASET_ROOT OUT_DIR [sequence ...]
+#   bash benchmarks/authors_octave.sh {strcf|dr2track|bacf|arcf|autotrack} DATASET_ROOT OUT_DIR [sequence ...]
 #
 # DATASET_ROOT is read by dcfkit.datasets (UAV123, UAV123@10fps, UAV123@20L, DTB70, UAVDT, OTB
 # layouts). Writes OUT_DIR/<DATASET>/<sequence>.txt (1-based x,y,w,h, one '%.4f' line per frame)
@@ -14,34 +15,45 @@
 # and is built into $AUTHORS_BUILD (default: a new temp dir); it is never copied into dcfkit.
 # What the built copy changes, only for portability (algorithms and parameters untouched):
 #  - gradientMex.cpp (Piotr's toolbox) gets Octave's 64-bit mwSize and <cstdlib>/<cstddef>;
-#  - mexResize is the stand-in $DCFKIT_REFERENCE/octave/mexResize.cpp (OpenCV resize with the
-#    authors' rule: 'auto' = INTER_LINEAR when the width grows, else INTER_AREA) instead of mexopencv;
+#  - mexResize is the stand-in $DCFKIT_REFERENCE/octave/mexResize.cpp (OpenCV resize; 'auto' =
+#    INTER_LINEAR when the new width exceeds the old width, else INTER_AREA) instead of their
+#    mexopencv build; their compiled mex compares the new width with the old *height*, which
+#    differs on non-square patches (the DSST scale samples of DR²Track, ARCF-HC and AutoTrack);
 #  - hann, ifft2(..,'symmetric'), gather, mtimesx are the .m shims of $DCFKIT_REFERENCE/octave
-#    (their mtimesx.m help file is moved aside so the shim is found);
+#    (their mtimesx.m help file is moved aside so the shim is found). The ifft2 shim returns
+#    real(ifft2(x)); MATLAB's 'symmetric' uses only half of x and may differ when x is not
+#    conjugate-symmetric, as ARCF-HC's and AutoTrack's filters (complex ADMM h-steps) are not;
 #  - DR²Track: built by $DCFKIT_REFERENCE/octave/setup_dr2track.sh (which applies the above);
 #  - STRCF: its Piotr's-toolbox submodule is absent from the export, so fhog.m and
 #    gradientMex.cpp/sse.hpp/wrappers.hpp come from the reference's DR2Track1/feature (the same
 #    toolbox files; that fhog.m calls gradientMex directly, with the same arguments); and
 #    benchmarks/octave/authors_run.m sets params.visualization = 0 after run_STRCF.m's settings;
-#  - BACF: the ARCF repository's copy, with sse.hpp from DR2Track1/feature (absent there);
-#    authors_run.m takes run_ARCF_H.m's settings and sets admm_gamma = 0 (no aberrance term:
-#    the filter update is BACF's) and learning_rate = 0.013 (run_BACF.m's; ARCF uses 0.019).
+#  - BACF and ARCF-HC: the ARCF repository's copy, with sse.hpp from DR2Track1/feature (absent
+#    there) and gpuArray = the identity (benchmarks/octave/shims/gpuArray.m, into utils/:
+#    tracker_HOGCN.m calls gpuArray(zeros(..)) whatever params.use_gpu says);
+#    BACF: authors_run.m takes run_ARCF_H.m's settings and sets admm_gamma = 0 (no aberrance
+#    term: the filter update is BACF's) and learning_rate = 0.013 (run_BACF.m's; ARCF uses 0.019);
+#    ARCF-HC: authors_run.m takes run_ARCF.m's settings and sets params.visualization = 0;
+#  - AutoTrack: its feature/ lacks sse.hpp and wrappers.hpp, which come from DR2Track1/feature
+#    (the same toolbox files; its fhog.m and gradientMex.cpp are DR2Track1's); mexResize.mex
+#    and the shims go into its utils/; run_AutoTrack.m runs as it is (visualization already 0).
 set -euo pipefail
-[ $# -ge 3 ] || { sed -n '2,10p' "$0"; exit 2; }
-case $1 in strcf|dr2track|bacf) ;; *) echo "tracker must be strcf, dr2track or bacf"; exit 2 ;; esac
+[ $# -ge 3 ] || { sed -n '2,12p' "$0"; exit 2; }
+case $1 in strcf|dr2track|bacf|arcf|autotrack) ;; *) echo "tracker must be strcf, dr2track, bacf, arcf or autotrack"; exit 2 ;; esac
 TRK=$1; ROOT=$(cd "$2" && pwd); mkdir -p "$3"; OUT=$(cd "$3" && pwd); shift 3
 HERE=$(cd "$(dirname "$0")" && pwd)
 REF=$(cd "${DCFKIT_REFERENCE:-$HERE/../../shared/reference}" && pwd)
 BUILD=${AUTHORS_BUILD:-$(mktemp -d /tmp/authors_octave.XXXXXX)}; mkdir -p "$BUILD"
 command -v mkoctfile >/dev/null || { echo "needs: apt-get install -y octave liboctave-dev octave-image libopencv-imgproc-dev"; exit 1; }
-# the portability patches STRCF's and BACF's copies share (code folder, gradientMex folder)
+# the portability patches the copies share (gradientMex folder, mexResize.mex path, mtimesx
+# folder, shim folder)
 port_lineage() {
-  sed -i '1i #include <cstdlib>\n#include <cstddef>' "$2/wrappers.hpp"
-  sed -i 's/const int dims\[3\]={h,w,d}, n=h\*w\*d;/const mwSize dims[3]={(mwSize)h,(mwSize)w,(mwSize)d}; const int n=h*w*d;/; s/  const int \*dims; int nDims;/  const mwSize *dims; int nDims;/' "$2/gradientMex.cpp"
-  (cd "$2" && mkoctfile --mex -O2 -DMATLAB_MEX_FILE -o gradientMex.mex gradientMex.cpp)
-  mkoctfile --mex -I/usr/include/opencv4 -o "$1/external_libs/mexResize/mexResize.mex" "$REF/octave/mexResize.cpp" -lopencv_imgproc -lopencv_core
-  mv "$1/external_libs/mtimesx/mtimesx.m" "$1/external_libs/mtimesx/mtimesx_mex_help.txt"
-  cp "$REF"/octave/{hann.m,ifft2.m,gather.m,mtimesx.m} "$1/utils/"
+  sed -i '1i #include <cstdlib>\n#include <cstddef>' "$1/wrappers.hpp"
+  sed -i 's/const int dims\[3\]={h,w,d}, n=h\*w\*d;/const mwSize dims[3]={(mwSize)h,(mwSize)w,(mwSize)d}; const int n=h*w*d;/; s/  const int \*dims; int nDims;/  const mwSize *dims; int nDims;/' "$1/gradientMex.cpp"
+  (cd "$1" && mkoctfile --mex -O2 -DMATLAB_MEX_FILE -o gradientMex.mex gradientMex.cpp)
+  mkoctfile --mex -I/usr/include/opencv4 -o "$2" "$REF/octave/mexResize.cpp" -lopencv_imgproc -lopencv_core
+  mv "$3/mtimesx.m" "$3/mtimesx_mex_help.txt"
+  cp "$REF"/octave/{hann.m,ifft2.m,gather.m,mtimesx.m} "$4/"
 }
 case $TRK in
   dr2track) bash "$REF/octave/setup_dr2track.sh" "$BUILD/code" ;;
@@ -49,11 +61,16 @@ case $TRK in
     C=$BUILD/code; P=$C/external_libs/pdollar_toolbox/channels
     rm -rf "$C"; cp -r "$REF/STRCF" "$C"; mkdir -p "$P"
     cp "$REF"/DR2Track/DR2Track1/feature/{fhog.m,gradientMex.cpp,sse.hpp,wrappers.hpp} "$P/"
-    port_lineage "$C" "$P" ;;
-  bacf)
+    port_lineage "$P" "$C/external_libs/mexResize/mexResize.mex" "$C/external_libs/mtimesx" "$C/utils" ;;
+  bacf|arcf)
     C=$BUILD/code; rm -rf "$C"; cp -r "$REF/ARCF" "$C"
     cp "$REF/DR2Track/DR2Track1/feature/sse.hpp" "$C/utils/"
-    port_lineage "$C" "$C/utils" ;;
+    port_lineage "$C/utils" "$C/external_libs/mexResize/mexResize.mex" "$C/external_libs/mtimesx" "$C/utils"
+    cp "$HERE/octave/shims/gpuArray.m" "$C/utils/" ;;
+  autotrack)
+    C=$BUILD/code; rm -rf "$C"; cp -r "$REF/AutoTrack" "$C"
+    cp "$REF"/DR2Track/DR2Track1/feature/{sse.hpp,wrappers.hpp} "$C/feature/"
+    port_lineage "$C/feature" "$C/utils/mexResize.mex" "$C/utils" "$C/utils" ;;
 esac
 # frame lists and 1-based first boxes, from dcfkit's own dataset loader
 DS=$(PYTHONPATH="$HERE/..${PYTHONPATH:+:$PYTHONPATH}" python3 - "$ROOT" "$BUILD/seqs" "$@" <<'EOF'

@@ -1,9 +1,11 @@
 function authors_run(tracker_name, code_dir, frames_file, init_file, out_file)
 % AUTHORS_RUN  One sequence through a runnable copy of the authors' tracker built by
 % benchmarks/authors_octave.sh (GNU Octave).
-%   tracker_name  'strcf' (their run_STRCF.m, hand-crafted), 'dr2track' (their run_DR2Track.m)
-%                 or 'bacf' (ARCF's run_ARCF_H.m settings with BACF's: no aberrance term,
-%                 learning rate 0.013, then their tracker_HOG.m)
+%   tracker_name  'strcf' (their run_STRCF.m, hand-crafted), 'dr2track' (their run_DR2Track.m),
+%                 'bacf' (ARCF's run_ARCF_H.m settings with BACF's: no aberrance term,
+%                 learning rate 0.013, then their tracker_HOG.m), 'arcf' (ARCF-HC: their
+%                 run_ARCF.m settings, then their tracker_HOGCN.m) or 'autotrack' (their
+%                 run_AutoTrack.m, which calls AutoTrack_optimized.m)
 %   code_dir      the built copy
 %   frames_file   one image path per line, in frame order
 %   init_file     the first frame's box, 1-based x,y,w,h
@@ -41,6 +43,16 @@ function authors_run(tracker_name, code_dir, frames_file, init_file, out_file)
       params.learning_rate = 0.013;  % run_BACF.m's (ARCF's is 0.019)
       params.visualization = 0;
       r = tracker_HOG(params);
+    case 'arcf'
+      addpath(genpath(code_dir));  % as their ARCF_Demo_single_seq.m does
+      body = regexprep(fileread('run_ARCF.m'), '^(\s*%[^\n]*\n)*\s*function[^\n]*\n', '', 'once');
+      call = 'results\s*=\s*tracker_HOGCN\(params\);';
+      if numel(regexp(body, call)) ~= 1, error('authors_run: unexpected run_ARCF.m'); end
+      eval(regexprep(body, call, ''));  % its settings, params.seq = seq included
+      params.visualization = 0;
+      r = tracker_HOGCN(params);
+    case 'autotrack'
+      r = run_AutoTrack(seq);  % adds its feature/, implementation/, utils/; visualization off
     case 'dr2track'
       addpath(fullfile(code_dir, 'utils'));
       r = run_DR2Track(seq);  % its visualization is already off
