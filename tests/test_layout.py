@@ -88,3 +88,13 @@ def test_imports_inside_functions_say_why():
                 if isinstance(inner, (ast.Import, ast.ImportFrom)) and "#" not in lines[inner.lineno - 1]:
                     silent.append(f"{path.relative_to(PACKAGE.parent)}:{inner.lineno}: {lines[inner.lineno - 1].strip()}")
     assert not silent, "import at the top, or say on the line why it is deferred:\n" + "\n".join(silent)
+
+
+def test_every_package_is_installed():
+    """pyproject.toml lists the packages setuptools installs; a subpackage missing there is
+    absent from an installed dcfkit (an editable install hides that)."""
+    import tomllib  # deferred: only this test reads pyproject.toml
+
+    listed = set(tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    found = {".".join(p.parent.relative_to(PACKAGE.parent).parts) for p in PACKAGE.rglob("__init__.py")}
+    assert found <= listed, f"add to pyproject.toml [tool.setuptools] packages: {sorted(found - listed)}"
