@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import os
 
-from .errors import ConfigError
+from .errors import ConfigError, shown
 
 IMAGE_PIXELS_VARIABLE = "DCFKIT_MAX_IMAGE_PIXELS"
 DEFAULT_MAX_IMAGE_PIXELS = 10**8  # 300 MB as BGR; an 8K video frame has 33 million
@@ -30,7 +30,7 @@ def pixel_budget(variable: str, default: int) -> int:
     except ValueError:
         value = math.nan
     if not (1 <= value < math.inf):
-        raise ConfigError(f"${variable} must be a number of pixels >= 1, got {text!r}")
+        raise ConfigError(f"${variable} must be a number of pixels >= 1, got {shown(text)}")
     return int(value)
 
 

@@ -117,7 +117,7 @@ def contract_problems(cls: type, base: type) -> list[str]:
             problems.append(f"its Params has no {kind.__name__} field '{field}' (the tracker reads "
                             f"params.{field}, in [{lowest:g}, {highest:g}])")
         elif not lowest <= (default := getattr(cls.Params(), field)) <= highest:
-            problems.append(f"its default {field}={default!r} is outside [{lowest:g}, {highest:g}]")
+            problems.append(f"its default {field}={shown(default)} is outside [{lowest:g}, {highest:g}]")
     return problems
 
 
@@ -129,7 +129,7 @@ def base_of(cls: type, kind: str, where: str) -> type:
         raise RegistryError(f"{where}: a {kind} must subclass {names}")
     base = bases[-1]  # the most specific, should a class subclass both roles' bases
     if hasattr(base, "role") and getattr(cls, "role", None) != base.role:
-        raise RegistryError(f"{where}: role {getattr(cls, 'role', None)!r} is not its base class "
+        raise RegistryError(f"{where}: role {shown(getattr(cls, 'role', None))} is not its base class "
                             f"{base.__name__}'s ({base.role!r})")
     return base
 
@@ -139,7 +139,7 @@ def check_contract_values(contract: Contract, params: Any, where: str) -> None:
     for field, (_, lowest, highest) in contract.params.items():
         value = getattr(params, field)
         if not lowest <= value <= highest:
-            raise ConfigError(f"{where}.{field}: {value!r} is outside [{lowest:g}, {highest:g}]")
+            raise ConfigError(f"{where}.{field}: {shown(value)} is outside [{lowest:g}, {highest:g}]")
 
 
 # What a plugin may raise at import or registration and be skipped for: any exception, and
@@ -205,7 +205,7 @@ class Registry:
         """
         kind, name = getattr(cls, "kind", ""), getattr(cls, "name", "")
         if kind not in KINDS:
-            raise RegistryError(f"{cls.__qualname__} (from {self._provider}): kind {kind!r} is not one of "
+            raise RegistryError(f"{cls.__qualname__} (from {self._provider}): kind {shown(kind)} is not one of "
                                 f"{', '.join(KINDS)}")
         if not name or not isinstance(name, str):
             raise RegistryError(f"{cls.__qualname__} (from {self._provider}): component has no name")
@@ -272,7 +272,7 @@ class Registry:
 
     def _check_kind(self, kind: str) -> dict[str, Entry]:
         if kind not in self._entries:
-            raise RegistryError(f"unknown component kind {kind!r}{closest(kind, KINDS)}; kinds: {', '.join(KINDS)}")
+            raise RegistryError(f"unknown component kind {shown(kind)}{closest(kind, KINDS)}; kinds: {', '.join(KINDS)}")
         return self._entries[kind]
 
     def plugin_versions(self, components) -> list[str]:

@@ -40,7 +40,7 @@ import numpy as np
 from . import __version__
 from .config import components
 from .datasets import DatasetError, Sequence, read_boxes
-from .errors import DcfkitError
+from .errors import DcfkitError, clip, shown
 from .registry import get_registry
 
 log = logging.getLogger(__name__)
@@ -357,7 +357,7 @@ def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]
     """Intact results of ``tracker_name`` under ``out_dir`` (:meth:`ResultStore.load`)."""
     folder = Path(out_dir) / tracker_name
     if not folder.is_dir():
-        raise DatasetError(f"no results folder for tracker {tracker_name!r}: {folder}")
+        raise DatasetError(f"no results folder for tracker {shown(tracker_name)}: {clip(str(folder))}")
     return ResultStore(folder).load(sequences)
 
 

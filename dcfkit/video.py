@@ -12,7 +12,7 @@ import cv2
 import numpy as np
 
 from .datasets import read_frame
-from .errors import InputError
+from .errors import InputError, shown
 from .limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff")
@@ -122,7 +122,7 @@ class VideoWriter:
 
     def __init__(self, path: str | Path, fps: float = 10.0):
         if Path(path).suffix.lower() not in VIDEO_SUFFIXES:
-            raise InputError(f"--save-video: cannot write a video named {str(path)!r}: the name must end in "
+            raise InputError(f"--save-video: cannot write a video named {shown(str(path))}: the name must end in "
                              f"{', '.join(VIDEO_SUFFIXES)}")
         self.path = check_output_file(path, "--save-video")
         self.fps = fps

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..errors import DcfkitError
+from ..errors import DcfkitError, shown
 from ..protocols import DEFAULT, PROTOCOLS
 
 
@@ -15,7 +15,7 @@ def parse_box(text: str) -> tuple[float, ...]:
     except ValueError:
         box = ()
     if len(box) != 4:
-        raise DcfkitError(f"--box expects x,y,w,h (four numbers), got {text!r}")
+        raise DcfkitError(f"--box expects x,y,w,h (four numbers), got {shown(text)}")
     return box
 
 
@@ -28,7 +28,7 @@ def _argument_type(convert, accept, expected: str):
         except ValueError:
             value = None
         if value is None or not accept(value):
-            raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}")
+            raise argparse.ArgumentTypeError(f"expected {expected}, got {shown(text)}")
         return value
     return parse
 
