@@ -142,10 +142,11 @@ def check_contract_values(contract: Contract, params: Any, where: str) -> None:
             raise ConfigError(f"{where}.{field}: {shown(value)} is outside [{lowest:g}, {highest:g}]")
 
 
-# What a plugin may raise at import or registration and be skipped for: any exception, and
-# SystemExit and KeyboardInterrupt that it raises itself (sys.exit(), raise KeyboardInterrupt);
-# an interrupt that a signal raised while it ran (Ctrl-C; SIGTERM, see dcfkit.tracking) goes on.
-PLUGIN_FAULTS = (Exception, SystemExit, KeyboardInterrupt)
+# What a plugin may raise at import or registration and be skipped for: anything it raises
+# itself, an Exception or not (sys.exit(), raise KeyboardInterrupt, its own BaseException
+# subclass, GeneratorExit), since one broken plugin must not end every command; an interrupt
+# that a signal raised while it ran (Ctrl-C; SIGTERM, see dcfkit.tracking) goes on.
+PLUGIN_FAULTS = (BaseException,)
 INTERRUPTS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
 
 
@@ -169,8 +170,8 @@ def signals_noted():
 
 
 def _raise_if_signalled(exc: BaseException, signalled: list) -> None:
-    """Re-raise an interrupt (not an Exception) that followed a signal: it is the user's, not
-    the plugin's."""
+    """Re-raise what is not an Exception (an interrupt, or what the plugin made of one) when a
+    signal arrived meanwhile: it is the user's, not the plugin's."""
     if signalled and not isinstance(exc, Exception):
         raise exc
 

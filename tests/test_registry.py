@@ -391,6 +391,41 @@ def test_a_plugin_raising_keyboard_interrupt_is_named_and_skipped(monkeypatch, s
     assert "flat" in r.names("label") and "gaussian" in r.names("label")  # the other plugin's, undone ones' not
 
 
+BOOM = "class Boom(BaseException):\n    pass\n"
+
+
+@pytest.mark.parametrize("source, message", [
+    (BOOM + "raise Boom('at import')", r"'dcfkit_test_base \(dcfkit_test_base\)' could not be imported and was "
+                                       r"skipped: Boom: at import \(at <string>:3\)"),
+    ("raise GeneratorExit", r"could not be imported and was skipped: GeneratorExit \(at <string>:1\)"),
+    (BOOM + PLUGIN.replace("registry.register(Flat)", "registry.register(Flat)\n    raise Boom('in the hook')"),
+     r"'dcfkit_test_base \(dcfkit_test_base\)' failed and was skipped: Boom: in the hook \(at <string>:\d+\)"),
+])
+def test_a_plugin_raising_another_base_exception_is_named_and_skipped(monkeypatch, source, message):
+    """A BaseException that is neither SystemExit nor KeyboardInterrupt (a class of the plugin's,
+    GeneratorExit) escaped the registry: every command ended in a traceback."""
+    ep = _entry_point(monkeypatch, "dcfkit_test_base", source)
+    with_entry_points(monkeypatch, [ep, install_plugin(monkeypatch, "dcfkit_test_good3", PLUGIN)])
+    with pytest.warns(reg.PluginWarning, match=message):
+        r = reg.build_registry()
+    assert "flat" in r.names("label") and "gaussian" in r.names("label")  # the other plugin's flat stays
+
+
+def test_every_command_names_a_plugin_that_raises_a_base_exception(monkeypatch, capsys):
+    from dcfkit import cli
+
+    with_entry_points(monkeypatch, [_entry_point(monkeypatch, "dcfkit_test_base2", BOOM + "raise Boom")])
+    monkeypatch.setattr(reg, "_REGISTRY", None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        status = cli.main(["track", "strcf", "--frames", "/nonexistent", "--box", "1,1,5,5"])
+    err = capsys.readouterr().err
+    assert status == 2 and "error: " in err and "Traceback" not in err
+    assert "warning: dcfkit plugin 'dcfkit_test_base2 (dcfkit_test_base2)' could not be imported and was " \
+           "skipped: Boom (at <string>:3)" in err
+    monkeypatch.setattr(reg, "_REGISTRY", None)
+
+
 def test_every_command_names_a_plugin_that_raises_keyboard_interrupt(monkeypatch, capsys):
     from dcfkit import cli
 
