@@ -16,6 +16,7 @@ import importlib.metadata
 import inspect
 import os
 import signal
+import types
 import typing
 import warnings
 from typing import Any, Mapping
@@ -84,20 +85,39 @@ def base_classes(kind: str) -> tuple[type, ...]:
     return tuple(getattr(loaded, n) for n in names)
 
 
+def _as_called(cls: type, method: str) -> tuple[Any, bool]:
+    """(what ``instance.method`` is, whether it receives the instance) for an instance of
+    ``cls``: the class attribute bound as Python binds it, so that a function, a
+    ``functools.lru_cache`` or ``partialmethod`` and a ``functools.wraps`` wrapper receive the
+    instance, a static method or a callable object does not. The instance is made without
+    running ``__init__``; TypeError if it cannot be (an abstract class)."""
+    raw = inspect.getattr_static(cls, method)
+    get = getattr(type(raw), "__get__", None)
+    if get is None:  # a callable object in the class: called with the tracker's arguments alone
+        return raw, False
+    instance = object.__new__(cls)
+    called = get(raw, instance, cls)
+    return called, getattr(called, "__self__", None) is instance
+
+
 def _signature_problem(cls: type, method: str, args: tuple[str, ...]) -> str | None:
     """Why ``cls().method(*args)`` cannot be called as the tracker calls it, or None."""
     found = getattr(cls, method, None)
     if not callable(found):
         return f"{method} is {'missing' if found is None else 'not a method'}"
     try:
-        signature = inspect.signature(found)
-    except (TypeError, ValueError):  # a callable without a signature (a builtin): take it on trust
+        called, takes_self = _as_called(cls, method)
+        signature = inspect.signature(called)
+    except (TypeError, ValueError):  # no signature (a builtin), or no instance without __init__: on trust
         return None
-    takes_self = inspect.isfunction(inspect.getattr_static(cls, method))  # not a static/class method
     try:
-        signature.bind(*([None] * (takes_self + len(args))))
+        signature.bind(*([None] * len(args)))
     except TypeError:
-        return (f"{method}{signature} cannot be called as {method}({', '.join(('self',) * takes_self + args)}) "
+        with_self = False  # a method is shown as written, self included
+        if isinstance(called, types.MethodType) and takes_self:
+            with contextlib.suppress(TypeError, ValueError):
+                signature, with_self = inspect.signature(called.__func__), True
+        return (f"{method}{signature} cannot be called as {method}({', '.join(('self',) * with_self + args)}) "
                 f"(the tracker passes {len(args)} argument{'s' * (len(args) != 1)})")
     return None
 
