@@ -59,13 +59,16 @@ def shipped_config_dir() -> Path:
 class TrackerParams:
     """Geometry of the search area and of the label (STRCF's init_size)."""
 
-    search_area_scale: float = param(5.0, "search area side / sqrt(target area) ('square') or per axis")
+    # upper bounds: far beyond any tracker's, where patches stop fitting in memory
+    search_area_scale: float = param(5.0, "search area side / sqrt(target area) ('square') or per axis", ge=1, le=50)
     search_area_shape: str = param("square", "'square' (5√(WH) square) or 'proportional' (5W x 5H)",
                                    choices=("square", "proportional"))
-    min_image_sample_size: float = param(150.0**2, "smallest area (px²) of the resampled search patch")
-    max_image_sample_size: float = param(200.0**2, "largest area (px²) of the resampled search patch")
-    cell_size: int = param(4, "feature cell size in pixels")
-    output_sigma_factor: float = param(1 / 16, "label σ as a fraction of sqrt(target area in cells)")
+    min_image_sample_size: float = param(150.0**2, "smallest area (px²) of the resampled search patch",
+                                         ge=8**2, le=2000**2)
+    max_image_sample_size: float = param(200.0**2, "largest area (px²) of the resampled search patch",
+                                         ge=8**2, le=2000**2)
+    cell_size: int = param(4, "feature cell size in pixels", ge=1, le=64)
+    output_sigma_factor: float = param(1 / 16, "label σ as a fraction of sqrt(target area in cells)", gt=0)
     fft_backend: str = param("scipy", "FFT implementation", choices=("scipy", "pyfftw"))
     training_sample: str = param("extract", "'extract' m^t at p^t (Algorithm 1) or 'shift' the detection sample "
                                  "to p^t in the Fourier domain, as DR²Track's code (by the translation over the "
@@ -92,29 +95,19 @@ class TrackerParams:
                             "'half_size' x = cx - w/2 with the size rounded (DR²Track's rect_position); "
                             "'floor_half' x = cx - floor(w/2) with the size floored (BACF's)",
                             choices=("exact", "rounded", "half_size", "floor_half"))
-    newton_iterations: int = param(5, "Newton steps refining the response peak")
+    newton_iterations: int = param(5, "Newton steps refining the response peak", ge=0, le=100)
     cell_selection_thresh: float = param(0.0, "BACF's small-target rule: if the search area holds fewer than this "
                                          "fraction of max_image_sample_size / cell_size² cells, use cells of "
-                                         "ceil(sqrt(area / (fraction x that many))) pixels instead (0: off)")
+                                         "ceil(sqrt(area / (fraction x that many))) pixels instead (0: off)",
+                                         ge=0, le=1)
     blank_std: float = param(1.0, "a frame whose pixel values vary less than this (standard deviation, RMS over "
                              "colour channels) is a dropped frame: the box is held, nothing is learnt (0: off); "
-                             "the first frame's search area must vary at least this much")
+                             "the first frame's search area must vary at least this much", ge=0)
 
-    def validate(self):  # upper bounds: far beyond any tracker's, where patches stop fitting in memory
-        if not 1 <= self.search_area_scale <= 50:
-            return "search_area_scale must be in [1, 50]"
-        if not 8**2 <= self.min_image_sample_size <= self.max_image_sample_size <= 2000**2:
-            return "need 8² <= min_image_sample_size <= max_image_sample_size <= 2000²"
-        if not 1 <= self.cell_size <= 64:
-            return "cell_size must be in [1, 64]"
-        if self.output_sigma_factor <= 0:
-            return "output_sigma_factor must be > 0"
-        if self.blank_std < 0:
-            return "blank_std must be >= 0"
-        if not 0 <= self.newton_iterations <= 100:
-            return "newton_iterations must be in [0, 100]"
-        if not 0 <= self.cell_selection_thresh <= 1:
-            return "cell_selection_thresh must be in [0, 1]"
+    def validate(self):
+        """min_image_sample_size <= max_image_sample_size."""
+        if self.min_image_sample_size > self.max_image_sample_size:
+            return "need min_image_sample_size <= max_image_sample_size"
 
 
 class _OverLimit(Exception):

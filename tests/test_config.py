@@ -74,7 +74,7 @@ def test_unknown_component_lists_registered_ones():
 def test_wrong_type_is_reported_with_key():
     with pytest.raises(ConfigError, match=r"solver.*iterations: expected an integer"):
         load_config("strcf", {"solver.iterations": "four"})
-    with pytest.raises(ConfigError, match=r"mu must be >= 0"):
+    with pytest.raises(ConfigError, match=r"label .*: mu must be in \[0, 1e\+06\], got -1\.0"):
         load_config("dr2track", {"label.mu": -1})
 
 
@@ -101,10 +101,12 @@ def test_non_finite_numbers_are_refused(key, value):
     ("strcf", "scale.n_scales", 10**6, r"scale.*n_scales must be in \[1, 101\]"),
     ("dr2track", "scale.model_max_area", -5, r"scale.*model_max_area must be in"),
     ("dr2track", "scale.cell_size", 0, r"scale.*cell_size must be in"),
-    ("dr2track", "scale.sigma_factor", 0, r"scale.*sigma_factor must be > 0"),
+    ("dr2track", "scale.sigma_factor", 0, r"scale.*sigma_factor must be in \(0, 10\], got 0"),
     ("strcf", "tracker.search_area_scale", 1e6, r"tracker: search_area_scale must be in \[1, 50\]"),
     ("strcf", "tracker.cell_size", 10000, r"tracker: cell_size must be in \[1, 64\]"),
-    ("strcf", "tracker.min_image_sample_size", 1e-300, r"tracker: need 8² <= min_image_sample_size"),
+    ("strcf", "tracker.min_image_sample_size", 1e-300,
+     r"tracker: min_image_sample_size must be in \[64, 4000000\], got 1e-300"),
+    ("strcf", "tracker.min_image_sample_size", 300**2, r"tracker: need min_image_sample_size <= max_image_sample_size"),
     ("strcf", "solver.iterations", 10**9, r"solver.*iterations must be in \[1, 10000\]"),
     ("dr2track", "scale.n_scales", 200, r"scale.*n_scales must be in \[3, 101\]"),
 ])
