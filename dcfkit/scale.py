@@ -48,6 +48,7 @@ def _factors(n: int, step: float) -> np.ndarray:
 
 
 MAX_SCALES = 101  # n_scales of either estimator: beyond it the samples stop fitting in memory
+MIN_LAM = 1e-10  # the DSST's λ, as the ADMM's penalty γ (solvers.PENALTY_RANGE)
 
 
 def _check_span(n: int, step: float) -> str | None:
@@ -87,8 +88,11 @@ class DSST(ScaleEstimator):
         step: float = param(1.03, "ratio between neighbouring scales", gt=1)
         # beyond 10, σ is over 1.7 n_scales: a flat label, every scale alike
         sigma_factor: float = param(0.25, "label width: σ = n_scales / √33 · sigma_factor", gt=0, le=10)
-        # the scale filter divides by Σ|x̂|² + λ, which may be λ alone
-        lam: float = param(0.01, "regularization of the scale filter", gt=0, le=1e10)
+        # the scale filter divides by Σ|x̂|² + λ, which may be λ alone: λ bounds its gain, 1/λ. The floor
+        # is the ADMM penalty's (solvers.PENALTY_RANGE), far below Σ|x̂|² of a textured sample (7 to 3000
+        # on the synthetic sequence, where the default 0.01 is a thousandth of the least); subnormals
+        # (1e-320) were accepted
+        lam: float = param(0.01, "λ: regularization of the scale filter", ge=MIN_LAM, le=1e10)
         learning_rate: float = param(0.025, "interpolation rate of the scale model", gt=0, le=1)
         model_max_area: int = param(512, "largest area (pixels) of a scale sample", ge=1, le=10000)
         cell_size: int = param(4, "fHOG cell size of the scale samples", ge=1, le=16)

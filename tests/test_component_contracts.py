@@ -141,6 +141,18 @@ def test_values_that_cannot_work_are_refused_at_load_naming_the_key(kind, cls, p
         dcfkit.load_tracker(TINY, overrides=slot_override(kind, cls, params))
 
 
+@pytest.mark.parametrize("lam", [5e-324, 1e-320, 2.2e-308, 1e-300, 9.9e-11])
+def test_a_dsst_lam_under_its_floor_is_refused_naming_it(lam):
+    """λ divides the scale filter's response (by Σ|x̂|² + λ, λ alone where the samples have no
+    energy): subnormal values such as 1e-320 were accepted. The floor is the ADMM penalty's."""
+    with pytest.raises(ConfigError, match=r"scale \(scale 'dsst'\): lam must be in \[1e-10, 1e\+10\], got "):
+        dcfkit.load_tracker(TINY, overrides={"scale": {"name": "dsst", "lam": lam}})
+
+
+def test_a_dsst_lam_at_its_floor_tracks():
+    assert track_tiny({"scale": {"name": "dsst", "lam": 1e-10}}) == "tracked"
+
+
 def test_a_dsst_working_patch_over_the_sample_budget_is_refused_naming_its_keys():
     """The budget is the tracker's (``$DCFKIT_MAX_SAMPLE_PIXELS``): registering the built-ins
     never depends on the environment."""
