@@ -13,9 +13,10 @@ A config names one component per slot (``features`` is a list) plus the tracker'
     scale: {name: dsst}
 
 Overrides are dotted keys (``label.mu=0.3``, ``features.0.name=gray``); a value ``null``
-removes an optional slot (``regularizers.temporal=null``). Naming another component
-(``label.name=gaussian``, or ``label: {name: gaussian}`` in a child file) drops the old
-component's parameters.
+removes an optional slot (``regularizers.temporal=null``; ``regularizers=null`` both roles).
+Naming another component (``label.name=gaussian``, or ``label: {name: gaussian}`` in a child
+file) drops the old component's parameters. ``base`` cannot be overridden: it is read with
+the file.
 """
 from __future__ import annotations
 
@@ -417,6 +418,10 @@ def load_config(source: str | Path | Mapping, overrides: Mapping[str, Any] | Non
     for key, value in (overrides or {}).items():
         if not isinstance(key, str):
             raise ConfigError(f"override keys are dotted strings such as 'label.mu', got {shown(key)}")
+        if key.split(".")[0].strip() == "base":  # set_dotted would set a key that nothing reads any more
+            raise ConfigError(f"override '{clip(key)}': a config's base is read with its file, before overrides "
+                              f"apply; give that config instead (its shipped name or file), or write a file whose "
+                              f"base: names it")
         check_value(value, f"override '{clip(key)}'")
         set_dotted(data, key, value)
     check_value(data, origin)  # dotted keys nest values deeper; merged files add up
@@ -489,9 +494,11 @@ def resolve(data: Mapping, origin: str) -> dict:
         raise ConfigError(f"{origin}: features must be a non-empty list, e.g. [{{name: fhog}}]")
     out["features"] = [_component(registry, "feature", f, f"{origin}: features[{i}]") for i, f in enumerate(features)]
     out["label"] = _component(registry, "label", data["label"], f"{origin}: label")
-    regs = data.get("regularizers") or {}
+    regs = data.get("regularizers")
+    regs = {} if regs is None else regs  # not `or {}`: [], '' or false stood for "none" unnoticed
     if not isinstance(regs, Mapping):
-        raise ConfigError(f"{origin}: regularizers must be a mapping with keys {', '.join(REGULARIZER_ROLES)}")
+        raise ConfigError(f"{origin}: regularizers: expected a mapping of roles ({', '.join(REGULARIZER_ROLES)}) to "
+                          f"components, got {shown(regs)} (null: none; regularizers.temporal: null drops one role)")
     out["regularizers"] = {}
     for role in regs:
         if role not in REGULARIZER_ROLES:

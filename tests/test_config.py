@@ -1,9 +1,10 @@
 """Configs: inheritance, overrides, validation and clear errors."""
+import re
 from pathlib import Path
 
 import pytest
 
-from dcfkit.config import load_config, shipped_config_dir
+from dcfkit.config import load_config, parse_overrides, shipped_config_dir
 from dcfkit.errors import ConfigError, DcfkitError, RegistryError
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
@@ -169,6 +170,37 @@ def test_unknown_top_level_key_and_wrong_regularizer_role(tmp_path):
         load_config(cfg)
     with pytest.raises(ConfigError, match=r"regularizers.spatial: 'temporal' is a temporal regularizer"):
         load_config("strcf", {"regularizers.spatial": {"name": "temporal"}})
+
+
+@pytest.mark.parametrize("override", ["base=bacf", "base=no_such_config", "base.x=1", " base =bacf"])
+def test_base_cannot_be_overridden(override, tmp_path, capsys):
+    """--set base=... set a key that nothing read any more: the config stayed on its own base,
+    silently, even when the new base did not exist."""
+    from dcfkit import cli
+
+    child = tmp_path / "child.yaml"
+    child.write_text("base: strcf\nname: child\n")
+    for source in ("strcf", child, {"base": "strcf", "name": "child"}):
+        with pytest.raises(ConfigError, match=r"override 'base(\.x)?': a config's base is read with its file, "
+                                              r"before overrides apply; give that config instead"):
+            load_config(source, parse_overrides([override]))
+    assert cli.main(["track", "strcf", "--frames", str(tmp_path), "--box", "1,1,5,5", "--set", override]) == 2
+    assert capsys.readouterr().err.startswith("dcfkit track: error: override 'base")
+
+
+@pytest.mark.parametrize("value, roles", [("null", (None, None)), ("{}", (None, None)),
+                                          ("{temporal: {name: temporal, theta: 3}}", (None, "temporal"))])
+def test_regularizers_replaced_by_an_override(value, roles):
+    cfg = load_config("strcf", parse_overrides([f"regularizers={value}"]))
+    assert tuple(r and r["name"] for r in (cfg["regularizers"]["spatial"], cfg["regularizers"]["temporal"])) == roles
+
+
+@pytest.mark.parametrize("value, shown", [("[]", "[]"), ("", "''"), ("false", "False"), ("0", "0"), ("[l2]", "['l2']")])
+def test_regularizers_that_are_not_a_mapping_are_refused(value, shown):
+    """[], '', false and 0 were read as "no regularizers" (anything falsy), a non-empty list was an error."""
+    with pytest.raises(ConfigError, match=r"strcf.yaml: regularizers: expected a mapping of roles \(spatial, temporal\) "
+                                          rf"to components, got {re.escape(shown)} \(null: none; "):
+        load_config("strcf", parse_overrides([f"regularizers={value}"]))
 
 
 def test_base_may_name_a_shipped_config(tmp_path):

@@ -33,11 +33,12 @@ TOP_LEVEL_HELP = {
     "name": "tracker name in results and plots (default: the file name without `.yaml`)",
     "description": "one line shown in reports",
     "base": "a config to inherit from: a file relative to this one, else a shipped config by name "
-            "(`dr2track`); mappings merge, lists replace",
+            "(`dr2track`); mappings merge, lists replace; read with the file, so `--set base=...` is an error",
     "tracker": "geometry of the search area and of the label (below)",
     "features": "**required**: a list of one or more features, their channels stacked",
     "label": "**required**: the regression target",
-    "regularizers": "a mapping with keys `spatial` and `temporal`; `null` (or absent) drops a role",
+    "regularizers": "a mapping with keys `spatial` and `temporal`; `null` (or absent) drops a role, "
+                    "`regularizers: null` both",
     "solver": "**required**: how the filter is trained",
     "search": "where the next frame is searched",
     "scale": "how the scale is estimated",
