@@ -40,6 +40,7 @@ pixels = _argument_type(float, lambda v: v >= 0, "a distance in pixels >= 0")  #
 frame_count = _argument_type(int, lambda v: 2 <= v <= MAX_DEMO_FRAMES,
                              f"a whole number of frames from 2 to {MAX_DEMO_FRAMES}")
 seed = _argument_type(int, lambda v: v >= 0, "a whole number >= 0")  # numpy refuses negative seeds
+variant_count = _argument_type(int, lambda v: v >= 1, "a whole number of variants >= 1")
 
 
 def add_protocol_argument(parser: argparse.ArgumentParser) -> None:

@@ -20,7 +20,9 @@ import functools
 import sys
 from pathlib import Path
 
+from ..ablation.spec import MAX_VARIANTS
 from ..config import TOP_LEVEL, TrackerParams, resolve
+from ..limits import IMAGE_PIXELS_VARIABLE, SAMPLE_PIXELS_VARIABLE, VARIANTS_VARIABLE
 from ..params import fields
 from ..registry import DISABLE_ENV, KINDS, build_registry
 from .components import cell, checks, component_rows, components_markdown, params_table, summary
@@ -138,7 +140,11 @@ def cli_reference() -> str:
         out += [f"## dcfkit {name}\n", f"{helps[name]}.\n", f"```text\n{command.format_usage().strip()}\n```\n",
                 _arguments_table(command)]
     out += ["## Environment\n", f"- `{DISABLE_ENV}=1`: load dcfkit's built-in components only, no plugins "
-            "(see [plugins.md](plugins.md)).\n"]
+            "(see [plugins.md](plugins.md)).",
+            f"- `{VARIANTS_VARIABLE}=N`: the most variants of an ablation spec (default {MAX_VARIANTS}; `ablate "
+            "--max-variants` wins).",
+            f"- `{IMAGE_PIXELS_VARIABLE}`, `{SAMPLE_PIXELS_VARIABLE}`: the memory budgets of one image and of one "
+            "frame's samples ([architecture.md](architecture.md)).\n"]
     return "\n".join(out).rstrip() + "\n"
 
 
