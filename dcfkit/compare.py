@@ -28,7 +28,7 @@ import numpy as np
 
 from . import metrics
 from .datasets import DatasetError, Sequence, read_boxes
-from .errors import shown
+from .errors import clip, shown
 from .results import ResultStore, result_files
 from .protocols import DEFAULT, Protocol, get_protocol
 
@@ -89,7 +89,7 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
                 "not_in_dataset": sorted((set(ours) & set(theirs)) - known),
                 "damaged": sorted(set(damaged) | set(damaged_ref))}
     if not both:
-        raise DatasetError(f"no sequence has results in both {results} ({len(ours)} files) and {reference} "
+        raise DatasetError(f"no sequence has results in both {clip(str(results))} ({len(ours)} files) and {clip(str(reference))} "
                            f"({len(theirs)} files) and ground truth in the dataset ({len(known)} sequences)")
     rows, scores, scores_ref = [], [], []
     for seq in both:

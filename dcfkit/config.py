@@ -327,7 +327,7 @@ def _load_file(path: Path, chain: tuple[Path, ...] = ()) -> tuple[dict, tuple[Pa
     if not isinstance(base, str):
         raise ConfigError(f"{path}: 'base' must be a file name, got {shown(base)}")
     base_path = path.parent / base
-    if not base_path.is_file():  # a shipped config by name ('dr2track' or 'dr2track.yaml')
+    if not os.path.isfile(base_path):  # a shipped config by name ('dr2track' or 'dr2track.yaml')
         shipped = shipped_config(base) if Path(base).name == base else None
         if shipped is None:
             raise ConfigError(f"{path}: base config '{clip(base)}' not found (looked for {clip(str(base_path))} "
@@ -450,12 +450,12 @@ def components(config: Mapping) -> list[tuple[str, str]]:
 def shipped_config(name: str | Path) -> Path | None:
     """The shipped config called ``name`` ('dr2track' or 'dr2track.yaml'), or None."""
     folder = shipped_config_dir()
-    return next((c for c in (folder / name, folder / f"{name}.yaml") if c.is_file()), None)
+    return next((c for c in (folder / name, folder / f"{name}.yaml") if os.path.isfile(c)), None)
 
 
 def _find(source: str | Path) -> Path:
     path = Path(source)
-    if path.is_file():
+    if os.path.isfile(path):  # os.path: a name too long for the file system is no file (Path.is_file raises)
         return path
     found = shipped_config(path)
     if found is not None:

@@ -351,7 +351,7 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
     names = {s.name for s in sequences}
     if trackers is None:
         if not out_dir.is_dir():
-            raise DatasetError(f"results folder not found: {out_dir}")
+            raise DatasetError(f"results folder not found: {clip(str(out_dir))}")
         trackers = [p.name for p in sorted(out_dir.iterdir())
                     if p.is_dir() and not p.name.startswith(".") and any((p / f"{n}.txt").is_file() for n in names)
                     and (p.resolve() not in exclude or _holds_results(p, names))]
@@ -453,7 +453,7 @@ def score_and_write(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] |
         raise DatasetError(f"{report_dir} holds a tracker's results; write the report elsewhere with --report-dir")
     results = gather_results(out_dir, sequences, trackers, exclude=[report_dir])
     if not results:
-        raise DatasetError(f"no tracker results found under {out_dir}")
+        raise DatasetError(f"no tracker results found under {clip(str(out_dir))}")
     ensure_writable(report_dir, report_file_names(sequences), "the report")  # before the scoring
     evaluation = evaluate(results, sequences, include_first, weighting, protocol)
     return evaluation, _write(evaluation, report_dir)

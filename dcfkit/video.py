@@ -12,7 +12,7 @@ import cv2
 import numpy as np
 
 from .datasets import read_frame
-from .errors import InputError, shown
+from .errors import InputError, clip, shown
 from .limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff")
@@ -29,7 +29,7 @@ def frame_files(folder: str | Path) -> list[Path]:
     there are none."""
     folder = Path(folder)
     if not folder.is_dir():
-        raise InputError(f"--frames: {folder} is not a folder")
+        raise InputError(f"--frames: {clip(str(folder))} is not a folder")
     files = sorted((p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES), key=_natural_key)
     if not files:
         raise InputError(f"--frames: no images ({', '.join(IMAGE_SUFFIXES)}) in {folder}")
@@ -87,7 +87,7 @@ def video_frames(video: str | os.PathLike) -> Iterator[np.ndarray]:
 def _open_video(video) -> cv2.VideoCapture:
     """An opened capture whose frame size is within ``max_image_pixels()``."""
     if not Path(video).is_file():
-        raise InputError(f"--video: file not found: {video}")
+        raise InputError(f"--video: file not found: {clip(str(video))}")
     cap = cv2.VideoCapture(str(video))
     if not cap.isOpened():
         raise InputError(f"--video: OpenCV cannot open {video}")
@@ -107,9 +107,9 @@ def check_output_file(path: str | Path, what: str) -> Path:
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise InputError(f"{what}: cannot create the folder {path.parent} ({exc.strerror})") from None
+        raise InputError(f"{what}: cannot create the folder {clip(str(path.parent))} ({exc.strerror})") from None
     if path.is_dir() or not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
-        raise InputError(f"{what}: cannot write {path}")
+        raise InputError(f"{what}: cannot write {clip(str(path))}")
     return path
 
 

@@ -524,3 +524,34 @@ def test_long_values_in_files_and_variables_are_shown_short(tmp_path, monkeypatc
         with pytest.raises(DcfkitError) as info:
             call()
         assert said in str(info.value) and len(str(info.value)) < MESSAGE_CHARS, str(info.value)[:2000]
+
+
+LONG_NAME = "q" * 5000  # over any file system's 255 bytes a name: pathlib's is_file() raised OSError
+
+
+@pytest.mark.parametrize("args,said", [
+    (["track", LONG_NAME, "--frames", "{root}/seqA/img", "--box", "10,10,14,10"], "error: config not found: qqq"),
+    (["track", "{long_base}", "--frames", "{root}/seqA/img", "--box", "10,10,14,10"],
+     "long_base.yaml: base config 'qqq"),
+    (["ablate", LONG_NAME, "--out", "{out}"], "error: ablation spec not found: qqq"),
+    (["ablate", "{long_config_spec}", "--out", "{out}"], "long_config_spec.yaml: variants.a: config 'qqq"),
+    (["ablate", "{long_root_spec}", "--out", "{out}", "--dry-run"], "long_root_spec.yaml: dataset root "),
+    (["eval", "strcf", "--root", LONG_NAME, "--out", "{out}"], "error: a name too long for the file system: qqq"),
+    (["eval", "strcf", "--dataset", "otb", "--root", "{root}", "--out", LONG_NAME], "error: cannot create the folder qqq"),
+    (["track", "strcf", "--frames", LONG_NAME, "--box", "10,10,14,10"], "error: a name too long for the file system"),
+    (["track", "strcf", "--frames", "{root}/seqA/img", "--box", "10,10,14,10", "--out", LONG_NAME],
+     "error: a name too long for the file system"),
+    (["report", LONG_NAME, "--dataset", "otb", "--root", "{root}"], "error: a name too long for the file system"),
+])
+def test_names_too_long_for_the_file_system_are_one_line_errors(args, said, otb_root, tmp_path, capsys):
+    """A path argument, a config's base: or a spec's config or root of 5000 characters: each
+    command ended in a traceback of pathlib's OSError (File name too long)."""
+    (tmp_path / "long_base.yaml").write_text(f"base: {LONG_NAME}\n")
+    (tmp_path / "long_config_spec.yaml").write_text(f"dataset: otb\nvariants: {{a: {LONG_NAME}}}\n")
+    (tmp_path / "long_root_spec.yaml").write_text(f"dataset: {{name: otb, root: {LONG_NAME}}}\nvariants: {{a: strcf}}\n")
+    paths = {"root": otb_root, "out": tmp_path / "out", **{name: tmp_path / f"{name}.yaml" for name in
+                                                           ("long_base", "long_config_spec", "long_root_spec")}}
+    status = cli.main([a.format(**paths) if "{" in a else a for a in args])
+    err = capsys.readouterr().err
+    assert status == 2 and said in err, err[:2000]
+    assert len(err) < MESSAGE_CHARS, err[:2000]

@@ -71,7 +71,7 @@ class AblationSpec:
         if self.root is None:
             raise ConfigError(f"{self.path}: dataset.root is not given; pass --root DIR "
                               f"(the {self.dataset} benchmark folder)")
-        if not self.root.is_dir():
+        if not os.path.isdir(self.root):
             hint = "" if self.root_origin == "--root" else f"; pass --root DIR (the {self.dataset} benchmark folder)"
             raise ConfigError(f"{self.path}: dataset root {clip(str(self.root))} ({self.root_origin}) "
                               f"is not a folder{hint}")
@@ -100,11 +100,11 @@ def variant_names(jobs: Iterable[Job]) -> dict[str, list[str]]:
 
 def _find_spec(source: str | os.PathLike) -> Path:
     path = Path(source)
-    if path.is_file():
+    if os.path.isfile(path):  # os.path: a name too long for the file system is no file (Path.is_file raises)
         return path.resolve()
     folder = shipped_config_dir() / "ablations"
     for candidate in (folder / path, folder / f"{path}.yaml"):
-        if candidate.is_file() and candidate.suffix in (".yaml", ".yml"):
+        if os.path.isfile(candidate) and candidate.suffix in (".yaml", ".yml"):
             return candidate.resolve()
     shipped = [p.stem for p in sorted(folder.glob("*.yaml")) if _is_spec_file(p)] if folder.is_dir() else []
     raise ConfigError(f"ablation spec not found: {clip(str(source))}"
@@ -148,7 +148,7 @@ def _load(spec_path: Path, config: Any, overrides: Mapping, where: str, key: str
         raise ConfigError(f"{spec_path}: {key}: expected a config file or shipped name "
                           f"(e.g. ../dr2track.yaml or dr2track), got {shown(config)}")
     local = spec_path.parent / config
-    found = local if local.is_file() else shipped_config(config)  # never the working directory
+    found = local if os.path.isfile(local) else shipped_config(config)  # never the working directory
     if found is None:
         raise ConfigError(f"{spec_path}: {where}: config '{clip(config)}' not found (looked for "
                           f"{clip(str(local))} and for a shipped config of that name)")

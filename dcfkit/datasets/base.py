@@ -15,7 +15,7 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
-from ..errors import DcfkitError, shown
+from ..errors import DcfkitError, clip, shown
 from ..limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 
@@ -285,7 +285,7 @@ def require_root(root, what: str) -> Path:
     """``root`` as a Path (``~`` expanded); :class:`DatasetError` if it is not a folder."""
     root = Path(root).expanduser()
     if not root.is_dir():
-        raise DatasetError(f"{what} root folder not found: {root}")
+        raise DatasetError(f"{what} root folder not found: {clip(str(root))}")
     return root
 
 
