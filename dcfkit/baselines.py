@@ -7,7 +7,7 @@ from typing import Any, Callable
 import cv2
 import numpy as np
 
-from .errors import DcfkitError
+from .errors import DcfkitError, shown
 
 # Preferred constructor first: legacy trackers take and return float boxes (Rect2d).
 _OPENCV_CONSTRUCTORS = {
@@ -88,7 +88,7 @@ def opencv_tracker(name: str) -> Callable[[Any], OpenCVTracker]:
     """
     key = str(name).upper()
     if key not in _OPENCV_CONSTRUCTORS:
-        raise OpenCVUnavailable(f"unknown OpenCV tracker {name!r}; choose from {', '.join(_OPENCV_CONSTRUCTORS)}")
+        raise OpenCVUnavailable(f"unknown OpenCV tracker {shown(name)}; choose from {', '.join(_OPENCV_CONSTRUCTORS)}")
     if key not in available_opencv_trackers():
         raise OpenCVUnavailable(
             f"OpenCV tracker {key} is not in this OpenCV build (available: "

@@ -28,6 +28,7 @@ import numpy as np
 
 from . import metrics
 from .datasets import DatasetError, Sequence, read_boxes
+from .errors import clip, shown
 from .results import ResultStore, result_files
 from .protocols import DEFAULT, Protocol, get_protocol
 
@@ -78,7 +79,7 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     """
     proto = get_protocol(protocol)
     if not divergence_px >= 0:
-        raise DatasetError(f"divergence_px must be a number >= 0, got {divergence_px!r}")
+        raise DatasetError(f"divergence_px must be a number >= 0, got {shown(divergence_px)}")
     (ours, damaged), (theirs, damaged_ref) = _intact_files(results), _intact_files(reference)
     sequences = list(sequences)
     known = {s.name for s in sequences}
@@ -88,7 +89,7 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
                 "not_in_dataset": sorted((set(ours) & set(theirs)) - known),
                 "damaged": sorted(set(damaged) | set(damaged_ref))}
     if not both:
-        raise DatasetError(f"no sequence has results in both {results} ({len(ours)} files) and {reference} "
+        raise DatasetError(f"no sequence has results in both {clip(str(results))} ({len(ours)} files) and {clip(str(reference))} "
                            f"({len(theirs)} files) and ground truth in the dataset ({len(known)} sequences)")
     rows, scores, scores_ref = [], [], []
     for seq in both:

@@ -13,9 +13,10 @@ A config names one component per slot (``features`` is a list) plus the tracker'
     scale: {name: dsst}
 
 Overrides are dotted keys (``label.mu=0.3``, ``features.0.name=gray``); a value ``null``
-removes an optional slot (``regularizers.temporal=null``). Naming another component
-(``label.name=gaussian``, or ``label: {name: gaussian}`` in a child file) drops the old
-component's parameters.
+removes an optional slot (``regularizers.temporal=null``; ``regularizers=null`` both roles).
+Naming another component (``label.name=gaussian``, or ``label: {name: gaussian}`` in a child
+file) drops the old component's parameters. ``base`` cannot be overridden: it is read with
+the file.
 """
 from __future__ import annotations
 
@@ -59,13 +60,16 @@ def shipped_config_dir() -> Path:
 class TrackerParams:
     """Geometry of the search area and of the label (STRCF's init_size)."""
 
-    search_area_scale: float = param(5.0, "search area side / sqrt(target area) ('square') or per axis")
+    # upper bounds: far beyond any tracker's, where patches stop fitting in memory
+    search_area_scale: float = param(5.0, "search area side / sqrt(target area) ('square') or per axis", ge=1, le=50)
     search_area_shape: str = param("square", "'square' (5√(WH) square) or 'proportional' (5W x 5H)",
                                    choices=("square", "proportional"))
-    min_image_sample_size: float = param(150.0**2, "smallest area (px²) of the resampled search patch")
-    max_image_sample_size: float = param(200.0**2, "largest area (px²) of the resampled search patch")
-    cell_size: int = param(4, "feature cell size in pixels")
-    output_sigma_factor: float = param(1 / 16, "label σ as a fraction of sqrt(target area in cells)")
+    min_image_sample_size: float = param(150.0**2, "smallest area (px²) of the resampled search patch",
+                                         ge=8**2, le=2000**2)
+    max_image_sample_size: float = param(200.0**2, "largest area (px²) of the resampled search patch",
+                                         ge=8**2, le=2000**2)
+    cell_size: int = param(4, "feature cell size in pixels", ge=1, le=64)
+    output_sigma_factor: float = param(1 / 16, "label σ as a fraction of sqrt(target area in cells)", gt=0)
     fft_backend: str = param("scipy", "FFT implementation", choices=("scipy", "pyfftw"))
     training_sample: str = param("extract", "'extract' m^t at p^t (Algorithm 1) or 'shift' the detection sample "
                                  "to p^t in the Fourier domain, as DR²Track's code (by the translation over the "
@@ -92,29 +96,19 @@ class TrackerParams:
                             "'half_size' x = cx - w/2 with the size rounded (DR²Track's rect_position); "
                             "'floor_half' x = cx - floor(w/2) with the size floored (BACF's)",
                             choices=("exact", "rounded", "half_size", "floor_half"))
-    newton_iterations: int = param(5, "Newton steps refining the response peak")
+    newton_iterations: int = param(5, "Newton steps refining the response peak", ge=0, le=100)
     cell_selection_thresh: float = param(0.0, "BACF's small-target rule: if the search area holds fewer than this "
                                          "fraction of max_image_sample_size / cell_size² cells, use cells of "
-                                         "ceil(sqrt(area / (fraction x that many))) pixels instead (0: off)")
+                                         "ceil(sqrt(area / (fraction x that many))) pixels instead (0: off)",
+                                         ge=0, le=1)
     blank_std: float = param(1.0, "a frame whose pixel values vary less than this (standard deviation, RMS over "
                              "colour channels) is a dropped frame: the box is held, nothing is learnt (0: off); "
-                             "the first frame's search area must vary at least this much")
+                             "the first frame's search area must vary at least this much", ge=0)
 
-    def validate(self):  # upper bounds: far beyond any tracker's, where patches stop fitting in memory
-        if not 1 <= self.search_area_scale <= 50:
-            return "search_area_scale must be in [1, 50]"
-        if not 8**2 <= self.min_image_sample_size <= self.max_image_sample_size <= 2000**2:
-            return "need 8² <= min_image_sample_size <= max_image_sample_size <= 2000²"
-        if not 1 <= self.cell_size <= 64:
-            return "cell_size must be in [1, 64]"
-        if self.output_sigma_factor <= 0:
-            return "output_sigma_factor must be > 0"
-        if self.blank_std < 0:
-            return "blank_std must be >= 0"
-        if not 0 <= self.newton_iterations <= 100:
-            return "newton_iterations must be in [0, 100]"
-        if not 0 <= self.cell_selection_thresh <= 1:
-            return "cell_selection_thresh must be in [0, 1]"
+    def validate(self):
+        """min_image_sample_size <= max_image_sample_size."""
+        if self.min_image_sample_size > self.max_image_sample_size:
+            return "need min_image_sample_size <= max_image_sample_size"
 
 
 class _OverLimit(Exception):
@@ -333,7 +327,7 @@ def _load_file(path: Path, chain: tuple[Path, ...] = ()) -> tuple[dict, tuple[Pa
     if not isinstance(base, str):
         raise ConfigError(f"{path}: 'base' must be a file name, got {shown(base)}")
     base_path = path.parent / base
-    if not base_path.is_file():  # a shipped config by name ('dr2track' or 'dr2track.yaml')
+    if not os.path.isfile(base_path):  # a shipped config by name ('dr2track' or 'dr2track.yaml')
         shipped = shipped_config(base) if Path(base).name == base else None
         if shipped is None:
             raise ConfigError(f"{path}: base config '{clip(base)}' not found (looked for {clip(str(base_path))} "
@@ -424,6 +418,10 @@ def load_config(source: str | Path | Mapping, overrides: Mapping[str, Any] | Non
     for key, value in (overrides or {}).items():
         if not isinstance(key, str):
             raise ConfigError(f"override keys are dotted strings such as 'label.mu', got {shown(key)}")
+        if key.split(".")[0].strip() == "base":  # set_dotted would set a key that nothing reads any more
+            raise ConfigError(f"override '{clip(key)}': a config's base is read with its file, before overrides "
+                              f"apply; give that config instead (its shipped name or file), or write a file whose "
+                              f"base: names it")
         check_value(value, f"override '{clip(key)}'")
         set_dotted(data, key, value)
     check_value(data, origin)  # dotted keys nest values deeper; merged files add up
@@ -452,12 +450,12 @@ def components(config: Mapping) -> list[tuple[str, str]]:
 def shipped_config(name: str | Path) -> Path | None:
     """The shipped config called ``name`` ('dr2track' or 'dr2track.yaml'), or None."""
     folder = shipped_config_dir()
-    return next((c for c in (folder / name, folder / f"{name}.yaml") if c.is_file()), None)
+    return next((c for c in (folder / name, folder / f"{name}.yaml") if os.path.isfile(c)), None)
 
 
 def _find(source: str | Path) -> Path:
     path = Path(source)
-    if path.is_file():
+    if os.path.isfile(path):  # os.path: a name too long for the file system is no file (Path.is_file raises)
         return path
     found = shipped_config(path)
     if found is not None:
@@ -496,9 +494,11 @@ def resolve(data: Mapping, origin: str) -> dict:
         raise ConfigError(f"{origin}: features must be a non-empty list, e.g. [{{name: fhog}}]")
     out["features"] = [_component(registry, "feature", f, f"{origin}: features[{i}]") for i, f in enumerate(features)]
     out["label"] = _component(registry, "label", data["label"], f"{origin}: label")
-    regs = data.get("regularizers") or {}
+    regs = data.get("regularizers")
+    regs = {} if regs is None else regs  # not `or {}`: [], '' or false stood for "none" unnoticed
     if not isinstance(regs, Mapping):
-        raise ConfigError(f"{origin}: regularizers must be a mapping with keys {', '.join(REGULARIZER_ROLES)}")
+        raise ConfigError(f"{origin}: regularizers: expected a mapping of roles ({', '.join(REGULARIZER_ROLES)}) to "
+                          f"components, got {shown(regs)} (null: none; regularizers.temporal: null drops one role)")
     out["regularizers"] = {}
     for role in regs:
         if role not in REGULARIZER_ROLES:

@@ -22,7 +22,7 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from .datasets import DatasetError, Sequence
-from .errors import ConfigError
+from .errors import ConfigError, shown
 from .results import (ResultStore, dcfkit_version, ensure_writable, exclusive, json_default, make_dir,
                       remove_temporary_files, run_key)
 from .runner import RunTask, execute
@@ -38,7 +38,7 @@ def tracker_name(config: Mapping) -> str:
     if not isinstance(name, str) or not name.strip():
         raise ConfigError("config has no top-level 'name' (the tracker name used for the output folder)")
     if name in (".", "..") or any(c in name for c in "/\\:"):
-        raise ConfigError(f"config 'name' {name!r} must be usable as a folder name (no / \\ :)")
+        raise ConfigError(f"config 'name' {shown(name)} must be usable as a folder name (no / \\ :)")
     return name
 
 
@@ -55,8 +55,8 @@ def _check_same_dataset(store: ResultStore, metas: dict, todo: list[Sequence]) -
     for seq in todo:
         old = (metas[seq.name] or {}).get("dataset")
         if old and seq.dataset and old != seq.dataset:
-            raise DatasetError(f"{store.sidecar_path(seq.name)} holds results on dataset {old!r}, and this run "
-                               f"is on {seq.dataset!r}: use a separate --out for each benchmark")
+            raise DatasetError(f"{store.sidecar_path(seq.name)} holds results on dataset {shown(old)}, and this run "
+                               f"is on {shown(seq.dataset)}: use a separate --out for each benchmark")
 
 
 def _say_what_is_recomputed(store: ResultStore, metas: dict, todo: list[Sequence], config: dict, key: str) -> None:

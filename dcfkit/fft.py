@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .errors import shown
+
 BACKENDS = ("scipy", "pyfftw")
 
 
@@ -69,4 +71,4 @@ def make_fft(backend: str = "scipy"):
         return ScipyFFT()
     if backend == "pyfftw":
         return PyFFTW()
-    raise ValueError(f"unknown FFT backend {backend!r}; choose one of {', '.join(BACKENDS)}")
+    raise ValueError(f"unknown FFT backend {shown(backend)}; choose one of {', '.join(BACKENDS)}")

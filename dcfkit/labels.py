@@ -95,8 +95,9 @@ class DistractorRepressed(Label):
 
     @dataclasses.dataclass(frozen=True)
     class Params:
-        top_n: int = param(30, "N: how many of the highest background local maxima are repressed")
-        mu: float = param(0.25, "μ: repression strength")
+        top_n: int = param(30, "N: how many of the highest background local maxima are repressed", ge=0)
+        # y = g - μR̃ is float32, and so are the filter and response it trains
+        mu: float = param(0.25, "μ: repression strength", ge=0, le=MAX_MU)
         variant: str = param("subtractive", "'subtractive' g - μR̃, 'overwrite' -μR̃ (the authors' code) or "
                              "'multiplicative' (the paper's g⊙d)",
                              choices=("subtractive", "overwrite", "multiplicative"))
@@ -106,22 +107,15 @@ class DistractorRepressed(Label):
         mirrored: bool = param(False, "repress each distractor's mirror image through the target instead (the "
                                "authors' solver reads ŷ where correlation needs its conjugate, so their filter "
                                "learns the label turned by 180°)")
-        neighbourhood: int = param(3, "side of the window in which a local maximum is the largest")
-        exclusion: float = param(1.0, "P^T: ignore maxima within this many target sizes of the peak")
+        # at most MAX_NEIGHBOURHOOD: the map is padded by half of it on every side
+        neighbourhood: int = param(3, "side of the window in which a local maximum is the largest (odd)",
+                                   ge=3, le=MAX_NEIGHBOURHOOD)
+        exclusion: float = param(1.0, "P^T: ignore maxima within this many target sizes of the peak", ge=0)
 
         def validate(self):
-            if self.top_n < 0:
-                return "top_n must be >= 0"
-            if self.mu < 0:
-                return "mu must be >= 0"
-            if self.mu > MAX_MU:  # y = g - μR̃ is float32, and so are the filter and response it trains
-                return f"mu must be <= {MAX_MU:g}"
-            if self.neighbourhood < 3 or self.neighbourhood % 2 == 0:
+            """neighbourhood an odd number."""
+            if self.neighbourhood % 2 == 0:
                 return "neighbourhood must be an odd number >= 3"
-            if self.neighbourhood > MAX_NEIGHBOURHOOD:  # the map is padded by half of it on every side
-                return f"neighbourhood must be <= {MAX_NEIGHBOURHOOD}"
-            if self.exclusion < 0:
-                return "exclusion must be >= 0"
 
     def distractors(self, detection: Detection) -> tuple[np.ndarray, np.ndarray]:
         """Δ and P^T of Eq. (3): (N, 2) signed offsets from the peak, and their normalised values."""

@@ -1,5 +1,5 @@
-"""Memory bounds that depend on the machine, so a user may raise them: environment variables
-read when used (a program may set them before tracking).
+"""Bounds on memory and time that depend on the machine or the study, so a user may raise
+them: environment variables read when used (a program may set them before tracking).
 
 ``$DCFKIT_MAX_IMAGE_PIXELS`` (default 10^8)
     the most pixels of one image: a frame read from a file (checked from its header before
@@ -7,21 +7,24 @@ read when used (a program may set them before tracking).
 ``$DCFKIT_MAX_SAMPLE_PIXELS`` (default 2048²)
     one frame's samples: the search samples at every search scale (in feature cells, a
     sixteenth of it), and the scale filter's samples and working patch.
+``$DCFKIT_MAX_VARIANTS`` (default :data:`dcfkit.ablation.spec.MAX_VARIANTS`, 1,000)
+    the variants of one ablation spec, named ones and grid points: each is resolved when the
+    spec is read (``dcfkit ablate --max-variants`` sets it for one command).
 """
 from __future__ import annotations
 
 import math
 import os
 
-from .errors import ConfigError
+from .errors import ConfigError, shown
 
 IMAGE_PIXELS_VARIABLE = "DCFKIT_MAX_IMAGE_PIXELS"
 DEFAULT_MAX_IMAGE_PIXELS = 10**8  # 300 MB as BGR; an 8K video frame has 33 million
 
 
-def pixel_budget(variable: str, default: int) -> int:
-    """A limit in pixels: the environment variable ``variable`` if set (``1e9`` is fine), else
-    ``default``; read when used, so a program may set it before tracking."""
+def pixel_budget(variable: str, default: int, unit: str = "pixels") -> int:
+    """A limit, a count of ``unit``: the environment variable ``variable`` if set (``1e9`` is
+    fine), else ``default``; read when used, so a program may set it before tracking."""
     text = os.environ.get(variable, "").strip()
     if not text:
         return default
@@ -30,7 +33,7 @@ def pixel_budget(variable: str, default: int) -> int:
     except ValueError:
         value = math.nan
     if not (1 <= value < math.inf):
-        raise ConfigError(f"${variable} must be a number of pixels >= 1, got {text!r}")
+        raise ConfigError(f"${variable} must be a number of {unit} >= 1, got {shown(text)}")
     return int(value)
 
 
@@ -54,3 +57,10 @@ def sample_budget() -> tuple[int, int]:
     return pixels, max(pixels // CELL_AREA, 1)
 
 
+VARIANTS_VARIABLE = "DCFKIT_MAX_VARIANTS"
+
+
+def max_variants(default: int) -> int:
+    """The most variants of one ablation spec: ``$DCFKIT_MAX_VARIANTS`` if set, else ``default``
+    (:data:`dcfkit.ablation.spec.MAX_VARIANTS`)."""
+    return pixel_budget(VARIANTS_VARIABLE, default, "variants")

@@ -30,6 +30,7 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
+from .errors import shown
 from .protocols import DEFAULT, Protocol, get_protocol
 
 __all__ = [
@@ -182,7 +183,7 @@ def average(scores: Iterable[Mapping], weighting: str | None = None,
     proto = get_protocol(protocol)
     weighting = weighting or proto.weighting
     if weighting not in ("sequence", "frame"):
-        raise ValueError(f"weighting must be 'sequence' or 'frame', got {weighting!r}")
+        raise ValueError(f"weighting must be 'sequence' or 'frame', got {shown(weighting)}")
     scores = [s for s in scores if s["frames"] > 0]
     other = {s.get("protocol") for s in scores} - {proto.name}
     if other:

@@ -17,11 +17,67 @@ from typing import Any, Mapping
 from .errors import ConfigError, clip, shown
 
 
-def param(default: Any, help: str, choices: tuple | None = None) -> Any:
-    """A dataclass field with a default, a one-line description and optional choices."""
+def _number(value: float) -> str:
+    """``value`` as a bound is written: ``10000``, ``0.5``, ``1e+10`` (exact: repr where %g rounds)."""
+    if isinstance(value, int):
+        return str(value)
+    return f"{value:g}" if float(f"{value:g}") == value else repr(value)
+
+
+@dataclasses.dataclass(frozen=True)
+class Bounds:
+    """The values a numeric parameter may take, declared with :func:`param`'s ``ge``, ``gt``,
+    ``le`` and ``lt``: from ``low`` to ``high``, each end included unless it is open."""
+
+    low: float = -math.inf
+    high: float = math.inf
+    low_open: bool = False
+    high_open: bool = False
+
+    def __contains__(self, value: Any) -> bool:
+        above = value > self.low if self.low_open else value >= self.low
+        return above and (value < self.high if self.high_open else value <= self.high)
+
+    def __str__(self) -> str:
+        """``[1, 10000]``, ``(0, 1]``, ``> 0``, ``<= 10``."""
+        if self.high == math.inf:
+            return f"{'>' if self.low_open else '>='} {_number(self.low)}"
+        if self.low == -math.inf:
+            return f"{'<' if self.high_open else '<='} {_number(self.high)}"
+        return (f"{'(' if self.low_open else '['}{_number(self.low)}, {_number(self.high)}"
+                f"{')' if self.high_open else ']'}")
+
+    def requirement(self) -> str:
+        """What a value must be, for a message: ``in [1, 10000]``, ``> 0``."""
+        two_sided = self.low != -math.inf and self.high != math.inf
+        return f"in {self}" if two_sided else str(self)
+
+
+def _bounds(ge: Any, gt: Any, le: Any, lt: Any) -> Bounds | None:
+    """The :class:`Bounds` that ``param``'s limits declare, or None; TypeError if they cannot hold."""
+    given = {k: v for k, v in (("ge", ge), ("gt", gt), ("le", le), ("lt", lt)) if v is not None}
+    if not given:
+        return None
+    if any(isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v) for v in given.values()) \
+            or ("ge" in given and "gt" in given) or ("le" in given and "lt" in given):
+        raise TypeError(f"param limits {given}: numbers, at most one of ge and gt and one of le and lt")
+    bounds = Bounds(given.get("ge", given.get("gt", -math.inf)), given.get("le", given.get("lt", math.inf)),
+                    "gt" in given, "lt" in given)
+    if bounds.low > bounds.high:
+        raise TypeError(f"param limits {given}: no value is within them")
+    return bounds
+
+
+def param(default: Any, help: str, choices: tuple | None = None, *, ge: float | None = None,
+          gt: float | None = None, le: float | None = None, lt: float | None = None) -> Any:
+    """A dataclass field with a default, a one-line description, optional choices and, for a
+    number, optional bounds: ``ge`` (>=), ``gt`` (>), ``le`` (<=), ``lt`` (<). A value outside
+    them is a ConfigError naming the key; ``dcfkit components`` lists them."""
     meta = {"help": help}
     if choices is not None:
         meta["choices"] = tuple(choices)
+    if (bounds := _bounds(ge, gt, le, lt)) is not None:
+        meta["bounds"] = bounds
     if isinstance(default, (list, dict, set)):
         raise TypeError(f"param({default!r}, {help!r}): a default must be immutable (use a tuple)")
     return dataclasses.field(default=default, metadata=meta)
@@ -119,6 +175,14 @@ def _supported(kind: Any) -> bool:
     return False
 
 
+def _numeric(kind: Any) -> bool:
+    """Whether values of this annotation are numbers (or None): what bounds apply to."""
+    if typing.get_origin(kind) in (typing.Union, types.UnionType):
+        args = [a for a in typing.get_args(kind) if a is not type(None)]
+        return len(args) == 1 and _numeric(args[0])
+    return kind in (int, float)
+
+
 def check_schema(schema: type) -> None:
     """A ConfigError if a ``Params`` field has no default, an annotation that parameters cannot be
     checked against, or a default that its own checks refuse (caught when a component registers)."""
@@ -134,12 +198,16 @@ def check_schema(schema: type) -> None:
             raise ConfigError(f"parameter '{f.name}': annotation {hints[f.name]!r} is not supported; use bool, "
                               f"int, float, str, Any, tuple, tuple[X, ...], tuple[X, Y] or X | None "
                               f"(for a set of allowed values: param(..., choices=...))")
+        if "bounds" in f.metadata and not _numeric(hints[f.name]):
+            raise ConfigError(f"parameter '{f.name}': bounds (ge, gt, le, lt) need an int or float annotation, "
+                              f"not {hints[f.name]!r}")
         defaults[f.name] = f.default
     parse_params(schema, defaults, "default Params")
 
 
 def fields(schema: type) -> list[dict]:
-    """Describe a schema: name, type, default, help and choices of each field."""
+    """Describe a schema: name, type, default, help, choices and bounds (``[1, 10000]``,
+    ``> 0``; None without) of each field."""
     hints = typing.get_type_hints(schema)
     out = []
     for f in dataclasses.fields(schema):
@@ -149,8 +217,24 @@ def fields(schema: type) -> list[dict]:
             "default": f.default,
             "help": f.metadata.get("help", ""),
             "choices": f.metadata.get("choices"),
+            "bounds": str(f.metadata["bounds"]) if "bounds" in f.metadata else None,
         })
     return out
+
+
+def _checked(field: dataclasses.Field, value: Any, kind: Any, where: str) -> Any:
+    """``value`` of ``field`` coerced to its annotation ``kind`` and checked against its choices
+    and bounds (a ConfigError naming ``where`` and the field otherwise)."""
+    key = f"{where}.{clip(field.name)}"
+    value = _coerce(value, kind, key)
+    choices = field.metadata.get("choices")
+    if choices is not None and value not in choices:
+        raise ConfigError(f"{key}: {shown(value)} is not one of {', '.join(map(str, choices))}"
+                          f"{closest(value, choices)}")
+    bounds = field.metadata.get("bounds")
+    if bounds is not None and value is not None and value not in bounds:
+        raise ConfigError(f"{where}: {field.name} must be {bounds.requirement()}, got {shown(value)}")
+    return value
 
 
 def parse_params(schema: type, values: Mapping[str, Any] | None, where: str) -> Any:
@@ -165,14 +249,7 @@ def parse_params(schema: type, values: Mapping[str, Any] | None, where: str) -> 
         k = unknown[0]
         valid = ", ".join(known) or "none"
         raise ConfigError(f"{where}: unknown parameter {shown(k)}{closest(k, known)}; valid parameters: {valid}")
-    kwargs = {}
-    for name, value in values.items():
-        key = f"{where}.{clip(str(name))}"
-        kwargs[name] = _coerce(value, hints[name], key)
-        choices = known[name].metadata.get("choices")
-        if choices is not None and kwargs[name] not in choices:
-            raise ConfigError(f"{key}: {shown(kwargs[name])} is not one of {', '.join(map(str, choices))}"
-                              f"{closest(kwargs[name], choices)}")
+    kwargs = {name: _checked(known[name], value, hints[name], where) for name, value in values.items()}
     try:
         instance = schema(**kwargs)
     except (TypeError, ValueError) as exc:

@@ -80,6 +80,8 @@ from typing import Callable
 
 import numpy as np
 
+from .errors import shown
+
 __all__ = ["DEFAULT", "PROTOCOLS", "FrameScores", "Protocol", "get_protocol"]
 
 DEFAULT = "otb"
@@ -260,4 +262,4 @@ def get_protocol(protocol: str | Protocol) -> Protocol:
     try:
         return PROTOCOLS[str(protocol).lower()]
     except KeyError:
-        raise ValueError(f"unknown scoring protocol {protocol!r}; one of: {', '.join(PROTOCOLS)}") from None
+        raise ValueError(f"unknown scoring protocol {shown(protocol)}; one of: {', '.join(PROTOCOLS)}") from None

@@ -16,6 +16,7 @@ import importlib.metadata
 import inspect
 import os
 import signal
+import types
 import typing
 import warnings
 from typing import Any, Mapping
@@ -84,20 +85,39 @@ def base_classes(kind: str) -> tuple[type, ...]:
     return tuple(getattr(loaded, n) for n in names)
 
 
+def _as_called(cls: type, method: str) -> tuple[Any, bool]:
+    """(what ``instance.method`` is, whether it receives the instance) for an instance of
+    ``cls``: the class attribute bound as Python binds it, so that a function, a
+    ``functools.lru_cache`` or ``partialmethod`` and a ``functools.wraps`` wrapper receive the
+    instance, a static method or a callable object does not. The instance is made without
+    running ``__init__``; TypeError if it cannot be (an abstract class)."""
+    raw = inspect.getattr_static(cls, method)
+    get = getattr(type(raw), "__get__", None)
+    if get is None:  # a callable object in the class: called with the tracker's arguments alone
+        return raw, False
+    instance = object.__new__(cls)
+    called = get(raw, instance, cls)
+    return called, getattr(called, "__self__", None) is instance
+
+
 def _signature_problem(cls: type, method: str, args: tuple[str, ...]) -> str | None:
     """Why ``cls().method(*args)`` cannot be called as the tracker calls it, or None."""
     found = getattr(cls, method, None)
     if not callable(found):
         return f"{method} is {'missing' if found is None else 'not a method'}"
     try:
-        signature = inspect.signature(found)
-    except (TypeError, ValueError):  # a callable without a signature (a builtin): take it on trust
+        called, takes_self = _as_called(cls, method)
+        signature = inspect.signature(called)
+    except (TypeError, ValueError):  # no signature (a builtin), or no instance without __init__: on trust
         return None
-    takes_self = inspect.isfunction(inspect.getattr_static(cls, method))  # not a static/class method
     try:
-        signature.bind(*([None] * (takes_self + len(args))))
+        signature.bind(*([None] * len(args)))
     except TypeError:
-        return (f"{method}{signature} cannot be called as {method}({', '.join(('self',) * takes_self + args)}) "
+        with_self = False  # a method is shown as written, self included
+        if isinstance(called, types.MethodType) and takes_self:
+            with contextlib.suppress(TypeError, ValueError):
+                signature, with_self = inspect.signature(called.__func__), True
+        return (f"{method}{signature} cannot be called as {method}({', '.join(('self',) * with_self + args)}) "
                 f"(the tracker passes {len(args)} argument{'s' * (len(args) != 1)})")
     return None
 
@@ -117,7 +137,7 @@ def contract_problems(cls: type, base: type) -> list[str]:
             problems.append(f"its Params has no {kind.__name__} field '{field}' (the tracker reads "
                             f"params.{field}, in [{lowest:g}, {highest:g}])")
         elif not lowest <= (default := getattr(cls.Params(), field)) <= highest:
-            problems.append(f"its default {field}={default!r} is outside [{lowest:g}, {highest:g}]")
+            problems.append(f"its default {field}={shown(default)} is outside [{lowest:g}, {highest:g}]")
     return problems
 
 
@@ -129,7 +149,7 @@ def base_of(cls: type, kind: str, where: str) -> type:
         raise RegistryError(f"{where}: a {kind} must subclass {names}")
     base = bases[-1]  # the most specific, should a class subclass both roles' bases
     if hasattr(base, "role") and getattr(cls, "role", None) != base.role:
-        raise RegistryError(f"{where}: role {getattr(cls, 'role', None)!r} is not its base class "
+        raise RegistryError(f"{where}: role {shown(getattr(cls, 'role', None))} is not its base class "
                             f"{base.__name__}'s ({base.role!r})")
     return base
 
@@ -139,13 +159,14 @@ def check_contract_values(contract: Contract, params: Any, where: str) -> None:
     for field, (_, lowest, highest) in contract.params.items():
         value = getattr(params, field)
         if not lowest <= value <= highest:
-            raise ConfigError(f"{where}.{field}: {value!r} is outside [{lowest:g}, {highest:g}]")
+            raise ConfigError(f"{where}.{field}: {shown(value)} is outside [{lowest:g}, {highest:g}]")
 
 
-# What a plugin may raise at import or registration and be skipped for: any exception, and
-# SystemExit and KeyboardInterrupt that it raises itself (sys.exit(), raise KeyboardInterrupt);
-# an interrupt that a signal raised while it ran (Ctrl-C; SIGTERM, see dcfkit.tracking) goes on.
-PLUGIN_FAULTS = (Exception, SystemExit, KeyboardInterrupt)
+# What a plugin may raise at import or registration and be skipped for: anything it raises
+# itself, an Exception or not (sys.exit(), raise KeyboardInterrupt, its own BaseException
+# subclass, GeneratorExit), since one broken plugin must not end every command; an interrupt
+# that a signal raised while it ran (Ctrl-C; SIGTERM, see dcfkit.tracking) goes on.
+PLUGIN_FAULTS = (BaseException,)
 INTERRUPTS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
 
 
@@ -169,8 +190,8 @@ def signals_noted():
 
 
 def _raise_if_signalled(exc: BaseException, signalled: list) -> None:
-    """Re-raise an interrupt (not an Exception) that followed a signal: it is the user's, not
-    the plugin's."""
+    """Re-raise what is not an Exception (an interrupt, or what the plugin made of one) when a
+    signal arrived meanwhile: it is the user's, not the plugin's."""
     if signalled and not isinstance(exc, Exception):
         raise exc
 
@@ -205,7 +226,7 @@ class Registry:
         """
         kind, name = getattr(cls, "kind", ""), getattr(cls, "name", "")
         if kind not in KINDS:
-            raise RegistryError(f"{cls.__qualname__} (from {self._provider}): kind {kind!r} is not one of "
+            raise RegistryError(f"{cls.__qualname__} (from {self._provider}): kind {shown(kind)} is not one of "
                                 f"{', '.join(KINDS)}")
         if not name or not isinstance(name, str):
             raise RegistryError(f"{cls.__qualname__} (from {self._provider}): component has no name")
@@ -272,7 +293,7 @@ class Registry:
 
     def _check_kind(self, kind: str) -> dict[str, Entry]:
         if kind not in self._entries:
-            raise RegistryError(f"unknown component kind {kind!r}{closest(kind, KINDS)}; kinds: {', '.join(KINDS)}")
+            raise RegistryError(f"unknown component kind {shown(kind)}{closest(kind, KINDS)}; kinds: {', '.join(KINDS)}")
         return self._entries[kind]
 
     def plugin_versions(self, components) -> list[str]:

@@ -18,6 +18,7 @@ import io
 import json
 import logging
 import math
+import os
 from pathlib import Path
 from typing import Iterable, Mapping, Sequence as Seq
 
@@ -25,6 +26,7 @@ import numpy as np
 
 from . import metrics
 from .datasets import ATTRIBUTE_NAMES, DatasetError, Sequence
+from .errors import clip, shown
 from .protocols import DEFAULT, Protocol, get_protocol
 from .results import atomic_write, ensure_writable, import_results, load_results
 
@@ -136,7 +138,7 @@ def _score_tracker(tracker: str, res: Mapping, sequences: list[Sequence], includ
         if seq.name in res:
             boxes, fps[seq.name] = _boxes_and_fps(res[seq.name])
             if len(boxes) > len(seq):
-                raise DatasetError(f"tracker {tracker!r}, sequence {seq.name!r}: {len(boxes)} boxes for "
+                raise DatasetError(f"tracker {shown(tracker)}, sequence {seq.name!r}: {len(boxes)} boxes for "
                                    f"{len(seq)} frames")
             if len(boxes) < len(seq):
                 log.warning("tracker %r, sequence %r: %d boxes for %d frames; the last %d frames are "
@@ -217,7 +219,7 @@ def format_rows(rows: Seq[Mapping], fmt: str = "table", columns: Seq[str] | None
     precision and leaves missing values empty.
     """
     if fmt not in ("table", "markdown", "csv"):
-        raise ValueError(f"format must be table, markdown or csv, got {fmt!r}")
+        raise ValueError(f"format must be table, markdown or csv, got {shown(fmt)}")
     if columns is None:
         columns = list(rows[0]) if rows else []
     if fmt == "csv":
@@ -349,16 +351,17 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
     names = {s.name for s in sequences}
     if trackers is None:
         if not out_dir.is_dir():
-            raise DatasetError(f"results folder not found: {out_dir}")
+            raise DatasetError(f"results folder not found: {clip(str(out_dir))}")
         trackers = [p.name for p in sorted(out_dir.iterdir())
                     if p.is_dir() and not p.name.startswith(".") and any((p / f"{n}.txt").is_file() for n in names)
                     and (p.resolve() not in exclude or _holds_results(p, names))]
     folders: dict[Path, Path] = {}
     for tracker in trackers:
-        folder = out_dir / tracker if (out_dir / tracker).is_dir() else Path(tracker)
-        if not folder.is_dir():
-            raise DatasetError(f"no results for tracker {tracker!r}: neither {out_dir / tracker} "
-                               f"nor {tracker} is a folder")
+        # os.path.isdir: a name too long for the file system is no folder (Path.is_dir raises)
+        folder = out_dir / tracker if os.path.isdir(out_dir / tracker) else Path(tracker)
+        if not os.path.isdir(folder):
+            raise DatasetError(f"no results for tracker {shown(tracker)}: neither {clip(str(out_dir / tracker))} "
+                               f"nor {clip(tracker)} is a folder")
         folders.setdefault(folder.resolve(), folder)
     shared = {name for name in (f.name for f in folders.values())
               if sum(g.name == name for g in folders.values()) > 1}
@@ -450,7 +453,7 @@ def score_and_write(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] |
         raise DatasetError(f"{report_dir} holds a tracker's results; write the report elsewhere with --report-dir")
     results = gather_results(out_dir, sequences, trackers, exclude=[report_dir])
     if not results:
-        raise DatasetError(f"no tracker results found under {out_dir}")
+        raise DatasetError(f"no tracker results found under {clip(str(out_dir))}")
     ensure_writable(report_dir, report_file_names(sequences), "the report")  # before the scoring
     evaluation = evaluate(results, sequences, include_first, weighting, protocol)
     return evaluation, _write(evaluation, report_dir)

@@ -40,7 +40,7 @@ import numpy as np
 from . import __version__
 from .config import components
 from .datasets import DatasetError, Sequence, read_boxes
-from .errors import DcfkitError
+from .errors import DcfkitError, clip, shown
 from .registry import get_registry
 
 log = logging.getLogger(__name__)
@@ -114,7 +114,7 @@ def atomic_write(path: Path, data: str | bytes) -> None:
     try:
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     except OSError as exc:
-        raise StoreError(f"cannot write {path}: {exc.strerror}") from None
+        raise StoreError(f"cannot write {clip(str(path))}: {exc.strerror}") from None
     try:
         os.fchmod(fd, _file_mode())
         with os.fdopen(fd, "wb") as f:
@@ -126,7 +126,7 @@ def atomic_write(path: Path, data: str | bytes) -> None:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         if isinstance(exc, OSError):
-            raise StoreError(f"cannot write {path}: {exc.strerror or exc}") from None
+            raise StoreError(f"cannot write {clip(str(path))}: {exc.strerror or exc}") from None
         raise
 
 
@@ -135,7 +135,7 @@ def make_dir(folder: Path) -> Path:
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise StoreError(f"cannot create the folder {folder}: {exc.strerror}") from None
+        raise StoreError(f"cannot create the folder {clip(str(folder))}: {exc.strerror}") from None
     return folder
 
 
@@ -149,7 +149,7 @@ def ensure_writable(folder: Path, names: Iterable[str] = (), what: str = "result
         os.close(fd)
         os.unlink(probe)
     except OSError as exc:
-        raise StoreError(f"cannot write {what} to {folder}: {exc.strerror}") from None
+        raise StoreError(f"cannot write {what} to {clip(str(folder))}: {exc.strerror}") from None
     blocked = [name for name in names if (folder / name).is_dir()]
     if blocked:
         raise StoreError(f"cannot write {what} to {folder}: {', '.join(blocked)} "
@@ -357,7 +357,7 @@ def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]
     """Intact results of ``tracker_name`` under ``out_dir`` (:meth:`ResultStore.load`)."""
     folder = Path(out_dir) / tracker_name
     if not folder.is_dir():
-        raise DatasetError(f"no results folder for tracker {tracker_name!r}: {folder}")
+        raise DatasetError(f"no results folder for tracker {shown(tracker_name)}: {clip(str(folder))}")
     return ResultStore(folder).load(sequences)
 
 
@@ -366,7 +366,7 @@ def result_files(folder) -> dict[str, Path]:
     some toolkits); a :class:`DatasetError` if ``folder`` is not a folder."""
     folder = Path(folder)
     if not folder.is_dir():
-        raise DatasetError(f"results folder not found: {folder}")
+        raise DatasetError(f"results folder not found: {clip(str(folder))}")
     return {p.stem: p for p in sorted(folder.glob("*.txt")) if not p.stem.endswith("_time")}
 
 

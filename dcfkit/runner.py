@@ -24,7 +24,7 @@ from typing import Any, Callable, Iterable, Mapping
 import cv2
 
 from .datasets import Sequence
-from .errors import DcfkitError
+from .errors import DcfkitError, shown
 from .registry import PluginWarning
 from .results import ResultStore, StoreError, dcfkit_version, now, plugin_versions, run_key
 from .tracking import TrackerFailure, track
@@ -265,7 +265,7 @@ def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None]
     tasks = list(tasks)
     version = version if version is not None else dcfkit_version()
     if executor not in ("local", "dask"):
-        raise DcfkitError(f"executor must be 'local' or 'dask', got {executor!r}")
+        raise DcfkitError(f"executor must be 'local' or 'dask', got {shown(executor)}")
     if jobs < 1:
         raise DcfkitError(f"jobs must be >= 1, got {jobs}")
 

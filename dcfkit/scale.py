@@ -47,12 +47,13 @@ def _factors(n: int, step: float) -> np.ndarray:
     return step ** (np.arange(n) - (n - 1) / 2)
 
 
-def _check_span(n: int, step: float, least: int = 1) -> str | None:
-    """Sanity bounds shared by both estimators: beyond them the samples stop fitting in memory."""
-    if not least <= n <= 101:
-        return f"n_scales must be in [{least}, 101]"
-    if step <= 1:
-        return "step must be > 1"
+MAX_SCALES = 101  # n_scales of either estimator: beyond it the samples stop fitting in memory
+MIN_LAM = 1e-10  # the DSST's λ, as the ADMM's penalty γ (solvers.PENALTY_RANGE)
+
+
+def _check_span(n: int, step: float) -> str | None:
+    """The span both estimators share: at most x10 each way (beyond it the samples stop fitting
+    in memory)."""
     if (n - 1) / 2 * math.log(step) > math.log(10):
         return (f"step={step:g} with n_scales={n}: the scales may span at most x10 each way "
                 f"(step ** ((n_scales - 1) / 2) <= 10)")
@@ -65,10 +66,11 @@ class Pyramid(ScaleEstimator):
 
     @dataclasses.dataclass(frozen=True)
     class Params:
-        n_scales: int = param(5, "number of scales searched")
-        step: float = param(1.01, "ratio between neighbouring scales")
+        n_scales: int = param(5, "number of scales searched", ge=1, le=MAX_SCALES)
+        step: float = param(1.01, "ratio between neighbouring scales", gt=1)
 
         def validate(self):
+            """step ** ((n_scales - 1) / 2) <= 10: the scales span at most x10 each way."""
             return _check_span(self.n_scales, self.step)
 
     def search_factors(self):
@@ -82,13 +84,18 @@ class DSST(ScaleEstimator):
 
     @dataclasses.dataclass(frozen=True)
     class Params:
-        n_scales: int = param(33, "number of scales in the scale filter")
-        step: float = param(1.03, "ratio between neighbouring scales")
-        sigma_factor: float = param(0.25, "label width: σ = n_scales / √33 · sigma_factor")
-        lam: float = param(0.01, "regularization of the scale filter")
-        learning_rate: float = param(0.025, "interpolation rate of the scale model")
-        model_max_area: int = param(512, "largest area (pixels) of a scale sample")
-        cell_size: int = param(4, "fHOG cell size of the scale samples")
+        n_scales: int = param(33, "number of scales in the scale filter", ge=3, le=MAX_SCALES)
+        step: float = param(1.03, "ratio between neighbouring scales", gt=1)
+        # beyond 10, σ is over 1.7 n_scales: a flat label, every scale alike
+        sigma_factor: float = param(0.25, "label width: σ = n_scales / √33 · sigma_factor", gt=0, le=10)
+        # the scale filter divides by Σ|x̂|² + λ, which may be λ alone: λ bounds its gain, 1/λ. The floor
+        # is the ADMM penalty's (solvers.PENALTY_RANGE), far below Σ|x̂|² of a textured sample (7 to 3000
+        # on the synthetic sequence, where the default 0.01 is a thousandth of the least); subnormals
+        # (1e-320) were accepted
+        lam: float = param(0.01, "λ: regularization of the scale filter", ge=MIN_LAM, le=1e10)
+        learning_rate: float = param(0.025, "interpolation rate of the scale model", gt=0, le=1)
+        model_max_area: int = param(512, "largest area (pixels) of a scale sample", ge=1, le=10000)
+        cell_size: int = param(4, "fHOG cell size of the scale samples", ge=1, le=16)
         model_size: str = param("base_target", "size of a scale sample: 'base_target' the target at the search "
                                 "patch's resolution (at least 2x2 cells), 'image_target' its size in image pixels "
                                 "(the authors' init_scale: floored; at least 2 cells, where theirs allows 2 px)",
@@ -107,19 +114,8 @@ class DSST(ScaleEstimator):
                                   "end unwindowed)", choices=("reextract", "shift"))
 
         def validate(self):
-            if self.sigma_factor <= 0:
-                return "sigma_factor must be > 0"
-            if self.sigma_factor > 10:  # σ beyond 1.7 n_scales: a flat label, every scale alike
-                return "sigma_factor must be <= 10"
-            if not 0 < self.lam <= 1e10:  # the scale filter divides by Σ|x̂|² + λ, which may be λ alone
-                return "lam must be in (0, 1e10]"
-            if not 0 < self.learning_rate <= 1:
-                return "learning_rate must be in (0, 1]"
-            if not 1 <= self.model_max_area <= 10000:
-                return "model_max_area must be in [1, 10000]"
-            if not 1 <= self.cell_size <= 16:
-                return "cell_size must be in [1, 16]"
-            return _check_span(self.n_scales, self.step, least=3)
+            """step ** ((n_scales - 1) / 2) <= 10: the scales span at most x10 each way."""
+            return _check_span(self.n_scales, self.step)
 
     def init(self, image, centre, base_target, scale, limits):
         super().init(image, centre, base_target, scale, limits)

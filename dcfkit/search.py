@@ -46,13 +46,9 @@ class MotionAware(Search):
 
     @dataclasses.dataclass(frozen=True)
     class Params:
-        gain: float = param(1.0, "multiplier of the last displacement (1 = Eq. 14)")
-
-        def validate(self):
-            # 0: the last position; beyond MAX_GAIN the predicted centre leaves any image (with
-            # tracker.clamp_position false, 1e30 px away: the sampling broke); < 0: against the motion
-            if not 0 <= self.gain <= MAX_GAIN:
-                return f"gain must be in [0, {MAX_GAIN:g}]"
+        # 0: the last position; beyond MAX_GAIN the predicted centre leaves any image (with
+        # tracker.clamp_position false, 1e30 px away: the sampling broke); < 0: against the motion
+        gain: float = param(1.0, "multiplier of the last displacement (1 = Eq. 14)", ge=0, le=MAX_GAIN)
 
     def reset(self, position):
         super().reset(position)

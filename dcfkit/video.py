@@ -13,7 +13,7 @@ import numpy as np
 
 from .datasets import read_frame
 from .datasets.base import jpeg_damage, jpeg_decodable
-from .errors import InputError
+from .errors import InputError, clip, shown
 from .limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff")
@@ -30,7 +30,7 @@ def frame_files(folder: str | Path) -> list[Path]:
     there are none."""
     folder = Path(folder)
     if not folder.is_dir():
-        raise InputError(f"--frames: {folder} is not a folder")
+        raise InputError(f"--frames: {clip(str(folder))} is not a folder")
     files = sorted((p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES), key=_natural_key)
     if not files:
         raise InputError(f"--frames: no images ({', '.join(IMAGE_SUFFIXES)}) in {folder}")
@@ -142,7 +142,7 @@ class _JpegPackets:
 def _open_video(video) -> cv2.VideoCapture:
     """An opened capture whose frame size is within ``max_image_pixels()``."""
     if not Path(video).is_file():
-        raise InputError(f"--video: file not found: {video}")
+        raise InputError(f"--video: file not found: {clip(str(video))}")
     cap = cv2.VideoCapture(str(video))
     if not cap.isOpened():
         raise InputError(f"--video: OpenCV cannot open {video}")
@@ -162,9 +162,9 @@ def check_output_file(path: str | Path, what: str) -> Path:
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise InputError(f"{what}: cannot create the folder {path.parent} ({exc.strerror})") from None
+        raise InputError(f"{what}: cannot create the folder {clip(str(path.parent))} ({exc.strerror})") from None
     if path.is_dir() or not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
-        raise InputError(f"{what}: cannot write {path}")
+        raise InputError(f"{what}: cannot write {clip(str(path))}")
     return path
 
 
@@ -177,7 +177,7 @@ class VideoWriter:
 
     def __init__(self, path: str | Path, fps: float = 10.0):
         if Path(path).suffix.lower() not in VIDEO_SUFFIXES:
-            raise InputError(f"--save-video: cannot write a video named {str(path)!r}: the name must end in "
+            raise InputError(f"--save-video: cannot write a video named {shown(str(path))}: the name must end in "
                              f"{', '.join(VIDEO_SUFFIXES)}")
         self.path = check_output_file(path, "--save-video")
         self.fps = fps

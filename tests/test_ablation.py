@@ -252,6 +252,50 @@ def alive(pid: int) -> bool:
     return text[text.rfind(")") + 2:].split()[0] != "Z"
 
 
+def product_grid(path: Path, n: int) -> Path:
+    """A spec whose grid is an n x n x n product (label.mu, label.top_n, label.exclusion), every point valid."""
+    mus, tops, exclusions = [round(0.05 * i, 2) for i in range(n)], list(range(1, n + 1)), [0.5 + i for i in range(n)]
+    return write_spec(path, f"dataset: {{name: otb, root: data}}\ngrid:\n  base: dr2track\n  mode: product\n"
+                            f"  parameters:\n    label.mu: {mus}\n    label.top_n: {tops}\n    label.exclusion: {exclusions}\n")
+
+
+RAISE_IT = r"\(dcfkit ablate --max-variants N, \$DCFKIT_MAX_VARIANTS or dcfkit.ablation.spec.MAX_VARIANTS raise it\)"
+
+
+def test_the_variant_limit_is_named_and_can_be_raised(tmp_path, data, monkeypatch, capsys):
+    """An 11x11x11 grid (1331 points) was over the limit of 1,000, which only a program could raise."""
+    big = product_grid(tmp_path / "big.yaml", 11)
+    with pytest.raises(ConfigError, match=r"big.yaml: grid.parameters: 1331 grid points \(product\) and 0 named "
+                                          r"variants; a spec has at most 1000 variants " + RAISE_IT):
+        load_spec(big)
+    small, out = str(product_grid(tmp_path / "small.yaml", 2)), str(tmp_path / "out")  # 8 variants
+    dry_run = ["ablate", small, "--out", out, "--sequences", "seqA", "--dry-run"]
+    monkeypatch.setenv("DCFKIT_MAX_VARIANTS", "7")
+    assert cli.main(dry_run) == 2 and "a spec has at most 7 variants (dcfkit ablate" in capsys.readouterr().err
+    assert len(load_spec(small, max_variants=8).variants) == 8  # the option wins over the variable
+    assert cli.main(dry_run + ["--max-variants", "8"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == "8 jobs, 8 distinct runs"
+    monkeypatch.setenv("DCFKIT_MAX_VARIANTS", "8")
+    assert len(load_spec(small).variants) == 8
+    named = write_spec(tmp_path / "named.yaml", "dataset: otb\nvariants: {a: strcf, b: bacf, c: dr2track}\n")
+    with pytest.raises(ConfigError, match=r"named.yaml: variants: 3 variants; a spec has at most 2 " + RAISE_IT):
+        load_spec(named, max_variants=2)
+    monkeypatch.setenv("DCFKIT_MAX_VARIANTS", "lots")
+    with pytest.raises(ConfigError, match=r"\$DCFKIT_MAX_VARIANTS must be a number of variants >= 1, got 'lots'"):
+        load_spec(small)
+    with pytest.raises(SystemExit):
+        cli.main(dry_run + ["--max-variants", "0"])
+    assert "argument --max-variants: expected a whole number of variants >= 1, got '0'" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_an_11x11x11_grid_is_read_with_the_limit_raised(tmp_path, data, capsys):
+    big = str(product_grid(tmp_path / "big.yaml", 11))
+    assert cli.main(["ablate", big, "--out", str(tmp_path / "out"), "--sequences", "seqA", "--max-variants", "1331",
+                     "--dry-run"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == "1331 jobs, 1331 distinct runs"
+
+
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux /proc to watch the worker processes")
 @pytest.mark.slow
 def test_sigkill_then_rerun_loses_and_recomputes_nothing(tmp_path, data):

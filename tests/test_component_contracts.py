@@ -141,6 +141,18 @@ def test_values_that_cannot_work_are_refused_at_load_naming_the_key(kind, cls, p
         dcfkit.load_tracker(TINY, overrides=slot_override(kind, cls, params))
 
 
+@pytest.mark.parametrize("lam", [5e-324, 1e-320, 2.2e-308, 1e-300, 9.9e-11])
+def test_a_dsst_lam_under_its_floor_is_refused_naming_it(lam):
+    """λ divides the scale filter's response (by Σ|x̂|² + λ, λ alone where the samples have no
+    energy): subnormal values such as 1e-320 were accepted. The floor is the ADMM penalty's."""
+    with pytest.raises(ConfigError, match=r"scale \(scale 'dsst'\): lam must be in \[1e-10, 1e\+10\], got "):
+        dcfkit.load_tracker(TINY, overrides={"scale": {"name": "dsst", "lam": lam}})
+
+
+def test_a_dsst_lam_at_its_floor_tracks():
+    assert track_tiny({"scale": {"name": "dsst", "lam": 1e-10}}) == "tracked"
+
+
 def test_a_dsst_working_patch_over_the_sample_budget_is_refused_naming_its_keys():
     """The budget is the tracker's (``$DCFKIT_MAX_SAMPLE_PIXELS``): registering the built-ins
     never depends on the environment."""
@@ -243,6 +255,92 @@ class IntThetaParams:
 def test_registration_refuses_a_component_that_breaks_its_contract(cls, message):
     with pytest.raises(RegistryError, match=message):
         reg.Registry().register(cls)
+
+
+def _wrapped(fn):
+    """A decorator as a plugin may write one: a ``functools.wraps`` wrapper taking ``*args``."""
+    @functools.wraps(fn)
+    def wrapper(self, *args, **kwargs):
+        return fn(self, *args, **kwargs)
+    return wrapper
+
+
+class CachedFeature(Feature):
+    """A constant feature: channels() cached with functools.lru_cache, extract() wrapped."""
+
+    name = "cached_constant"
+
+    @functools.lru_cache(maxsize=None)
+    def channels(self):
+        return 1
+
+    @_wrapped
+    def extract(self, patch, cell_size):
+        return np.ones((1, patch.shape[0] // cell_size, patch.shape[1] // cell_size), np.float32)
+
+
+class PartialLabel(Label):
+    """The Gaussian label as it comes: make() a functools.partialmethod of a more general method."""
+
+    name = "partial_gaussian"
+
+    def _make(self, repress: bool, g, detection):
+        return g, np.zeros((0, 2), int)
+
+    make = functools.partialmethod(_make, False)
+
+    @functools.lru_cache(maxsize=None)
+    def reset(self):
+        pass
+
+
+class WrappedSearch(Search):
+    """The fixed search, with observe() wrapped and centre() a partialmethod taking a keyword."""
+
+    name = "wrapped_search"
+
+    @_wrapped
+    def observe(self, position):
+        super().observe(position)
+
+    def _centre(self, shift=0.0):
+        return Search.centre(self)
+
+    centre = functools.partialmethod(_centre, shift=0.0)
+
+
+@pytest.mark.parametrize("kind, cls", [("feature", CachedFeature), ("label", PartialLabel),
+                                       ("search", WrappedSearch)], ids=lambda v: getattr(v, "name", v))
+def test_decorated_methods_meet_the_contract_and_track(kind, cls, monkeypatch):
+    """lru_cache, partialmethod and functools.wraps methods used to be refused at registration
+    (the check did not bind them to an instance as Python does)."""
+    registry = reg.build_registry(external=False)
+    registry.register(cls)
+    monkeypatch.setattr(reg, "_REGISTRY", registry)
+    assert track_tiny(slot_override(kind, cls, {})) == "tracked"
+
+
+def _short_make(self, g):
+    return g, np.zeros((0, 2), int)
+
+
+def _make3(self, a, b, g, detection=None):
+    return g, np.zeros((0, 2), int)
+
+
+@pytest.mark.parametrize("members, message", [
+    ({"make": functools.lru_cache(maxsize=None)(_short_make)},
+     r"make\(self, g\) cannot be called as make\(self, g, detection\) \(the tracker passes 2 arguments\)"),
+    ({"make": _wrapped(_short_make)}, r"make\(self, g\) cannot be called as make\(self, g, detection\)"),
+    ({"make": functools.partialmethod(_make3, 1, 2, 3)}, r"make\(detection=None\) cannot be called as "
+                                                          r"make\(g, detection\)"),
+    ({"make": functools.partialmethod(_make3, 1, 2, 3, 4)}, r"make\(\) cannot be called as make\(g, detection\)"),
+    ({"make": _make, "reset": functools.partialmethod(_make3, 1)}, r"reset\(b, g, detection=None\) cannot be called as "
+                                                                   r"reset\(\)"),
+])
+def test_decorated_methods_that_break_the_contract_are_still_refused(members, message):
+    with pytest.raises(RegistryError, match=message):
+        reg.Registry().register(_component(Label, "decorated", **members))
 
 
 def test_a_temporal_regularizer_must_declare_theta_and_its_value_is_bounded():

@@ -1,9 +1,10 @@
 """Configs: inheritance, overrides, validation and clear errors."""
+import re
 from pathlib import Path
 
 import pytest
 
-from dcfkit.config import load_config, shipped_config_dir
+from dcfkit.config import load_config, parse_overrides, shipped_config_dir
 from dcfkit.errors import ConfigError, DcfkitError, RegistryError
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
@@ -74,7 +75,7 @@ def test_unknown_component_lists_registered_ones():
 def test_wrong_type_is_reported_with_key():
     with pytest.raises(ConfigError, match=r"solver.*iterations: expected an integer"):
         load_config("strcf", {"solver.iterations": "four"})
-    with pytest.raises(ConfigError, match=r"mu must be >= 0"):
+    with pytest.raises(ConfigError, match=r"label .*: mu must be in \[0, 1e\+06\], got -1\.0"):
         load_config("dr2track", {"label.mu": -1})
 
 
@@ -101,10 +102,12 @@ def test_non_finite_numbers_are_refused(key, value):
     ("strcf", "scale.n_scales", 10**6, r"scale.*n_scales must be in \[1, 101\]"),
     ("dr2track", "scale.model_max_area", -5, r"scale.*model_max_area must be in"),
     ("dr2track", "scale.cell_size", 0, r"scale.*cell_size must be in"),
-    ("dr2track", "scale.sigma_factor", 0, r"scale.*sigma_factor must be > 0"),
+    ("dr2track", "scale.sigma_factor", 0, r"scale.*sigma_factor must be in \(0, 10\], got 0"),
     ("strcf", "tracker.search_area_scale", 1e6, r"tracker: search_area_scale must be in \[1, 50\]"),
     ("strcf", "tracker.cell_size", 10000, r"tracker: cell_size must be in \[1, 64\]"),
-    ("strcf", "tracker.min_image_sample_size", 1e-300, r"tracker: need 8² <= min_image_sample_size"),
+    ("strcf", "tracker.min_image_sample_size", 1e-300,
+     r"tracker: min_image_sample_size must be in \[64, 4000000\], got 1e-300"),
+    ("strcf", "tracker.min_image_sample_size", 300**2, r"tracker: need min_image_sample_size <= max_image_sample_size"),
     ("strcf", "solver.iterations", 10**9, r"solver.*iterations must be in \[1, 10000\]"),
     ("dr2track", "scale.n_scales", 200, r"scale.*n_scales must be in \[3, 101\]"),
 ])
@@ -167,6 +170,37 @@ def test_unknown_top_level_key_and_wrong_regularizer_role(tmp_path):
         load_config(cfg)
     with pytest.raises(ConfigError, match=r"regularizers.spatial: 'temporal' is a temporal regularizer"):
         load_config("strcf", {"regularizers.spatial": {"name": "temporal"}})
+
+
+@pytest.mark.parametrize("override", ["base=bacf", "base=no_such_config", "base.x=1", " base =bacf"])
+def test_base_cannot_be_overridden(override, tmp_path, capsys):
+    """--set base=... set a key that nothing read any more: the config stayed on its own base,
+    silently, even when the new base did not exist."""
+    from dcfkit import cli
+
+    child = tmp_path / "child.yaml"
+    child.write_text("base: strcf\nname: child\n")
+    for source in ("strcf", child, {"base": "strcf", "name": "child"}):
+        with pytest.raises(ConfigError, match=r"override 'base(\.x)?': a config's base is read with its file, "
+                                              r"before overrides apply; give that config instead"):
+            load_config(source, parse_overrides([override]))
+    assert cli.main(["track", "strcf", "--frames", str(tmp_path), "--box", "1,1,5,5", "--set", override]) == 2
+    assert capsys.readouterr().err.startswith("dcfkit track: error: override 'base")
+
+
+@pytest.mark.parametrize("value, roles", [("null", (None, None)), ("{}", (None, None)),
+                                          ("{temporal: {name: temporal, theta: 3}}", (None, "temporal"))])
+def test_regularizers_replaced_by_an_override(value, roles):
+    cfg = load_config("strcf", parse_overrides([f"regularizers={value}"]))
+    assert tuple(r and r["name"] for r in (cfg["regularizers"]["spatial"], cfg["regularizers"]["temporal"])) == roles
+
+
+@pytest.mark.parametrize("value, shown", [("[]", "[]"), ("", "''"), ("false", "False"), ("0", "0"), ("[l2]", "['l2']")])
+def test_regularizers_that_are_not_a_mapping_are_refused(value, shown):
+    """[], '', false and 0 were read as "no regularizers" (anything falsy), a non-empty list was an error."""
+    with pytest.raises(ConfigError, match=r"strcf.yaml: regularizers: expected a mapping of roles \(spatial, temporal\) "
+                                          rf"to components, got {re.escape(shown)} \(null: none; "):
+        load_config("strcf", parse_overrides([f"regularizers={value}"]))
 
 
 def test_base_may_name_a_shipped_config(tmp_path):

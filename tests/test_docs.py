@@ -1,6 +1,7 @@
 """Generated reference docs (dcfkit/cli/docs.py): the committed files are current, and the renderers."""
 import dataclasses
 import difflib
+import json
 from pathlib import Path
 
 import pytest
@@ -29,9 +30,10 @@ def test_config_reference_documents_every_key_and_every_parameter():
             assert f"#### {kind} `{name}`" in text
             for f in fields(registry.entry(kind, name).cls.Params):
                 assert f"| `{f['name']}` |" in text
-    assert "| `output_sigma_factor` | float | `0.0625` |" in text  # the tracker section
+    assert "| `output_sigma_factor` | float | `0.0625` | `> 0` |" in text  # the tracker section
+    assert "Also checked: min_image_sample_size <= max_image_sample_size." in text
     assert "| `scale` | `pyramid` |" in text and "| `search` | `fixed` |" in text  # what resolve() fills in
-    assert "| `variant` | str | `subtractive` | 'subtractive' g - μR̃, 'overwrite' -μR̃ (the authors' code) or " \
+    assert "| `variant` | str | `subtractive` |  | 'subtractive' g - μR̃, 'overwrite' -μR̃ (the authors' code) or " \
            "'multiplicative' (the paper's g⊙d) (one of: `subtractive`, `overwrite`, `multiplicative`) |" in text
 
 
@@ -55,7 +57,7 @@ def test_params_table_escapes_and_lists_choices():
         mode: str = param("a", "either a | b", choices=("a", "b"))
 
     assert components.params_table(fields(Params)).splitlines()[2] == \
-        "| `mode` | str | `a` | either a \\| b (one of: `a`, `b`) |"
+        "| `mode` | str | `a` |  | either a \\| b (one of: `a`, `b`) |"
     assert components.params_table([]) == "No parameters.\n"
 
 
@@ -64,7 +66,9 @@ def test_components_markdown_command_uses_the_shared_renderer(capsys):
     out = capsys.readouterr().out
     assert out == components.components_markdown(components.component_rows(get_registry(), ["label"]))
     assert "### label `gaussian`\n\nThe fixed Gaussian label of STRCF/BACF (Eq. 1). (from dcfkit)\n\nNo parameters.\n" in out
-    assert "| `top_n` | int | `30` | N: how many of the highest background local maxima are repressed |" in out
+    assert "| `top_n` | int | `30` | `>= 0` | N: how many of the highest background local maxima are repressed |" in out
+    assert "| `neighbourhood` | int | `3` | `[3, 101]` |" in out
+    assert "\nAlso checked: neighbourhood an odd number.\n" in out
 
 
 def test_summary_is_the_whole_first_paragraph():
@@ -84,3 +88,34 @@ def test_check_mode_reports_stale_files(tmp_path, capsys):
     assert docs_gen.main([str(tmp_path)]) == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cli.md", "configs.md"]
     assert docs_gen.main([str(tmp_path), "--check"]) == 0
+
+
+def test_components_lists_each_parameters_bounds_and_the_rules_between_them(capsys):
+    """``solver.beta`` must be > 0, ``iterations`` in [1, 10000]...: the table said nothing of it."""
+    assert main(["components", "--kind", "solver"]) == 0
+    out = capsys.readouterr().out
+    assert "iterations (int, default 4, [1, 10000]): E: ADMM iterations per frame" in out
+    assert "beta (float, default 10.0, > 0): β: penalty growth per iteration" in out
+    assert "learning_rate (float, default 0.013, (0, 1]): η:" in out  # admm_bacf's own field
+    assert "h_step (str, default standard): " in out  # no bounds, none shown
+    assert "also: every penalty γ of the schedule (γ⁰, then γ ← min(gamma_max, beta·γ)) in [1e-10, 1e10]" in out
+    assert main(["components", "--kind", "scale", "--format", "json"]) == 0
+    rows = {row["name"]: row for row in json.loads(capsys.readouterr().out)}
+    dsst = {f["name"]: f["bounds"] for f in rows["dsst"]["params"]}
+    assert dsst["n_scales"] == "[3, 101]" and dsst["step"] == "> 1" and dsst["model_update"] is None
+    assert rows["pyramid"]["checks"].startswith("step ** ((n_scales - 1) / 2) <= 10")
+
+
+def test_a_contract_range_is_listed_for_a_field_that_declares_none():
+    """A plugin's temporal regularizer whose theta has no bounds of its own: the tracker's
+    contract bounds it to [0, 1e10] all the same, and the listing says so."""
+    from dcfkit.regularizers import TemporalRegularizer
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        theta: float = param(1.0, "θ")
+
+    registry = build_registry(external=False)
+    registry.register(type("Plain", (TemporalRegularizer,), {"name": "plain_theta", "Params": Params}))
+    (row,) = [r for r in components.component_rows(registry, ["regularizer"]) if r["name"] == "plain_theta"]
+    assert row["params"][0]["bounds"] == "[0, 1e+10]" and row["checks"] == ""

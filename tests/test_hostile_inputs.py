@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 import dcfkit
 from dcfkit import cli
 from dcfkit.datasets import DatasetError, read_frame
-from dcfkit.errors import ConfigError, InputError
+from dcfkit.errors import ConfigError, DcfkitError, InputError
 from dcfkit.synthetic import make_sequence
 from dcfkit.video import iter_frames
 
@@ -603,3 +603,107 @@ def test_a_short_video_is_an_error_only_where_the_frame_count_is_an_index():
         _stopped_short("cut.avi", 8, 10)
     with pytest.warns(RuntimeWarning, match=r"long\.mkv stops at frame 8 of the 10 .*tracked as the last"):
         _stopped_short("long.mkv", 8, 10)
+
+
+# --------------------------------------------------------------------------- long values in messages
+
+LONG = "q" * 100_000  # an argument this long fits in argv (131072 bytes each on Linux)
+MESSAGE_CHARS = 1000  # one error line, whatever the size of the value it is about
+
+
+@pytest.fixture(scope="module")
+def otb_root(tmp_path_factory):
+    """ROOT/seqA/img/0001.jpg, 0002.jpg and ROOT/seqA/groundtruth_rect.txt: a 2-frame OTB sequence."""
+    root = tmp_path_factory.mktemp("otb")
+    (root / "seqA" / "img").mkdir(parents=True)
+    for i in (1, 2):
+        cv2.imwrite(str(root / "seqA" / "img" / f"{i:04d}.jpg"), SEQUENCE.frames[i - 1])
+    (root / "seqA" / "groundtruth_rect.txt").write_text("11,11,14,10\n11,11,14,10\n")
+    return root
+
+
+@pytest.mark.parametrize("args,said", [
+    (["eval", "strcf", "--dataset", LONG, "--root", "{root}", "--out", "{out}"], "error: unknown dataset 'qqq"),
+    (["eval", "strcf", "--dataset", "otb", "--root", "{root}", "--sequences", LONG, "--out", "{out}"],
+     "error: sequence 'qqq"),
+    (["eval", "strcf", "--dataset", "otb", "--root", "{root}", "--set", "name=/" + LONG, "--out", "{out}"],
+     "error: config 'name' '/qqq"),
+    (["eval", "opencv:" + LONG, "--dataset", "otb", "--root", "{root}", "--out", "{out}"],
+     "error: unknown OpenCV tracker 'qqq"),
+    (["report", "{out}", "--dataset", "otb", "--root", "{root}", "--trackers", LONG],
+     "error: no results for tracker 'qqq"),
+    (["ablate", "{spec}", "--out", "{out}", "--dry-run"], "spec.yaml: dataset.name: unknown dataset 'qqq"),
+    (["ablate", "{otb_spec}", "--out", "{out}", "--root", "{root}", "--sequences", LONG, "--dry-run"],
+     "error: sequence 'qqq"),
+    (["track", "strcf", "--frames", "{root}/seqA/img", "--box", LONG], "error: --box expects x,y,w,h"),
+    (["track", "strcf", "--frames", "{root}/seqA/img", "--box", "10,10,14,10", "--save-video", LONG],
+     "error: --save-video: cannot write a video named 'qqq"),
+    (["compare", "{out}", "{out}", "--root", "{root}", "--divergence-px", LONG],
+     "error: argument --divergence-px: expected a distance in pixels >= 0, got 'qqq"),
+    (["ablate", "{spec}", "--out", "{out}", "--executor", LONG], "error: argument --executor: invalid choice"),
+])
+def test_long_arguments_are_shown_short_in_messages(args, said, otb_root, tmp_path, capsys):
+    """A value of 100,000 characters in a command-line argument, a config name or a spec's
+    dataset name: the error names it with its start only (it used to be echoed whole)."""
+    (tmp_path / "spec.yaml").write_text(f"dataset: {{name: {LONG}}}\nvariants: {{a: strcf}}\n")
+    (tmp_path / "otb_spec.yaml").write_text("dataset: otb\nvariants: {a: strcf}\n")
+    paths = {"root": otb_root, "out": tmp_path / "out", "spec": tmp_path / "spec.yaml",
+             "otb_spec": tmp_path / "otb_spec.yaml"}
+    (tmp_path / "out").mkdir()
+    try:
+        status = cli.main([a.format(**paths) if "{" in a else a for a in args])
+    except SystemExit as usage:  # argparse's usage errors
+        status = usage.code
+    err = capsys.readouterr().err
+    assert status == 2 and said in err, err[:2000]
+    line = next(x for x in err.splitlines() if "error:" in x)
+    assert len(line) < MESSAGE_CHARS and len(err) < 3 * MESSAGE_CHARS, err[:2000]
+
+
+def test_long_values_in_files_and_variables_are_shown_short(tmp_path, monkeypatch):
+    from dcfkit.datasets import read_boxes
+    from dcfkit.datasets.base import read_flags
+    from dcfkit.evaluation import tracker_name
+    from dcfkit.limits import max_image_pixels
+
+    (tmp_path / "gt.txt").write_text("1,1,2,2\n" + "9," * 100_000 + "\n")
+    (tmp_path / "att.txt").write_text("1 " * 100_000)
+    monkeypatch.setenv("DCFKIT_MAX_IMAGE_PIXELS", LONG)
+    for call, said in [(lambda: read_boxes(tmp_path / "gt.txt"), "gt.txt, line 2: expected 4 numbers"),
+                       (lambda: read_flags(tmp_path / "att.txt", ("SV", "ARC")), "att.txt, line 1: expected 2"),
+                       (lambda: tracker_name({"name": "a/" + LONG}), "config 'name' 'a/qqq"),
+                       (max_image_pixels, "$DCFKIT_MAX_IMAGE_PIXELS must be a number of pixels >= 1, got 'qqq")]:
+        with pytest.raises(DcfkitError) as info:
+            call()
+        assert said in str(info.value) and len(str(info.value)) < MESSAGE_CHARS, str(info.value)[:2000]
+
+
+LONG_NAME = "q" * 5000  # over any file system's 255 bytes a name: pathlib's is_file() raised OSError
+
+
+@pytest.mark.parametrize("args,said", [
+    (["track", LONG_NAME, "--frames", "{root}/seqA/img", "--box", "10,10,14,10"], "error: config not found: qqq"),
+    (["track", "{long_base}", "--frames", "{root}/seqA/img", "--box", "10,10,14,10"],
+     "long_base.yaml: base config 'qqq"),
+    (["ablate", LONG_NAME, "--out", "{out}"], "error: ablation spec not found: qqq"),
+    (["ablate", "{long_config_spec}", "--out", "{out}"], "long_config_spec.yaml: variants.a: config 'qqq"),
+    (["ablate", "{long_root_spec}", "--out", "{out}", "--dry-run"], "long_root_spec.yaml: dataset root "),
+    (["eval", "strcf", "--root", LONG_NAME, "--out", "{out}"], "error: a name too long for the file system: qqq"),
+    (["eval", "strcf", "--dataset", "otb", "--root", "{root}", "--out", LONG_NAME], "error: cannot create the folder qqq"),
+    (["track", "strcf", "--frames", LONG_NAME, "--box", "10,10,14,10"], "error: a name too long for the file system"),
+    (["track", "strcf", "--frames", "{root}/seqA/img", "--box", "10,10,14,10", "--out", LONG_NAME],
+     "error: a name too long for the file system"),
+    (["report", LONG_NAME, "--dataset", "otb", "--root", "{root}"], "error: a name too long for the file system"),
+])
+def test_names_too_long_for_the_file_system_are_one_line_errors(args, said, otb_root, tmp_path, capsys):
+    """A path argument, a config's base: or a spec's config or root of 5000 characters: each
+    command ended in a traceback of pathlib's OSError (File name too long)."""
+    (tmp_path / "long_base.yaml").write_text(f"base: {LONG_NAME}\n")
+    (tmp_path / "long_config_spec.yaml").write_text(f"dataset: otb\nvariants: {{a: {LONG_NAME}}}\n")
+    (tmp_path / "long_root_spec.yaml").write_text(f"dataset: {{name: otb, root: {LONG_NAME}}}\nvariants: {{a: strcf}}\n")
+    paths = {"root": otb_root, "out": tmp_path / "out", **{name: tmp_path / f"{name}.yaml" for name in
+                                                           ("long_base", "long_config_spec", "long_root_spec")}}
+    status = cli.main([a.format(**paths) if "{" in a else a for a in args])
+    err = capsys.readouterr().err
+    assert status == 2 and said in err, err[:2000]
+    assert len(err) < MESSAGE_CHARS, err[:2000]

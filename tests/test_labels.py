@@ -78,8 +78,8 @@ def test_exclusion_zone_and_wrapped_offsets_of_the_distractors():
 
 
 @pytest.mark.parametrize("values, message", [
-    ({"mu": 1e300}, r"label: mu must be <= 1e\+06"),                        # y = g - μR̃ was -inf in float32
-    ({"neighbourhood": 10**6 + 1}, r"label: neighbourhood must be <= 101"),  # a wrap-padded 10^6-wide copy
+    ({"mu": 1e300}, r"label: mu must be in \[0, 1e\+06\], got 1e\+300"),                        # y = g - μR̃ was -inf in float32
+    ({"neighbourhood": 10**6 + 1}, r"label: neighbourhood must be in \[3, 101\], got 1000001"),  # a wrap-padded 10^6-wide copy
 ])
 def test_repression_values_beyond_float32_or_memory_are_refused(values, message):
     with pytest.raises(ConfigError, match=message):

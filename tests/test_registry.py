@@ -11,7 +11,7 @@ import pytest
 from dcfkit import registry as reg
 from dcfkit.errors import ConfigError, RegistryError
 from dcfkit.labels import Label
-from dcfkit.params import param, parse_params
+from dcfkit.params import fields, param, parse_params
 
 
 class FakeEntryPoint:
@@ -228,6 +228,10 @@ def test_an_entry_point_naming_the_hook_function_gets_a_hint(monkeypatch):
     ("level: 'tuple[float, ...]' = param((1.0, 2.0), 'x')", None),
     ("level: tuple = param((1, 'a'), 'x')", None),
     ("level: 'int | float' = param(1, 'x')", r"parameter 'level': annotation .* is not supported"),
+    ("level: float = param(0.5, 'x', gt=0, le=1)", None),
+    ("level: 'int | None' = param(None, 'x', ge=1)", None),
+    ("level: float = param(1.5, 'x', gt=0, le=1)", r"default Params: level must be in \(0, 1\], got 1.5"),
+    ("level: str = param('a', 'x', ge=0)", r"parameter 'level': bounds \(ge, gt, le, lt\) need an int or float"),
 ])
 def test_params_schemas_are_checked_when_the_component_registers(field, message):
     namespace = {"dataclasses": dataclasses, "np": np, "param": param}
@@ -247,6 +251,33 @@ def test_params_schemas_are_checked_when_the_component_registers(field, message)
     else:
         with pytest.raises(RegistryError, match=r"label 'checked' \(from \?\): " + message):
             r.register(Checked)
+
+
+@pytest.mark.parametrize("limits, inside, outside, message", [
+    ({"ge": 1, "le": 10000}, [1, 10000], [0, 10001, -1e300], r"x: n must be in \[1, 10000\], got "),
+    ({"gt": 0}, [5e-324, 1e300], [0, -0.0, -1e-300], r"x: n must be > 0, got "),
+    ({"gt": 0, "lt": 1}, [0.5], [0, 1], r"x: n must be in \(0, 1\), got "),
+    ({"le": 10}, [-1e300, 10], [10.5], r"x: n must be <= 10, got "),
+])
+def test_declared_bounds_are_checked_and_described(limits, inside, outside, message):
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        n: float = param(0.5 if "lt" in limits else 1, "a number", **limits)
+
+    for value in inside:
+        assert parse_params(Params, {"n": value}, "x").n == value
+    for value in outside:
+        with pytest.raises(ConfigError, match=message):
+            parse_params(Params, {"n": value}, "x")
+    assert fields(Params)[0]["bounds"] == message.split("must be ")[1].split(", got")[0].removeprefix("in ").replace(
+        "\\", "")
+
+
+@pytest.mark.parametrize("limits", [{"ge": 0, "gt": 0}, {"le": 1, "lt": 1}, {"ge": 2, "le": 1}, {"ge": "0"},
+                                    {"gt": float("nan")}, {"le": True}])
+def test_impossible_bounds_are_a_type_error_where_the_field_is_declared(limits):
+    with pytest.raises(TypeError, match="param limits"):
+        param(1.0, "a number", **limits)
 
 
 def test_union_and_fixed_tuple_annotations_are_checked():
@@ -389,6 +420,41 @@ def test_a_plugin_raising_keyboard_interrupt_is_named_and_skipped(monkeypatch, s
     with pytest.warns(reg.PluginWarning, match=message):
         r = _build_or_fail()
     assert "flat" in r.names("label") and "gaussian" in r.names("label")  # the other plugin's, undone ones' not
+
+
+BOOM = "class Boom(BaseException):\n    pass\n"
+
+
+@pytest.mark.parametrize("source, message", [
+    (BOOM + "raise Boom('at import')", r"'dcfkit_test_base \(dcfkit_test_base\)' could not be imported and was "
+                                       r"skipped: Boom: at import \(at <string>:3\)"),
+    ("raise GeneratorExit", r"could not be imported and was skipped: GeneratorExit \(at <string>:1\)"),
+    (BOOM + PLUGIN.replace("registry.register(Flat)", "registry.register(Flat)\n    raise Boom('in the hook')"),
+     r"'dcfkit_test_base \(dcfkit_test_base\)' failed and was skipped: Boom: in the hook \(at <string>:\d+\)"),
+])
+def test_a_plugin_raising_another_base_exception_is_named_and_skipped(monkeypatch, source, message):
+    """A BaseException that is neither SystemExit nor KeyboardInterrupt (a class of the plugin's,
+    GeneratorExit) escaped the registry: every command ended in a traceback."""
+    ep = _entry_point(monkeypatch, "dcfkit_test_base", source)
+    with_entry_points(monkeypatch, [ep, install_plugin(monkeypatch, "dcfkit_test_good3", PLUGIN)])
+    with pytest.warns(reg.PluginWarning, match=message):
+        r = reg.build_registry()
+    assert "flat" in r.names("label") and "gaussian" in r.names("label")  # the other plugin's flat stays
+
+
+def test_every_command_names_a_plugin_that_raises_a_base_exception(monkeypatch, capsys):
+    from dcfkit import cli
+
+    with_entry_points(monkeypatch, [_entry_point(monkeypatch, "dcfkit_test_base2", BOOM + "raise Boom")])
+    monkeypatch.setattr(reg, "_REGISTRY", None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        status = cli.main(["track", "strcf", "--frames", "/nonexistent", "--box", "1,1,5,5"])
+    err = capsys.readouterr().err
+    assert status == 2 and "error: " in err and "Traceback" not in err
+    assert "warning: dcfkit plugin 'dcfkit_test_base2 (dcfkit_test_base2)' could not be imported and was " \
+           "skipped: Boom (at <string>:3)" in err
+    monkeypatch.setattr(reg, "_REGISTRY", None)
 
 
 def test_every_command_names_a_plugin_that_raises_keyboard_interrupt(monkeypatch, capsys):

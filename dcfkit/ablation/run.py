@@ -6,7 +6,7 @@ import contextlib
 import json
 from pathlib import Path
 
-from ..errors import DcfkitError
+from ..errors import DcfkitError, shown
 from ..protocols import DEFAULT
 from ..results import LABEL_KEYS, ResultStore, atomic_write, dcfkit_version, ensure_writable, exclusive, read_json
 from ..runner import RunTask, execute, usable_cores
@@ -33,7 +33,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     if jobs < 1:
         raise DcfkitError(f"jobs must be >= 1, got {jobs}")
     if executor not in ("local", "dask"):
-        raise DcfkitError(f"executor must be 'local' or 'dask', got {executor!r}")
+        raise DcfkitError(f"executor must be 'local' or 'dask', got {shown(executor)}")
     out = Path(out).expanduser().resolve()
     seqs = spec.load_sequences()
     version = dcfkit_version()

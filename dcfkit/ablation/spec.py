@@ -12,6 +12,7 @@ from typing import Any, Iterable, Mapping
 
 import yaml
 
+from .. import limits
 from ..config import load_config, read_yaml, shipped_config, shipped_config_dir
 from ..datasets import DatasetError, canonical_name, load_dataset
 from ..errors import ConfigError, DcfkitError, clip, shown
@@ -22,7 +23,10 @@ SPEC_KEYS = ("name", "description", "dataset", "sequences", "variants", "grid")
 VARIANT_KEYS = ("config", "overrides", "description")
 GRID_KEYS = ("base", "overrides", "mode", "parameters")
 GRID_MODES = ("sweep", "product")
-MAX_VARIANTS = 1000  # named and grid variants in one spec: each is resolved (some 4 ms) when the spec is read
+# named and grid variants in one spec, each resolved when the spec is read (some 4 ms; 15 ms on a
+# busy machine): the default of $DCFKIT_MAX_VARIANTS and `dcfkit ablate --max-variants`
+MAX_VARIANTS = 1000
+RAISE_VARIANTS = f"dcfkit ablate --max-variants N, ${limits.VARIANTS_VARIABLE} or dcfkit.ablation.spec.MAX_VARIANTS raise it"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -67,7 +71,7 @@ class AblationSpec:
         if self.root is None:
             raise ConfigError(f"{self.path}: dataset.root is not given; pass --root DIR "
                               f"(the {self.dataset} benchmark folder)")
-        if not self.root.is_dir():
+        if not os.path.isdir(self.root):
             hint = "" if self.root_origin == "--root" else f"; pass --root DIR (the {self.dataset} benchmark folder)"
             raise ConfigError(f"{self.path}: dataset root {clip(str(self.root))} ({self.root_origin}) "
                               f"is not a folder{hint}")
@@ -96,11 +100,11 @@ def variant_names(jobs: Iterable[Job]) -> dict[str, list[str]]:
 
 def _find_spec(source: str | os.PathLike) -> Path:
     path = Path(source)
-    if path.is_file():
+    if os.path.isfile(path):  # os.path: a name too long for the file system is no file (Path.is_file raises)
         return path.resolve()
     folder = shipped_config_dir() / "ablations"
     for candidate in (folder / path, folder / f"{path}.yaml"):
-        if candidate.is_file() and candidate.suffix in (".yaml", ".yml"):
+        if os.path.isfile(candidate) and candidate.suffix in (".yaml", ".yml"):
             return candidate.resolve()
     shipped = [p.stem for p in sorted(folder.glob("*.yaml")) if _is_spec_file(p)] if folder.is_dir() else []
     raise ConfigError(f"ablation spec not found: {clip(str(source))}"
@@ -144,7 +148,7 @@ def _load(spec_path: Path, config: Any, overrides: Mapping, where: str, key: str
         raise ConfigError(f"{spec_path}: {key}: expected a config file or shipped name "
                           f"(e.g. ../dr2track.yaml or dr2track), got {shown(config)}")
     local = spec_path.parent / config
-    found = local if local.is_file() else shipped_config(config)  # never the working directory
+    found = local if os.path.isfile(local) else shipped_config(config)  # never the working directory
     if found is None:
         raise ConfigError(f"{spec_path}: {where}: config '{clip(config)}' not found (looked for "
                           f"{clip(str(local))} and for a shipped config of that name)")
@@ -166,7 +170,7 @@ def format_value(value: Any) -> str:
     return yaml.safe_dump(value, default_flow_style=True, width=10**6).strip().removesuffix("...").strip()
 
 
-def _parse_grid(spec_path: Path, data: Any, named: dict[str, Variant]) -> tuple[Grid, list[Variant]]:
+def _parse_grid(spec_path: Path, data: Any, named: dict[str, Variant], limit: int) -> tuple[Grid, list[Variant]]:
     grid = _mapping(data, f"{spec_path}: grid", "a mapping with base, mode and parameters")
     _check_keys(grid, GRID_KEYS, f"{spec_path}: grid")
     mode = grid.get("mode", "sweep")
@@ -189,7 +193,7 @@ def _parse_grid(spec_path: Path, data: Any, named: dict[str, Variant]) -> tuple[
         raise ConfigError(f"{spec_path}: grid.parameters: empty; give at least one dotted key with a list of values")
     parsed = _parse_parameters(spec_path, params)
     variants = []
-    for point in _grid_points(spec_path, parsed, mode, len(named)):
+    for point in _grid_points(spec_path, parsed, mode, len(named), limit):
         name = ", ".join(f"{parsed[k][0]}={format_value(v)}" for k, v in point.items())
         where = clip("grid (" + ", ".join(f"{k}={format_value(v)}" for k, v in point.items()) + ")")
         config, _ = _load(spec_path, base_source, {**base_overrides, **point}, where, "grid.base")
@@ -230,30 +234,42 @@ def _first_repeat(items: Iterable) -> Any:
     return None
 
 
-def _grid_points(spec_path: Path, parsed: Mapping, mode: str, named: int) -> list[dict]:
+def _grid_points(spec_path: Path, parsed: Mapping, mode: str, named: int, limit: int) -> list[dict]:
     """The grid's points (dotted key -> value), counted before they are made: a product of a few
     long lists is more variants than can be resolved, or held."""
     lengths = [len(values) for _, values in parsed.values()]
     count = sum(lengths) if mode == "sweep" else math.prod(lengths)
-    if named + count > MAX_VARIANTS:
+    if named + count > limit:
         raise ConfigError(f"{spec_path}: grid.parameters: {count} grid points ({mode}) and {named} named variants; "
-                          f"a spec has at most {MAX_VARIANTS} variants (dcfkit.ablation.spec.MAX_VARIANTS)")
+                          f"a spec has at most {limit} variants ({RAISE_VARIANTS})")
     if mode == "sweep":
         return [{key: value} for key, (_, values) in parsed.items() for value in values]
     keys = list(parsed)
     return [dict(zip(keys, combo)) for combo in itertools.product(*(parsed[k][1] for k in keys))]
 
 
+def variant_limit(given: int | None = None) -> int:
+    """The most variants a spec may have: ``given`` (``dcfkit ablate --max-variants``), else
+    ``$DCFKIT_MAX_VARIANTS``, else :data:`MAX_VARIANTS`."""
+    if given is None:
+        return limits.max_variants(MAX_VARIANTS)
+    if isinstance(given, bool) or not isinstance(given, int) or given < 1:
+        raise ConfigError(f"max_variants must be a whole number >= 1, got {shown(given)}")
+    return given
+
+
 def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
-              sequences: Iterable[str] | str | None = None) -> AblationSpec:
+              sequences: Iterable[str] | str | None = None, max_variants: int | None = None) -> AblationSpec:
     """Read and validate an ablation spec (a path, or a shipped name such as ``table3``).
 
     ``root`` replaces the spec's ``dataset.root`` (relative to the working directory);
     the spec's own root is relative to the spec file. ``sequences`` (names, or one
     comma-separated string) replaces the spec's subset. Every variant's config is resolved
     here, so a wrong key or value fails before anything runs; errors name the spec file
-    and the key.
+    and the key. A spec has at most :func:`variant_limit` variants (``max_variants``, else
+    ``$DCFKIT_MAX_VARIANTS``, else :data:`MAX_VARIANTS`).
     """
+    limit = variant_limit(max_variants)
     path = _find_spec(source)
     data = read_yaml(path)
     _check_keys(data, SPEC_KEYS, str(path))
@@ -261,10 +277,10 @@ def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
         if data.get(key) is not None and not isinstance(data[key], str):
             raise ConfigError(f"{path}: {key}: expected a string, got {shown(data[key])}")
     dataset_name, root_path, origin = _parse_dataset(path, data.get("dataset"), root)
-    named = _parse_variants(path, data.get("variants"))
+    named = _parse_variants(path, data.get("variants"), limit)
     grid, grid_variants = None, []
     if data.get("grid") is not None:
-        grid, grid_variants = _parse_grid(path, data["grid"], named)
+        grid, grid_variants = _parse_grid(path, data["grid"], named, limit)
     for v in grid_variants:
         if v.name in named:
             raise ConfigError(f"{path}: grid point {shown(v.name)} has the same name as variants.{clip(v.name)}; "
@@ -316,12 +332,12 @@ def _parse_sequences(path: Path, data: Mapping, sequences) -> tuple | None:
     return tuple(dict.fromkeys(sequences))
 
 
-def _parse_variants(path: Path, raw: Any) -> dict[str, Variant]:
+def _parse_variants(path: Path, raw: Any, limit: int) -> dict[str, Variant]:
     """The named variants, each config resolved with its overrides."""
     raw_variants = _mapping(raw, f"{path}: variants", "a mapping of variant names to {config: ..., overrides: {...}}")
-    if len(raw_variants) > MAX_VARIANTS:
-        raise ConfigError(f"{path}: variants: {len(raw_variants)} variants; a spec has at most {MAX_VARIANTS} "
-                          f"(dcfkit.ablation.spec.MAX_VARIANTS)")
+    if len(raw_variants) > limit:
+        raise ConfigError(f"{path}: variants: {len(raw_variants)} variants; a spec has at most {limit} "
+                          f"({RAISE_VARIANTS})")
     named: dict[str, Variant] = {}
     for name, entry in raw_variants.items():
         where = f"variants.{clip(str(name))}"

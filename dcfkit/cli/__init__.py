@@ -2,10 +2,11 @@
 library's (:mod:`dcfkit.evaluation`, :mod:`dcfkit.ablation`, :mod:`dcfkit.report`, ...)."""
 from __future__ import annotations
 
+import errno
 import sys
 import warnings
 
-from ..errors import DcfkitError
+from ..errors import DcfkitError, clip
 from ..registry import PluginWarning
 from ..tracking import interrupt_on_termination
 from .parser import build_parser
@@ -39,3 +40,9 @@ def main(argv: list[str] | None = None) -> int:
         except BrokenPipeError:  # e.g. piped into head
             sys.stderr.close()
             return 0
+        except OSError as exc:  # pathlib's is_file() and the like raise it for any argument or config value
+            if exc.errno != errno.ENAMETOOLONG:
+                raise
+            print(f"dcfkit {args.command}: error: a name too long for the file system: "
+                  f"{clip(str(exc.filename))}", file=sys.stderr)
+            return 2

@@ -5,10 +5,11 @@ import argparse
 from pathlib import Path
 
 from ..ablation import expand, job_dir, load_spec, run_ablation, summary_columns, variant_names
+from ..ablation.spec import MAX_VARIANTS
 from ..errors import DcfkitError
 from ..report import format_table
 from ..results import ResultStore
-from .common import add_protocol_argument
+from .common import add_protocol_argument, variant_count
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -27,6 +28,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="benchmark root folder (default: the spec's dataset.root, relative to the spec)")
     parser.add_argument("--sequences", default=None,
                         help="comma-separated sequence names (default: the spec's, else all)")
+    parser.add_argument("--max-variants", type=variant_count, default=None, metavar="N",
+                        help="the most variants (named ones and grid points) the spec may have (default: "
+                             f"$DCFKIT_MAX_VARIANTS, else {MAX_VARIANTS}); each is resolved when the spec is read")
     add_protocol_argument(parser)
     parser.add_argument("--dry-run", action="store_true",
                         help="list the jobs and whether each is done; run nothing")
@@ -49,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
     executor = args.executor or ("dask" if args.scheduler else "local")
     if args.scheduler and executor != "dask":
         raise DcfkitError("--scheduler needs --executor dask")
-    spec = load_spec(args.spec, root=args.root, sequences=args.sequences)
+    spec = load_spec(args.spec, root=args.root, sequences=args.sequences, max_variants=args.max_variants)
     if args.dry_run:
         return _dry_run(spec, args.out.expanduser().resolve())
     res = run_ablation(spec, args.out, jobs=args.jobs, executor=executor, scheduler=args.scheduler,

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..errors import DcfkitError
+from ..errors import DcfkitError, shown
 from ..protocols import DEFAULT, PROTOCOLS
 
 
@@ -15,7 +15,7 @@ def parse_box(text: str) -> tuple[float, ...]:
     except ValueError:
         box = ()
     if len(box) != 4:
-        raise DcfkitError(f"--box expects x,y,w,h (four numbers), got {text!r}")
+        raise DcfkitError(f"--box expects x,y,w,h (four numbers), got {shown(text)}")
     return box
 
 
@@ -28,7 +28,7 @@ def _argument_type(convert, accept, expected: str):
         except ValueError:
             value = None
         if value is None or not accept(value):
-            raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}")
+            raise argparse.ArgumentTypeError(f"expected {expected}, got {shown(text)}")
         return value
     return parse
 
@@ -40,6 +40,7 @@ pixels = _argument_type(float, lambda v: v >= 0, "a distance in pixels >= 0")  #
 frame_count = _argument_type(int, lambda v: 2 <= v <= MAX_DEMO_FRAMES,
                              f"a whole number of frames from 2 to {MAX_DEMO_FRAMES}")
 seed = _argument_type(int, lambda v: v >= 0, "a whole number >= 0")  # numpy refuses negative seeds
+variant_count = _argument_type(int, lambda v: v >= 1, "a whole number of variants >= 1")
 
 
 def add_protocol_argument(parser: argparse.ArgumentParser) -> None:

@@ -1,5 +1,6 @@
-"""``dcfkit components``: every registered component, its parameters and defaults, as a
-table, Markdown (also used for docs/configs.md) or JSON."""
+"""``dcfkit components``: every registered component, its parameters with their defaults and
+bounds, and what its ``Params.validate`` checks of them together, as a table, Markdown (also
+used for docs/configs.md) or JSON."""
 from __future__ import annotations
 
 import argparse
@@ -11,7 +12,7 @@ from typing import Any, Iterable
 
 import yaml
 
-from ..params import fields
+from ..params import Bounds, fields
 from ..registry import KINDS, PluginWarning, get_registry
 
 
@@ -34,26 +35,48 @@ def run(args: argparse.Namespace) -> int:
         for row in rows:
             print(f"{row['kind']:<12} {row['name']:<22} {row['doc']}  [{row['provider']}]")
             for f in row["params"]:
-                print(f"{'':<14}{f['name']} ({f['type']}, default {f['default']}): {f['help']}")
+                bounds = f", {f['bounds']}" if f["bounds"] else ""
+                print(f"{'':<14}{f['name']} ({f['type']}, default {f['default']}{bounds}): {f['help']}")
+            if row["checks"]:
+                print(f"{'':<14}also: {row['checks']}")
     for failure in registry.failures:
         print(f"warning: {failure}", file=sys.stderr)
     return 1 if registry.failures else 0
 
 
-def summary(cls: type) -> str:
-    """First paragraph of a class docstring, on one line ('' without a docstring)."""
+def summary(cls: Any) -> str:
+    """First paragraph of a class's (or function's) docstring, on one line ('' without one)."""
     doc = inspect.cleandoc(cls.__doc__ or "")
     return " ".join(doc.split("\n\n")[0].split())
 
 
+def checks(schema: type) -> str:
+    """What ``schema.validate`` checks beyond each field's bounds: its docstring's first
+    paragraph ('' without one)."""
+    validate = getattr(schema, "validate", None)
+    return summary(validate) if validate is not None else ""
+
+
+def params_of(entry) -> list[dict]:
+    """:func:`dcfkit.params.fields` of a registered component's ``Params``; a field the
+    tracker reads (its kind's contract) and that declares no bounds shows the contract's."""
+    params = fields(entry.cls.Params)
+    for f in params:
+        if f["bounds"] is None and f["name"] in entry.contract.params:
+            _, low, high = entry.contract.params[f["name"]]
+            f["bounds"] = str(Bounds(low, high))
+    return params
+
+
 def component_rows(registry, kinds: Iterable[str] | None = None) -> list[dict]:
-    """One dict per registered component: kind, name, provider, doc, params (and role)."""
+    """One dict per registered component: kind, name, provider, doc, params, checks (what its
+    ``Params.validate`` checks, from its docstring; '' without) and, for a regularizer, role."""
     rows = []
     for kind in kinds or KINDS:
         for name in registry.names(kind):
             entry = registry.entry(kind, name)
             row = {"kind": kind, "name": name, "provider": entry.provider, "doc": summary(entry.cls),
-                   "params": fields(entry.cls.Params)}
+                   "params": params_of(entry), "checks": checks(entry.cls.Params)}
             if kind == "regularizer":
                 row["role"] = getattr(entry.cls, "role", None)
             rows.append(row)
@@ -77,10 +100,11 @@ def params_table(params: list[dict]) -> str:
     """Markdown table of :func:`dcfkit.params.fields` output."""
     if not params:
         return "No parameters.\n"
-    lines = ["| parameter | type | default | description |", "|---|---|---|---|"]
+    lines = ["| parameter | type | default | range | description |", "|---|---|---|---|---|"]
     for f in params:
         help_ = f["help"] + (f" (one of: {', '.join(f'`{c}`' for c in f['choices'])})" if f["choices"] else "")
-        lines.append(f"| `{f['name']}` | {cell(f['type'])} | `{cell(yaml_value(f['default']))}` "
+        bounds = f"`{cell(f['bounds'])}`" if f["bounds"] else ""
+        lines.append(f"| `{f['name']}` | {cell(f['type'])} | `{cell(yaml_value(f['default']))}` | {bounds} "
                      f"| {cell(help_)} |")
     return "\n".join(lines) + "\n"
 
@@ -90,8 +114,9 @@ def components_markdown(rows: list[dict], level: int = 3) -> str:
     out = []
     for row in rows:
         role = f" Role: `{row['role']}`." if row.get("role") else ""
+        checks = f"\nAlso checked: {row['checks']}\n" if row["checks"] else ""
         out.append(f"{'#' * level} {row['kind']} `{row['name']}`\n\n{row['doc']} (from {row['provider']}){role}\n\n"
-                   f"{params_table(row['params'])}")
+                   f"{params_table(row['params'])}{checks}")
     return "\n".join(out)
 
 

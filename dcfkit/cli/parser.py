@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 
 from .. import __version__
+from ..errors import SHOWN_CHARS
 from . import ablate, components, evaluate, track
 
 DESCRIPTION = """dcfkit: discriminative correlation filter trackers assembled from YAML.
@@ -27,8 +28,18 @@ COMMANDS = {
 }
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse's parser, but a usage error shows at most the start and end of its message:
+    argparse echoes an invalid choice or unrecognized argument whole, however long."""
+
+    def error(self, message: str):
+        if len(message) > 2 * SHOWN_CHARS:  # the start names the argument, the end the valid choices
+            message = f"{message[:SHOWN_CHARS]}...{message[-SHOWN_CHARS:]}"
+        super().error(message)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="dcfkit", description=DESCRIPTION)
+    parser = Parser(prog="dcfkit", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"dcfkit {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     for name, (help_, add_arguments, run) in COMMANDS.items():

@@ -17,7 +17,7 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
-from ..errors import DcfkitError
+from ..errors import DcfkitError, clip, shown
 from ..limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 
@@ -313,7 +313,7 @@ def read_boxes(path: str | os.PathLike, one_based: bool = True) -> np.ndarray:
         except ValueError:
             raise DatasetError(
                 f"{path}, line {n + 1}: expected 4 numbers 'x,y,w,h' separated by commas, "
-                f"tabs or spaces, got {line.strip()!r}") from None
+                f"tabs or spaces, got {shown(line.strip())}") from None
     if one_based:
         boxes[:, :2] -= 1.0
     return boxes
@@ -325,7 +325,7 @@ def read_flags(path: Path, names: tuple[str, ...]) -> dict[str, bool]:
     if len(fields) != len(names) or any(f not in ("0", "1") for f in fields):
         raise DatasetError(
             f"{path}, line 1: expected {len(names)} 0/1 flags ({' '.join(names)}), "
-            f"got {' '.join(fields)!r}")
+            f"got {shown(' '.join(fields))}")
     return {name: f == "1" for name, f in zip(names, fields)}
 
 
@@ -340,10 +340,10 @@ def numbered_frames(folder: Path, pattern: str, first: int, last: int, what: str
     names = [pattern % k for k in range(first, last + 1)]
     missing = [n for n in names if n not in present]
     if missing:
-        shown = ", ".join(missing[:3]) + (f" and {len(missing) - 3} more" if len(missing) > 3 else "")
+        listed = ", ".join(missing[:3]) + (f" and {len(missing) - 3} more" if len(missing) > 3 else "")
         raise DatasetError(
             f"{what}: {len(missing)} of frames {pattern % first}..{pattern % last} missing "
-            f"in {folder}: {shown}")
+            f"in {folder}: {listed}")
     return tuple(folder / n for n in names)
 
 
@@ -378,7 +378,7 @@ def require_root(root, what: str) -> Path:
     """``root`` as a Path (``~`` expanded); :class:`DatasetError` if it is not a folder."""
     root = Path(root).expanduser()
     if not root.is_dir():
-        raise DatasetError(f"{what} root folder not found: {root}")
+        raise DatasetError(f"{what} root folder not found: {clip(str(root))}")
     return root
 
 
@@ -411,14 +411,14 @@ def select_sequences(available: list[str], requested: Iterable[str] | str | None
 
 
 def _not_found(want: str, available: list[str], where: str, missing_annotation: Path | None) -> DatasetError:
-    shown = ", ".join(available[:40]) + (" ..." if len(available) > 40 else "")
+    listed = ", ".join(available[:40]) + (" ..." if len(available) > 40 else "")
     if missing_annotation is not None:
-        return DatasetError(f"sequence {want!r} of {where}: annotation file not found: "
-                            f"{missing_annotation}. Available ({len(available)}): {shown or 'none'}")
+        return DatasetError(f"sequence {shown(want)} of {where}: annotation file not found: "
+                            f"{missing_annotation}. Available ({len(available)}): {listed or 'none'}")
     close = difflib.get_close_matches(want, available, n=1, cutoff=0.5)
     hint = f" Did you mean {close[0]!r}?" if close else ""
-    return DatasetError(f"sequence {want!r} not found in {where}.{hint} "
-                        f"Available ({len(available)}): {shown or 'none'}")
+    return DatasetError(f"sequence {shown(want)} not found in {where}.{hint} "
+                        f"Available ({len(available)}): {listed or 'none'}")
 
 
 # --------------------------------------------------------------------------- the <seq>/img layout

@@ -14,7 +14,7 @@ import enum
 from pathlib import Path
 from typing import Callable, Iterable, Iterator, Mapping
 
-from ..errors import RegistryError
+from ..errors import RegistryError, shown
 from .base import DatasetError, Sequence, require_root
 
 Loader = Callable[..., list[Sequence]]  # (root, sequences=None) -> list[Sequence]
@@ -87,7 +87,7 @@ def register_layout(name: str, load: Loader, description: str, *,
 def _check_new_layout(layout: Layout) -> None:
     where = f"dataset layout {layout.name!r}"
     if not layout.name:
-        raise RegistryError(f"dataset layout {layout.description!r}: the name is empty")
+        raise RegistryError(f"dataset layout {shown(layout.description)}: the name is empty")
     if "auto" in (layout.name,) + layout.aliases:
         raise RegistryError(f"{where}: 'auto' cannot be a name: load_dataset('auto', root) detects the dataset")
     for taken in (n for n in (layout.name,) + layout.aliases if n in _NAMES):
@@ -99,7 +99,7 @@ def _check_new_layout(layout: Layout) -> None:
         raise RegistryError(f"{where}: load and detect must be functions")
     if not layout.description or "\n" in layout.description:
         raise RegistryError(f"{where}: the description must be one non-empty line, "
-                            f"got {layout.description!r}")
+                            f"got {shown(layout.description)}")
 
 
 def unregister_layout(name: str) -> Layout:
@@ -157,7 +157,7 @@ def canonical_name(name: str) -> str:
     """Canonical dataset name for ``name`` (case-insensitive, ``-``/``@`` accepted)."""
     found = _NAMES.get(_key(name))
     if found is None:
-        raise DatasetError(f"unknown dataset {name!r}; valid names: {', '.join(_LAYOUTS)} "
+        raise DatasetError(f"unknown dataset {shown(name)}; valid names: {', '.join(_LAYOUTS)} "
                            f"(case-insensitive). Their layouts:\n{_known_layouts()}")
     return found
 
@@ -206,5 +206,5 @@ def _evidence(layout: Layout, root: Path) -> Evidence:
     try:
         return Evidence(int(level))
     except (TypeError, ValueError):
-        raise RegistryError(f"dataset layout {layout.name!r}: detect({root}) returned {level!r}, "
+        raise RegistryError(f"dataset layout {layout.name!r}: detect({root}) returned {shown(level)}, "
                             f"not an Evidence level (0..{int(Evidence.NAME)}) or a bool") from None

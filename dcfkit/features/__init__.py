@@ -87,8 +87,10 @@ class FHOG(Feature):
 
     @dataclasses.dataclass(frozen=True)
     class Params:
-        n_orients: int = param(9, "unsigned orientation bins (signed ones: twice as many)")
-        clip: float = param(0.2, "truncation of the normalised histograms")
+        # at most MAX_ORIENTS: 3 channels each, the size of the maps and the solver's time; clip at least
+        # MIN_CLIP: a smaller one keeps only which bins are empty, or rounds to float32's 0
+        n_orients: int = param(9, "unsigned orientation bins (signed ones: twice as many)", ge=2, le=MAX_ORIENTS)
+        clip: float = param(0.2, "truncation of the normalised histograms", ge=MIN_CLIP, le=1)
         soft_orientation: bool = param(False, "split each gradient between the two nearest orientation bins "
                                               "(false: nearest bin only, as Piotr's fhog used by STRCF/BACF)")
         channel_order: str = param("bgr", "which colour channel's gradient a pixel takes when two are equally "
@@ -99,14 +101,7 @@ class FHOG(Feature):
                                 choices=("exact", "sse"))
 
         def validate(self):
-            if self.n_orients < 2:
-                return "n_orients must be at least 2"
-            if self.n_orients > MAX_ORIENTS:  # 3 channels each: the size of the maps, the solver's time
-                return f"n_orients must be at most {MAX_ORIENTS}"
-            if not 0 < self.clip <= 1:
-                return "clip must be in (0, 1]"
-            if self.clip < MIN_CLIP:  # a smaller one keeps only which bins are empty, or rounds to float32's 0
-                return f"clip must be at least {MIN_CLIP:g}"
+            """arithmetic 'sse' only with soft_orientation false."""
             if self.arithmetic == "sse" and self.soft_orientation:
                 return "arithmetic 'sse' (Piotr's gradientMex) bins orientations hard: set soft_orientation false"
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ConfigError
+from ..errors import ConfigError, clip, shown
 
 SHAPE = (32768, 10)
 SHA256 = "e6a0a45f68cf5880d018f9e2f82dff180e992296d335b0fa8eb253b9db403ec0"
@@ -84,11 +84,10 @@ def _is_file(p: Path | None) -> bool:
 def table_path_problem(path: str) -> str | None:
     """Why ``path`` cannot name a table (checked when a config is read), or None."""
     p = _expanded(path)
-    shown = path if len(path) <= 200 else f"{path[:200]}..."
     if not path.endswith((".npy", ".mat")):
-        return f"table_path: {shown!r} must be a .npy or .mat file"
+        return f"table_path: {shown(path)} must be a .npy or .mat file"
     if not _is_file(p):
-        return f"table_path: file not found: {shown}"
+        return f"table_path: file not found: {clip(path)}"
     return None
 
 

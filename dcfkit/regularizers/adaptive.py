@@ -49,19 +49,17 @@ class LocalVariation(SpatialRegularizer):
 
     @dataclasses.dataclass(frozen=True)
     class Params:
-        inside: float = param(1e-3, "w inside the target box before the response varies (reg_window_min)")
-        outside: float = param(1e5, "w outside the target box (reg_window_max)")
-        delta: float = param(0.2, "δ: w inside the box is δ log(Π + 1)")
+        inside: float = param(1e-3, "w inside the target box before the response varies (reg_window_min)",
+                              ge=0, le=MAX_WEIGHT)
+        outside: float = param(1e5, "w outside the target box (reg_window_max)", ge=0, le=MAX_WEIGHT)
+        delta: float = param(0.2, "δ: w inside the box is δ log(Π + 1)", ge=0, le=MAX_WEIGHT)
         placement: str = param("authors", "where an odd box sits in an even patch: 'centred' or 'authors' "
                                "(init_regwindow's, a cell lower and to the right)", choices=PLACEMENTS)
 
         def validate(self):
-            if not 0 <= self.inside <= self.outside:
-                return "need 0 <= inside <= outside"
-            if self.outside > MAX_WEIGHT:
-                return f"outside must be <= {MAX_WEIGHT:g}"
-            if not 0 <= self.delta <= MAX_WEIGHT:
-                return f"delta must be in [0, {MAX_WEIGHT:g}]"
+            """inside <= outside."""
+            if self.inside > self.outside:
+                return "need inside <= outside"
 
     def reset(self):
         self.previous = None
@@ -92,21 +90,12 @@ class GlobalVariation(TemporalRegularizer):
 
     @dataclasses.dataclass(frozen=True)
     class Params:
-        theta: float = param(13.0, "ζ: the reference θ before any variation, and its scale (zeta)")
-        nu: float = param(0.2, "ν: how fast θ̃ falls as the response varies")
+        theta: float = param(13.0, "ζ: the reference θ before any variation, and its scale (zeta)",
+                             ge=0, le=MAX_THETA)
+        nu: float = param(0.2, "ν: how fast θ̃ falls as the response varies", ge=0, le=1e6)
         occlusion: float = param(0.3, "φ: from this η on the frame is an occlusion and the filter is kept "
-                                 "(inf: never)")
-        norm_scale: float = param(1e4, "η = ‖Π‖₂ / norm_scale (the authors' 1e4)")
-
-        def validate(self):
-            if not 0 <= self.theta <= MAX_THETA:
-                return f"theta must be in [0, {MAX_THETA:g}]"
-            if not 0 <= self.nu <= 1e6:
-                return "nu must be in [0, 1e6]"
-            if not self.occlusion > 0:
-                return "occlusion must be > 0"
-            if not 1e-6 <= self.norm_scale <= 1e12:
-                return "norm_scale must be in [1e-6, 1e12]"
+                                 "(inf: never)", gt=0)
+        norm_scale: float = param(1e4, "η = ‖Π‖₂ / norm_scale (the authors' 1e4)", ge=1e-6, le=1e12)
 
     def reset(self):
         self.previous = None

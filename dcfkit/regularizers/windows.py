@@ -16,16 +16,15 @@ class BoxWindow(SpatialRegularizer):
 
     @dataclasses.dataclass(frozen=True)
     class Params:
-        inside: float = param(1e-3, "w inside the target box (reg_window_min)")
-        outside: float = param(1e5, "w outside the target box (reg_window_max)")
+        inside: float = param(1e-3, "w inside the target box (reg_window_min)", ge=0, le=MAX_WEIGHT)
+        outside: float = param(1e5, "w outside the target box (reg_window_max)", ge=0, le=MAX_WEIGHT)
         placement: str = param("centred", "where an odd box sits in an even patch: 'centred' or 'authors' "
                                "(init_regwindow's, a cell lower and to the right)", choices=PLACEMENTS)
 
         def validate(self):
-            if not 0 <= self.inside <= self.outside:
-                return "need 0 <= inside <= outside"
-            if self.outside > MAX_WEIGHT:
-                return f"outside must be <= {MAX_WEIGHT:g}"
+            """inside <= outside."""
+            if self.inside > self.outside:
+                return "need inside <= outside"
 
     def weights_squared(self, shape, target_cells):
         mask = target_mask(shape, target_cells, self.params.placement)
@@ -40,17 +39,15 @@ class SmoothWindow(SpatialRegularizer):
 
     @dataclasses.dataclass(frozen=True)
     class Params:
-        minimum: float = param(0.1, "w at the target centre")
-        edge: float = param(3.0, "w at the border of the target box")
-        power: float = param(2.0, "exponent of the normalised distance")
+        minimum: float = param(0.1, "w at the target centre", ge=0, le=MAX_WEIGHT)
+        edge: float = param(3.0, "w at the border of the target box", ge=0, le=MAX_WEIGHT)
+        # <= 0: an infinite weight at the centre
+        power: float = param(2.0, "exponent of the normalised distance", gt=0, le=MAX_POWER)
 
         def validate(self):
-            if not 0 <= self.minimum <= self.edge:
-                return "need 0 <= minimum <= edge"
-            if self.edge > MAX_WEIGHT:
-                return f"edge must be <= {MAX_WEIGHT:g}"
-            if not 0 < self.power <= MAX_POWER:  # <= 0: an infinite weight at the centre
-                return f"power must be in (0, {MAX_POWER:g}]"
+            """minimum <= edge."""
+            if self.minimum > self.edge:
+                return "need minimum <= edge"
 
     def weights_squared(self, shape, target_cells):
         ys = (np.arange(shape[0]) - (shape[0] - 1) / 2) / max(target_cells[0] / 2, 0.5)
@@ -69,15 +66,9 @@ class Crop(SpatialRegularizer):
 
     @dataclasses.dataclass(frozen=True)
     class Params:
-        lam: float = param(0.01, "λ: ridge weight on the filter inside the box")
+        lam: float = param(0.01, "λ: ridge weight on the filter inside the box", ge=0, le=MAX_WEIGHT**2)  # λ is w²
         placement: str = param("centred", "where an odd box sits in an even patch: 'centred' or 'authors' "
                                "(BACF's get_subwindow_no_window, a cell lower and to the right)", choices=PLACEMENTS)
-
-        def validate(self):
-            if self.lam < 0:
-                return "lam must be >= 0"
-            if self.lam > MAX_WEIGHT**2:  # λ is w² inside the box
-                return f"lam must be <= {MAX_WEIGHT**2:g}"
 
     def weights_squared(self, shape, target_cells):
         return np.where(target_mask(shape, target_cells, self.params.placement), self.params.lam,
@@ -91,10 +82,4 @@ class Temporal(TemporalRegularizer):
 
     @dataclasses.dataclass(frozen=True)
     class Params:
-        theta: float = param(15.0, "θ: weight of the distance to the previous frame's filter")
-
-        def validate(self):
-            if self.theta < 0:
-                return "theta must be >= 0"
-            if self.theta > MAX_THETA:
-                return f"theta must be <= {MAX_THETA:g}"
+        theta: float = param(15.0, "θ: weight of the distance to the previous frame's filter", ge=0, le=MAX_THETA)

@@ -56,26 +56,26 @@ def sherman_morrison_solve(a: np.ndarray, b: np.ndarray, c: float) -> np.ndarray
     return x.reshape(shape)
 
 
+# Every penalty γ the ADMM uses: it divides by γ and by θ + γ, and multiplies by γK, in float32
+PENALTY_RANGE = (1e-10, 1e10)
+
+
 @dataclasses.dataclass(frozen=True)
 class ADMMParams:
-    iterations: int = param(4, "E: ADMM iterations per frame")
-    gamma0: float = param(1.0, "γ⁰: initial penalty")
-    beta: float = param(10.0, "β: penalty growth per iteration")
-    gamma_max: float = param(10000.0, "γ_max: largest penalty")
+    iterations: int = param(4, "E: ADMM iterations per frame", ge=1, le=10000)
+    gamma0: float = param(1.0, "γ⁰: initial penalty", ge=PENALTY_RANGE[0], le=PENALTY_RANGE[1])
+    beta: float = param(10.0, "β: penalty growth per iteration", gt=0)
+    gamma_max: float = param(10000.0, "γ_max: largest penalty", ge=PENALTY_RANGE[0], le=PENALTY_RANGE[1])
     h_step: str = param("standard", "'standard' h from v + u/γ (Eq. 10 with the unscaled multiplier), or 'authors' "
                         "from γ(v + u) as DR²Track's run_training.m (the same on the first iteration)",
                         choices=("standard", "authors"))
 
     def validate(self):
-        if not 1 <= self.iterations <= 10000:
-            return "iterations must be in [1, 10000]"
-        if self.gamma0 <= 0 or self.gamma_max <= 0 or self.beta <= 0:
-            return "gamma0, beta and gamma_max must be > 0"
+        """every penalty γ of the schedule (γ⁰, then γ ← min(gamma_max, beta·γ)) in [1e-10, 1e10];
+        with h_step 'authors', the growth of the multiplier's error at most 1e10."""
         return schedule_problem(self)
 
 
-# Every penalty γ the ADMM uses: it divides by γ and by θ + γ, and multiplies by γK, in float32
-PENALTY_RANGE = (1e-10, 1e10)
 # h_step 'authors' adds the unscaled multiplier u = γz to v (Eq. 10 reads z): inside the target
 # box each iteration multiplies the multiplier's error by |1 - γ|; beyond this the filter is noise
 AUTHORS_GROWTH_MAX = 1e10
@@ -92,10 +92,7 @@ def penalties(p: ADMMParams) -> list[float]:
 def schedule_problem(p: ADMMParams) -> str | None:
     """Why the penalties of ``p`` cannot work in float32 (:data:`PENALTY_RANGE`,
     :data:`AUTHORS_GROWTH_MAX`), or None."""
-    low, high = PENALTY_RANGE
-    for key, value in (("gamma0", p.gamma0), ("gamma_max", p.gamma_max)):
-        if not low <= value <= high:
-            return f"{key} must be in [{low:g}, {high:g}]"
+    low = PENALTY_RANGE[0]  # gamma0 and gamma_max are within the range (their bounds): β is not
     schedule = penalties(p)
     worst = min(range(len(schedule)), key=schedule.__getitem__)
     if schedule[worst] < low:
@@ -178,11 +175,8 @@ class ADMMStrcf(Solver):
 
 @dataclasses.dataclass(frozen=True)
 class BACFParams(ADMMParams):
-    iterations: int = param(2, "E: ADMM iterations per frame")
-    learning_rate: float = param(0.013, "η: weight of the new sample in the running sample model")
-
-    def validate(self):
-        return super().validate() or (None if 0 < self.learning_rate <= 1 else "learning_rate must be in (0, 1]")
+    iterations: int = param(2, "E: ADMM iterations per frame", ge=1, le=10000)
+    learning_rate: float = param(0.013, "η: weight of the new sample in the running sample model", gt=0, le=1)
 
 
 class ADMMBacf(Solver):

@@ -34,14 +34,9 @@ MAX_ABERRANCE = 1e4  # γ: the sample is scaled by √(1 + γ), kept well inside
 
 @dataclasses.dataclass(frozen=True)
 class ARCFParams(BACFParams):
-    iterations: int = param(5, "E: ADMM iterations per frame (admm_iterations)")
-    learning_rate: float = param(0.0192, "η: weight of the new sample in the running sample model")
-    aberrance: float = param(0.71, "γ of the aberrance term (admm_gamma); 0 is BACF")
-
-    def validate(self):
-        if not 0 <= self.aberrance <= MAX_ABERRANCE:
-            return f"aberrance must be in [0, {MAX_ABERRANCE:g}]"
-        return super().validate()
+    iterations: int = param(5, "E: ADMM iterations per frame (admm_iterations)", ge=1, le=10000)
+    learning_rate: float = param(0.0192, "η: weight of the new sample in the running sample model", gt=0, le=1)
+    aberrance: float = param(0.71, "γ of the aberrance term (admm_gamma); 0 is BACF", ge=0, le=MAX_ABERRANCE)
 
 
 def point_symmetric(m: np.ndarray) -> np.ndarray:

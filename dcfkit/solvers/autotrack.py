@@ -19,12 +19,7 @@ from .admm import ADMMParams, ADMMStrcf, admm
 
 @dataclasses.dataclass(frozen=True)
 class AutoTrackParams(ADMMParams):
-    epsilon: float = param(1.0, "ε of the θ-step θ = θ̃ - ‖ĝ - ĝ_prev‖² / (2ε)")
-
-    def validate(self):
-        if not 1e-10 <= self.epsilon <= 1e10:
-            return "epsilon must be in [1e-10, 1e10]"
-        return super().validate()
+    epsilon: float = param(1.0, "ε of the θ-step θ = θ̃ - ‖ĝ - ĝ_prev‖² / (2ε)", ge=1e-10, le=1e10)
 
 
 def full_spectrum(half: np.ndarray, width: int) -> np.ndarray:
