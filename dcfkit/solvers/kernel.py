@@ -49,8 +49,11 @@ def parseval_weights(width: int) -> np.ndarray:
 def squared_norm(xf: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
     """‖x‖² = Σ_c Σ_p x_c(p)² of real (..., C, H, W) maps from their (..., C, H, W//2+1) half
     spectra, by Parseval (1/(H·W) of the full spectrum's energy) -> (...,) float64, exact."""
-    energy = np.square(xf.real, dtype=np.float64) + np.square(xf.imag, dtype=np.float64)
-    return np.einsum("...chw,w->...", energy, parseval_weights(shape[1])) / (shape[0] * shape[1])
+    xf = np.ascontiguousarray(xf)
+    parts = xf.view(xf.real.dtype)  # (..., C, H, 2 Wr): re, im interleaved
+    # per column Σ_c Σ_h (re² + im²), accumulated in float64 without a float64 copy of the spectra
+    columns = np.einsum("...chw,...chw->...w", parts, parts, dtype=np.float64)
+    return columns @ np.repeat(parseval_weights(shape[1]), 2) / (shape[0] * shape[1])
 
 
 def kernel_correlation(xf: np.ndarray, zf: np.ndarray, shape: tuple[int, int], p, fft) -> np.ndarray:
