@@ -1,9 +1,12 @@
 """KCF's kernel solver and DSST's ridge solver against dense references (every cyclic shift
-written out, np.linalg.solve)."""
+written out, np.linalg.solve), and the two shipped trackers on generated scenes: both follow
+a moving target, KCF keeps its box size, DSST follows a zoom."""
+import cv2
 import numpy as np
 import pytest
 
 import dcfkit
+from dcfkit.config import load_config
 from dcfkit.errors import ConfigError
 from dcfkit.fft import make_fft
 from dcfkit.labels import gaussian_label
@@ -208,3 +211,64 @@ def test_a_regularizer_the_closed_forms_have_no_term_for_is_refused(solver, role
     with pytest.raises(ConfigError, match=rf"solver '{solver}' has no {role} term.*regularizers\.{role}: null"):
         dcfkit.load_tracker({"name": "t", "features": [{"name": "gray"}], "label": {"name": "gaussian"},
                              "regularizers": {role: spec}, "solver": {"name": solver}})
+
+
+def test_the_configs_have_the_papers_parameters():
+    kcf, dsst = load_config("kcf"), load_config("dsst")
+    assert kcf["solver"] == {"name": "kernel_ridge", "kernel": "gaussian", "sigma": 0.5, "poly_a": 1.0, "poly_b": 9,
+                             "lam": 1e-4, "learning_rate": 0.02}
+    assert kcf["tracker"]["search_area_scale"] == 2.5 and kcf["tracker"]["search_area_shape"] == "proportional"
+    assert kcf["tracker"]["output_sigma_factor"] == 0.1 and kcf["tracker"]["cell_size"] == 4
+    assert kcf["tracker"]["window"] == "hann" and [f["name"] for f in kcf["features"]] == ["fhog"]
+    assert kcf["scale"] == {"name": "fixed"} and kcf["regularizers"] == {"spatial": None, "temporal": None}
+    assert dsst["solver"] == {"name": "ridge", "lam": 0.01, "learning_rate": 0.025}
+    assert dsst["tracker"]["search_area_scale"] == 2 and dsst["tracker"]["output_sigma_factor"] == 1 / 16
+    assert [f["name"] for f in dsst["features"]] == ["gray", "fhog"] and dsst["tracker"]["window"] == "hann"
+    scale = dsst["scale"]
+    assert scale["name"] == "dsst" and scale["n_scales"] == 33 and scale["step"] == 1.02
+    assert scale["sigma_factor"] == 0.25 and scale["learning_rate"] == 0.025 and scale["lam"] == 0.01
+    assert scale["model_max_area"] == 512
+
+
+# ------------------------------------------------------------------------- the trackers
+
+
+def zoom_scene(n=40, size=(240, 320), target=(30, 40), zoom=1.01, seed=0):
+    """A camera zooming in by ``zoom`` a frame (and panning 1 px a frame) over textured ground
+    with a textured box on it: the target grows by zoom^k. Returns frames and (x, y, w, h) boxes."""
+    rng = np.random.default_rng(seed)
+    H, W = size
+    world = cv2.resize(rng.random((H // 8, W // 8)).astype(np.float32), (W, H), interpolation=cv2.INTER_CUBIC)
+    world = world + 0.5 * cv2.resize(rng.random((H // 2, W // 2)).astype(np.float32), (W, H))
+    box = cv2.resize(rng.random((target[0] // 3, target[1] // 3)).astype(np.float32), target[::-1],
+                     interpolation=cv2.INTER_NEAREST)
+    cy, cx = H / 2, W / 2
+    world[int(cy - target[0] / 2):int(cy + target[0] / 2), int(cx - target[1] / 2):int(cx + target[1] / 2)] = 2 * box
+    world = np.clip(world * 100, 0, 255).astype(np.uint8)
+    frames, boxes = [], []
+    for k in range(n):
+        s, shift = zoom**k, np.array([0.5 * k, 1.0 * k])  # the target's centre moves by shift (y, x)
+        M = np.float32([[s, 0, cx + shift[1] - s * cx], [0, s, cy + shift[0] - s * cy]])
+        frames.append(cv2.cvtColor(cv2.warpAffine(world, M, (W, H), flags=cv2.INTER_LINEAR), cv2.COLOR_GRAY2BGR))
+        h, w = target[0] * s, target[1] * s
+        boxes.append((cx + shift[1] - (w - 1) / 2, cy + shift[0] - (h - 1) / 2, w, h))
+    return frames, np.array(boxes)
+
+
+def track(config, frames, box):
+    tracker = dcfkit.load_tracker(config)
+    tracker.init(frames[0], box)
+    return np.array([box] + [tracker.update(f) for f in frames[1:]], float)
+
+
+def test_kcf_keeps_the_box_size_and_dsst_follows_a_zoom():
+    frames, truth = zoom_scene()
+    assert truth[-1, 2] / truth[0, 2] > 1.45  # the target grows by half
+    centre = lambda b: b[:, :2] + (b[:, 2:] - 1) / 2  # noqa: E731
+    kcf, dsst = track("kcf", frames, truth[0]), track("dsst", frames, truth[0])
+    assert np.all(kcf[:, 2:] == truth[0, 2:])  # no scale estimation: KCF's box keeps its size
+    assert np.hypot(*(centre(kcf) - centre(truth)).T).max() < 10  # and still follows the centre
+    ratio = dsst[:, 2] / truth[:, 2]
+    assert np.all(np.abs(ratio[-10:] - 1) < 0.1), ratio.round(3)  # DSST's box grows with the target
+    assert np.isclose(dsst[-1, 2] / dsst[-1, 3], truth[0, 2] / truth[0, 3])  # one scale for both sides
+    assert np.hypot(*(centre(dsst) - centre(truth)).T).max() < 6
