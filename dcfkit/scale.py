@@ -1,10 +1,11 @@
 """Scale estimators.
 
-``pyramid`` (STRCF, BACF): the translation filter is evaluated on samples at a few relative
-scales and the best response picks the scale. ``dsst`` (DR²Track, after Danelljan et al.
-PAMI 2017): a separate 1-D correlation filter over a pyramid of target-sized fHOG samples.
-Both keep the scale within limits set at init (search region at least ~5 px; target at most
-the image, or its initial size if that is larger).
+``fixed`` (KCF): the target keeps its initial size. ``pyramid`` (STRCF, BACF): the
+translation filter is evaluated on samples at a few relative scales and the best response
+picks the scale. ``dsst`` (DR²Track and DSST, after Danelljan et al. PAMI 2017): a separate
+1-D correlation filter over a pyramid of target-sized fHOG samples. The last two keep the
+scale within limits set at init (search region at least ~5 px; target at most the image, or
+its initial size if that is larger).
 """
 from __future__ import annotations
 
@@ -57,6 +58,14 @@ def _check_span(n: int, step: float) -> str | None:
     if (n - 1) / 2 * math.log(step) > math.log(10):
         return (f"step={step:g} with n_scales={n}: the scales may span at most x10 each way "
                 f"(step ** ((n_scales - 1) / 2) <= 10)")
+
+
+class Fixed(ScaleEstimator):
+    """No scale estimation: the box keeps its initial size (KCF). The base class's one search
+    scale, 1, and an update that returns the scale it is given (within the limits, which
+    hold the initial scale)."""
+
+    name = "fixed"
 
 
 class Pyramid(ScaleEstimator):
@@ -216,4 +225,4 @@ def scale_limits(base_target: np.ndarray, base_region: np.ndarray, image_shape, 
     return float(lo), float(max(hi, lo))
 
 
-BUILTIN = (Pyramid, DSST)
+BUILTIN = (Fixed, Pyramid, DSST)

@@ -112,6 +112,7 @@ class Tracker:
         self.spatial = build("regularizer", regs["spatial"], "regularizers.spatial") if regs.get("spatial") else None
         self.temporal = build("regularizer", regs["temporal"], "regularizers.temporal") if regs.get("temporal") else None
         self.solver = build("solver", config["solver"], "solver")
+        self._check_terms()
         self.search = build("search", config["search"], "search")
         self.scale_estimator = build("scale", config["scale"], "scale")
         self.fft = make_fft(self.params.fft_backend)
@@ -123,6 +124,15 @@ class Tracker:
         self.last_distractors = np.zeros((0, 2))
         self.held_frames: list[int] = []  # 1-based numbers of frames held as blank
         self._check_config_budget()
+
+    def _check_terms(self) -> None:
+        """ConfigError if a regularizer is configured that the solver has no term for (``Solver.terms``):
+        it would be ignored."""
+        for role, regularizer in (("spatial", self.spatial), ("temporal", self.temporal)):
+            if regularizer is not None and role not in self.solver.terms:
+                raise ConfigError(f"{self.name}: solver '{self.solver.name}' has no {role} term, so "
+                                  f"regularizers.{role} '{regularizer.name}' would be ignored: "
+                                  f"set regularizers.{role}: null")
 
     # -- budgets: memory and time per frame stay bounded (docs/architecture.md) -------------
     def _search_scales(self) -> np.ndarray:

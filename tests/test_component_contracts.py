@@ -46,6 +46,8 @@ def slot_override(kind: str, cls: type, params: dict) -> dict:
         return {"features": [spec]}
     if kind == "regularizer":
         return {f"regularizers.{cls.role}": spec}
+    if kind == "solver":  # without the regularizers it has no term for (KCF's, DSST's), which the tracker refuses
+        return {kind: spec, **{f"regularizers.{role}": None for role in ("spatial", "temporal") if role not in cls.terms}}
     return {kind: spec}
 
 
@@ -133,6 +135,9 @@ def test_every_accepted_parameter_value_tracks(kind, cls, data):
     ("feature", "colornames", {"table_path": "missing.npy"}, "table_path"),   # found missing at frame 1
     ("search", "motion_aware", {"gain": 1e30}, "gain"),           # IndexError with clamp_position false
     ("scale", "dsst", {"lam": 0.0}, "lam"),                       # 0/0 on a featureless scale sample
+    ("solver", "kernel_ridge", {"lam": 0.0}, "lam"),               # ŷ / 0 where k̂^{xx} is 0
+    ("solver", "kernel_ridge", {"sigma": 1e-300}, "sigma"),        # σ² underflows: 0/0 at the peak
+    ("solver", "ridge", {"lam": 0.0}, "lam"),                      # 0/0 on a featureless sample
     ("scale", "dsst", {"sigma_factor": 1e300}, "sigma_factor"),   # a flat scale label
 ])
 def test_values_that_cannot_work_are_refused_at_load_naming_the_key(kind, cls, params, key):

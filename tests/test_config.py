@@ -10,7 +10,7 @@ from dcfkit.errors import ConfigError, DcfkitError, RegistryError
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
 
-@pytest.mark.parametrize("name", ["strcf", "bacf", "dr2track"])
+@pytest.mark.parametrize("name", ["strcf", "bacf", "dr2track", "kcf", "dsst"])
 def test_shipped_configs_resolve(name):
     cfg = load_config(CONFIGS / f"{name}.yaml")
     assert cfg["name"] == name

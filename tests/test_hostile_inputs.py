@@ -20,12 +20,13 @@ from hypothesis import strategies as st
 
 import dcfkit
 from dcfkit import cli
+from dcfkit.config import load_config
 from dcfkit.datasets import DatasetError, read_frame
 from dcfkit.errors import ConfigError, DcfkitError, InputError
 from dcfkit.synthetic import make_sequence
 from dcfkit.video import iter_frames
 
-CONFIGS = ("strcf", "bacf", "dr2track")
+CONFIGS = ("strcf", "bacf", "dr2track", "kcf", "dsst")
 SEQUENCE = make_sequence(n_frames=2, size=(72, 96), target=(10, 14), distractor=False)
 _TRACKERS: dict[str, dcfkit.Tracker] = {}
 
@@ -120,17 +121,20 @@ def pyramid_span(least: int):
 def tracker_configs(draw):
     """A shipped config with its tracker section and scale parameters anywhere in their ranges."""
     config = draw(st.sampled_from(CONFIGS))
+    scale = load_config(config)["scale"]["name"]
     sides = st.one_of(st.integers(8, 250), st.integers(8, 2000))  # of the sample areas' squares
     low, high = sorted(float(v * v) for v in draw(st.lists(sides, min_size=2, max_size=2)))
-    n, step = draw(pyramid_span(3 if config == "dr2track" else 1))
     overrides = {"tracker.search_area_scale": draw(st.floats(1, 50)),
                  "tracker.search_area_shape": draw(st.sampled_from(["square", "proportional"])),
                  "tracker.min_image_sample_size": low, "tracker.max_image_sample_size": high,
                  "tracker.cell_size": draw(st.one_of(st.integers(2, 8), st.integers(1, 64))),
                  "tracker.cell_selection_thresh": draw(st.sampled_from([0.0, 0.75**2, 1.0])),
-                 "tracker.sampling": draw(st.sampled_from(["subpixel", "whole_pixel"])),
-                 "scale.n_scales": n, "scale.step": step}
-    if config == "dr2track":
+                 "tracker.sampling": draw(st.sampled_from(["subpixel", "whole_pixel"]))}
+    if scale == "fixed":  # KCF: one scale, no parameters
+        return config, overrides
+    n, step = draw(pyramid_span(3 if scale == "dsst" else 1))
+    overrides.update({"scale.n_scales": n, "scale.step": step})
+    if scale == "dsst":
         overrides.update({"scale.model_max_area": draw(st.integers(1, 10000)),
                           "scale.cell_size": draw(st.integers(1, 16)),
                           "scale.sampling": draw(st.sampled_from(["working_patch", "whole_pixel"]))})

@@ -10,7 +10,7 @@ from dcfkit.metrics import score_sequence
 from dcfkit.response import shift_spectrum
 from dcfkit.synthetic import make_sequence
 
-CONFIGS = ["strcf", "bacf", "dr2track", "configs/ablations/dr2track_no_dr.yaml",
+CONFIGS = ["strcf", "bacf", "dr2track", "kcf", "dsst", "configs/ablations/dr2track_no_dr.yaml",
            "configs/ablations/dr2track_no_ma.yaml"]
 
 
@@ -168,7 +168,7 @@ def centres(boxes):
     return boxes[:, :2] + (boxes[:, 2:] - 1) / 2
 
 
-@pytest.mark.parametrize("config", ["strcf", "bacf", "dr2track"])
+@pytest.mark.parametrize("config", ["strcf", "bacf", "dr2track", "kcf", "dsst"])
 @pytest.mark.parametrize("box", [(200, 150, 5, 4), (0, 0, 480, 360), (470, 350, 30, 30)],
                          ids=["tiny", "whole-image", "partly-outside"])
 def test_extreme_boxes_follow_the_image_content(config, box, sequence):
@@ -181,6 +181,8 @@ def test_extreme_boxes_follow_the_image_content(config, box, sequence):
     boxes = np.array(run(dcfkit.load_tracker(config), sliding(sequence.frames[0], 10, *velocity), box))
     assert np.all(np.isfinite(boxes))
     assert np.all((boxes[:, 2:] > 0.8 * np.array(box[2:])) & (boxes[:, 2:] < 1.25 * np.array(box[2:])))
+    if box[2] < 10 and config in ("kcf", "dsst"):
+        return  # their papers' search area (2.5 and 2 times the box, 4-px cells, no upsampling) is 4x4 cells here
     travel = 9 * velocity
     assert np.hypot(*(centres(boxes)[-1] - centres([box])[0] - travel)) < np.hypot(*travel) / 3
 
@@ -212,7 +214,7 @@ def test_pyfftw_backend_tracks_like_scipy(sequence):
     assert np.abs(boxes - reference).max() < 0.5  # the two FFT libraries differ in the last bits only
 
 
-@pytest.mark.parametrize("config", ["strcf", "bacf", "dr2track"])
+@pytest.mark.parametrize("config", ["strcf", "bacf", "dr2track", "kcf", "dsst"])
 def test_dropped_black_frames_are_held_and_not_learnt(config, sequence):
     frames = list(sequence.frames[:30])
     frames[10] = frames[11] = np.zeros_like(frames[10])
@@ -225,7 +227,9 @@ def test_dropped_black_frames_are_held_and_not_learnt(config, sequence):
     # off: the black frames are tracked like any other, and the box moves
     tracker = dcfkit.load_tracker(config, overrides={"tracker.blank_std": 0})
     boxes = run(tracker, frames, sequence.ground_truth[0])
-    assert tracker.held_frames == [] and boxes[10] != boxes[9]
+    assert tracker.held_frames == []
+    if config != "kcf":  # KCF's one feature, fHOG, is 0 on a black frame: a flat response, the box stays
+        assert boxes[10] != boxes[9]
 
 
 def test_a_held_frame_leaves_the_filter_and_scale_unchanged(sequence):

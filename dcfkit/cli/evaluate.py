@@ -21,7 +21,7 @@ from .common import add_dataset_arguments, add_protocol_argument, pixels
 
 def add_eval_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("configs", nargs="+", metavar="CONFIG",
-                        help="tracker config YAML file(s) or shipped config names (strcf, bacf, dr2track); "
+                        help="tracker config YAML file(s) or shipped config names (strcf, bacf, dr2track, kcf, dsst); "
                              "'opencv:CSRT', 'opencv:KCF' or 'opencv:MOSSE' runs an OpenCV baseline")
     add_dataset_arguments(parser)
     parser.add_argument("--out", required=True, type=Path, help="results folder (OUT/<tracker>/)")

@@ -16,7 +16,7 @@ from .common import MAX_DEMO_FRAMES, frame_count, parse_box, seed
 
 
 def add_track_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("config", help="config file or shipped name (strcf, bacf, dr2track)")
+    p.add_argument("config", help="config file or shipped name (strcf, bacf, dr2track, kcf, dsst)")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--video", help="video file")
     src.add_argument("--frames", help="folder of image files, tracked in natural name order (frame2 before frame10)")

@@ -5,7 +5,10 @@
   ``admm_strcf`` (STRCF, DR²Track) and ``admm_bacf`` (BACF's running sample model);
 * :mod:`.arcf` -- ``admm_arcf``, BACF's with ARCF's aberrance repression term;
 * :mod:`.autotrack` -- ``admm_autotrack``, STRCF's with AutoTrack's θ-step;
-* :mod:`.kernels` -- the ADMM's per-frequency arithmetic, compiled (numba) on first use.
+* :mod:`.kernels` -- the ADMM's per-frequency arithmetic, compiled (numba) on first use;
+* :mod:`.kcf` -- ``kernel_ridge``: KCF's kernelized ridge regression (Gaussian, linear or
+  polynomial kernel);
+* :mod:`.dsst` -- ``ridge``: DSST's multichannel ridge regression in closed form.
 """
 from __future__ import annotations
 
@@ -14,8 +17,11 @@ from .admm import ADMMBacf, ADMMParams, ADMMStrcf, BACFParams, admm, penalties, 
 from .arcf import ADMMArcf, ARCFParams
 from .autotrack import ADMMAutoTrack, AutoTrackParams
 from .base import Solver
+from .dsst import Ridge, RidgeParams
+from .kcf import KernelParams, KernelRidge, kernel_correlation
 
-BUILTIN = (ADMMStrcf, ADMMBacf, ADMMArcf, ADMMAutoTrack)
+BUILTIN = (ADMMStrcf, ADMMBacf, ADMMArcf, ADMMAutoTrack, KernelRidge, Ridge)
 
-__all__ = ["ADMMArcf", "ADMMAutoTrack", "ARCFParams", "AutoTrackParams", "ADMMBacf", "ADMMParams", "ADMMStrcf", "BACFParams", "BUILTIN", "Solver", "admm", "penalties",
-           "schedule_problem", "sherman_morrison_solve"]
+__all__ = ["ADMMArcf", "ADMMAutoTrack", "ADMMBacf", "ADMMParams", "ADMMStrcf", "ARCFParams", "AutoTrackParams",
+           "BACFParams", "BUILTIN", "KernelParams", "KernelRidge", "Ridge", "RidgeParams", "Solver", "admm",
+           "kernel_correlation", "penalties", "schedule_problem", "sherman_morrison_solve"]

@@ -16,9 +16,14 @@ class Solver(Component):
     response maps of the search samples (Eq. 12) and ``observe`` with what the detection saw,
     before training. A solver declares its own ``Params`` (none by default); the ADMM
     solvers' are :class:`ADMMParams`.
+
+    ``terms`` names the regularizers whose terms ``train`` solves with (w² for 'spatial', θ
+    for 'temporal'); the tracker refuses a config that gives the solver a regularizer it
+    has no term for, instead of ignoring it (KCF's and DSST's closed forms have neither).
     """
 
     kind = "solver"
+    terms: tuple[str, ...] = ("spatial", "temporal")
     contract = Contract(required={"reset": (), "train": ("xf", "yf", "w2", "theta", "fft")},
                         optional={"response": ("hf", "samples", "shape", "fft"), "observe": ("detection",)})
 
