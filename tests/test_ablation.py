@@ -119,6 +119,13 @@ def test_shipped_specs_expand():
     assert {j.variant: j.config for j in jobs}["N=50"] == load_config("dr2track", {"label.top_n": 50})
 
 
+def test_the_family_spec_holds_every_shipped_tracker():
+    family = load_spec("family", root=".")
+    shipped = sorted(p.stem for p in shipped_config_dir().glob("*.yaml"))
+    assert sorted(v.config["name"] for v in family.variants) == shipped
+    assert all(v.config == load_config(v.config["name"]) for v in family.variants)
+
+
 @pytest.mark.parametrize("text, expected", [
     ("dataset: {name: otb}\nvariant: {a: {config: dr2track}}\n", ["'variant'", "did you mean 'variants'"]),
     ("dataset: {name: otb}\nvariants: {a: {overrides: {label.mu: 1}}}\n", ["variants.a.config", "missing"]),
