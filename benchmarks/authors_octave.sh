@@ -15,15 +15,19 @@
 # and is built into $AUTHORS_BUILD (default: a new temp dir); it is never copied into dcfkit.
 # What the built copy changes, only for portability (algorithms and parameters untouched):
 #  - gradientMex.cpp (Piotr's toolbox) gets Octave's 64-bit mwSize and <cstdlib>/<cstddef>;
-#  - mexResize is the stand-in $DCFKIT_REFERENCE/octave/mexResize.cpp (OpenCV resize; 'auto' =
-#    INTER_LINEAR when the new width exceeds the old width, else INTER_AREA) instead of their
-#    mexopencv build; their compiled mex compares the new width with the old *height*, which
-#    differs on non-square patches (the DSST scale samples of DR²Track, ARCF-HC and AutoTrack);
+#  - mexResize is dcfkit's stand-in benchmarks/octave/mexResize.cpp (OpenCV resize per channel,
+#    default/'linear' = INTER_LINEAR, 'antialias' = INTER_AREA) instead of their mexopencv build,
+#    for every tracker (DR²Track's is rebuilt over the one setup_dr2track.sh makes). Its 'auto'
+#    follows their compiled mex: INTER_LINEAR when the new width exceeds the old *height* (number
+#    of rows; MxArray::toMat hands the image over untransposed), else INTER_AREA. Until
+#    2026-11-25 the stand-in of $DCFKIT_REFERENCE/octave compared with the old width, which
+#    differs on non-square patches only (the DSST scale samples of DR²Track, ARCF-HC, AutoTrack);
 #  - hann, ifft2(..,'symmetric'), gather, mtimesx are the .m shims of $DCFKIT_REFERENCE/octave
 #    (their mtimesx.m help file is moved aside so the shim is found). The ifft2 shim returns
 #    real(ifft2(x)); MATLAB's 'symmetric' uses only half of x and may differ when x is not
 #    conjugate-symmetric, as ARCF-HC's and AutoTrack's filters (complex ADMM h-steps) are not;
-#  - DR²Track: built by $DCFKIT_REFERENCE/octave/setup_dr2track.sh (which applies the above);
+#  - DR²Track: built by $DCFKIT_REFERENCE/octave/setup_dr2track.sh (which applies the above,
+#    with the old stand-in), then utils/mexResize.mex is replaced by dcfkit's;
 #  - STRCF: its Piotr's-toolbox submodule is absent from the export, so fhog.m and
 #    gradientMex.cpp/sse.hpp/wrappers.hpp come from the reference's DR2Track1/feature (the same
 #    toolbox files; that fhog.m calls gradientMex directly, with the same arguments); and
@@ -45,18 +49,24 @@ HERE=$(cd "$(dirname "$0")" && pwd)
 REF=$(cd "${DCFKIT_REFERENCE:-$HERE/../../shared/reference}" && pwd)
 BUILD=${AUTHORS_BUILD:-$(mktemp -d /tmp/authors_octave.XXXXXX)}; mkdir -p "$BUILD"
 command -v mkoctfile >/dev/null || { echo "needs: apt-get install -y octave liboctave-dev octave-image libopencv-imgproc-dev"; exit 1; }
+# dcfkit's mexResize stand-in (the compiled mex's 'auto' rule), built to $1
+build_mexresize() {
+  mkoctfile --mex -O2 -I/usr/include/opencv4 -o "$1" "$HERE/octave/mexResize.cpp" -lopencv_imgproc -lopencv_core
+}
 # the portability patches the copies share (gradientMex folder, mexResize.mex path, mtimesx
 # folder, shim folder)
 port_lineage() {
   sed -i '1i #include <cstdlib>\n#include <cstddef>' "$1/wrappers.hpp"
   sed -i 's/const int dims\[3\]={h,w,d}, n=h\*w\*d;/const mwSize dims[3]={(mwSize)h,(mwSize)w,(mwSize)d}; const int n=h*w*d;/; s/  const int \*dims; int nDims;/  const mwSize *dims; int nDims;/' "$1/gradientMex.cpp"
   (cd "$1" && mkoctfile --mex -O2 -DMATLAB_MEX_FILE -o gradientMex.mex gradientMex.cpp)
-  mkoctfile --mex -I/usr/include/opencv4 -o "$2" "$REF/octave/mexResize.cpp" -lopencv_imgproc -lopencv_core
+  build_mexresize "$2"
   mv "$3/mtimesx.m" "$3/mtimesx_mex_help.txt"
   cp "$REF"/octave/{hann.m,ifft2.m,gather.m,mtimesx.m} "$4/"
 }
 case $TRK in
-  dr2track) bash "$REF/octave/setup_dr2track.sh" "$BUILD/code" ;;
+  dr2track)
+    bash "$REF/octave/setup_dr2track.sh" "$BUILD/code"
+    rm -f "$BUILD/code/utils/mexResize.mex"; build_mexresize "$BUILD/code/utils/mexResize.mex" ;;
   strcf)
     C=$BUILD/code; P=$C/external_libs/pdollar_toolbox/channels
     rm -rf "$C"; cp -r "$REF/STRCF" "$C"; mkdir -p "$P"

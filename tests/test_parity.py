@@ -5,7 +5,10 @@ boxes of the authors' code with ``dcfkit compare``'s library function. Issue 13'
 every sequence |ΔAUC| <= 0.02 and a mean IoU between the two box series >= 0.8. The
 authors' boxes come from:
 
-* DR²Track: ``reference_results/DR2Track`` (their MATLAB code under GNU Octave);
+* DR²Track: ``tests/data/authors_octave/DR2Track`` (``run_DR2Track.m`` under GNU Octave 7.3 by
+  ``benchmarks/authors_octave.sh``, 2026-11-25, with the stand-in mexResize that follows the
+  compiled mex's 'auto' rule; ``reference_results/DR2Track`` was made with the earlier stand-in,
+  which compared with the old width, and parts from it on the DSST's non-square scale samples);
 * STRCF: ``tests/data/authors_octave/STRCF`` (``run_STRCF.m`` under GNU Octave 7.3 by
   ``benchmarks/authors_octave.sh``; see that folder's README);
 * BACF: ``reference_results/BACF`` (their published MATLAB result files), and for
@@ -13,13 +16,13 @@ authors' boxes come from:
   frame 16 of wakeboard7, where two of the five scales score 0.07% apart, the published
   file departs from a run of the authors' own code here (the xfail below).
 
-Measured when written (2026-11-24): DR²Track |ΔAUC| <= 0.006, IoU 0.969-0.999, no centre
-more than 2 px from theirs; STRCF identical box for box on all eight sequences; BACF
+Measured when written (2026-11-24): STRCF identical box for box on all eight sequences; BACF
 identical or IoU >= 0.995 on the five, identical to the Octave run on wakeboard7.
 
-For DR²Track on UAVDT S0601 the stored file is not used: from its frame 28, where the scale
-filter's two best scales differ by 3e-4, it parts from a rerun of the authors' own code here
-(``tests/data/authors_octave/DR2Track``), which the preset reproduces.
+DR²Track against the 2026-11-25 runs: identical box for box (0.01 px) on six of the eight;
+building4 and truck4_2 differ on isolated frames from frame 69 and 109, where dcfkit's
+displacement before round() lies within 0.003 px of a half pixel (1.4979, -0.4997 px) and the
+authors' rounds the other way (|ΔAUC| <= 0.001, IoU >= 0.998, no centre more than 2 px apart).
 """
 from pathlib import Path
 
@@ -50,16 +53,14 @@ def assert_within_the_bar(rows):
         assert row["iou"] >= 0.8, row
 
 
-@pytest.mark.parametrize("dataset,folder,sequences", [UAV + (None,), ("dtb70", "DTB70", ["Gull1"])])
-def test_dr2track_reference_reproduces_the_authors_boxes(dataset, folder, sequences, shared_data, tmp_path):
-    reference = shared_data / "reference_results" / "DR2Track" / folder
-    assert_within_the_bar(compare_preset("dr2track", dataset, folder, sequences, reference, shared_data, tmp_path))
-
-
-def test_dr2track_reference_is_the_authors_code_on_s0601(shared_data, tmp_path):
-    reference = OCTAVE_RUNS / "DR2Track" / "UAVDT"
-    (row,) = compare_preset("dr2track", "uavdt", "UAVDT", None, reference, shared_data, tmp_path)
-    assert row["diverges_at"] is None and row["iou"] >= 0.99, row
+@pytest.mark.parametrize("dataset,folder,sequences", [UAV + (None,), ("dtb70", "DTB70", ["Gull1"]),
+                                                      ("uavdt", "UAVDT", ["S0601"])])
+def test_dr2track_reference_is_the_authors_code(dataset, folder, sequences, shared_data, tmp_path):
+    reference = OCTAVE_RUNS / "DR2Track" / folder
+    rows = compare_preset("dr2track", dataset, folder, sequences, reference, shared_data, tmp_path)
+    assert_within_the_bar(rows)
+    for row in rows:
+        assert row["diverges_at"] is None and row["iou"] >= 0.99, row
 
 
 @pytest.mark.parametrize("dataset,folder", [UAV, ("dtb70", "DTB70"), ("uavdt", "UAVDT")])
