@@ -23,6 +23,13 @@ DR²Track against the 2026-11-25 runs: identical box for box (0.01 px) on six of
 building4 and truck4_2 differ on isolated frames from frame 69 and 109, where dcfkit's
 displacement before round() lies within 0.003 px of a half pixel (1.4979, -0.4997 px) and the
 authors' rounds the other way (|ΔAUC| <= 0.001, IoU >= 0.998, no centre more than 2 px apart).
+
+ARCF-HC and AutoTrack, whose shipped configs are their authors' code, against the authors'
+published MATLAB files (issue 16's bar: |ΔAUC| <= 0.03 on each sequence, the mean within 0.02)
+and against their code under Octave (``tests/data/authors_octave/{ARCF-HC,AutoTrack}``).
+Measured 2026-11-25: ARCF |ΔAUC| <= 0.019 and mean -0.004 against MATLAB, <= 0.007 against
+Octave; AutoTrack mean +0.013 against MATLAB, <= 0.012 on four sequences, and on truck4_1 and
+wakeboard10, where its occlusion test is decided by rounding, +0.036 and +0.044 (the xfail).
 """
 from pathlib import Path
 
@@ -35,12 +42,20 @@ from dcfkit.evaluation import run_one_pass
 
 OCTAVE_RUNS = Path(__file__).parent / "data" / "authors_octave"
 UAV = ("uav123_10fps", "UAV123_10fps")
+FAITHFUL = ("arcf", "autotrack")  # shipped configs that are their authors' code
+# AutoTrack's occlusion test divides by its last response map, whose values near zero are
+# float32 rounding noise: where a frame's test sits near its threshold, a last-bit change flips
+# it (scipy's FFT for pyfftw moves wakeboard10 by 0.030 AUC), and MATLAB, Octave and dcfkit
+# each take their own branch on these two (docs/results.md)
+AUTOTRACK_ROUNDING_BOUND = ("truck4_1", "wakeboard10")
 
 
 def compare_preset(preset, dataset, folder, sequences, reference, shared_data, tmp_path):
-    """Run ``configs/reference/<preset>.yaml`` on the sequences and compare it with ``reference``."""
+    """Run ``configs/reference/<preset>.yaml`` (or the shipped config ``preset`` when it names no
+    reference preset: ARCF's and AutoTrack's are their authors' code) on the sequences and
+    compare it with ``reference``."""
     seqs = load_dataset(dataset, shared_data / folder, sequences)
-    config = load_config(f"reference/{preset}")
+    config = load_config(preset if preset in FAITHFUL else f"reference/{preset}")
     run_one_pass(config, seqs, tmp_path, progress=False)
     table = compare_folders(tmp_path / config["name"], reference, seqs, protocol="otb")
     assert [r["sequence"] for r in table["rows"]] == [s.name for s in seqs]
@@ -91,3 +106,40 @@ def test_bacf_reference_is_the_authors_code_on_wakeboard7(shared_data, tmp_path)
 def test_bacf_reference_on_wakeboard7_against_the_published_file(shared_data, tmp_path):
     reference = shared_data / "reference_results" / "BACF" / "UAV123_10fps"
     assert_within_the_bar(compare_preset("bacf", *UAV, ["wakeboard7"], reference, shared_data, tmp_path))
+
+
+def published(tracker, shared_data):
+    """The authors' published MATLAB result files of ``tracker`` on UAV123@10fps."""
+    return shared_data / "reference_results" / tracker / "UAV123_10fps"
+
+
+def test_arcf_reproduces_the_authors_published_scores(shared_data, tmp_path):
+    """Issue 16's bar against the authors' MATLAB result files: |ΔAUC| <= 0.03 on every sequence,
+    the mean within 0.02; and issue 13's against their code run here under Octave."""
+    rows = compare_preset("arcf", *UAV, None, published("ARCF-HC", shared_data), shared_data, tmp_path)
+    assert all(abs(row["d_auc"]) <= 0.03 for row in rows), rows
+    assert abs(sum(row["d_auc"] for row in rows)) / len(rows) <= 0.02
+    assert_within_the_bar(compare_preset("arcf", *UAV, None, OCTAVE_RUNS / "ARCF-HC" / "UAV123_10fps", shared_data,
+                                         tmp_path / "octave"))
+
+
+def test_autotrack_reproduces_the_authors_published_scores(shared_data, tmp_path):
+    rows = compare_preset("autotrack", *UAV, None, published("AutoTrack", shared_data), shared_data, tmp_path)
+    assert abs(sum(row["d_auc"] for row in rows)) / len(rows) <= 0.02
+    for row in rows:
+        if row["sequence"] not in AUTOTRACK_ROUNDING_BOUND:
+            assert abs(row["d_auc"]) <= 0.03, row
+    octave = compare_preset("autotrack", *UAV, None, OCTAVE_RUNS / "AutoTrack" / "UAV123_10fps", shared_data,
+                            tmp_path / "octave")
+    assert_within_the_bar([row for row in octave if row["sequence"] != "truck4_1"])
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "AutoTrack's occlusion test (eta = norm(response_diff) / 1e4 >= 0.3, response_diff divided by the last "
+    "response map) is decided by float32 rounding where it sits near its threshold: on truck4_1 and "
+    "wakeboard10 the published MATLAB file, the authors' code under Octave and dcfkit part there "
+    "(truck4_1 AUC 0.535 / 0.529 / 0.571, wakeboard10 0.412 / 0.452 / 0.456)"))
+def test_autotrack_on_its_rounding_bound_sequences(shared_data, tmp_path):
+    rows = compare_preset("autotrack", *UAV, list(AUTOTRACK_ROUNDING_BOUND), published("AutoTrack", shared_data),
+                          shared_data, tmp_path)
+    assert all(abs(row["d_auc"]) <= 0.03 for row in rows), rows
