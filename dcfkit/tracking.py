@@ -118,7 +118,9 @@ def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | N
                     out = init_box
                 else:
                     out = tracker.update(image)
-            except Exception as exc:
+            except (KeyboardInterrupt, SystemExit):  # Ctrl-C, SIGTERM (Interrupted) and exit() end the run
+                raise
+            except BaseException as exc:  # a component's own BaseException subclass, too: its frame fails
                 call = "init" if index == 0 else "update"
                 said = str(exc).removeprefix(f"frame {index + 1}: ")  # the tracker's own errors name the frame
                 raise TrackerFailure(index + 1, f"{call} raised {type(exc).__name__}: {said}") from exc

@@ -13,8 +13,8 @@ from dcfkit.tracking import Interrupted, TrackerFailure, empty_track, interrupt_
 class Stepper:
     """Moves the box 1 px right per update; raises on update ``fail_at`` (1-based frame)."""
 
-    def __init__(self, fail_at=None, out=None):
-        self.fail_at, self.out, self.frame = fail_at, out, 1
+    def __init__(self, fail_at=None, out=None, error=ValueError("boom")):
+        self.fail_at, self.out, self.frame, self.error = fail_at, out, 1, error
 
     def init(self, image, box):
         self.box = np.asarray(box, float)
@@ -22,7 +22,7 @@ class Stepper:
     def update(self, image):
         self.frame += 1
         if self.frame == self.fail_at:
-            raise ValueError("boom")
+            raise self.error
         self.box = self.box + [1, 0, 0, 0]
         return self.out if self.out is not None else self.box
 
@@ -46,6 +46,24 @@ def test_a_failure_names_the_frame_from_1_and_keeps_the_frames_before():
     assert caught.value.frame == 4 and isinstance(caught.value.__cause__, ValueError)
     np.testing.assert_array_equal(done.boxes[:, 0], [1, 2, 3])
     assert done.times.shape == (3,)
+
+
+class Abort(BaseException):
+    """A component's own BaseException subclass (not an interruption)."""
+
+
+@pytest.mark.parametrize("error", [Abort("boom"), GeneratorExit("boom")])
+def test_a_base_exception_of_a_component_fails_its_frame(error):
+    done = empty_track()
+    with pytest.raises(TrackerFailure, match=rf"^frame 3: update raised {type(error).__name__}: boom$"):
+        track(Stepper(fail_at=3, error=error), FRAMES, (1, 2, 3, 4), partial=done)
+    assert len(done.boxes) == 2
+
+
+@pytest.mark.parametrize("error", [KeyboardInterrupt(), SystemExit(3), Interrupted(15)])
+def test_interruptions_still_end_the_run(error):
+    with pytest.raises(type(error)):
+        track(Stepper(fail_at=2, error=error), FRAMES, (1, 2, 3, 4))
 
 
 def test_a_non_box_is_a_failure_naming_the_frame():
