@@ -27,8 +27,9 @@ from dcfkit.results import import_results, load_results, run_key
 N_FRAMES = 6
 
 
-class Crash(BaseException):
-    """Stands for the process dying (not caught by the runner, like KeyboardInterrupt)."""
+class Crash(KeyboardInterrupt):
+    """Stands for the process dying: an interruption, which nothing catches (a component's other
+    BaseExceptions fail its sequence, tests/test_tracking.py)."""
 
 
 class DriftTracker:
