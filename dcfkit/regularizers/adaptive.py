@@ -21,7 +21,8 @@ import dataclasses
 import numpy as np
 
 from ..params import param
-from .base import MAX_THETA, MAX_WEIGHT, PLACEMENTS, SpatialRegularizer, TemporalRegularizer, target_mask
+from .base import MAX_THETA, MAX_WEIGHT, PLACEMENTS, TemporalRegularizer, target_mask
+from .windows import BoxWindow
 
 
 def response_variation(previous: tuple[np.ndarray, tuple[float, float]], detection) -> np.ndarray:
@@ -40,26 +41,20 @@ def _record(detection) -> tuple[np.ndarray, tuple[float, float]]:
     return np.array(detection.response, np.float32), tuple(detection.offset or (0.0, 0.0))
 
 
-class LocalVariation(SpatialRegularizer):
-    """AutoTrack's spatial window: ``outside`` beyond the target box; inside, ``inside`` until
-    the second detection, then δ log(Π + 1) of the latest (module doc). State: the last
-    response and its peak."""
+class LocalVariation(BoxWindow):
+    """AutoTrack's spatial window: STRCF's box window (``outside`` beyond the target box,
+    ``inside`` on it) whose inside becomes δ log(Π + 1) of the latest detections from the
+    second on. State: the last response and its peak."""
 
     name = "local_variation"
 
     @dataclasses.dataclass(frozen=True)
-    class Params:
+    class Params(BoxWindow.Params):
         inside: float = param(1e-3, "w inside the target box before the response varies (reg_window_min)",
                               ge=0, le=MAX_WEIGHT)
-        outside: float = param(1e5, "w outside the target box (reg_window_max)", ge=0, le=MAX_WEIGHT)
-        delta: float = param(0.2, "δ: w inside the box is δ log(Π + 1)", ge=0, le=MAX_WEIGHT)
         placement: str = param("authors", "where an odd box sits in an even patch: 'centred' or 'authors' "
                                "(init_regwindow's, a cell lower and to the right)", choices=PLACEMENTS)
-
-        def validate(self):
-            """inside <= outside."""
-            if self.inside > self.outside:
-                return "need inside <= outside"
+        delta: float = param(0.2, "δ: w inside the box is δ log(Π + 1)", ge=0, le=MAX_WEIGHT)
 
     def reset(self):
         self.previous = None
@@ -67,8 +62,7 @@ class LocalVariation(SpatialRegularizer):
 
     def weights_squared(self, shape, target_cells):
         self.mask = target_mask(shape, target_cells, self.params.placement)
-        w = np.where(self.mask, self.params.inside, self.params.outside)
-        return (w ** 2).astype(np.float32)
+        return super().weights_squared(shape, target_cells)
 
     def adapt(self, w2, detection):
         previous, self.previous = self.previous, _record(detection)
@@ -83,7 +77,7 @@ class LocalVariation(SpatialRegularizer):
 
 class GlobalVariation(TemporalRegularizer):
     """AutoTrack's temporal weight: the reference θ̃ = ζ / (1 + log(ν η + 1)), η = ‖Π‖₂ / 10⁴,
-    or ∞ (keep the filter) when η ≥ φ (module doc). ``theta`` is ζ, used until the second
+    or ∞ (keep the filter) when η ≥ φ. ``theta`` is ζ, used until the second
     detection. State: the last response and its peak."""
 
     name = "global_variation"

@@ -45,7 +45,7 @@ def point_symmetric(m: np.ndarray) -> np.ndarray:
 
 
 class ADMMArcf(ADMMBacf):
-    """ARCF-HC: :class:`ADMMBacf` whose label is pulled towards the last response (module doc).
+    """ARCF-HC: :class:`ADMMBacf` whose label is pulled towards the last response.
 
     State between frames: the running sample model and last filter (BACF's), the last
     response map ``previous`` (H, W) float32 fftshift-ed, and its peak's index ``peak``."""

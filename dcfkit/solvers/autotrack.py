@@ -30,7 +30,7 @@ def full_spectrum(half: np.ndarray, width: int) -> np.ndarray:
 
 
 class ADMMAutoTrack(ADMMStrcf):
-    """AutoTrack: :class:`ADMMStrcf` with the θ-step (module doc). The tracker's θ is the
+    """AutoTrack: :class:`ADMMStrcf` with the θ-step. The tracker's θ is the
     reference θ̃. State between frames: the last filter and how many frames were trained."""
 
     name = "admm_autotrack"
