@@ -30,15 +30,10 @@ from .base import Solver
 
 @dataclasses.dataclass(frozen=True)
 class RidgeParams:
-    lam: float = param(0.01, "λ: ridge regularization, ĥ = A / (B + λ)")
-    learning_rate: float = param(0.025, "η: weight of the new frame in the numerator A and denominator B")
-
-    def validate(self):
-        if not 1e-10 <= self.lam <= 1e10:  # ĥ divides by B + λ, which is λ alone where the sample has no energy
-            return "lam must be in [1e-10, 1e10]"
-        if not 0 < self.learning_rate <= 1:
-            return "learning_rate must be in (0, 1]"
-        return None
+    # ĥ divides by B + λ, which is λ alone where the sample has no energy
+    lam: float = param(0.01, "λ: ridge regularization, ĥ = A / (B + λ)", ge=1e-10, le=1e10)
+    learning_rate: float = param(0.025, "η: weight of the new frame in the numerator A and denominator B",
+                                 gt=0, le=1)
 
 
 class Ridge(Solver):

@@ -84,24 +84,15 @@ class KernelParams:
     kernel: str = param("gaussian", "κ: 'gaussian' exp(-‖x - x'‖² / (σ² N)) (KCF), 'linear' ⟨x, x'⟩ / N "
                         "(KCF's DCF), 'polynomial' (⟨x, x'⟩ / N + a)^b; N = the sample's C·H·W values",
                         choices=KERNELS)
-    sigma: float = param(0.5, "σ of the Gaussian kernel")
-    poly_a: float = param(1.0, "a of the polynomial kernel (>= 0: a positive semi-definite kernel)")
-    poly_b: int = param(9, "b, the polynomial kernel's degree")
-    lam: float = param(1e-4, "λ: ridge regularization, α̂ = ŷ / (k̂^{xx} + λ)")
-    learning_rate: float = param(0.02, "η: weight of the new frame in the model x̂ and in α̂ (KCF's interp_factor)")
-
-    def validate(self):
-        if not 1e-6 <= self.sigma <= 1e6:  # σ² N divides the distance; beyond these the kernel is 0 or 1
-            return "sigma must be in [1e-6, 1e6]"
-        if not 0 <= self.poly_a <= 100:  # a < 0: not positive semi-definite, k̂^{xx} + λ may reach 0
-            return "poly_a must be in [0, 100]"
-        if not 1 <= self.poly_b <= 20:  # (1 + 100)^20 keeps k̂ well inside float64
-            return "poly_b must be in [1, 20]"
-        if not 1e-10 <= self.lam <= 1e10:  # α̂ divides by k̂^{xx} + λ, which may be λ alone
-            return "lam must be in [1e-10, 1e10]"
-        if not 0 < self.learning_rate <= 1:
-            return "learning_rate must be in (0, 1]"
-        return None
+    # σ² N divides the distance; beyond these bounds the kernel is 0 or 1 everywhere
+    sigma: float = param(0.5, "σ of the Gaussian kernel", ge=1e-6, le=1e6)
+    # a < 0 is not positive semi-definite: k̂^{xx} + λ may reach 0; (1 + 100)^20 stays well inside float64
+    poly_a: float = param(1.0, "a of the polynomial kernel", ge=0, le=100)
+    poly_b: int = param(9, "b, the polynomial kernel's degree", ge=1, le=20)
+    # α̂ divides by k̂^{xx} + λ, which may be λ alone
+    lam: float = param(1e-4, "λ: ridge regularization, α̂ = ŷ / (k̂^{xx} + λ)", ge=1e-10, le=1e10)
+    learning_rate: float = param(0.02, "η: weight of the new frame in the model x̂ and in α̂ (KCF's interp_factor)",
+                                 gt=0, le=1)
 
 
 class KernelRidge(Solver):
