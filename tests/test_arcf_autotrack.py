@@ -140,11 +140,13 @@ def test_autotrack_solver_matches_the_authors_loop_with_the_theta_step(epsilon):
     w = np.where(target_mask(shape, (4.0, 5.0), "authors"), 1e-3, 1e5)
     y = np.fft.fft2(gaussian_label(shape, 1.0))
     frames = [features(shape, 4) for _ in range(3)]
-    solver = ADMMAutoTrack(AutoTrackParams(iterations=4, h_step="authors", epsilon=epsilon, gamma_max=10000))
+    solver = ADMMAutoTrack(AutoTrackParams(iterations=4, h_step="authors", epsilon=epsilon, gamma_max=10000,
+                                           theta_first=zeta))
     ours = [solver.train(half(x), half(np.fft.ifft2(y).real), (w ** 2).astype(np.float32), theta, FFT)
             for x, theta in zip(frames, (0.0, zeta, ref_mu))]
     g_pre = np.zeros((4, *shape), complex)
-    for i, (x, mu, step) in enumerate(zip(frames, (0.0, zeta, ref_mu), (False, False, True))):
+    # AutoTrack_optimized.m:232-235: mu = 0 on frame 1, zeta on every later one; ref_mu only in the mu-step
+    for i, (x, mu, step) in enumerate(zip(frames, (0.0, zeta, zeta), (False, False, True))):
         g_pre = autotrack_update(np.fft.fft2(x), y, g_pre, w, mu, ref_mu, epsilon, step)
         expected = np.fft.rfft2(np.fft.ifft2(g_pre).real)
         np.testing.assert_allclose(ours[i], expected, atol=2e-3 * np.abs(expected).max(), err_msg=f"frame {i + 1}")
