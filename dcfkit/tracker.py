@@ -361,9 +361,12 @@ class Tracker:
         what = f"frame {self.frame}: spatial regularizer '{self.spatial.name}'"
         with blamed_on(what):
             w2 = np.asarray(self.spatial.adapt(self.w2, detection))
-        if w2.shape != self.w2.shape or np.isnan(w2).any() or (w2 < 0).any():
-            raise TrackingError(f"{what}: adapt() must return w² of shape {self.w2.shape}, >= 0 (inf allowed), "
-                                f"got shape {w2.shape}")
+        if w2.shape != self.w2.shape or w2.dtype.kind not in "iuf":
+            raise TrackingError(f"{what}: adapt() must return real w² of shape {self.w2.shape}, got "
+                                f"shape {w2.shape} of dtype {w2.dtype}")
+        if np.isnan(w2).any() or (w2 < 0).any():
+            raise TrackingError(f"{what}: adapt() returned w² with NaN or negative values (it must be >= 0; "
+                                f"inf is allowed)")
         self.w2 = w2.astype(np.float32, copy=False)
 
     def _theta(self, detection: Detection | None) -> float:

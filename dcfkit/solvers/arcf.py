@@ -26,8 +26,8 @@ import dataclasses
 import numpy as np
 
 from ..params import param
+from ..response import response as linear_response
 from .admm import ADMMBacf, BACFParams, admm
-from .base import linear_response
 
 MAX_ABERRANCE = 1e4  # γ: the sample is scaled by √(1 + γ), kept well inside float32
 
@@ -62,6 +62,8 @@ class ADMMArcf(ADMMBacf):
     def observe(self, detection):
         """The frame's response: the last map is shifted by its peak's move (``circshift`` in
         tracker_HOGCN.m), and this one replaces it once the frame is trained."""
+        if self.current is not None:  # the last frame was not trained (a temporal θ = inf): its map is the last
+            (self.previous, self.peak), self.current = self.current, None
         current = np.fft.fftshift(np.asarray(detection.response, np.float32))
         peak = np.array(np.unravel_index(int(np.argmax(current)), current.shape))
         if self.previous is not None:
