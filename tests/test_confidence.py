@@ -1,0 +1,102 @@
+"""Per-frame confidence: APCE and the peak on hand-made maps, the tracker's last_confidence,
+track()'s confidence column, and confidence falling when the frames go wrong."""
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from dcfkit import load_tracker
+from dcfkit.confidence import NO_CONFIDENCE, Confidence, apce, confidence_of, format_confidence
+from dcfkit.synthetic import make_sequence
+from dcfkit.tracking import Track, track
+
+
+def test_apce_of_a_single_peak_by_hand():
+    r = np.zeros((3, 3))
+    r[1, 1] = 4.0  # |4 - 0|² = 16; mean((R - 0)²) = 16 / 9
+    assert apce(r) == pytest.approx(9.0)
+    assert Confidence.of(r) == Confidence(4.0, pytest.approx(9.0))
+
+
+def test_apce_of_a_map_with_a_floor_and_a_second_peak_by_hand():
+    r = np.array([[1, 1, 1], [1, 5, 3], [1, 1, 1]], dtype=np.float32)
+    # min 1: |5 - 1|² = 16; (R - 1)² sums to 16 + 4 = 20 over 9 cells
+    assert apce(r) == pytest.approx(16 / (20 / 9))
+    c = Confidence.of(r)
+    assert c.peak == 5.0 and c.apce == pytest.approx(7.2)
+    assert apce(r) < apce(np.where(r == 3, 1, r))  # the second peak lowers it
+
+
+def test_apce_is_invariant_to_gain_and_offset_and_zero_for_a_flat_map():
+    r = np.random.default_rng(1).random((7, 9))
+    assert apce(3.5 * r - 2) == pytest.approx(apce(r))
+    assert apce(np.full((4, 4), 0.3)) == 0.0
+
+
+def test_confidence_is_frozen_and_none_is_nan():
+    assert math.isnan(NO_CONFIDENCE.peak) and math.isnan(NO_CONFIDENCE.apce)
+    assert Confidence.of(None) is NO_CONFIDENCE
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        Confidence(1.0, 2.0).peak = 3.0
+    assert format_confidence(np.array([[np.nan, np.nan], [0.5, 12.25]])) == "nan,nan\n0.5,12.25\n"
+
+
+def test_tracker_confidence_is_read_from_its_last_response():
+    seq = make_sequence(n_frames=4, seed=2)
+    tracker = load_tracker("strcf")
+    tracker.init(seq.frames[0], seq.ground_truth[0])
+    assert tracker.last_confidence is NO_CONFIDENCE  # frame 1: no response
+    tracker.update(seq.frames[1])
+    c = tracker.last_confidence
+    assert c.peak == pytest.approx(float(tracker.last_response.max()))
+    assert c.apce == pytest.approx(apce(tracker.last_response)) and c.apce > 1
+    tracker.update(np.zeros_like(seq.frames[2]))  # a blank frame is held: no response
+    assert tracker.held_frames == [3] and tracker.last_confidence is NO_CONFIDENCE
+
+
+def test_track_collects_one_confidence_per_frame_and_keeps_the_boxes():
+    seq = make_sequence(n_frames=8, seed=3)
+    run = track(load_tracker("strcf"), seq.frames, seq.ground_truth[0])
+    assert run.confidence.shape == (8, 2)
+    assert np.isnan(run.confidence[0]).all() and np.isfinite(run.confidence[1:]).all()
+    tracker = load_tracker("strcf")  # the same tracker, never asked for its confidence
+    tracker.init(seq.frames[0], seq.ground_truth[0])
+    boxes = [seq.ground_truth[0]] + [tracker.update(f) for f in seq.frames[1:]]
+    np.testing.assert_array_equal(run.boxes, np.asarray(boxes, dtype=np.float64))
+
+
+class NoConfidence:
+    def init(self, image, box):
+        self.box = box
+
+    def update(self, image):
+        return self.box
+
+
+class BrokenConfidence(NoConfidence):
+    @property
+    def last_confidence(self):
+        raise RuntimeError("no")
+
+
+@pytest.mark.parametrize("kind", [NoConfidence, BrokenConfidence])
+def test_trackers_without_a_readable_confidence_give_nan(kind):
+    frames = [np.zeros((20, 20), np.uint8)] * 3
+    run = track(kind(), frames, (2, 2, 5, 5))
+    assert run.confidence.shape == (3, 2) and np.isnan(run.confidence).all()
+    assert np.isnan(confidence_of(kind())).all()
+    assert Track(np.zeros((2, 4)), np.zeros(2)).confidence.shape == (2, 2)
+
+
+@pytest.mark.parametrize("config", ["strcf", "kcf", "dr2track"])
+def test_confidence_drops_when_the_frames_turn_to_noise(config):
+    seq = make_sequence(n_frames=30, seed=0)
+    frames = list(seq.frames)
+    rng = np.random.default_rng(0)
+    for i in range(20, 30):  # from frame 21 on, noise: the target is gone
+        frames[i] = rng.integers(0, 256, frames[i].shape, dtype=np.uint8)
+    c = track(load_tracker(config), frames, seq.ground_truth[0]).confidence
+    before, noise = c[1:20], c[20:]
+    assert np.median(noise[:, 1]) < 0.5 * np.median(before[:, 1])  # APCE
+    assert np.median(noise[:, 0]) < np.median(before[:, 0])  # peak
