@@ -4,10 +4,16 @@
     one ``x,y,w,h`` line per frame, ``%.3f``, **1-based** (1 is added to x and y), so the
     MATLAB OTB/UAV123 toolkit and pysot read it unchanged. Frame 1 holds the initial
     ground-truth box; a lost target is ``nan,nan,nan,nan``.
+``FOLDER/<sequence>_time.txt``
+    tracker seconds per frame, one ``%.8f`` a line (decoding excluded; frame 1 is ``init``),
+    as the OTB and GOT-10k toolkits read them.
+``FOLDER/<sequence>_confidence.txt``
+    one ``peak,apce`` line per frame (:mod:`dcfkit.confidence`), ``%.6g``; ``nan,nan`` for
+    frame 1 (``init``: no response), frames held as blank, and trackers without a confidence.
 ``FOLDER/<sequence>.json``
-    sidecar: the run key (:func:`run_key`), the SHA-256 of the ``.txt`` as written, per-frame
-    tracker seconds, fps, the config, the dcfkit and plugin versions. Written last: it marks
-    the sequence as done.
+    sidecar: the run key (:func:`run_key`), the SHA-256 of the ``.txt`` as written (and of
+    the time and confidence files), per-frame tracker seconds, fps, the config, the dcfkit
+    and plugin versions. Written last: it marks the sequence as done.
 ``FOLDER/<sequence>.error.json``
     instead, when the tracker raised: frame (1-based), error, traceback.
 
@@ -38,6 +44,7 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from . import __version__
+from .confidence import format_confidence, format_times
 from .config import components
 from .datasets import DatasetError, Sequence, read_boxes
 from .errors import DcfkitError, clip, shown
@@ -46,6 +53,7 @@ from .registry import get_registry
 log = logging.getLogger(__name__)
 
 LABEL_KEYS = ("name", "description")  # config keys that never change a box
+TIME_SUFFIX, CONFIDENCE_SUFFIX = "_time", "_confidence"  # <sequence>_time.txt, <sequence>_confidence.txt
 
 
 # --------------------------------------------------------------------------- identity
@@ -237,8 +245,18 @@ class ResultStore:
     def error_path(self, name: str) -> Path:
         return self.folder / f"{name}.error.json"
 
+    def time_path(self, name: str) -> Path:
+        return self.folder / f"{name}{TIME_SUFFIX}.txt"
+
+    def confidence_path(self, name: str) -> Path:
+        return self.folder / f"{name}{CONFIDENCE_SUFFIX}.txt"
+
+    def _written(self, name: str) -> tuple[Path, ...]:
+        """The files a finished run writes besides its sidecar."""
+        return self.boxes_path(name), self.time_path(name), self.confidence_path(name)
+
     def file_names(self, name: str) -> list[str]:
-        return [p.name for p in (self.boxes_path(name), self.sidecar_path(name), self.error_path(name))]
+        return [p.name for p in (*self._written(name), self.sidecar_path(name), self.error_path(name))]
 
     def sidecar(self, name: str) -> dict | None:
         return read_json(self.sidecar_path(name))
@@ -282,13 +300,26 @@ class ResultStore:
             return None
         return f"{path} (written by dcfkit < 0.4, without a checksum) is not as its run wrote it"
 
-    def write(self, seq: Sequence, boxes: np.ndarray, meta: dict) -> None:
-        """Store a finished run: boxes, then the sidecar (``meta`` plus the boxes' checksum)."""
+    def write(self, seq: Sequence, boxes: np.ndarray, meta: dict, times: np.ndarray | None = None,
+              confidence: np.ndarray | None = None) -> None:
+        """Store a finished run: boxes, the ``times`` and ``confidence`` files (each left out,
+        and any older one removed, when None), then the sidecar (``meta`` plus the checksums)."""
         text = format_boxes(boxes)
         with contextlib.suppress(FileNotFoundError):
             self.sidecar_path(seq.name).unlink()  # an older sidecar must never describe new boxes
         atomic_write(self.boxes_path(seq.name), text)
         meta = {**meta, "frames": len(boxes), "sha256": checksum(text.encode())}
+        for field, path, data, form in (("time_sha256", self.time_path(seq.name), times, format_times),
+                                        ("confidence_sha256", self.confidence_path(seq.name), confidence,
+                                         format_confidence)):
+            meta.pop(field, None)
+            if data is None:
+                with contextlib.suppress(FileNotFoundError):
+                    path.unlink()
+                continue
+            extra = form(data)
+            atomic_write(path, extra)
+            meta[field] = checksum(extra.encode())
         atomic_write(self.sidecar_path(seq.name), json.dumps(meta, indent=1, default=json_default) + "\n")
         with contextlib.suppress(FileNotFoundError):
             self.error_path(seq.name).unlink()
@@ -297,7 +328,7 @@ class ResultStore:
         """Store a failed run (removing any results, which another config may have left)."""
         record = {**record, "sequence": seq.name, "dataset": seq.dataset, "type": type(exc).__name__,
                   "traceback": "".join(traceback.format_exception(exc)), "time": now()}
-        for stale in (self.sidecar_path(seq.name), self.boxes_path(seq.name)):
+        for stale in (self.sidecar_path(seq.name), *self._written(seq.name)):
             with contextlib.suppress(FileNotFoundError):
                 stale.unlink()
         make_dir(self.folder)
@@ -337,7 +368,8 @@ def _check_sidecar(meta: dict) -> None:
     """A :class:`ValueError` or :class:`TypeError` naming the first field of a results
     sidecar that has the wrong type."""
     checks = {"frames": lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0,
-              "sha256": lambda v: isinstance(v, str),
+              "sha256": lambda v: isinstance(v, str), "time_sha256": lambda v: isinstance(v, str),
+              "confidence_sha256": lambda v: isinstance(v, str),
               "run_key": lambda v: isinstance(v, str), "config_hash": lambda v: isinstance(v, str),
               "fps": lambda v: v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)),
               "times": lambda v: isinstance(v, list) and all(isinstance(t, (int, float)) for t in v)}
@@ -362,12 +394,14 @@ def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]
 
 
 def result_files(folder) -> dict[str, Path]:
-    """``{sequence: folder/<sequence>.txt}``, leaving out ``*_time.txt`` (timings written by
-    some toolkits); a :class:`DatasetError` if ``folder`` is not a folder."""
+    """``{sequence: folder/<sequence>.txt}``, leaving out ``*_time.txt`` (timings, written by
+    dcfkit and some toolkits) and ``*_confidence.txt`` (dcfkit's per-frame confidence); a
+    :class:`DatasetError` if ``folder`` is not a folder."""
     folder = Path(folder)
     if not folder.is_dir():
         raise DatasetError(f"results folder not found: {clip(str(folder))}")
-    return {p.stem: p for p in sorted(folder.glob("*.txt")) if not p.stem.endswith("_time")}
+    return {p.stem: p for p in sorted(folder.glob("*.txt"))
+            if not p.stem.endswith((TIME_SUFFIX, CONFIDENCE_SUFFIX))}
 
 
 def import_results(folder) -> dict[str, SequenceResult]:

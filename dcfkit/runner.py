@@ -94,7 +94,7 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
             "init_box": [float(v) for v in seq.init_box], "fps": run.fps, "total_time": float(run.times.sum()),
             "run_key": task.key, "dcfkit_version": version, "plugins": plugin_versions(task.config),
             "time": now(), "config": task.config, "times": run.times.tolist()}
-    store.write(seq, run.boxes, meta)
+    store.write(seq, run.boxes, meta, run.times, run.confidence)
     return {"sequence": seq.name, "status": "done", "fps": run.fps, "frames": len(seq)}
 
 

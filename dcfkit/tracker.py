@@ -20,6 +20,7 @@ from typing import Any, Mapping
 import cv2
 import numpy as np
 
+from .confidence import Confidence
 from .config import TrackerParams, load_config
 from .errors import ConfigError, InputError, TrackingError, blamed_on, shown
 from .features import extract_stack
@@ -118,7 +119,8 @@ class Tracker:
         self.fft = make_fft(self.params.fft_backend)
         self.frame = 0
         # diagnostics of the last frame: the response map (cells, centred: fftshift), the image box
-        # (x, y, w, h) it covers, and the repressed distractors as (x, y) image pixels
+        # (x, y, w, h) it covers, and the repressed distractors as (x, y) image pixels; the
+        # confidence read from the map is the property last_confidence
         self.last_response: np.ndarray | None = None
         self.last_search_box: tuple[float, float, float, float] | None = None
         self.last_distractors = np.zeros((0, 2))
@@ -428,6 +430,15 @@ class Tracker:
         if not self.params.clamp_position:
             return centre
         return np.clip(centre, 0, np.array(shape[:2], dtype=float) - 1)
+
+    @property
+    def last_confidence(self) -> Confidence:
+        """The last frame's :class:`~dcfkit.confidence.Confidence`: ``peak`` (max of
+        ``last_response``) and ``apce`` (Wang et al.'s average peak-to-correlation energy, chosen
+        over the PSR because it has no sidelobe window to size in cells). Both NaN after
+        ``init`` and on a held blank frame, which have no response. Read-only: computed from
+        ``last_response`` when asked, it changes nothing the tracker does."""
+        return Confidence.of(self.last_response)
 
     @property
     def box(self) -> tuple[float, float, float, float]:

@@ -17,6 +17,7 @@ from typing import Callable, Iterable
 
 import numpy as np
 
+from .confidence import confidence_of
 from .errors import DcfkitError, shown
 from .signals import handlers_replaced
 
@@ -25,11 +26,18 @@ OnFrame = Callable[[int, np.ndarray, np.ndarray, object], None]
 
 @dataclasses.dataclass
 class Track:
-    """What a run produced: ``boxes`` ``(N, 4)`` 0-based (frame 1: the initial box) and
-    ``times`` ``(N,)`` tracker seconds per frame (decoding excluded)."""
+    """What a run produced: ``boxes`` ``(N, 4)`` 0-based (frame 1: the initial box),
+    ``times`` ``(N,)`` tracker seconds per frame (decoding excluded) and ``confidence``
+    ``(N, 2)``, each frame's ``(peak, apce)`` (:mod:`dcfkit.confidence`; NaN for frame 1, held
+    blank frames and trackers without ``last_confidence``; all NaN if not given)."""
 
     boxes: np.ndarray
     times: np.ndarray
+    confidence: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.confidence is None:
+            self.confidence = np.full((len(self.boxes), 2), np.nan)
 
     @property
     def fps(self) -> float | None:
@@ -103,12 +111,13 @@ def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | N
           partial: Track | None = None) -> Track:
     """Run ``tracker`` through ``frames``: ``init`` on the first with ``init_box``, ``update`` on
     each later one. ``on_frame(index, image, box, tracker)`` is called after each frame (0-based
-    index; progress bars, video writers, confidence read from ``tracker``).
+    index; progress bars, video writers). Each frame's confidence is read from
+    ``tracker.last_confidence`` after the frame's time is taken (:func:`confidence_of`).
 
     Whatever ends the loop, ``partial`` (if given, an empty :class:`Track`) holds the frames
     done so far, so a caller can keep them. A tracker exception becomes a
     :class:`TrackerFailure` naming the frame and the call."""
-    boxes, times = [], []
+    boxes, times, confidence = [], [], []
     try:
         for index, image in enumerate(frames):  # decoding happens here: not timed
             start = time.perf_counter()
@@ -125,6 +134,7 @@ def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | N
                 said = str(exc).removeprefix(f"frame {index + 1}: ")  # the tracker's own errors name the frame
                 raise TrackerFailure(index + 1, f"{call} raised {type(exc).__name__}: {said}") from exc
             times.append(time.perf_counter() - start)
+            confidence.append(confidence_of(tracker))
             boxes.append(as_box(out, index + 1))
             if on_frame is not None:
                 on_frame(index, image, boxes[-1], tracker)
@@ -132,7 +142,9 @@ def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | N
         if partial is not None:
             partial.boxes = np.array(boxes, dtype=np.float64).reshape(-1, 4)
             partial.times = np.array(times[:len(boxes)], dtype=np.float64)
-    return Track(np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(times, dtype=np.float64))
+            partial.confidence = np.array(confidence[:len(boxes)], dtype=np.float64).reshape(-1, 2)
+    return Track(np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(times, dtype=np.float64),
+                 np.array(confidence, dtype=np.float64).reshape(-1, 2))
 
 
 def empty_track() -> Track:

@@ -101,7 +101,7 @@ def test_result_files_are_one_based_with_sidecar(tmp_path, seqs):
     summary = run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
     assert summary["done"] == ["a", "b", "c"] and not summary["failed"] and not summary["skipped"]
     d = tmp_path / "out" / "drift"
-    assert files(d) == {"a.txt", "a.json", "b.txt", "b.json", "c.txt", "c.json"}
+    assert files(d) == {f"{n}{end}" for n in "abc" for end in (".txt", ".json", "_time.txt", "_confidence.txt")}
     lines = (d / "a.txt").read_text().splitlines()
     assert lines[0] == "3.000,4.000,5.000,6.000"  # 0-based (2, 3) written 1-based
     assert lines[5] == "8.000,4.000,5.000,6.000"
@@ -109,6 +109,10 @@ def test_result_files_are_one_based_with_sidecar(tmp_path, seqs):
     assert meta["run_key"] == run_key(CONFIG) == summary["run_key"]
     assert meta["dcfkit_version"] == results.dcfkit_version()
     assert len(meta["times"]) == N_FRAMES and meta["fps"] > 0 and meta["config"] == CONFIG
+    times = np.loadtxt(d / "a_time.txt")  # the toolkits' time file: one float a line
+    np.testing.assert_allclose(times, meta["times"], atol=1e-8)
+    # DriftTracker has no last_confidence: every line nan,nan
+    assert (d / "a_confidence.txt").read_text() == "nan,nan\n" * N_FRAMES
     res = load_results(tmp_path / "out", "drift", seqs)
     np.testing.assert_allclose(res["b"].boxes, gt_boxes())
     assert res["b"].times.shape == (N_FRAMES,) and res["b"].fps > 0
@@ -280,7 +284,7 @@ def test_crash_mid_sequence_leaves_no_partial_result(tmp_path, seqs):
     with pytest.raises(Crash):
         run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter({2: (3, Crash)}), progress=False)
     d = tmp_path / "drift"
-    assert files(d) == {"a.txt", "a.json"}  # no half file, no temp file
+    assert files(d) == {"a.txt", "a.json", "a_time.txt", "a_confidence.txt"}  # no half file, no temp file
     rerun = Counter()
     summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=rerun, progress=False)
     assert rerun.made == 2 and summary["done"] == ["b", "c"] and summary["skipped"] == ["a"]
@@ -501,7 +505,8 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
                               "--sequences", "a,c", "--set", "drift=0.5", "--no-progress"])
     assert cli_evaluate.run_eval(args) == 0
     assert seen["overrides"] == {"drift": 0.5}
-    assert files(tmp_path / "out" / "fast") == {"a.txt", "a.json", "c.txt", "c.json"}
+    assert files(tmp_path / "out" / "fast") == {f"{n}{end}" for n in "ac"
+                                                for end in (".txt", ".json", "_time.txt", "_confidence.txt")}
     printed = capsys.readouterr().out
     assert "fast: 2 run, 0 already done, 0 failed" in printed
     # the drift tracker lags the ground truth by 0.5k px on frame k (boxes 5x6): IoU (5-0.5k)/(5+0.5k) =

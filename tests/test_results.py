@@ -221,7 +221,7 @@ def test_a_terminated_eval_keeps_finished_sequences_and_leaves_no_partial_file(t
         with interrupt_on_termination():
             run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Terminated, progress=False)
     assert sorted(load_results(tmp_path, "drift", seqs)) == ["a"]
-    assert sorted(p.name for p in (tmp_path / "drift").iterdir()) == [".locks", "a.json", "a.txt"]
+    assert sorted(p.name for p in (tmp_path / "drift").iterdir()) == [".locks", "a.json", "a.txt", "a_confidence.txt", "a_time.txt"]
 
 
 def test_finished_results_in_a_read_only_folder_are_still_scored(tmp_path, seqs, monkeypatch):

@@ -8,6 +8,8 @@ resolved config of :func:`dcfkit.config.load_config`.
 Results are stored per *run*, keyed by what determines the boxes::
 
     OUT/jobs/<dataset>/<key>/<sequence>.txt          1-based x,y,w,h per frame
+    OUT/jobs/<dataset>/<key>/<sequence>_time.txt     seconds per frame (as dcfkit eval)
+    OUT/jobs/<dataset>/<key>/<sequence>_confidence.txt  peak,apce per frame (as dcfkit eval)
     OUT/jobs/<dataset>/<key>/<sequence>.json         sidecar (times, fps, config hash); marks done
     OUT/jobs/<dataset>/<key>/<sequence>.error.json   instead, when the tracker raised
     OUT/configs/<key>.json                           the config behind <key>

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from ..config import parse_overrides
 from ..metrics import score_sequence
 from ..synthetic import make_sequence
 from ..tracker import load_tracker
-from ..results import atomic_write
+from ..confidence import format_confidence, format_times
+from ..results import CONFIDENCE_SUFFIX, TIME_SUFFIX, atomic_write
 from ..tracking import Track, empty_track, termination_deferred, track
 from ..video import VideoWriter, check_output_file, iter_frames
 from .common import MAX_DEMO_FRAMES, frame_count, parse_box, seed
@@ -23,7 +25,9 @@ def add_track_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--box", required=True, help="initial box x,y,w,h (0-based pixels unless --one-based); "
                    "write --box=-5,10,40,30 when x is negative")
     p.add_argument("--one-based", action="store_true", help="--box and --out use 1-based (OTB toolkit) pixels")
-    p.add_argument("--out", help="write one x,y,w,h line per frame here (default: stdout)")
+    p.add_argument("--out", help="write one x,y,w,h line per frame here, and beside it OUT_confidence (peak,apce "
+                   "per frame) and OUT_time (seconds per frame) with OUT's suffix (default: x,y,w,h,peak,apce "
+                   "lines on stdout)")
     p.add_argument("--save-video", help="write an annotated video (.mp4, .avi, .mkv, .mov or .m4v)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a config key, e.g. label.mu=0.3")
 
@@ -34,6 +38,9 @@ def run_track(args: argparse.Namespace) -> int:
     done are written."""
     tracker = load_tracker(args.config, overrides=parse_overrides(args.set))
     out = check_output_file(args.out, "--out") if args.out else None
+    if out:
+        for tag in (CONFIDENCE_SUFFIX, TIME_SUFFIX):
+            check_output_file(beside(out, tag), "--out")
     offset = 1.0 if args.one_based else 0.0
     x, y, w, h = parse_box(args.box)
     writer = VideoWriter(args.save_video) if args.save_video else None
@@ -52,15 +59,25 @@ def run_track(args: argparse.Namespace) -> int:
     return 0
 
 
-def _write_boxes(done: Track, out, offset: float, name: str) -> None:
+def beside(out: Path, tag: str) -> Path:
+    """``boxes.txt`` -> ``boxes_confidence.txt``: a file written with ``--out``."""
+    return out.with_name(f"{out.stem}{tag}{out.suffix}")
+
+
+def _write_boxes(done: Track, out: Path | None, offset: float, name: str) -> None:
+    """``--out``: the boxes (x,y,w,h, as the toolkits read them), the confidence (peak,apce)
+    and the seconds of each frame in three files; stdout: one x,y,w,h,peak,apce line a frame
+    (frame 1 and held blank frames: nan,nan, they have no response)."""
     if not len(done.boxes):
         return
-    lines = "".join("%.3f,%.3f,%.3f,%.3f\n" % tuple(b) for b in done.boxes + [offset, offset, 0, 0])
+    boxes = done.boxes + [offset, offset, 0, 0]
     if out:
         with termination_deferred():
-            atomic_write(out, lines)
+            atomic_write(out, "".join("%.3f,%.3f,%.3f,%.3f\n" % tuple(b) for b in boxes))
+            atomic_write(beside(out, CONFIDENCE_SUFFIX), format_confidence(done.confidence))
+            atomic_write(beside(out, TIME_SUFFIX), format_times(done.times))
     else:
-        print(lines, end="")
+        print("".join("%.3f,%.3f,%.3f,%.3f,%.6g,%.6g\n" % (*b, *c) for b, c in zip(boxes, done.confidence)), end="")
     seconds = float(done.times.sum())
     print(f"{name}: {len(done.boxes)} frames, {len(done.boxes) / max(seconds, 1e-9):.1f} fps", file=sys.stderr)
 
