@@ -1,8 +1,10 @@
 """Filter solvers (``solver:`` in a config): train each frame's filter and detect with it.
 
 * :mod:`.base` -- the :class:`Solver` contract;
-* :mod:`.admm` -- ADMM for the spatially and temporally regularized objective (Eqs. 4–11):
-  ``admm_strcf`` (STRCF, DR²Track) and ``admm_bacf`` (BACF's running sample model);
+* :mod:`.strcf_bacf` -- the ADMM for the spatially and temporally regularized objective
+  (``admm``, Eqs. 4–11) and its two solvers, ``admm_strcf`` (STRCF, DR²Track) and
+  ``admm_bacf`` (BACF's running sample model); the module is not named ``admm``, the function
+  this package exports under that name;
 * :mod:`.arcf` -- ``admm_arcf``, BACF's with ARCF's aberrance repression term;
 * :mod:`.autotrack` -- ``admm_autotrack``, STRCF's with AutoTrack's θ-step;
 * :mod:`.kernels` -- the ADMM's per-frequency arithmetic, compiled (numba) on first use;
@@ -12,7 +14,7 @@
 """
 from __future__ import annotations
 
-from .admm import ADMMBacf, ADMMParams, ADMMStrcf, BACFParams, admm, penalties, schedule_problem, \
+from .strcf_bacf import ADMMBacf, ADMMParams, ADMMStrcf, BACFParams, admm, penalties, schedule_problem, \
     sherman_morrison_solve
 from .arcf import ADMMArcf, ARCFParams
 from .autotrack import ADMMAutoTrack, AutoTrackParams

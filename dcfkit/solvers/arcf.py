@@ -27,7 +27,7 @@ import numpy as np
 
 from ..params import param
 from ..response import response as linear_response
-from .admm import ADMMBacf, BACFParams, admm
+from .strcf_bacf import ADMMBacf, BACFParams, admm
 
 MAX_ABERRANCE = 1e4  # γ: the sample is scaled by √(1 + γ), kept well inside float32
 

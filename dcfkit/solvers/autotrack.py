@@ -17,7 +17,7 @@ import numpy as np
 
 from ..params import param
 from ..regularizers.base import MAX_THETA
-from .admm import ADMMParams, ADMMStrcf, admm
+from .strcf_bacf import ADMMParams, ADMMStrcf, admm
 
 
 @dataclasses.dataclass(frozen=True)
