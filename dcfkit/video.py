@@ -115,10 +115,14 @@ class _JpegPackets:
         if cap.getBackendName() != "FFMPEG" or fourcc not in JPEG_FOURCCS:
             return None
         raw = cv2.VideoCapture(str(video), cv2.CAP_FFMPEG, [cv2.CAP_PROP_FORMAT, -1])
-        ok, packet = raw.read() if raw.isOpened() and raw.get(cv2.CAP_PROP_FORMAT) == -1 else (False, None)
-        first = packet.tobytes() if ok else b""
-        if first.startswith(b"\xff\xd8") and jpeg_decodable(first):
-            return cls(video, raw, first)
+        try:
+            ok, packet = raw.read() if raw.isOpened() and raw.get(cv2.CAP_PROP_FORMAT) == -1 else (False, None)
+            first = packet.tobytes() if ok else b""
+            if first.startswith(b"\xff\xd8") and jpeg_decodable(first):
+                return cls(video, raw, first)
+        except BaseException:  # the raw capture is not left to the garbage collector
+            raw.release()
+            raise
         raw.release()
         return None
 

@@ -711,3 +711,39 @@ def test_names_too_long_for_the_file_system_are_one_line_errors(args, said, otb_
     err = capsys.readouterr().err
     assert status == 2 and said in err, err[:2000]
     assert len(err) < MESSAGE_CHARS, err[:2000]
+
+
+def test_the_raw_capture_of_a_motion_jpeg_check_is_released_when_reading_it_fails(monkeypatch):
+    """_JpegPackets.of opens a second capture; an error while it reads the first packet must
+    not leave that capture to the garbage collector."""
+    from dcfkit import video
+
+    released = []
+
+    class Raw:
+        def __init__(self, *args):
+            pass
+
+        def isOpened(self):
+            return True
+
+        def get(self, prop):
+            return -1
+
+        def read(self):
+            raise OSError("device gone")
+
+        def release(self):
+            released.append(True)
+
+    class Decoding:
+        def get(self, prop):
+            return float(int.from_bytes(b"MJPG", "little"))
+
+        def getBackendName(self):
+            return "FFMPEG"
+
+    monkeypatch.setattr(video.cv2, "VideoCapture", Raw)
+    with pytest.raises(OSError, match="device gone"):
+        video._JpegPackets.of("clip.avi", Decoding())
+    assert released == [True]
