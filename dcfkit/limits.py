@@ -22,7 +22,7 @@ IMAGE_PIXELS_VARIABLE = "DCFKIT_MAX_IMAGE_PIXELS"
 DEFAULT_MAX_IMAGE_PIXELS = 10**8  # 300 MB as BGR; an 8K video frame has 33 million
 
 
-def pixel_budget(variable: str, default: int, unit: str = "pixels") -> int:
+def env_limit(variable: str, default: int, unit: str = "pixels") -> int:
     """A limit, a count of ``unit``: the environment variable ``variable`` if set (``1e9`` is
     fine), else ``default``; read when used, so a program may set it before tracking."""
     text = os.environ.get(variable, "").strip()
@@ -40,7 +40,7 @@ def pixel_budget(variable: str, default: int, unit: str = "pixels") -> int:
 def max_image_pixels() -> int:
     """The most pixels dcfkit holds in one image: a frame it reads from a file, or a region it
     copies from a frame for one sample (``$DCFKIT_MAX_IMAGE_PIXELS``, default 10^8)."""
-    return pixel_budget(IMAGE_PIXELS_VARIABLE, DEFAULT_MAX_IMAGE_PIXELS)
+    return env_limit(IMAGE_PIXELS_VARIABLE, DEFAULT_MAX_IMAGE_PIXELS)
 
 
 SAMPLE_PIXELS_VARIABLE = "DCFKIT_MAX_SAMPLE_PIXELS"
@@ -53,7 +53,7 @@ def sample_budget() -> tuple[int, int]:
     in pixels and in feature cells, and the scale filter's samples (``$DCFKIT_MAX_SAMPLE_PIXELS``,
     default 2048²; cells: a sixteenth of it). Beyond them memory and time per frame grow without
     bound (features are ``channels x cells`` floats)."""
-    pixels = pixel_budget(SAMPLE_PIXELS_VARIABLE, DEFAULT_MAX_SAMPLE_PIXELS)
+    pixels = env_limit(SAMPLE_PIXELS_VARIABLE, DEFAULT_MAX_SAMPLE_PIXELS)
     return pixels, max(pixels // CELL_AREA, 1)
 
 
@@ -63,4 +63,4 @@ VARIANTS_VARIABLE = "DCFKIT_MAX_VARIANTS"
 def max_variants(default: int) -> int:
     """The most variants of one ablation spec: ``$DCFKIT_MAX_VARIANTS`` if set, else ``default``
     (:data:`dcfkit.ablation.spec.MAX_VARIANTS`)."""
-    return pixel_budget(VARIANTS_VARIABLE, default, "variants")
+    return env_limit(VARIANTS_VARIABLE, default, "variants")
