@@ -27,6 +27,7 @@ import numpy as np
 
 from ..params import param
 from ..response import response as linear_response
+from .base import running_average
 from .strcf_bacf import ADMMBacf, BACFParams, admm
 
 MAX_ABERRANCE = 1e4  # γ: the sample is scaled by √(1 + γ), kept well inside float32
@@ -72,10 +73,7 @@ class ADMMArcf(ADMMBacf):
 
     def train(self, xf, yf, w2, theta, fft):
         p = self.params
-        if self.model is None:
-            self.model = xf.copy()
-        else:
-            self.model = (1 - p.learning_rate) * self.model + p.learning_rate * xf
+        self.model = running_average(self.model, xf, p.learning_rate)
         label = yf  # frame 1: M = 0, but the data term weighs 1 + γ all the same
         if self.previous is not None:
             shape, half = w2.shape, yf.shape[-1]

@@ -25,7 +25,7 @@ import dataclasses
 import numpy as np
 
 from ..params import param
-from .base import Solver
+from .base import Solver, running_average
 
 
 @dataclasses.dataclass(frozen=True)
@@ -51,10 +51,7 @@ class Ridge(Solver):
     def train(self, xf, yf, w2, theta, fft):
         num = np.conj(yf)[None] * xf
         den = np.einsum("chw,chw->hw", xf.real, xf.real) + np.einsum("chw,chw->hw", xf.imag, xf.imag)
-        if self.num is None:
-            self.num, self.den = num.astype(np.complex64, copy=False), den.astype(np.float32, copy=False)
-        else:
-            eta = self.params.learning_rate
-            self.num = ((1 - eta) * self.num + eta * num).astype(np.complex64, copy=False)
-            self.den = ((1 - eta) * self.den + eta * den).astype(np.float32, copy=False)
+        eta = self.params.learning_rate
+        self.num = running_average(self.num, num, eta, np.complex64)
+        self.den = running_average(self.den, den, eta, np.float32)
         return (self.num / (self.den + np.float32(self.params.lam))).astype(np.complex64, copy=False)

@@ -30,7 +30,7 @@ import dataclasses
 import numpy as np
 
 from ..params import param
-from .base import Solver
+from .base import Solver, running_average
 
 KERNELS = ("gaussian", "linear", "polynomial")
 
@@ -114,12 +114,9 @@ class KernelRidge(Solver):
         # k^{xx} is real and even, so k̂^{xx} is real: the eigenvalues of the kernel matrix, >= 0 for
         # these kernels (positive semi-definite); the imaginary part and anything below 0 are rounding
         alphaf = yf / (np.maximum(kf.real, 0.0) + self.params.lam)
-        if self.model is None:
-            self.model, self.alphaf = np.asarray(xf, np.complex64).copy(), alphaf
-        else:
-            eta = self.params.learning_rate
-            self.model = ((1 - eta) * self.model + eta * xf).astype(np.complex64, copy=False)
-            self.alphaf = (1 - eta) * self.alphaf + eta * alphaf
+        eta = self.params.learning_rate
+        self.model = running_average(self.model, xf, eta, np.complex64)
+        self.alphaf = running_average(self.alphaf, alphaf, eta)
         return self.model
 
     def response(self, hf, samples, shape, fft):

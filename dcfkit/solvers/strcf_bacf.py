@@ -31,7 +31,7 @@ from typing import Callable
 import numpy as np
 
 from ..params import param
-from .base import Solver
+from .base import Solver, running_average
 
 
 def _floats(z: np.ndarray) -> np.ndarray:
@@ -191,10 +191,7 @@ class ADMMBacf(Solver):
         self.v_prev = None
 
     def train(self, xf, yf, w2, theta, fft):
-        if self.model is None:
-            self.model = xf.copy()
-        else:
-            self.model = (1 - self.params.learning_rate) * self.model + self.params.learning_rate * xf
+        self.model = running_average(self.model, xf, self.params.learning_rate)
         vf, _ = admm(self.model, yf, w2, theta, self.v_prev, self.params, fft)
         self.v_prev = vf
         return vf
