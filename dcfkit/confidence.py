@@ -72,13 +72,3 @@ def confidence_of(tracker) -> tuple[float, float]:
         return NO_CONFIDENCE.as_tuple() if c is None else (float(c.peak), float(c.apce))
     except Exception:  # noqa: BLE001 - read-only diagnostic
         return NO_CONFIDENCE.as_tuple()
-
-
-def format_confidence(confidence: np.ndarray) -> str:
-    """``(N, 2)`` ``(peak, apce)`` rows as ``peak,apce`` lines, ``%.6g``; NaN as ``nan``."""
-    return "".join("%.6g,%.6g\n" % (p, a) for p, a in np.asarray(confidence, dtype=np.float64).reshape(-1, 2))
-
-
-def format_times(times: np.ndarray) -> str:
-    """Seconds per frame, one ``%.8f`` a line (the OTB and GOT-10k toolkits' ``_time.txt``)."""
-    return "".join("%.8f\n" % t for t in np.asarray(times, dtype=np.float64).reshape(-1))

@@ -44,7 +44,6 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from . import __version__
-from .confidence import format_confidence, format_times
 from .config import components
 from .datasets import DatasetError, Sequence, read_boxes
 from .errors import DcfkitError, clip, shown
@@ -206,10 +205,21 @@ def read_json(path: Path) -> dict | None:
     return data if isinstance(data, dict) else None
 
 
-def format_boxes(boxes: np.ndarray) -> str:
-    """0-based ``(N, 4)`` boxes as the 1-based ``%.3f`` lines of a result file."""
-    one_based = np.asarray(boxes, dtype=np.float64) + np.array([1.0, 1.0, 0.0, 0.0])
-    return "".join("%.3f,%.3f,%.3f,%.3f\n" % tuple(b) for b in one_based)
+def format_boxes(boxes: np.ndarray, offset: float = 1.0) -> str:
+    """0-based ``(N, 4)`` boxes as ``%.3f`` ``x,y,w,h`` lines, ``offset`` added to x and y: 1 for
+    the 1-based lines of a result file, 0 for ``dcfkit track --out`` without ``--one-based``."""
+    shifted = np.asarray(boxes, dtype=np.float64) + np.array([offset, offset, 0.0, 0.0])
+    return "".join("%.3f,%.3f,%.3f,%.3f\n" % tuple(b) for b in shifted)
+
+
+def format_confidence(confidence: np.ndarray) -> str:
+    """``(N, 2)`` ``(peak, apce)`` rows as ``peak,apce`` lines, ``%.6g``; NaN as ``nan``."""
+    return "".join("%.6g,%.6g\n" % (p, a) for p, a in np.asarray(confidence, dtype=np.float64).reshape(-1, 2))
+
+
+def format_times(times: np.ndarray) -> str:
+    """Seconds per frame, one ``%.8f`` a line (the OTB and GOT-10k toolkits' ``_time.txt``)."""
+    return "".join("%.8f\n" % t for t in np.asarray(times, dtype=np.float64).reshape(-1))
 
 
 def checksum(data: bytes) -> str:

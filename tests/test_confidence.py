@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from dcfkit import load_tracker
-from dcfkit.confidence import NO_CONFIDENCE, Confidence, apce, confidence_of, format_confidence
+from dcfkit.confidence import NO_CONFIDENCE, Confidence, apce, confidence_of
+from dcfkit.results import format_confidence
 from dcfkit.synthetic import make_sequence
 from dcfkit.tracking import Track, track
 

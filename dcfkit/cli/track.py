@@ -10,8 +10,7 @@ from ..config import parse_overrides
 from ..metrics import score_sequence
 from ..synthetic import make_sequence
 from ..tracker import load_tracker
-from ..confidence import format_confidence, format_times
-from ..results import CONFIDENCE_SUFFIX, TIME_SUFFIX, atomic_write
+from ..results import CONFIDENCE_SUFFIX, TIME_SUFFIX, atomic_write, format_boxes, format_confidence, format_times
 from ..tracking import Track, empty_track, termination_deferred, track
 from ..video import VideoWriter, check_output_file, iter_frames
 from .common import MAX_DEMO_FRAMES, frame_count, parse_box, seed
@@ -70,13 +69,13 @@ def _write_boxes(done: Track, out: Path | None, offset: float, name: str) -> Non
     (frame 1 and held blank frames: nan,nan, they have no response)."""
     if not len(done.boxes):
         return
-    boxes = done.boxes + [offset, offset, 0, 0]
     if out:
         with termination_deferred():
-            atomic_write(out, "".join("%.3f,%.3f,%.3f,%.3f\n" % tuple(b) for b in boxes))
+            atomic_write(out, format_boxes(done.boxes, offset))
             atomic_write(beside(out, CONFIDENCE_SUFFIX), format_confidence(done.confidence))
             atomic_write(beside(out, TIME_SUFFIX), format_times(done.times))
     else:
+        boxes = done.boxes + [offset, offset, 0, 0]
         print("".join("%.3f,%.3f,%.3f,%.3f,%.6g,%.6g\n" % (*b, *c) for b, c in zip(boxes, done.confidence)), end="")
     seconds = float(done.times.sum())
     print(f"{name}: {len(done.boxes)} frames, {len(done.boxes) / max(seconds, 1e-9):.1f} fps", file=sys.stderr)

@@ -115,10 +115,11 @@ def _read_image_bytes(path, what: str) -> bytes:
 def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
     """A BGR image; :class:`DatasetError` naming the file when it is missing, not an image, larger
     than :func:`~dcfkit.limits.max_image_pixels` (read from its header, before decoding), a
-    truncated JPEG (``cv2.imread`` would return one grey below the cut, with a warning only), or
-    a JPEG whose data libjpeg reports corrupt (``cv2.imread`` would return it with a warning, part
-    of it grey or wrong), or a TIFF whose data libtiff cannot decode (likewise). A JPEG that lacks just its end-of-image marker, or has zero bytes
-    before it, common defects, is read as imread would. Decoding is OpenCV's, unchanged."""
+    truncated JPEG (``cv2.imread`` would return one grey below the cut, with a warning only), a
+    JPEG whose data libjpeg reports corrupt (``cv2.imread`` would return it with a warning, part
+    of it grey or wrong), or a TIFF whose data libtiff cannot decode (likewise). A JPEG that
+    lacks just its end-of-image marker, or has zero bytes before it, common defects, is read as
+    imread would. Decoding is OpenCV's, unchanged."""
     import cv2  # deferred: listing sequences needs no OpenCV
 
     data = _read_image_bytes(path, what)
