@@ -11,15 +11,16 @@ with, and OpenCV, which dcfkit does, return the same pixels (they do for the JPE
 development data: both bundle libjpeg-turbo). What got10k 0.1.3 does, and what this adapter
 does about it:
 
-**Images.** ``Tracker.track``, the frame loop of every got10k experiment but VOT's
-(``got10k/trackers/__init__.py``), opens each frame with ``PIL.Image.open`` and converts any
-mode but ``'RGB'`` (grayscale ``'L'``, palette, RGBA) with ``convert('RGB')``.
-``ExperimentVOT`` hands over ``Image.open``'s image unconverted, or with ``read_image=False``
-the file's path. dcfkit takes BGR, the order of ``cv2.imread``: the adapter converts a PIL
-image as ``track`` does and reverses its channels, reads a path with dcfkit's own
-:func:`~dcfkit.datasets.read_frame`, and takes a numpy array as got10k's order, RGB
-(``(H, W, 3)``) or gray (``(H, W)``). RGB given as BGR is no error a tracker can see: its
-gray and Color Names features (STRCF's, among others) would read other colours.
+**Images.** ``Tracker.track``, the frame loop of got10k's experiments but VOT's supervised
+and real-time runs (``got10k/trackers/__init__.py``), opens each frame with
+``PIL.Image.open`` and converts any mode but ``'RGB'`` (grayscale ``'L'``, palette, RGBA)
+with ``convert('RGB')``. Those two VOT runs hand over ``Image.open``'s image unconverted,
+or with ``read_image=False`` the file's path. dcfkit takes BGR, the order of
+``cv2.imread``: the adapter converts a PIL image as ``track`` does and reverses its
+channels, reads a path with dcfkit's own :func:`~dcfkit.datasets.read_frame`, and takes a
+numpy array in got10k's order: RGB (``(H, W, 3)``) or gray (``(H, W)``). RGB given as BGR
+is no error a tracker can see: its gray and Color Names features (STRCF's, among others)
+would read other colours.
 
 **Boxes.** The datasets read their annotation files unchanged with ``np.loadtxt``
 (``got10k/datasets/otb.py``, ``uav123.py``, ``dtb70.py``, ``tcolor128.py``, ``lasot.py``,
