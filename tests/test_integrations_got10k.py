@@ -71,7 +71,8 @@ def test_other_frames_got10k_can_hand_over(adapter, tmp_path, kind):
     files, frames, truth = synthetic_folder(tmp_path / "seq", 2, n_frames=5)
     if kind == "gray PIL image":
         frames = [cv2.cvtColor(cv2.cvtColor(f, cv2.COLOR_BGR2GRAY), cv2.COLOR_GRAY2BGR) for f in frames]
-        given = [Image.fromarray(f[:, :, 0], mode="L") for f in frames]
+        given = [Image.fromarray(f[:, :, 0]) for f in frames]
+        assert given[0].mode == "L"
     elif kind == "image path":
         given = files
     else:
@@ -101,22 +102,30 @@ def test_is_a_got10k_tracker_named_by_the_config(adapter):
         adapter.Tracker("strcf", overrides={"tracker.no_such_key": 1})
 
 
+def opened(path: str) -> Image.Image:
+    """The image got10k's loop would hand over, its file closed."""
+    with Image.open(path) as image:
+        image.load()
+    return image
+
+
 def test_misuse_is_dcfkits_error_naming_the_frame(adapter, tmp_path):
     files, frames, truth = synthetic_folder(tmp_path / "seq", 4, n_frames=3)
+    images = [opened(f) for f in files]
     tracker = adapter.Tracker("strcf")
     with pytest.raises(TrackingError, match="before init"):
-        tracker.update(Image.open(files[1]))
-    tracker.init(Image.open(files[0]), truth[0] + ONE_BASED)
-    tracker.update(Image.open(files[1]))
+        tracker.update(images[1])
+    tracker.init(images[0], truth[0] + ONE_BASED)
+    tracker.update(images[1])
     with pytest.raises(InputError, match="4 numbers"):
-        tracker.init(Image.open(files[0]), "10,10,5")
+        tracker.init(images[0], "10,10,5")
     with pytest.raises(TrackingError, match="before init"):  # not the last sequence's tracker
-        tracker.update(Image.open(files[1]))
-    tracker.init(Image.open(files[0]), truth[0] + ONE_BASED)
+        tracker.update(images[1])
+    tracker.init(images[0], truth[0] + ONE_BASED)
     with pytest.raises(InputError, match="frame 2: expected a PIL image"):
         tracker.update(b"not an image")
     with pytest.raises(InputError, match="frame 3: the image is"):
-        tracker.update(Image.open(files[2]).crop((0, 0, 100, 100)))
+        tracker.update(images[2].crop((0, 0, 100, 100)))
 
 
 def test_without_got10k_the_import_names_the_extra(monkeypatch):
