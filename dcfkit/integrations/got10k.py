@@ -67,6 +67,7 @@ except ImportError as exc:  # the toolkit is an optional extra
 __all__ = ["Tracker", "to_bgr"]
 
 ONE_BASED = np.array([1.0, 1.0, 0.0, 0.0])  # added to (x, y, w, h): 0-based -> 1-based
+ONE_BASED.setflags(write=False)  # every adapter's offset
 
 
 def to_bgr(image: Any, frame: int) -> np.ndarray:
