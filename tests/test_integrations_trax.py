@@ -52,6 +52,15 @@ def direct_run(images, box, config="strcf"):
     return np.array(boxes), confidence
 
 
+SERVER = [sys.executable, "-m", "dcfkit.cli", "trax"]
+
+
+def server_env() -> dict:
+    """The environment of a server process: it imports the dcfkit under test, installed or not."""
+    root = str(Path(dcfkit.__file__).resolve().parents[1])
+    return {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [root, os.environ.get("PYTHONPATH")]))}
+
+
 @contextlib.contextmanager
 def served(trax, *args):
     """``dcfkit trax ARGS`` in a process, connected to a ``trax.client.Client`` on its stdin and
@@ -59,11 +68,9 @@ def served(trax, *args):
     read. A watchdog kills a server that hangs, so that the client's read returns."""
     from trax.client import Client
 
-    root = Path(dcfkit.__file__).resolve().parents[1]  # the dcfkit under test, installed or not
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(root), os.environ.get("PYTHONPATH")]))}
     with tempfile.TemporaryFile("w+") as stderr:
-        process = subprocess.Popen([sys.executable, "-m", "dcfkit.cli", "trax", *args], stdin=subprocess.PIPE,
-                                   stdout=subprocess.PIPE, stderr=stderr, bufsize=0, env=env)
+        process = subprocess.Popen(SERVER + list(args), stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=stderr,
+                                   bufsize=0, env=server_env())
         watchdog = threading.Timer(120, process.kill)
         watchdog.start()
         log = []
@@ -215,3 +222,11 @@ def test_a_clobbered_opencv_is_warned_of_at_start_up(trax, clobbered_opencv, mon
     assert [c["name"] for c in served_configs] == ["strcf"]
     err = capsys.readouterr().err
     assert err.startswith("dcfkit trax: warning: OpenCV's contrib modules are missing") and "Repair with: pip" in err
+
+
+def test_a_client_that_ends_without_quit_ends_the_server_with_a_message(trax):
+    run = subprocess.run(SERVER + ["strcf"], stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                         env=server_env(), timeout=120)
+    assert run.returncode == 2 and run.stdout.startswith('@@TRAX:hello "dcfkit.version=')
+    assert run.stderr.startswith("dcfkit trax: error: TraX: no request from the client: it closed the connection "
+                                 "without sending quit") and "Traceback" not in run.stderr

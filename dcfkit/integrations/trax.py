@@ -50,7 +50,7 @@ CHANNEL = trax.ImageChannel.COLOR
 
 
 class ProtocolError(DcfkitError):
-    """The TraX connection failed (the client went away, or sent what the protocol forbids)."""
+    """The TraX connection failed (the client went away, or sent what libtrax cannot read)."""
 
 
 def serve(config: Mapping[str, Any]) -> None:
@@ -60,20 +60,22 @@ def serve(config: Mapping[str, Any]) -> None:
     as the reason of a ``quit``, then raised; a failed connection raises :class:`ProtocolError`."""
     Tracker(config)  # every check of the config, before the handshake: an error is said on stderr alone
     with contextlib.redirect_stdout(sys.stderr):  # the protocol's messages are the only output on stdout
-        server = _protocol(lambda: trax.Server(REGION_FORMATS, IMAGE_FORMATS, [CHANNEL], **_metadata(config)))
+        server = _protocol(lambda: trax.Server(REGION_FORMATS, IMAGE_FORMATS, [CHANNEL], **_metadata(config)),
+                           "cannot start the server")
         try:
             _session(server, config)
         except DcfkitError as exc:
             if not isinstance(exc, ProtocolError):
-                _protocol(lambda: server.quit(reason=ascii_text(str(exc))))
+                _protocol(lambda: server.quit(reason=ascii_text(str(exc))), "cannot send quit")
             raise
-        _protocol(server.quit)
+        _protocol(server.quit, "cannot send quit")
 
 
 def _metadata(config: Mapping[str, Any]) -> dict:
     """What the handshake tells the client about the tracker."""
-    return {"tracker_name": ascii_text(config["name"]), "tracker_description": ascii_text(config.get("description", "")),
-            "tracker_family": "dcfkit", "metadata": {"dcfkit.version": __version__}}
+    return {"tracker_name": ascii_text(config["name"]), "tracker_family": "dcfkit",
+            "tracker_description": ascii_text(config.get("description", "")),
+            "metadata": {"dcfkit.version": __version__}}
 
 
 def ascii_text(text: str) -> str:
@@ -83,20 +85,27 @@ def ascii_text(text: str) -> str:
     return "".join(letters).encode("ascii", "replace").decode("ascii")
 
 
-def _protocol(call):
-    """``call()``, a failure of the connection said as a :class:`ProtocolError`."""
+def _protocol(call, failure: str):
+    """``call()``, a failure of the connection said as a :class:`ProtocolError`: ``failure``,
+    then libtrax's words."""
     try:
         return call()
     except trax.TraxException as exc:
-        raise ProtocolError(f"TraX: {exc}") from None
+        raise ProtocolError(f"TraX: {failure} ({exc})") from None
+
+
+def _wait(server):
+    """The client's next request."""
+    return _protocol(server.wait, "no request from the client: it closed the connection without sending quit, "
+                                  "or sent what the protocol does not allow")
 
 
 def _session(server, config: Mapping[str, Any]) -> None:
     """Track each object the client initialises until it quits."""
-    request = _protocol(server.wait)
+    request = _wait(server)
     while request.type != trax.TraxStatus.QUIT:
         if request.type != trax.TraxStatus.INITIALIZE:
-            raise ProtocolError("TraX: the client sent a frame before initializing an object")
+            raise DcfkitError("TraX: the client sent a frame before initializing an object")
         run = _Run(server, request)
         track(Tracker(config), run.images(), run.box, on_frame=run.reply)
         request = run.next_request
@@ -118,14 +127,14 @@ class _Run:
         request, frame = self.first, 1
         while True:
             yield read_image(request.image, f"frame {frame}")
-            request, frame = _protocol(self.server.wait), frame + 1
+            request, frame = _wait(self.server), frame + 1
             if request.type != trax.TraxStatus.FRAME:
                 self.next_request = request
                 return
 
     def reply(self, index: int, image: np.ndarray, box: np.ndarray, tracker) -> None:
         region = trax.Rectangle.create(*(float(v) for v in box))
-        _protocol(lambda: self.server.status([(region, confidence_properties(tracker))]))
+        _protocol(lambda: self.server.status([(region, confidence_properties(tracker))]), "cannot reply")
 
 
 def region_box(region) -> tuple[float, float, float, float]:
