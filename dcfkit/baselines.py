@@ -8,6 +8,7 @@ import cv2
 import numpy as np
 
 from .errors import DcfkitError, shown
+from .opencv_check import contrib_problem
 
 # Preferred constructor first: legacy trackers take and return float boxes (Rect2d).
 _OPENCV_CONSTRUCTORS = {
@@ -92,5 +93,6 @@ def opencv_tracker(name: str) -> Callable[[Any], OpenCVTracker]:
     if key not in available_opencv_trackers():
         raise OpenCVUnavailable(
             f"OpenCV tracker {key} is not in this OpenCV build (available: "
-            f"{', '.join(available_opencv_trackers()) or 'none'}); install opencv-contrib-python-headless")
+            f"{', '.join(available_opencv_trackers()) or 'none'}); "
+            + (contrib_problem(cv2) or "install opencv-contrib-python-headless"))
     return _OpenCVFactory(key)

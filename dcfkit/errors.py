@@ -27,6 +27,10 @@ class TrackingError(DcfkitError, RuntimeError):
     """Tracking could not continue on a frame (the message names the frame)."""
 
 
+class MissingDependency(DcfkitError, ImportError):
+    """An optional package is not installed (the message names the extra that installs it)."""
+
+
 def shown(value: Any) -> str:
     """``repr(value)`` in at most :data:`SHOWN_CHARS` characters, whatever the value's size or depth."""
     short = reprlib.Repr()  # its limits are per level: a few items, a few levels, a few characters each

@@ -89,3 +89,23 @@ def pip_install_copy(tmp_path_factory):
         return target
 
     return install
+
+
+@pytest.fixture
+def clobbered_opencv(tmp_path, monkeypatch):
+    """cv2 as ``pip install opencv-python`` leaves it over dcfkit's contrib build (the two
+    packages installed, as vot-toolkit's requirements make it): its own binary, with no Color
+    Names table in it, and the contrib's ``cv2/legacy`` stub folder, importable and empty. A
+    stand-in module, imported as cv2 by dcfkit too; no cached Color Names table."""
+    import types  # deferred: only this fixture builds modules
+
+    cv2 = types.ModuleType("cv2")
+    cv2.__file__, cv2.__version__ = str(tmp_path / "__init__.py"), "5.0.0"
+    cv2.legacy, cv2.TrackerMIL_create = types.ModuleType("cv2.legacy"), object
+    (tmp_path / "cv2.abi3.so").write_bytes(b"\x7fELF not the contrib build")
+    monkeypatch.setitem(sys.modules, "cv2", cv2)
+    monkeypatch.setattr("dcfkit.baselines.cv2", cv2)
+    monkeypatch.setattr("dcfkit.opencv_check.installed_opencv",
+                        lambda: {"opencv-contrib-python-headless": "4.14.0.94", "opencv-python": "5.0.0.93"})
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    return cv2

@@ -12,6 +12,7 @@ from typing import Any, Iterable
 
 import yaml
 
+from ..opencv_check import contrib_problem
 from ..params import Bounds, fields
 from ..registry import KINDS, PluginWarning, get_registry
 
@@ -22,7 +23,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """List the components; exit status 1 if a plugin could not be loaded."""
+    """List the components; exit status 1 if a plugin could not be loaded. A cv2 without
+    OpenCV's contrib modules is warned about (:mod:`dcfkit.opencv_check`)."""
     with warnings.catch_warnings():  # the skipped plugins are listed below, each once
         warnings.simplefilter("ignore", PluginWarning)
         registry = get_registry()
@@ -41,6 +43,9 @@ def run(args: argparse.Namespace) -> int:
                 print(f"{'':<14}also: {row['checks']}")
     for failure in registry.failures:
         print(f"warning: {failure}", file=sys.stderr)
+    problem = contrib_problem()  # the colornames feature listed above needs OpenCV's contrib build
+    if problem:
+        print(f"warning: {problem}", file=sys.stderr)
     return 1 if registry.failures else 0
 
 

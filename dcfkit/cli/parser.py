@@ -5,13 +5,13 @@ import argparse
 
 from .. import __version__
 from ..errors import SHOWN_CHARS
-from . import ablate, components, evaluate, track
+from . import ablate, components, evaluate, track, trax
 
 DESCRIPTION = """dcfkit: discriminative correlation filter trackers assembled from YAML.
 
 Commands: track (one video), demo (a generated sequence, no data needed), components,
 eval (one-pass evaluation on a benchmark), report, compare (two result folders side by
-side), ablate."""
+side), ablate, trax (serve the VOT toolkit's TraX protocol)."""
 
 #: name -> (help, add_arguments, run)
 COMMANDS = {
@@ -25,6 +25,8 @@ COMMANDS = {
     "compare": ("two folders of result files side by side per sequence: scores, their differences, box "
                 "agreement (parity checks)", evaluate.add_compare_arguments, evaluate.run_compare),
     "ablate": ("run an ablation spec: variants x parameter grids x sequences", ablate.add_arguments, ablate.run),
+    "trax": ("serve a config over the TraX protocol on stdin/stdout, for the VOT toolkit (needs dcfkit[trax])",
+             trax.add_arguments, trax.run),
 }
 
 

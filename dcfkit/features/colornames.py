@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError, clip, shown
+from ..opencv_check import contrib_problem
 
 SHAPE = (32768, 10)
 SHA256 = "e6a0a45f68cf5880d018f9e2f82dff180e992296d335b0fa8eb253b9db403ec0"
@@ -61,9 +62,10 @@ def _from_opencv() -> np.ndarray:
         if start >= 0:
             table = np.frombuffer(data, np.float32, count=SHAPE[0] * SHAPE[1], offset=start).reshape(SHAPE)
             return _verify(table, path)
-    raise ConfigError(
-        "the Color Names table was not found in the installed OpenCV (" + (", ".join(binaries) or "no cv2 binary")
-        + "); install opencv-contrib-python-headless, or set colornames.table_path to a .npy/.mat file")
+    where = ", ".join(binaries) or "no cv2 binary"
+    raise ConfigError(f"the Color Names table was not found in the installed OpenCV ({where}); "
+                      + (contrib_problem(cv2) or "install opencv-contrib-python-headless")
+                      + " (or set colornames.table_path to a .npy/.mat file)")
 
 
 def _expanded(path: str) -> Path | None:

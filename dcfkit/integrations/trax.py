@@ -1,0 +1,173 @@
+"""dcfkit as a TraX server, the protocol through which the VOT toolkit runs trackers
+(``vot-trax`` package, ``pip install "dcfkit[trax]"``; ``dcfkit trax CONFIG`` serves it).
+
+The client starts the server process and talks to it over its stdin and stdout (or the
+socket ``$TRAX_SOCKET`` names): ``stdout`` belongs to the protocol, so :func:`serve` sends
+Python's prints to ``stderr``, where the log goes too. One session serves one object
+(``initialize``, then ``frame`` after ``frame``); a new ``initialize`` starts a new tracker.
+
+Regions: a TraX rectangle is ``left, top, width, height`` in 0-based pixels, dcfkit's own
+in-memory convention, so boxes pass unchanged (vot-toolkit's dummy sequence pastes its target
+at pixel ``(x, y)`` and annotates ``Rectangle(x, y, w, h)``; it rasterises a rectangle as the
+pixels ``x .. x + w - 1``). A polygon (VOT's rotated boxes) initialises with its axis-aligned
+bounding box, as vot-toolkit's ``Rectangle.convert`` makes it; replies are rectangles.
+Images: ``path`` (read by :func:`dcfkit.datasets.read_frame`, with its checks) and ``memory``
+(``rgb`` or ``gray8``), on the ``color`` channel.
+
+Each reply carries the object's properties ``confidence`` (the response's peak,
+:mod:`dcfkit.confidence`: VOT's long-term analysis thresholds it) and ``apce``; a frame
+without a response (the initialising frame, a frame held as blank) has neither.
+
+An error on a frame (an unreadable image, a tracker failure) ends the session: the client is
+sent ``quit`` with the message as its reason (``trax.reason``; ``trax.client.Client`` raises
+``TraxException("Server terminated the session: <reason>")``), and the error is raised.
+"""
+from __future__ import annotations
+
+import contextlib
+import math
+import sys
+import unicodedata
+from typing import Any, Iterator, Mapping
+
+import numpy as np
+
+from .. import __version__
+from ..confidence import confidence_of
+from ..datasets import read_frame
+from ..errors import DcfkitError, InputError, MissingDependency
+from ..tracker import Tracker
+from ..tracking import track
+
+try:
+    import trax  # vot-trax: the optional dependency this module exists for
+except ImportError as exc:
+    raise MissingDependency('the TraX server needs the vot-trax package: pip install "dcfkit[trax]"') from exc
+
+REGION_FORMATS = [trax.Region.RECTANGLE, trax.Region.POLYGON]
+IMAGE_FORMATS = [trax.Image.PATH, trax.Image.MEMORY]
+CHANNEL = trax.ImageChannel.COLOR
+
+
+class ProtocolError(DcfkitError):
+    """The TraX connection failed (the client went away, or sent what libtrax cannot read)."""
+
+
+def serve(config: Mapping[str, Any]) -> None:
+    """Serve TraX on stdin/stdout (or ``$TRAX_SOCKET``) until the client quits, one
+    :class:`~dcfkit.tracker.Tracker` built from ``config`` (a resolved config,
+    :func:`dcfkit.load_config`) per ``initialize``. An error on a frame is sent to the client
+    as the reason of a ``quit``, then raised; a failed connection raises :class:`ProtocolError`."""
+    Tracker(config)  # every check of the config, before the handshake: an error is said on stderr alone
+    with contextlib.redirect_stdout(sys.stderr):  # the protocol's messages are the only output on stdout
+        server = _protocol(lambda: trax.Server(REGION_FORMATS, IMAGE_FORMATS, [CHANNEL], **_metadata(config)),
+                           "cannot start the server")
+        try:
+            _session(server, config)
+        except DcfkitError as exc:
+            if not isinstance(exc, ProtocolError):
+                _protocol(lambda: server.quit(reason=ascii_text(str(exc))), "cannot send quit")
+            raise
+        _protocol(server.quit, "cannot send quit")
+
+
+def _metadata(config: Mapping[str, Any]) -> dict:
+    """What the handshake tells the client about the tracker."""
+    return {"tracker_name": ascii_text(config["name"]), "tracker_family": "dcfkit",
+            "tracker_description": ascii_text(config.get("description", "")),
+            "metadata": {"dcfkit.version": __version__}}
+
+
+def ascii_text(text: str) -> str:
+    """``text`` in ASCII ('é' as 'e', '—' as '?'): libtrax reads a byte over 127 as the end of
+    the stream (a signed ``char``), so one in the handshake or a quit's reason ends the session."""
+    letters = (c for c in unicodedata.normalize("NFKD", text) if not unicodedata.combining(c))  # é: e + ´
+    return "".join(letters).encode("ascii", "replace").decode("ascii")
+
+
+def _protocol(call, failure: str):
+    """``call()``, a failure of the connection said as a :class:`ProtocolError`: ``failure``,
+    then libtrax's words."""
+    try:
+        return call()
+    except trax.TraxException as exc:
+        raise ProtocolError(f"TraX: {failure} ({exc})") from None
+
+
+def _wait(server):
+    """The client's next request."""
+    return _protocol(server.wait, "no request from the client: it closed the connection without sending quit, "
+                                  "or sent what the protocol does not allow")
+
+
+def _session(server, config: Mapping[str, Any]) -> None:
+    """Track each object the client initialises until it quits."""
+    request = _wait(server)
+    while request.type != trax.TraxStatus.QUIT:
+        if request.type != trax.TraxStatus.INITIALIZE:
+            raise DcfkitError("TraX: the client sent a frame before initializing an object")
+        run = _Run(server, request)
+        track(Tracker(config), run.images(), run.box, on_frame=run.reply)
+        request = run.next_request
+
+
+class _Run:
+    """One object, from its ``initialize`` to the next ``initialize`` or ``quit``: the frames as
+    :func:`dcfkit.tracking.track` reads them (numbered from 1, the initialising frame), and the
+    replies it sends."""
+
+    def __init__(self, server, request):
+        self.server = server
+        self.first = request
+        (region, _properties), = request.objects  # the server is single-object: libtrax sends one
+        self.box = region_box(region)
+        self.next_request = None
+
+    def images(self) -> Iterator[np.ndarray]:
+        request, frame = self.first, 1
+        while True:
+            yield read_image(request.image, f"frame {frame}")
+            request, frame = _wait(self.server), frame + 1
+            if request.type != trax.TraxStatus.FRAME:
+                self.next_request = request
+                return
+
+    def reply(self, index: int, image: np.ndarray, box: np.ndarray, tracker) -> None:
+        region = trax.Rectangle.create(*(float(v) for v in box))
+        _protocol(lambda: self.server.status([(region, confidence_properties(tracker))]), "cannot reply")
+
+
+def region_box(region) -> tuple[float, float, float, float]:
+    """A TraX rectangle as ``(x, y, w, h)``; a polygon as its axis-aligned bounding box."""
+    if region.type == trax.Region.RECTANGLE:
+        return tuple(float(v) for v in region.bounds())
+    if region.type == trax.Region.POLYGON:
+        points = np.array(list(region), dtype=np.float64)
+        (left, top), (right, bottom) = points.min(axis=0), points.max(axis=0)
+        return float(left), float(top), float(right - left), float(bottom - top)
+    raise InputError(f"frame 1: a TraX {region.type} region; dcfkit takes a rectangle or a polygon")
+
+
+def read_image(images: Mapping[str, Any], what: str) -> np.ndarray:
+    """The ``color`` image of a request as a BGR (or gray) uint8 array."""
+    image = images.get(CHANNEL)
+    if isinstance(image, trax.FileImage):
+        return read_frame(image.path(), what)
+    if isinstance(image, trax.MemoryImage):
+        return memory_image(image.array(), what)
+    kind = image.type() if image is not None else "no"
+    raise InputError(f"{what}: a TraX {kind} image on the color channel; dcfkit reads path and memory images")
+
+
+def memory_image(array: np.ndarray, what: str) -> np.ndarray:
+    """A TraX memory image (``(H, W, 3)`` RGB or ``(H, W, 1)`` gray) as BGR or ``(H, W)`` gray uint8."""
+    if array.dtype != np.uint8:
+        raise InputError(f"{what}: a {array.dtype} memory image (gray16?); dcfkit tracks 8-bit images")
+    return np.ascontiguousarray(array[:, :, ::-1]) if array.shape[2] == 3 else array[:, :, 0]
+
+
+def confidence_properties(tracker) -> dict[str, float]:
+    """``confidence`` (the response's peak) and ``apce`` of the last frame; none on a frame
+    without a response (:func:`dcfkit.confidence.confidence_of` gives NaN)."""
+    peak, apce = confidence_of(tracker)
+    return {"confidence": peak, "apce": apce} if math.isfinite(peak) else {}
