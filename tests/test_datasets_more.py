@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import sys
 import types
 import warnings
@@ -331,6 +332,8 @@ def test_vot_layouts_regions_and_image_folders(tmp_path, jpg):
     assert detect_dataset(root) == "vot"  # by the folders alone, nothing else fits
     write(root / "ants1" / "sequence", "channels.color=color\n")  # a folder means %08d.jpg in it
     assert load_dataset("vot", root, "ants1")[0].frames[3].name == "00000004.jpg"
+    write(root / "ants1" / "sequence", "fps=30\nname=ants1\n")  # no channel listed: the default, color/
+    assert load_dataset("vot", root, "ants1")[0].frames[3] == root / "ants1" / "color" / "00000004.jpg"
 
 
 @pytest.mark.parametrize("line, message", [
@@ -580,3 +583,23 @@ def test_sequences_made_by_hand_are_scored_unless_withheld():
         assert scored_sequences([seq, plain]) == [plain]
         with pytest.raises(DatasetError, match="no scores: this dataset publishes the ground truth of frame 1 only"):
             scored_sequences([seq])
+
+
+def test_the_dataset_plugin_of_the_tutorial_runs(tmp_path, jpg, monkeypatch, capsys):
+    tutorial = (Path(__file__).resolve().parents[1] / "docs" / "plugins.md").read_text(encoding="utf-8")
+    (source,) = re.findall(r"<!-- example: dataset plugin -->\n```python\n(.*?)```", tutorial, re.S)
+    install(monkeypatch, {"dcfkit_tc128": source})
+    root = tmp_path / "Temple-color-128"
+    write(root / "Airport_ce" / "Airport_ce_gt.txt", lines([[11, 21, 12, 10], [12, 21, 12, 10], [13, 21, 12, 10]]))
+    write(root / "Airport_ce" / "Airport_ce_frames.txt", "2,4\n")
+    frames(root / "Airport_ce" / "img", ["0001.jpg", "0002.jpg", "0003.jpg", "0004.jpg"], jpg)
+    assert detect_dataset(root) == "tc128"
+    (seq,) = load_dataset("temple-color-128", root)
+    assert [f.name for f in seq.frames] == ["0002.jpg", "0003.jpg", "0004.jpg"] and seq.dataset == "tc128"
+    np.testing.assert_array_equal(seq.ground_truth[0], [10, 20, 12, 10])
+    assert cli.main(["datasets"]) == 0
+    assert "[dcfkit_tc128 (dcfkit_tc128)]" in capsys.readouterr().out
+    write(root / "Airport_ce" / "Airport_ce_frames.txt", "2,5\n")
+    with pytest.raises(DatasetError, match=r"Airport_ce_gt\.txt: 3 annotation lines but 4 frames \(frames 2\.\.5\)"):
+        load_dataset("tc128", root)
+    monkeypatch.setattr(reg, "_REGISTRY", None)

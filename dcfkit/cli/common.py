@@ -53,6 +53,7 @@ def add_protocol_argument(parser: argparse.ArgumentParser) -> None:
 
 def add_dataset_arguments(parser: argparse.ArgumentParser, root_help: str = "benchmark root folder") -> None:
     """``--dataset``, ``--root`` and ``--sequences``."""
-    parser.add_argument("--dataset", default="auto", help="dataset name (default: detect from --root)")
+    parser.add_argument("--dataset", default="auto",
+                        help="dataset name, as `dcfkit datasets` lists them (default: detect from --root)")
     parser.add_argument("--root", required=True, type=Path, help=root_help)
     parser.add_argument("--sequences", default=None, help="comma-separated sequence names (default: all)")

@@ -114,15 +114,15 @@ def read_properties(path: Path) -> dict[str, str]:
 
 def image_pattern(folder: Path) -> str:
     """Where the frames are, relative to the sequence folder: the ``sequence`` file's
-    ``channels.color`` (a folder means ``<folder>/%08d.jpg``), else ``color/%08d.jpg`` if that
-    folder exists, else ``%08d.jpg``."""
+    ``channels.color`` (a folder means ``<folder>/%08d.jpg``); without a ``sequence`` file or a
+    channel in it, ``color/%08d.jpg`` if that folder exists, else ``%08d.jpg``."""
     meta = folder / "sequence"
-    if not meta.is_file():
+    channels = {k: v for k, v in read_properties(meta).items() if k.startswith("channels.")} if meta.is_file() else {}
+    if not channels:  # as the VOT toolkit: no channel listed, the default one
         return "color/%08d.jpg" if (folder / "color").is_dir() else "%08d.jpg"
-    channels = read_properties(meta)
     if "channels.color" not in channels:
-        found = ", ".join(k for k in channels if k.startswith("channels.")) or "none"
-        raise DatasetError(f"{meta}: no channels.color entry (dcfkit reads the color channel; channels: {found})")
+        raise DatasetError(f"{meta}: no channels.color entry (dcfkit reads the color channel; channels: "
+                           f"{', '.join(channels)})")
     pattern = channels["channels.color"].replace("\\", "/")
     if not posixpath.splitext(pattern)[1]:
         pattern = posixpath.join(pattern, "%08d.jpg")
