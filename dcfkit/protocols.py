@@ -263,13 +263,15 @@ def _got10k_frames(pred: np.ndarray, gt: np.ndarray) -> FrameScores:
 
 # --------------------------------------------------------------------------- registry
 
+_OTB = Protocol("otb", "OTB / UAV123 MATLAB toolkit",
+                "calcSeqErrRobust.m, calcRectInt.m, genPerfMat.m, plotDrawSave.m", _otb_frames,
+                success_thresholds=np.linspace(0.0, 1.0, 21),
+                precision_thresholds=np.arange(0, 51, dtype=np.float64),
+                norm_precision_thresholds=np.linspace(0.0, 0.5, 51),
+                drop_zero_curves=True)
+
 PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
-    Protocol("otb", "OTB / UAV123 MATLAB toolkit",
-             "calcSeqErrRobust.m, calcRectInt.m, genPerfMat.m, plotDrawSave.m", _otb_frames,
-             success_thresholds=np.linspace(0.0, 1.0, 21),
-             precision_thresholds=np.arange(0, 51, dtype=np.float64),
-             norm_precision_thresholds=np.linspace(0.0, 0.5, 51),
-             drop_zero_curves=True),
+    _OTB,
     Protocol("pysot", "pysot toolkit OPE benchmark",
              "toolkit/evaluation/ope_benchmark.py, toolkit/utils/statistics.py", _pysot_frames,
              success_thresholds=np.arange(0, 1.05, 0.05),
@@ -281,12 +283,8 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
              precision_thresholds=np.arange(0, 51, dtype=np.float64),
              norm_precision_thresholds=np.linspace(0.0, 0.5, 51),
              weighting="frame", overlap_scores=True),
-    Protocol("lasot", "LaSOT toolkit",
-             "calc_seq_err_robust.m, eval_tracker.m, calc_rect_int.m, plot_draw_save.m", _lasot_frames,
-             success_thresholds=np.linspace(0.0, 1.0, 21),
-             precision_thresholds=np.arange(0, 51, dtype=np.float64),
-             norm_precision_thresholds=np.linspace(0.0, 0.5, 51),
-             drop_zero_curves=True),
+    dataclasses.replace(_OTB, name="lasot", title="LaSOT toolkit", frames=_lasot_frames,
+                        source="calc_seq_err_robust.m, eval_tracker.m, calc_rect_int.m, plot_draw_save.m"),
 )}
 
 

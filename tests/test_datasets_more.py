@@ -260,6 +260,7 @@ def test_polygon_to_box_by_both_rules_against_hand_computed_boxes():
     np.testing.assert_allclose(region_box("1,2,11,2,11,7,1,7"), [1, 2, 10, 5])
     np.testing.assert_allclose(region_box("0,0,4,0,6,3,4,6,0,6,-2,3"), [-2, 0, 8, 6])  # six corners
     np.testing.assert_array_equal(region_box(" 5.5,6,7,8 "), [5.5, 6, 7, 8])
+    np.testing.assert_array_equal(region_box("5.5\t6 7,8"), [5.5, 6, 7, 8])
     assert np.isnan(region_box("nan,nan,nan,nan")).all()
     with pytest.raises(ValueError, match="takes 4 corners, not 6"):
         polygon_box(np.zeros((6, 2)) + np.arange(6)[:, None], "area")
@@ -400,6 +401,32 @@ def test_otb_attributes_from_the_toolkit_att_files_and_pysot_json(tmp_path, jpg)
     write(root / "OTB100.json", "{\n  'Jogging-1': []\n}")
     with pytest.raises(DatasetError, match=r"OTB100\.json, line 2: not JSON"):
         load_dataset("otb", root)
+
+
+# --------------------------------------------------------------------------- detection across layouts
+
+
+def test_each_layout_is_detected_as_itself_and_the_older_ones_still_are(tmp_path, jpg):
+    from test_datasets import dtb_root, uav_root, write_anno, touch_frames  # the older layouts' builders
+
+    def place(name: str) -> Path:  # each in a folder of its own, named neutrally
+        return tmp_path / name / "data"
+    roots = {"lasot": lasot_root(place("lasot"), jpg, name="data"),
+             "got10k_val": got_root(place("got"), jpg, ("val",)),
+             "trackingnet": trackingnet_root(place("tn"), jpg) / "TEST",
+             "trackingnet_train": trackingnet_root(place("tn2"), jpg) / "TRAIN_0",
+             "vot": vot_root(place("vot"), jpg),
+             "otb": otb_root(place("otb"), jpg),
+             "uav123_10fps": uav_root(place("uav"), seqs=("wakeboard7",)),
+             "dtb70": dtb_root(place("dtb"))[0]}
+    uavdt = place("uavdt")
+    write_anno(uavdt / "anno" / "S0601_gt.txt", 2)
+    touch_frames(uavdt / "data_seq" / "S0601", "img%06d.jpg", 1, 2)
+    roots["uavdt"] = uavdt
+    assert {name: detect_dataset(root) for name, root in roots.items()} == {name: name for name in roots}
+    assert [s.name for s in load_dataset("auto", roots["vot"])] == ["ants1", "bag"]
+    with pytest.raises(DatasetError, match=r"sequence 'antz' not found in VOT at .* Did you mean 'ants1'\?"):
+        load_dataset("vot", roots["vot"], "antz")
 
 
 # --------------------------------------------------------------------------- end to end

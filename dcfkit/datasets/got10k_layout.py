@@ -23,13 +23,19 @@ from .registry import Evidence, register_layout
 SPLITS = ("train", "val", "test")
 
 
-def split_folder(root, split: str) -> Path:
-    """``ROOT/<split>``, or ROOT itself when it is that split's folder."""
-    root = require_root(root, f"GOT-10k {split}")
+def _find_split(root: Path, split: str) -> Path | None:
+    """``ROOT/<split>``, or ROOT itself when it is named after the split; None otherwise."""
     if (root / split).is_dir():
         return root / split
-    if root.name.lower() == split:
-        return root
+    return root if root.name.lower() == split else None
+
+
+def split_folder(root, split: str) -> Path:
+    """``ROOT/<split>``, or ROOT itself when it is that split's folder; DatasetError otherwise."""
+    root = require_root(root, f"GOT-10k {split}")
+    folder = _find_split(root, split)
+    if folder is not None:
+        return folder
     present = [s for s in SPLITS if (root / s).is_dir()]
     held = f"it holds {', '.join(present)}" if present else "expected ROOT/train, ROOT/val, ROOT/test"
     raise DatasetError(f"GOT-10k {split}: folder not found: {root / split} ({held}; ROOT may also be the "
@@ -77,7 +83,7 @@ def _loader(split: str) -> Callable[..., list[Sequence]]:
 
 def _detector(split: str) -> Callable[[Path], Evidence]:
     def detect(root: Path) -> Evidence:
-        folder = root / split if (root / split).is_dir() else root if root.name.lower() == split else None
+        folder = _find_split(root, split)
         if folder is None or not (folder / "list.txt").is_file():
             return Evidence.NONE
         return Evidence.NAME if any(folder.glob("GOT-10k_*/groundtruth.txt")) else Evidence.NONE

@@ -31,6 +31,7 @@ from .registry import Evidence, register_layout
 #: the corners' mean, the bounds scaled to the polygon's area, plus 1 in w and h.
 POLYGON_RULES = ("bounds", "area")
 _PATTERN = re.compile(r"^[^%]*%0?\d*d[^%]*$")  # one integer field, as in color/%08d.jpg
+_SEPARATORS = re.compile(r"[,\s]+")  # VOT writes commas; some copies have tabs or spaces
 _GOT10K_FILES = ("meta_info.ini", "absence.label", "cover.label")  # GOT-10k's folders are otherwise VOT-like
 
 
@@ -79,11 +80,12 @@ def mask_box(text: str) -> np.ndarray:
 
 
 def region_box(line: str, rule: str = "bounds") -> np.ndarray:
-    """The ``(4,)`` 0-based box of one ``groundtruth.txt`` line; ValueError if malformed."""
+    """The ``(4,)`` 0-based box of one ``groundtruth.txt`` line (values separated by commas, tabs
+    or spaces; a mask by commas); ValueError if malformed."""
     text = line.strip()
     if text.startswith("m"):
         return mask_box(text[1:])
-    values = [float(f) for f in text.split(",")]
+    values = [float(f) for f in _SEPARATORS.split(text) if f]
     if len(values) == 4:
         return np.array(values, dtype=np.float64)
     if len(values) >= 6 and len(values) % 2 == 0:
