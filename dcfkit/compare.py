@@ -27,7 +27,7 @@ from typing import Iterable
 import numpy as np
 
 from . import metrics
-from .datasets import DatasetError, Sequence, read_boxes
+from .datasets import DatasetError, Sequence, read_boxes, scored_sequences
 from .errors import clip, shown
 from .results import ResultStore, result_files
 from .protocols import DEFAULT, Protocol, get_protocol
@@ -75,13 +75,14 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     (``only_in_results``, ``only_in_reference``, ``not_in_dataset``, ``damaged``: sequence names).
     Raises :class:`DatasetError` for a missing folder, a malformed line (naming file and
     line), two files of one sequence with different line counts, or a line count that is
-    not the sequence's frame count (naming the sequence).
+    not the sequence's frame count (naming the sequence). Sequences whose ground truth is
+    withheld after frame 1 (test splits) are left out, as in :func:`dcfkit.report.evaluate`.
     """
     proto = get_protocol(protocol)
     if not divergence_px >= 0:
         raise DatasetError(f"divergence_px must be a number >= 0, got {shown(divergence_px)}")
     (ours, damaged), (theirs, damaged_ref) = _intact_files(results), _intact_files(reference)
-    sequences = list(sequences)
+    sequences = scored_sequences(sequences)
     known = {s.name for s in sequences}
     both = [s for s in sequences if s.name in ours and s.name in theirs]
     left_out = {"only_in_results": sorted(set(ours) - set(theirs)),

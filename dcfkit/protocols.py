@@ -31,6 +31,18 @@ UAV123 tables.
   the success curve. Sequences weigh equally, and a sequence whose curve is all zero is
   left out of that curve's mean (``aa(sum(aa,2)>eps,:)``).
 
+``lasot``: the LaSOT evaluation toolkit (``calc_seq_err_robust.m``, ``eval_tracker.m``,
+``calc_rect_int.m``, ``plot_draw_save.m``), the OTB toolkit with absent frames.
+
+* ``otb``'s rules, except for a NaN ground-truth row: the target is absent (LaSOT's
+  full-occlusion or out-of-view flags; the toolkit reads them from ``annos/absent``). The
+  toolkit removes absent frames before scoring but divides by all frames, so an absent frame
+  counts in the denominator and fails every threshold: overlap -1 and error +inf. (pytracking's
+  LaSOT analysis and pysot's LaSOT benchmark do the same.)
+* A failed prediction is repaired when it has one NaN value or more (``sum(isnan(r))``; the
+  OTB toolkit wants four), or ``w <= 0`` or ``h <= 0``; in an absent frame too, where the
+  toolkit's ground truth holds numbers, never NaN.
+
 ``pysot``: pysot's ``toolkit/evaluation/ope_benchmark.py`` and ``toolkit/utils/statistics.py``.
 
 * Every frame is in the denominator; the first frame is scored as the file has it; failed
@@ -52,8 +64,9 @@ UAV123 tables.
 ``got10k/utils/metrics.py``.
 
 * The first frame is not scored (``anno[1:]``). Absent frames are not scored either:
-  GOT-10k marks them with its ``cover`` flags, which UAV benchmarks do not have, so a row
-  with a NaN is absent (the rule of the toolkit's LaSOT and UAV123 experiments).
+  GOT-10k marks them with its ``cover`` flags (0: not visible), which dcfkit's GOT-10k
+  loaders turn into NaN rows, and UAV benchmarks have none, so a row with a NaN is absent
+  (also the rule of the toolkit's LaSOT and UAV123 experiments).
 * IoU of continuous boxes, ``inter / (union + eps)`` clipped to [0, 1]; an empty ground
   truth that is not NaN is scored (IoU 0).
 * AO = mean IoU, SR@0.5 and SR@0.75 = fraction of IoU ``> 0.5`` / ``> 0.75``, success
@@ -147,12 +160,14 @@ def _centres(boxes: np.ndarray) -> np.ndarray:
 # --------------------------------------------------------------------------- otb
 
 
-def _matlab_substitute(pred: np.ndarray, gt: np.ndarray) -> np.ndarray:
+def _matlab_substitute(pred: np.ndarray, gt: np.ndarray, any_nan: bool = False) -> np.ndarray:
     """calcSeqErrRobust's repair of failed predictions, as a forward fill: row ``i >= 1`` is
     flagged by its own (original) values, and a flagged row takes the last unflagged row
-    before it, which is what replacing row i by the already-replaced row i-1 amounts to."""
+    before it, which is what replacing row i by the already-replaced row i-1 amounts to.
+    ``any_nan``: one NaN value flags the row (LaSOT's ``sum(isnan(r))``), not four."""
     with np.errstate(invalid="ignore"):
-        bad = np.isnan(pred) | (pred[:, 2:3] <= 0) | (pred[:, 3:4] <= 0)
+        nan = np.isnan(pred).any(axis=1, keepdims=True) if any_nan else np.isnan(pred)
+        bad = nan | (pred[:, 2:3] <= 0) | (pred[:, 3:4] <= 0)
     flagged = (bad & ~np.isnan(gt)).all(axis=1)
     flagged[:1] = False
     source = np.where(flagged, 0, np.arange(len(pred)))
@@ -169,10 +184,10 @@ def _calc_rect_int(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return inter / (a[:, 2] * a[:, 3] + b[:, 2] * b[:, 3] - inter)
 
 
-def _otb_frames(pred: np.ndarray, gt: np.ndarray) -> FrameScores:
+def _otb_frames(pred: np.ndarray, gt: np.ndarray, any_nan: bool = False) -> FrameScores:
     n = len(gt)
     with np.errstate(invalid="ignore", divide="ignore"):
-        rect = _matlab_substitute(pred, gt)
+        rect = _matlab_substitute(pred, gt, any_nan)
         rect[:1] = gt[:1]  # the first frame is scored with the ground truth
         offset = _centres(rect) - _centres(gt)
         error = np.sqrt((offset ** 2).sum(axis=1))
@@ -183,6 +198,20 @@ def _otb_frames(pred: np.ndarray, gt: np.ndarray) -> FrameScores:
     error[~in_view] = -1.0
     norm_error[~in_view] = -1.0
     return FrameScores(overlap, error, norm_error, np.ones(n, dtype=bool))
+
+
+# --------------------------------------------------------------------------- lasot
+
+
+def _lasot_frames(pred: np.ndarray, gt: np.ndarray) -> FrameScores:
+    absent = np.isnan(gt).any(axis=1)
+    # the toolkit's file holds numbers (0,0,0,0 or a box) in an absent frame: repair and score as
+    # otb does with a ground truth that is not in view, then fail both thresholds there
+    f = _otb_frames(pred, np.where(absent[:, None], 0.0, gt), any_nan=True)
+    error, norm_error = f.error.copy(), f.norm_error.copy()
+    error[absent] = np.inf
+    norm_error[absent] = np.inf
+    return FrameScores(f.overlap, error, norm_error, f.counted)
 
 
 # --------------------------------------------------------------------------- pysot
@@ -234,13 +263,15 @@ def _got10k_frames(pred: np.ndarray, gt: np.ndarray) -> FrameScores:
 
 # --------------------------------------------------------------------------- registry
 
+_OTB = Protocol("otb", "OTB / UAV123 MATLAB toolkit",
+                "calcSeqErrRobust.m, calcRectInt.m, genPerfMat.m, plotDrawSave.m", _otb_frames,
+                success_thresholds=np.linspace(0.0, 1.0, 21),
+                precision_thresholds=np.arange(0, 51, dtype=np.float64),
+                norm_precision_thresholds=np.linspace(0.0, 0.5, 51),
+                drop_zero_curves=True)
+
 PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
-    Protocol("otb", "OTB / UAV123 MATLAB toolkit",
-             "calcSeqErrRobust.m, calcRectInt.m, genPerfMat.m, plotDrawSave.m", _otb_frames,
-             success_thresholds=np.linspace(0.0, 1.0, 21),
-             precision_thresholds=np.arange(0, 51, dtype=np.float64),
-             norm_precision_thresholds=np.linspace(0.0, 0.5, 51),
-             drop_zero_curves=True),
+    _OTB,
     Protocol("pysot", "pysot toolkit OPE benchmark",
              "toolkit/evaluation/ope_benchmark.py, toolkit/utils/statistics.py", _pysot_frames,
              success_thresholds=np.arange(0, 1.05, 0.05),
@@ -252,6 +283,8 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
              precision_thresholds=np.arange(0, 51, dtype=np.float64),
              norm_precision_thresholds=np.linspace(0.0, 0.5, 51),
              weighting="frame", overlap_scores=True),
+    dataclasses.replace(_OTB, name="lasot", title="LaSOT toolkit", frames=_lasot_frames,
+                        source="calc_seq_err_robust.m, eval_tracker.m, calc_rect_int.m, plot_draw_save.m"),
 )}
 
 

@@ -3,7 +3,10 @@
 Every component, built-in or third-party, is registered through one hook,
 ``dcfkit_register_components(registry)``, in which a plugin calls
 ``registry.register(SomeComponent)``. Built-ins live in :mod:`dcfkit.builtin` and are
-registered exactly like plugins found through the ``dcfkit`` entry-point group.
+registered exactly like plugins found through the ``dcfkit`` entry-point group. In the same
+hook a plugin registers a benchmark layout with ``registry.register_dataset(name, load,
+description, detect=..., aliases=...)`` (the arguments of
+:func:`dcfkit.datasets.register_layout`); :mod:`dcfkit.datasets` looks it up here.
 Set ``DCFKIT_DISABLE_PLUGINS=1`` to load built-ins only. Nothing happens at import time:
 the registry is built on first use of :func:`get_registry`.
 """
@@ -29,6 +32,7 @@ from .signals import handlers_replaced
 
 PROJECT = "dcfkit"
 KINDS = ("feature", "label", "regularizer", "solver", "search", "scale")
+DATASET = "dataset"  # the kind of the benchmark layouts plugins register (an Entry's cls is the Layout)
 DISABLE_ENV = "DCFKIT_DISABLE_PLUGINS"
 # The base classes of each kind (a regularizer's: one per role), whose ``contract`` a component
 # must meet. Named, not imported: their modules import this one.
@@ -44,7 +48,8 @@ hookimpl = pluggy.HookimplMarker(PROJECT)
 class HookSpecs:
     @hookspec
     def dcfkit_register_components(self, registry: "Registry") -> None:
-        """Register components by calling ``registry.register(cls)`` for each."""
+        """Register components by calling ``registry.register(cls)`` for each, and benchmark
+        layouts by calling ``registry.register_dataset(name, load, description, ...)``."""
 
 
 class Component:
@@ -202,18 +207,19 @@ class PluginWarning(RuntimeWarning):
 
 @dataclasses.dataclass(frozen=True)
 class Entry:
-    cls: type
+    cls: Any  # the component class; for kind DATASET, the dcfkit.datasets.Layout
     provider: str
     distribution: str | None = None  # "name version" of the plugin's package; None for built-ins
     contract: Contract = dataclasses.field(default_factory=Contract, compare=False)  # its kind's (or role's)
 
 
 class Registry:
-    """Component classes by (kind, name), with the plugin that provided each."""
+    """Component classes by (kind, name), and plugins' benchmark layouts by name (kind
+    :data:`DATASET`), with the plugin that provided each."""
 
     def __init__(self):
-        self._entries: dict[str, dict[str, Entry]] = {k: {} for k in KINDS}
-        self._ambiguous: dict[str, dict[str, list[str]]] = {k: {} for k in KINDS}
+        self._entries: dict[str, dict[str, Entry]] = {k: {} for k in KINDS + (DATASET,)}
+        self._ambiguous: dict[str, dict[str, list[str]]] = {k: {} for k in KINDS + (DATASET,)}
         self._provider, self._distribution = "?", None
         self.failures: list[str] = []
 
@@ -241,12 +247,28 @@ class Registry:
         problems = contract_problems(cls, base)
         if problems:
             raise RegistryError(f"{where}: {'; '.join(problems)}")
+        self._add(kind, name, Entry(cls, self._provider, self._distribution, base.__dict__["contract"]))
+        return cls
+
+    def register_dataset(self, name: str, load, description: str, *, detect=None, aliases=()):
+        """Register a benchmark layout: the arguments of :func:`dcfkit.datasets.register_layout`.
+        A name or alias of a layout dcfkit has (or one registered in code) is a RegistryError; one
+        that two plugins register is withdrawn, as a component's name. Returns the Layout."""
+        layouts = importlib.import_module("dcfkit.datasets.registry")  # named: that module imports this one
+        layout = layouts.new_layout(name, load, description, detect=detect, aliases=aliases,
+                                    provider=self._provider)
+        for key in (layout.name,) + layout.aliases:
+            self._add(DATASET, key, Entry(layout, self._provider, self._distribution))
+        return layout
+
+    def _add(self, kind: str, name: str, entry: Entry) -> None:
+        """Enter ``entry`` as ``name``; a name a second plugin registers is withdrawn from both."""
         if name in self._ambiguous[kind]:
             if self._distribution is None or self._provider in self._ambiguous[kind][name]:
                 raise RegistryError(f"{kind} '{name}' from {self._provider} is already registered by "
                                     f"{' and '.join(self._ambiguous[kind][name])}")
             self._ambiguous[kind][name].append(self._provider)
-            return cls
+            return
         existing = self._entries[kind].get(name)
         if existing is not None:
             if existing.distribution is None or self._distribution is None or existing.provider == self._provider:
@@ -254,19 +276,35 @@ class Registry:
                                     f"{existing.provider}")
             del self._entries[kind][name]
             self._ambiguous[kind][name] = [existing.provider, self._provider]
-            return cls
-        self._entries[kind][name] = Entry(cls, self._provider, self._distribution, base.__dict__["contract"])
-        return cls
+            return
+        self._entries[kind][name] = entry
 
     def names(self, kind: str) -> list[str]:
         return sorted(self._check_kind(kind))
 
+    def datasets(self) -> list:
+        """The benchmark layouts plugins registered (:class:`dcfkit.datasets.Layout`), each
+        once, in registration order; one whose name is withdrawn is left out (its aliases that
+        are not withdrawn still find it: :meth:`dataset`)."""
+        return [e.cls for key, e in self._entries[DATASET].items() if key == e.cls.name]
+
+    def dataset(self, name: str):
+        """The layout a plugin registered as ``name`` (a name or alias; None if none did); a
+        RegistryError if two plugins did."""
+        if name in self._ambiguous[DATASET]:
+            raise self._withdrawn(DATASET, name)
+        entry = self._entries[DATASET].get(name)
+        return entry.cls if entry is not None else None
+
+    def _withdrawn(self, kind: str, name: str) -> RegistryError:
+        return RegistryError(f"{kind} '{name}' is registered by more than one plugin "
+                             f"({' and '.join(self._ambiguous[kind][name])}), so it is not used; "
+                             f"uninstall all but one of them")
+
     def entry(self, kind: str, name: str) -> Entry:
         entries = self._check_kind(kind)
         if name in self._ambiguous[kind]:
-            raise RegistryError(f"{kind} '{name}' is registered by more than one plugin "
-                                f"({' and '.join(self._ambiguous[kind][name])}), so it is not used; "
-                                f"uninstall all but one of them")
+            raise self._withdrawn(kind, name)
         if name not in entries:
             skipped = f"; skipped plugins: {' | '.join(self.failures)}" if self.failures else ""
             raise RegistryError(f"unknown {kind} '{clip(name)}'{closest(name, entries)}; "

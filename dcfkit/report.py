@@ -25,7 +25,7 @@ from typing import Iterable, Mapping, Sequence as Seq
 import numpy as np
 
 from . import metrics
-from .datasets import ATTRIBUTE_NAMES, DatasetError, Sequence
+from .datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
 from .errors import clip, shown
 from .protocols import DEFAULT, Protocol, get_protocol
 from .results import atomic_write, ensure_writable, import_results, load_results
@@ -91,12 +91,14 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
     ``got10k``, else AUC), ``curves`` (tracker -> averaged ``precision``/``success``/
     ``norm_precision`` curves), ``attribute_curves`` (attribute -> tracker -> curves),
     ``attributes`` (attribute -> number of sequences), ``thresholds``, ``protocol`` (name,
-    title, source) and ``settings``.
+    title, source) and ``settings``. Sequences whose ground truth is withheld after frame 1
+    (test splits) are left out (:func:`~dcfkit.datasets.scored_sequences`: a
+    :class:`DatasetError` if that leaves none).
     """
     proto = get_protocol(protocol)
     weighting = weighting or proto.weighting
     keys = proto.score_keys
-    sequences = list(sequences)
+    sequences = scored_sequences(sequences)
     per_seq, fps, missing = {}, {}, {}
     for tracker, res in results.items():
         per_seq[tracker], fps[tracker], missing[tracker] = _score_tracker(tracker, res, sequences, include_first,
@@ -449,6 +451,7 @@ def score_and_write(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] |
     """:func:`write_report` that also returns what :func:`evaluate` returned: (evaluation, paths)."""
     out_dir = Path(out_dir)
     report_dir = Path(report_dir) if report_dir is not None else out_dir / "report"
+    sequences = scored_sequences(sequences)  # a test split stops here, before any folder is made
     if _holds_results(report_dir, {s.name for s in sequences}):
         raise DatasetError(f"{report_dir} holds a tracker's results; write the report elsewhere with --report-dir")
     results = gather_results(out_dir, sequences, trackers, exclude=[report_dir])

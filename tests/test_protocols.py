@@ -54,7 +54,7 @@ def frames(protocol, pred, gt):
 
 
 def test_registry():
-    assert list(PROTOCOLS) == ["otb", "pysot", "got10k"]
+    assert list(PROTOCOLS) == ["otb", "pysot", "got10k", "lasot"]
     assert get_protocol("OTB") is PROTOCOLS["otb"] and get_protocol(PROTOCOLS["pysot"]) is PROTOCOLS["pysot"]
     with pytest.raises(ValueError, match="unknown scoring protocol 'vot'; one of: otb, pysot, got10k"):
         get_protocol("vot")
@@ -237,7 +237,7 @@ def test_missing_rows_fail_in_every_protocol():
     gt = zero_based([[11, 11, 10, 10]] * 3 + [NAN])
     for name in PROTOCOLS:
         s = metrics.score_sequence(gt[:2], gt, protocol=name)
-        assert s["precision_curve"][-1] == pytest.approx({"otb": 2 / 4, "pysot": 2 / 4, "got10k": 1 / 2}[name])
+        assert s["precision_curve"][-1] == pytest.approx({"otb": 2 / 4, "pysot": 2 / 4, "got10k": 1 / 2, "lasot": 2 / 4}[name])
 
 
 # --------------------------------------------------------------------------- an independent OTB loop
@@ -317,6 +317,80 @@ def test_otb_against_the_independent_loop(seed):
     s = metrics.score_sequence(zero_based(pred), zero_based(gt))
     np.testing.assert_allclose(s["success_curve"], success)
     np.testing.assert_allclose(s["precision_curve"], precision)
+
+
+# --------------------------------------------------------------------------- an independent LaSOT loop
+
+
+def lasot_curves(res, anno, absent):
+    """calc_seq_err_robust.m and eval_tracker.m of the LaSOT toolkit for one sequence, frame by
+    frame in plain Python, written for this test from the MATLAB source: the toolkit's inputs are
+    the annotation (numbers in every frame) and the ``absent`` flags (annos/absent/<seq>.txt)."""
+    res = [list(r) for r in res]
+    for i in range(1, len(res)):
+        r, g = res[i], anno[i]
+        # if (sum(isnan(r)) | ~isreal(r) | r(3)<=0 | r(4)<=0) & (~isnan(r_anno)): a scalar & a 1x4 vector
+        failed = any(math.isnan(v) for v in r) or r[2] <= 0 or r[3] <= 0
+        if failed and not any(math.isnan(v) for v in g):
+            res[i] = list(res[i - 1])
+    res[0] = list(anno[0])
+    kept = [i for i in range(len(anno)) if not absent[i]]  # rect_mat(absent_idx, :) = []
+    overlaps, errors = [], []
+    for r, g in ((res[i], anno[i]) for i in kept):
+        dx = (r[0] + (r[2] - 1) / 2) - (g[0] + (g[2] - 1) / 2)
+        dy = (r[1] + (r[3] - 1) / 2) - (g[1] + (g[3] - 1) / 2)
+        if not all(v > 0 for v in g):
+            overlaps.append(-1.0)
+            errors.append(-1.0)
+            continue
+        errors.append(math.sqrt(dx * dx + dy * dy))
+        iw = matlab_max(0, matlab_min(r[0] + r[2] - 1, g[0] + g[2] - 1) - matlab_max(r[0], g[0]) + 1)
+        ih = matlab_max(0, matlab_min(r[1] + r[3] - 1, g[1] + g[3] - 1) - matlab_max(r[1], g[1]) + 1)
+        overlaps.append(iw * ih / (r[2] * r[3] + g[2] * g[3] - iw * ih))
+    n = len(anno)  # len_all: absent frames stay in the denominator
+    success = [sum(o > k * 0.05 for o in overlaps) / n for k in range(21)]
+    precision = [sum(e <= t for e in errors) / n for t in range(51)]
+    return success, precision
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_lasot_against_the_independent_loop(seed):
+    rng = np.random.default_rng(100 + seed)
+    n = 150
+    gt = np.column_stack([rng.uniform(1, 100, (n, 2)), rng.uniform(1, 60, (n, 2))]).round(0)
+    absent = np.zeros(n, bool)
+    absent[rng.choice(np.arange(1, n), 25, replace=False)] = True
+    gt[rng.choice(n, 5, replace=False), :2] = 0  # the toolkit's out-of-view boxes outside the absent flags
+    gt[absent[:, None] & (rng.random((n, 1)) < 0.5)[:, [0, 0, 0, 0]]] = 0  # LaSOT writes 0,0,0,0 in some absent frames
+    pred = np.round(gt + rng.normal(0, [8, 8, 6, 6], (n, 4)), 1)
+    pred[rng.choice(n, 10, replace=False)] = np.nan
+    pred[rng.choice(n, 10, replace=False), 1] = np.nan  # partly NaN: LaSOT repairs it, OTB keeps it
+    pred[rng.choice(n, 5, replace=False), 3] = 0
+    pred[absent & (rng.random(n) < 0.3)] = np.nan  # failures in absent frames are repaired too
+    success, precision = lasot_curves(pred.tolist(), gt.tolist(), absent.tolist())
+    ours = gt.copy()
+    ours[absent] = np.nan  # what dcfkit's LaSOT loader makes of the absent flags
+    s = metrics.score_sequence(zero_based(pred), zero_based(ours), protocol="lasot")
+    np.testing.assert_allclose(s["success_curve"], success)
+    np.testing.assert_allclose(s["precision_curve"], precision)
+    otb = metrics.score_sequence(zero_based(pred), zero_based(ours), protocol="otb")
+    assert otb["precision"] > s["precision"]  # otb lets absent frames pass every precision threshold
+
+
+def test_lasot_absent_frames_fail_both_curves_by_hand():
+    """Four frames, frame 3 absent, and a box with one NaN in frame 4: LaSOT repairs that box
+    from frame 3's (which sits on frame 4's ground truth) and fails frame 3 on every threshold;
+    otb keeps the NaN box (its centre fails, MATLAB's min/max give it an overlap of 1) and lets
+    the absent frame pass precision. Both score 3 of 4 frames, different ones."""
+    gt = [[11, 11, 10, 10], [12, 11, 10, 10], NAN, [14, 11, 10, 10]]
+    pred = [[11, 11, 10, 10], [12, 11, 10, 10], [14, 11, 10, 10], [math.nan, 11, 10, 10]]
+    lasot = frames("lasot", np.array(pred, float), np.array(gt, float))
+    otb = frames("otb", np.array(pred, float), np.array(gt, float))
+    assert lasot.overlap.tolist() == [1, 1, -1, 1] and lasot.error.tolist() == [0, 0, math.inf, 0]
+    assert otb.overlap.tolist() == [1, 1, -1, 1] and otb.error[:3].tolist() == [0, 0, -1] and math.isnan(otb.error[3])
+    for name in ("lasot", "otb"):
+        s = metrics.score_sequence(zero_based(pred), zero_based(gt), protocol=name)
+        assert s["precision"] == 3 / 4 and s["success_curve"][0] == 3 / 4 and s["frames"] == 4
 
 
 # --------------------------------------------------------------------------- the authors' results

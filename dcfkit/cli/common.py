@@ -47,11 +47,13 @@ def add_protocol_argument(parser: argparse.ArgumentParser) -> None:
     """``--protocol``, for the commands that print scores."""
     parser.add_argument("--protocol", choices=tuple(PROTOCOLS), default=DEFAULT,
                         help="scoring rules: otb (the OTB / UAV123 MATLAB toolkit, which computed the published "
-                             "UAV123 tables), pysot or got10k; docs/evaluation.md lists the differences")
+                             "UAV123 tables), pysot, got10k or lasot (the LaSOT toolkit: absent frames fail); "
+                             "docs/evaluation.md lists the differences")
 
 
 def add_dataset_arguments(parser: argparse.ArgumentParser, root_help: str = "benchmark root folder") -> None:
     """``--dataset``, ``--root`` and ``--sequences``."""
-    parser.add_argument("--dataset", default="auto", help="dataset name (default: detect from --root)")
+    parser.add_argument("--dataset", default="auto",
+                        help="dataset name, as `dcfkit datasets` lists them (default: detect from --root)")
     parser.add_argument("--root", required=True, type=Path, help=root_help)
     parser.add_argument("--sequences", default=None, help="comma-separated sequence names (default: all)")

@@ -71,13 +71,21 @@ def run_eval(args: argparse.Namespace) -> int:
                                jobs=args.jobs, progress=not args.no_progress)
         print(f"{summary['tracker']}: {len(summary['done'])} run, {len(summary['skipped'])} "
               f"already done, {len(summary['failed'])} failed -> {summary['dir']}")
-        scores = evaluate({summary["tracker"]: load_results(args.out, summary["tracker"], sequences)},
-                          sequences, protocol=args.protocol)
-        print(f"  {score_line(scores['overall'][0], args.protocol)}")
+        print(f"  {_scores(args, summary['tracker'], sequences)}")
         for message in summary["failed"].values():
             print(f"  FAILED {message}")
         status = status or (1 if summary["failed"] else 0)
     return status
+
+
+def _scores(args: argparse.Namespace, tracker: str, sequences: list) -> str:
+    """The score line of one tracker's results, or why there is none (a test split)."""
+    if all(s.ground_truth_withheld for s in sequences):
+        return (f"no scores: the ground truth of these {len(sequences)} sequences is withheld after frame 1 "
+                f"(a test split); submit {Path(args.out) / tracker}/<sequence>.txt to the benchmark's server "
+                f"(docs/evaluation.md, 'Test splits')")
+    scores = evaluate({tracker: load_results(args.out, tracker, sequences)}, sequences, protocol=args.protocol)
+    return score_line(scores["overall"][0], args.protocol)
 
 
 def add_report_arguments(parser: argparse.ArgumentParser) -> None:

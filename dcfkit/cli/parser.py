@@ -5,13 +5,14 @@ import argparse
 
 from .. import __version__
 from ..errors import SHOWN_CHARS
-from . import ablate, components, evaluate, track, trax
+from . import ablate, components, datasets, evaluate, track, trax
 
 DESCRIPTION = """dcfkit: discriminative correlation filter trackers assembled from YAML.
 
 Commands: track (one video), demo (a generated sequence, no data needed), components,
-eval (one-pass evaluation on a benchmark), report, compare (two result folders side by
-side), ablate, trax (serve the VOT toolkit's TraX protocol)."""
+datasets (the benchmark layouts --dataset accepts), eval (one-pass evaluation on a
+benchmark), report, compare (two result folders side by side), ablate, trax (serve the
+VOT toolkit's TraX protocol)."""
 
 #: name -> (help, add_arguments, run)
 COMMANDS = {
@@ -19,6 +20,8 @@ COMMANDS = {
     "demo": ("run STRCF and DR²Track on a generated sequence (no data needed)", track.add_demo_arguments,
              track.run_demo),
     "components": ("list registered components and their parameters", components.add_arguments, components.run),
+    "datasets": ("list the benchmark layouts --dataset accepts (dcfkit's and plugins')", datasets.add_arguments,
+                 datasets.run),
     "eval": ("one-pass evaluation of configs on a benchmark", evaluate.add_eval_arguments, evaluate.run_eval),
     "report": ("tables and precision/success plots of evaluation results", evaluate.add_report_arguments,
                evaluate.run_report),

@@ -1,14 +1,17 @@
-"""Benchmark sequences: UAV123 (+@10fps, 20L), DTB70, UAVDT, OTB, each in its own layout.
+"""Benchmark sequences: UAV123 (+@10fps, 20L), DTB70, UAVDT, OTB, LaSOT, GOT-10k, TrackingNet
+and VOT, each in its own layout.
 
 Conventions
 -----------
 * Boxes in memory are ``(x, y, w, h)`` float64 in **0-based** pixel coordinates of the
-  top-left corner. Benchmark annotation files are **1-based** (OTB convention), so the
-  loaders subtract 1 from x and y (w and h are unchanged). Result files written by
-  :mod:`dcfkit.evaluation` add the 1 back, so they score unchanged in the MATLAB / pysot
-  toolkits.
-* A row of NaN marks a frame where the target is out of view. Such rows are kept (the
-  frame still exists and the tracker still sees it); :mod:`dcfkit.metrics` skips them.
+  top-left corner. Most benchmark annotation files are **1-based** (OTB convention), so the
+  loaders subtract 1 from x and y (w and h are unchanged); TrackingNet's and VOT's are
+  0-based and read as they are. Result files written by :mod:`dcfkit.evaluation` add the 1
+  back, so they score unchanged in the MATLAB / pysot toolkits.
+* A row of NaN marks a frame where the target is out of view (absent). Such rows are kept
+  (the frame still exists and the tracker still sees it); each scoring protocol of
+  :mod:`dcfkit.protocols` says how they count. A test split that publishes frame 1's box
+  only has NaN rows after it and ``ground_truth_withheld`` set (:func:`scored_sequences`).
 * Images are decoded by OpenCV (:func:`read_frame`): ``(H, W, 3) uint8``, **BGR** channel order.
 
 Only sequences present on disk are listed. Each layout lives in its own module and registers
@@ -16,7 +19,7 @@ itself in :mod:`~dcfkit.datasets.registry` (name, aliases, loader, detection, de
 another benchmark is added with :func:`register_layout`. See ``docs/evaluation.md`` for the
 layouts.
 """
-from .base import ATTRIBUTE_NAMES, DatasetError, Sequence, read_boxes, read_frame
+from .base import ATTRIBUTE_NAMES, DatasetError, Sequence, read_boxes, read_frame, scored_sequences
 from .registry import (DATASETS, Evidence, Layout, canonical_name, detect_dataset, get_layout, layouts,
                        load_dataset, register_layout, registered_layout, unregister_layout)
 
@@ -27,6 +30,10 @@ from .uav123_layout import uav123, uav123_10fps, uav123_20l
 from .dtb70_layout import dtb70
 from .uavdt_layout import uavdt
 from .otb_layout import otb
+from .lasot_layout import lasot, lasot_test
+from .got10k_layout import got10k_test, got10k_train, got10k_val
+from .trackingnet_layout import trackingnet, trackingnet_train
+from .vot_layout import vot, vot_area
 # isort: on
 
 __all__ = [
@@ -40,6 +47,11 @@ __all__ = [
     "detect_dataset",
     "dtb70",
     "get_layout",
+    "got10k_test",
+    "got10k_train",
+    "got10k_val",
+    "lasot",
+    "lasot_test",
     "layouts",
     "load_dataset",
     "otb",
@@ -47,9 +59,14 @@ __all__ = [
     "read_frame",
     "register_layout",
     "registered_layout",
+    "scored_sequences",
+    "trackingnet",
+    "trackingnet_train",
     "uav123",
     "uav123_10fps",
     "uav123_20l",
     "uavdt",
     "unregister_layout",
+    "vot",
+    "vot_area",
 ]

@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import io
+import logging
 import os
 import re
 import stat
@@ -20,12 +21,15 @@ import numpy as np
 from ..errors import DcfkitError, clip, shown
 from ..limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
+log = logging.getLogger(__name__)
+
 
 class DatasetError(DcfkitError, ValueError):
     """A benchmark folder, annotation file or sequence name is wrong (the message says where)."""
 
 
-#: Long names of the UAV123 attribute abbreviations (column order of the att files).
+#: Long names of the attribute abbreviations of UAV123 (first, in the column order of its att
+#: files), OTB and LaSOT; each layout module keeps its benchmark's column order.
 ATTRIBUTE_NAMES = {
     "SV": "Scale Variation",
     "ARC": "Aspect Ratio Change",
@@ -39,6 +43,12 @@ ATTRIBUTE_NAMES = {
     "VC": "Viewpoint Change",
     "CM": "Camera Motion",
     "SOB": "Similar Object",
+    "OCC": "Occlusion",
+    "DEF": "Deformation",
+    "MB": "Motion Blur",
+    "IPR": "In-Plane Rotation",
+    "OPR": "Out-of-Plane Rotation",
+    "ROT": "Rotation",
 }
 
 
@@ -53,7 +63,9 @@ class Sequence:
     0-based ``(x, y, w, h)``, read-only, with NaN rows kept for out-of-view frames.
     ``attributes`` maps an attribute abbreviation (e.g. ``"SV"``) to whether the sequence
     has it; it is empty when the benchmark provides none. ``annotation`` is the file the
-    ground truth was read from (None for sequences made in code).
+    ground truth was read from (None for sequences made in code). ``ground_truth_withheld``
+    is True for a test split that publishes frame 1's box only (GOT-10k, TrackingNet): rows
+    2..N are NaN, so the sequence can be tracked but not scored (:func:`scored_sequences`).
     """
 
     name: str
@@ -62,6 +74,7 @@ class Sequence:
     attributes: Mapping[str, bool] = dataclasses.field(default_factory=dict)
     dataset: str = ""
     annotation: Path | None = None
+    ground_truth_withheld: bool = False
 
     def __post_init__(self):
         gt = np.array(self.ground_truth, dtype=np.float64, copy=True).reshape(-1, 4)
@@ -78,7 +91,8 @@ class Sequence:
 
     def __repr__(self) -> str:
         flags = ",".join(k for k, v in self.attributes.items() if v)
-        return f"Sequence({self.dataset}/{self.name}, {len(self)} frames{', ' + flags if flags else ''})"
+        withheld = ", ground truth withheld" if self.ground_truth_withheld else ""
+        return f"Sequence({self.dataset}/{self.name}, {len(self)} frames{withheld}{', ' + flags if flags else ''})"
 
     @property
     def init_box(self) -> np.ndarray:
@@ -320,6 +334,27 @@ def read_boxes(path: str | os.PathLike, one_based: bool = True) -> np.ndarray:
     return boxes
 
 
+def read_frame_values(path: Path, n_frames: int) -> np.ndarray:
+    """One whole number per frame, separated by commas, spaces or new lines (LaSOT's
+    ``full_occlusion.txt`` holds one line, GOT-10k's ``.label`` files one value a line), as
+    ``(n_frames,) int64``; :class:`DatasetError` naming the file and the line of a value that is
+    not a whole number, or the count when it is not ``n_frames``."""
+    values = []
+    for n, line in enumerate(read_text(path).splitlines()):
+        for field in (f for f in _SEPARATORS.split(line.strip()) if f):
+            try:
+                value = float(field)
+                if not value.is_integer():
+                    raise ValueError
+            except ValueError:
+                raise DatasetError(f"{path}, line {n + 1}: expected whole numbers, one per frame, "
+                                   f"got {shown(field)}") from None
+            values.append(int(value))
+    if len(values) != n_frames:
+        raise DatasetError(f"{path}: {len(values)} values for {n_frames} frames; one value per frame is required")
+    return np.array(values, dtype=np.int64)
+
+
 def read_flags(path: Path, names: tuple[str, ...]) -> dict[str, bool]:
     """One line of 0/1 flags, one per name in ``names`` (e.g. a UAV123 att file)."""
     fields = [f for f in _SEPARATORS.split(read_text(path).strip()) if f]
@@ -348,20 +383,35 @@ def numbered_frames(folder: Path, pattern: str, first: int, last: int, what: str
     return tuple(folder / n for n in names)
 
 
-def annotated_frames(folder: Path, pattern: str, boxes: np.ndarray, anno: Path, what: str) -> tuple[Path, ...]:
-    """Frames 1..N of a folder holding exactly the N annotated ``.jpg`` frames; the error names
-    either the missing frames or, when the images simply run out, the annotation's length."""
-    if not folder.is_dir():
-        raise DatasetError(f"{what}: image folder not found: {folder}")
-    present = set(os.listdir(folder))
-    n_jpgs = sum(1 for f in present if f.lower().endswith(".jpg"))
+def annotated_frames(folder: Path, pattern: str, boxes: np.ndarray, anno: Path, what: str,
+                     first: int = 1) -> tuple[Path, ...]:
+    """Frames ``first``.. of a folder holding exactly the N annotated ``.jpg`` frames; the error
+    names either the missing frames or, when the images simply run out, the annotation's length."""
+    n_jpgs = count_jpgs(folder, what)
     counted = f"{n_jpgs} .jpg files in {folder}"
-    if n_jpgs < len(boxes) and all(pattern % k in present for k in range(1, n_jpgs + 1)):
+    last = first + len(boxes) - 1
+    if n_jpgs < len(boxes) and all((folder / (pattern % k)).is_file() for k in range(first, first + n_jpgs)):
         raise DatasetError(f"{anno}: {len(boxes)} annotation lines but {counted}: either the annotation has "
-                           f"extra lines or frames {pattern % (n_jpgs + 1)}..{pattern % len(boxes)} are missing")
-    frames = numbered_frames(folder, pattern, 1, len(boxes), what)
+                           f"extra lines or frames {pattern % (first + n_jpgs)}..{pattern % last} are missing")
+    frames = numbered_frames(folder, pattern, first, last, what)
     check_box_count(boxes, n_jpgs, anno, counted)  # extra images
     return frames
+
+
+def count_jpgs(folder: Path, what: str) -> int:
+    """How many ``.jpg`` files ``folder`` holds; :class:`DatasetError` if it is not a folder."""
+    if not folder.is_dir():
+        raise DatasetError(f"{what}: image folder not found: {folder}")
+    return sum(1 for f in os.listdir(folder) if f.lower().endswith(".jpg"))
+
+
+def withheld_after_first(boxes: np.ndarray, n_frames: int, anno: Path, frames_desc: str) -> tuple[np.ndarray, bool]:
+    """(ground truth, withheld) of a test split's annotation, which holds one box per frame or,
+    as published, frame 1's only: then rows 2..N are NaN and ``withheld`` is True."""
+    if len(boxes) == 1 and n_frames > 1:
+        return np.vstack([boxes, np.full((n_frames - 1, 4), np.nan)]), True
+    check_box_count(boxes, n_frames, anno, frames_desc + "; a test split's annotation may also hold frame 1's box only")
+    return boxes, False
 
 
 def check_box_count(boxes: np.ndarray, n_frames: int, anno: Path, frames_desc: str) -> None:
@@ -373,6 +423,27 @@ def check_box_count(boxes: np.ndarray, n_frames: int, anno: Path, frames_desc: s
 
 
 # --------------------------------------------------------------------------- roots and selection
+
+
+def scored_sequences(sequences: Iterable[Sequence]) -> list[Sequence]:
+    """The sequences whose ground truth can score a tracker: all but those whose ground truth the
+    benchmark withholds after frame 1 (``ground_truth_withheld``), which are left out with a
+    warning; a :class:`DatasetError` saying so when none is left (a test split, whose results
+    are scored by the benchmark's server), never scores computed against NaN rows."""
+    sequences = list(sequences)
+    scored = [s for s in sequences if not s.ground_truth_withheld]
+    withheld = [s.name for s in sequences if s.ground_truth_withheld]
+    if withheld and not scored:
+        dataset = sequences[0].dataset or "this dataset"
+        raise DatasetError(
+            f"no scores: {dataset} publishes the ground truth of frame 1 only for these {len(withheld)} sequences "
+            f"(a test split: {', '.join(withheld[:5])}{' ...' if len(withheld) > 5 else ''}). Submit the result "
+            f"files OUT/<tracker>/<sequence>.txt to the benchmark's evaluation server (docs/evaluation.md, "
+            f"'Test splits')")
+    if withheld:
+        log.warning("%d of %d sequences left out of the scores: their ground truth is withheld after frame 1 "
+                    "(a test split): %s", len(withheld), len(sequences), ", ".join(withheld[:10]))
+    return scored
 
 
 def require_root(root, what: str) -> Path:

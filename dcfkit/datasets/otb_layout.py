@@ -1,15 +1,27 @@
 """OTB-2013/2015 (OTB50, OTB100): ``ROOT/<seq>/img/*.jpg`` and ``ROOT/<seq>/groundtruth_rect.txt``,
-or ``groundtruth_rect.1.txt``, ``.2.txt`` … for the sequences with several targets."""
+or ``groundtruth_rect.1.txt``, ``.2.txt`` … for the sequences with several targets.
+
+Attributes (dcfkit ships none) come from the user's copy of either the OTB toolkit's
+``anno/att/<seq>.txt`` files, copied or linked to ``ROOT/anno/att/`` (11 flags in the order of
+:data:`OTB_ATTRIBUTES`), or pysot's ``OTB100.json`` in ROOT (each sequence's ``attr`` list);
+an att file wins over the JSON, and a sequence in neither has none.
+"""
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
 import numpy as np
 
+from ..errors import shown
 from .base import (DatasetError, Sequence, check_box_count, first_frame_digits, image_sequence_folders,
-                   read_boxes, read_text, require_root, select_sequences)
+                   read_boxes, read_flags, read_text, require_root, select_sequences)
 from .registry import Evidence, register_layout
+
+#: Column order of the OTB toolkit's att files (``attName`` of its perfPlot.m).
+OTB_ATTRIBUTES = ("IV", "OPR", "SV", "OCC", "DEF", "MB", "FM", "IPR", "OV", "BC", "LR")
+PYSOT_JSON = "OTB100.json"
 
 # OTB sequences whose image folder holds more frames than are annotated (as in the
 # got10k and pysot toolkits): name -> first and last image number used.
@@ -74,19 +86,52 @@ def _frames(name: str, anno: Path, boxes: np.ndarray) -> tuple[Path, ...]:
     return tuple(numbered[k] for k in range(first, last + 1))
 
 
+def _pysot_attributes(path: Path) -> dict[str, dict[str, bool]]:
+    """Sequence name (lower case) -> attributes, from pysot's JSON (``{seq: {"attr": [...]}}``)."""
+    try:
+        table = json.loads(read_text(path))
+    except json.JSONDecodeError as exc:
+        raise DatasetError(f"{path}, line {exc.lineno}: not JSON ({exc.msg})") from None
+    if not isinstance(table, dict):
+        raise DatasetError(f"{path}: expected an object of sequences, got a {type(table).__name__}")
+    out = {}
+    for name, entry in table.items():
+        attrs = entry.get("attr") if isinstance(entry, dict) else None
+        if not isinstance(attrs, list) or not set(attrs) <= set(OTB_ATTRIBUTES):
+            raise DatasetError(f"{path}: sequence {name!r}: 'attr' must be a list of {', '.join(OTB_ATTRIBUTES)}, "
+                               f"got {shown(attrs)}")
+        out[name.lower()] = {a: a in attrs for a in OTB_ATTRIBUTES}
+    return out
+
+
+def _attribute_source(root: Path):
+    """``attributes(name) -> dict``: the toolkit's att file, else pysot's JSON entry, else none."""
+    att_dir = root / "anno" / "att"
+    att_files = {p.stem.lower(): p for p in att_dir.glob("*.txt")} if att_dir.is_dir() else {}
+    from_json = _pysot_attributes(root / PYSOT_JSON) if (root / PYSOT_JSON).is_file() else {}
+
+    def attributes(name: str) -> dict[str, bool]:
+        att_file = att_files.get(name.lower())
+        return read_flags(att_file, OTB_ATTRIBUTES) if att_file else from_json.get(name.lower(), {})
+    return attributes
+
+
 def otb(root, sequences=None) -> list[Sequence]:
     """OTB-2013/2015: ``ROOT/<seq>/img/*.jpg`` and ``ROOT/<seq>/groundtruth_rect.txt``.
 
     Multi-target sequences (``groundtruth_rect.1.txt`` …) are named ``Jogging-1`` etc.;
     David, Football1, Freeman3, Freeman4 and Diving use the frame ranges of the OTB toolkit.
+    Attributes as the module says.
     """
     root = require_root(root, "OTB")
     targets = _targets(root)
+    chosen = select_sequences(sorted(targets), sequences, f"OTB at {root}")
+    attributes = _attribute_source(root)
     out = []
-    for name in select_sequences(sorted(targets), sequences, f"OTB at {root}"):
+    for name in chosen:
         anno = targets[name]
         boxes = read_boxes(anno)
-        out.append(Sequence(name, _frames(name, anno, boxes), boxes, {}, "otb", anno))
+        out.append(Sequence(name, _frames(name, anno, boxes), boxes, attributes(name), "otb", anno))
     return out
 
 

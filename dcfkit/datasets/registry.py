@@ -3,18 +3,22 @@
 Each layout registers its name (and aliases), its loader ``(root, sequences=None) ->
 list[Sequence]``, a one-line description of its folders (shown in error messages) and a
 ``detect(root)`` that says how specifically ``root`` looks like it. The built-in layouts
-register themselves when :mod:`dcfkit.datasets` is imported; a plugin calls
-:func:`register_layout` the same way.
+register themselves when :mod:`dcfkit.datasets` is imported, and a script calls
+:func:`register_layout` the same way. A plugin package registers its layouts in its dcfkit
+hook with ``registry.register_dataset(...)`` (:mod:`dcfkit.registry`, docs/plugins.md);
+they are looked up after these, the plugins loaded on first need.
 """
 from __future__ import annotations
 
 import contextlib
 import dataclasses
 import enum
+import warnings
 from pathlib import Path
 from typing import Callable, Iterable, Iterator, Mapping
 
-from ..errors import RegistryError, shown
+from ..errors import RegistryError, describe_error, shown
+from ..registry import PluginWarning, get_registry
 from .base import DatasetError, Sequence, require_root
 
 Loader = Callable[..., list[Sequence]]  # (root, sequences=None) -> list[Sequence]
@@ -51,10 +55,12 @@ class Layout:
     description: str
     detect: Detector | None = None
     aliases: tuple[str, ...] = ()
+    provider: str = ""  # the plugin that registered it; "" for dcfkit's and those registered in code
 
     def __str__(self) -> str:
         also = f" (also {', '.join(self.aliases)})" if self.aliases else ""
-        return f"{self.name}{also}: {self.description}"
+        source = f" [plugin {self.provider}]" if self.provider else ""
+        return f"{self.name}{also}: {self.description}{source}"
 
 
 _LAYOUTS: dict[str, Layout] = {}  # canonical name -> layout, in registration order
@@ -76,16 +82,25 @@ def register_layout(name: str, load: Loader, description: str, *,
     returns an :class:`Evidence` (or a bool) for :func:`detect_dataset`, which skips layouts
     without one. A name or alias that is already registered is a :class:`RegistryError`.
     """
-    layout = Layout(_key(name), load, str(description).strip(), detect,
-                    tuple(dict.fromkeys(_key(a) for a in aliases if _key(a) != _key(name))))
-    _check_new_layout(layout)
+    layout = new_layout(name, load, description, detect=detect, aliases=aliases)
     _LAYOUTS[layout.name] = layout
     _NAMES.update(dict.fromkeys((layout.name,) + layout.aliases, layout.name))
     return layout
 
 
+def new_layout(name: str, load: Loader, description: str, *, detect: Detector | None = None,
+               aliases: Iterable[str] = (), provider: str = "") -> Layout:
+    """A checked :class:`Layout`, not yet registered (:func:`register_layout` registers it here, a
+    plugin's ``registry.register_dataset`` in :mod:`dcfkit.registry`); a :class:`RegistryError`
+    if it is malformed or a name is taken here."""
+    layout = Layout(_key(name), load, str(description).strip(), detect,
+                    tuple(dict.fromkeys(_key(a) for a in aliases if _key(a) != _key(name))), provider)
+    _check_new_layout(layout)
+    return layout
+
+
 def _check_new_layout(layout: Layout) -> None:
-    where = f"dataset layout {layout.name!r}"
+    where = f"dataset layout {layout.name!r}" + (f" (from {layout.provider})" if layout.provider else "")
     if not layout.name:
         raise RegistryError(f"dataset layout {shown(layout.description)}: the name is empty")
     if "auto" in (layout.name,) + layout.aliases:
@@ -93,8 +108,9 @@ def _check_new_layout(layout: Layout) -> None:
     for taken in (n for n in (layout.name,) + layout.aliases if n in _NAMES):
         owner = _NAMES[taken]
         also = "" if owner == taken else f" (as a name of {owner!r})"
-        raise RegistryError(f"{where}: the name {taken!r} is already registered{also}; "
-                            f"unregister_layout({owner!r}) first to replace it")
+        fix = "give the plugin's layout another name" if layout.provider else \
+            f"unregister_layout({owner!r}) first to replace it"
+        raise RegistryError(f"{where}: the name {taken!r} is already registered{also}; {fix}")
     if not callable(layout.load) or not (layout.detect is None or callable(layout.detect)):
         raise RegistryError(f"{where}: load and detect must be functions")
     if not layout.description or "\n" in layout.description:
@@ -103,8 +119,11 @@ def _check_new_layout(layout: Layout) -> None:
 
 
 def unregister_layout(name: str) -> Layout:
-    """Remove the layout called ``name`` (or one of its aliases) with all its names."""
-    layout = _LAYOUTS.pop(canonical_name(name))
+    """Remove the layout called ``name`` (or one of its aliases) with all its names; a plugin's
+    cannot be (uninstall the plugin, or set DCFKIT_DISABLE_PLUGINS)."""
+    if _key(name) not in _NAMES:
+        raise DatasetError(f"no dataset layout {shown(name)} registered in code; layouts: {', '.join(_LAYOUTS)}")
+    layout = _LAYOUTS.pop(_NAMES[_key(name)])
     for n in (layout.name,) + layout.aliases:
         del _NAMES[n]
     return layout
@@ -123,24 +142,34 @@ def registered_layout(name: str, load: Loader, description: str, *,
 
 
 def layouts() -> tuple[Layout, ...]:
-    """Every registered layout, in registration order."""
-    return tuple(_LAYOUTS.values())
+    """Every registered layout: dcfkit's and those registered in code, in registration order,
+    then the plugins' (one whose name was since registered in code is shadowed by it)."""
+    return tuple(_LAYOUTS.values()) + tuple(p for p in get_registry().datasets() if p.name not in _NAMES)
+
+
+def _find(name: str) -> Layout | None:
+    """The layout called ``name`` (or an alias): one registered here first, then a plugin's;
+    None if there is none; a RegistryError if two plugins register the name."""
+    key = _key(name)
+    if key in _NAMES:
+        return _LAYOUTS[_NAMES[key]]
+    return get_registry().dataset(key)
 
 
 class _Loaders(Mapping):
     """Canonical name -> loader of every registered layout; read-only, always current."""
 
     def __getitem__(self, name: str) -> Loader:
-        return _LAYOUTS[name].load
+        return {layout.name: layout for layout in layouts()}[name].load
 
     def __iter__(self) -> Iterator[str]:
-        return iter(_LAYOUTS)
+        return iter([layout.name for layout in layouts()])
 
     def __len__(self) -> int:
-        return len(_LAYOUTS)
+        return len(layouts())
 
     def __repr__(self) -> str:
-        return f"DATASETS({', '.join(_LAYOUTS)})"
+        return f"DATASETS({', '.join(self)})"
 
 
 DATASETS: Mapping[str, Loader] = _Loaders()
@@ -150,21 +179,24 @@ DATASETS: Mapping[str, Loader] = _Loaders()
 
 
 def _known_layouts() -> str:
-    return "\n".join(f"  {layout}" for layout in _LAYOUTS.values())
+    return "\n".join(f"  {layout}" for layout in layouts())
 
 
 def canonical_name(name: str) -> str:
     """Canonical dataset name for ``name`` (case-insensitive, ``-``/``@`` accepted)."""
-    found = _NAMES.get(_key(name))
-    if found is None:
-        raise DatasetError(f"unknown dataset {shown(name)}; valid names: {', '.join(_LAYOUTS)} "
-                           f"(case-insensitive). Their layouts:\n{_known_layouts()}")
-    return found
+    return get_layout(name).name
 
 
 def get_layout(name: str) -> Layout:
-    """The layout registered as ``name`` or an alias; :class:`DatasetError` listing them otherwise."""
-    return _LAYOUTS[canonical_name(name)]
+    """The layout registered as ``name`` or an alias; :class:`DatasetError` listing them otherwise
+    (and the plugins that were skipped, whose layouts may be the one meant)."""
+    found = _find(name)
+    if found is None:
+        failures = get_registry().failures
+        skipped = f"\nSkipped plugins: {' | '.join(failures)}" if failures else ""
+        raise DatasetError(f"unknown dataset {shown(name)}; valid names: {', '.join(DATASETS)} "
+                           f"(case-insensitive). Their layouts:\n{_known_layouts()}{skipped}")
+    return found
 
 
 def load_dataset(name: str | None, root, sequences: Iterable[str] | str | None = None) -> list[Sequence]:
@@ -186,14 +218,14 @@ def detect_dataset(root) -> str:
     """The dataset whose layout ``root`` fits most specifically; :class:`DatasetError` when
     none fits or several fit equally well (the message lists them: pass the name instead)."""
     root = require_root(root, "dataset")
-    evidence = {layout.name: _evidence(layout, root) for layout in _LAYOUTS.values()
-                if layout.detect is not None}
+    known = {layout.name: layout for layout in layouts()}
+    evidence = {name: _evidence(layout, root) for name, layout in known.items() if layout.detect is not None}
     best = max(evidence.values(), default=Evidence.NONE)
     if best == Evidence.NONE:
         raise DatasetError(f"no known benchmark layout under {root}; expected one of:\n{_known_layouts()}")
     found = [name for name, level in evidence.items() if level == best]
     if len(found) > 1:
-        candidates = "\n".join(f"  {_LAYOUTS[name]}" for name in found)
+        candidates = "\n".join(f"  {known[name]}" for name in found)
         raise DatasetError(
             f"cannot tell which dataset {root} holds: {', '.join(found)} fit equally well "
             f"({_EVIDENCE_TEXT[best]}); pass the dataset name ({' or '.join(found)}). "
@@ -202,7 +234,14 @@ def detect_dataset(root) -> str:
 
 
 def _evidence(layout: Layout, root: Path) -> Evidence:
-    level = layout.detect(root)
+    try:
+        level = layout.detect(root)
+    except Exception as exc:  # a plugin's bug must not stop detection of every other benchmark
+        if not layout.provider:
+            raise
+        warnings.warn(f"dataset layout {layout.name!r} of dcfkit plugin '{layout.provider}' was left out of "
+                      f"detection: detect({root}) raised {describe_error(exc)}", PluginWarning, stacklevel=3)
+        return Evidence.NONE
     try:
         return Evidence(int(level))
     except (TypeError, ValueError):

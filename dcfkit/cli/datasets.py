@@ -1,0 +1,42 @@
+"""``dcfkit datasets``: every benchmark layout ``--dataset`` accepts, dcfkit's and the plugins',
+with its other names, its folders and who provides it, as a table or JSON."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import warnings
+
+from ..datasets import layouts
+from ..registry import PluginWarning, get_registry
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--format", choices=("table", "json"), default="table")
+
+
+def dataset_rows() -> list[dict]:
+    """One dict per layout: name, aliases, provider, layout (its folders), detected (whether
+    ``--dataset auto`` considers it)."""
+    return [{"name": layout.name, "aliases": list(layout.aliases), "provider": layout.provider or "dcfkit",
+             "layout": layout.description, "detected": layout.detect is not None} for layout in layouts()]
+
+
+def run(args: argparse.Namespace) -> int:
+    """List the layouts; exit status 1 if a plugin could not be loaded."""
+    with warnings.catch_warnings():  # the skipped plugins are listed below, each once
+        warnings.simplefilter("ignore", PluginWarning)
+        registry = get_registry()
+        rows = dataset_rows()
+    if args.format == "json":
+        print(json.dumps(rows, indent=2))
+    else:
+        for row in rows:
+            print(f"{row['name']:<18} {row['layout']}  [{row['provider']}]")
+            notes = ([f"also: {', '.join(row['aliases'])}"] if row["aliases"] else []) + \
+                ([] if row["detected"] else ["by name only (not detected)"])
+            if notes:
+                print(f"{'':<19}{'; '.join(notes)}")
+    for failure in registry.failures:
+        print(f"warning: {failure}", file=sys.stderr)
+    return 1 if registry.failures else 0
