@@ -27,6 +27,7 @@ is a :class:`StoreError` naming the file.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import dataclasses
 import functools
 import glob
@@ -103,16 +104,33 @@ def now() -> str:
     return datetime.now(timezone.utc).isoformat(timespec="seconds")
 
 
+_COMMAND: contextvars.ContextVar[list | None] = contextvars.ContextVar("dcfkit_command", default=None)
+
+
+@contextlib.contextmanager
+def running_command(argv: list[str]):
+    """Within: :func:`invocation` says ``argv`` (the CLI's ``dcfkit ...`` when its ``main`` is
+    called with arguments, as tests and scripts do, rather than their own process's)."""
+    token = _COMMAND.set(list(argv))
+    try:
+        yield
+    finally:
+        _COMMAND.reset(token)
+
+
 def invocation() -> dict:
-    """How this process was started: ``{"command": argv, "cwd": working directory}``, with
-    ``python -m PACKAGE`` as the first words when it was run so (``sys.argv[0]`` is then the
-    path of ``__main__.py``, which does not run alone). Result sidecars record the client's."""
-    argv = list(sys.argv)
-    spec = getattr(sys.modules.get("__main__"), "__spec__", None)
-    if spec is not None and spec.name.endswith(".__main__"):
-        argv[:1] = ["python", "-m", spec.name.removesuffix(".__main__")]
-    elif argv:
-        argv[0] = os.path.basename(argv[0]) or argv[0]
+    """How this command was given: ``{"command": argv, "cwd": working directory}``. The
+    process's ``sys.argv`` (with ``python -m PACKAGE`` as the first words when it was run so:
+    ``sys.argv[0]`` is then the path of ``__main__.py``, which does not run alone) unless
+    :func:`running_command` says otherwise. Result sidecars record the client's."""
+    argv = _COMMAND.get()
+    if argv is None:
+        argv = list(sys.argv)
+        spec = getattr(sys.modules.get("__main__"), "__spec__", None)
+        if spec is not None and spec.name.endswith(".__main__"):
+            argv[:1] = ["python", "-m", spec.name.removesuffix(".__main__")]
+        elif argv:
+            argv[0] = os.path.basename(argv[0]) or argv[0]
     return {"command": argv, "cwd": os.getcwd()}
 
 

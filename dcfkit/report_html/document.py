@@ -2,8 +2,9 @@
 
 The data travels as one JSON block that ``report.js`` reads and draws into the page with
 text nodes only, so no user text (tracker, sequence, config value) is ever parsed as HTML.
-In the JSON, ``<``, ``>``, ``&`` and ``/`` are escaped: user text cannot end the block, and
-the file holds no URL at all. A Content-Security-Policy allows the page's own script (by its
+In the JSON, ``<``, ``>``, ``&`` and ``/`` are escaped (and in the header's text, HTML's
+characters and ``/``): user text cannot end the block or add markup, and the file holds no
+URL at all. A Content-Security-Policy allows the page's own script (by its
 hash), inline styles and ``data:`` images, and nothing from anywhere else.
 """
 from __future__ import annotations
@@ -60,7 +61,10 @@ def render(page: Mapping) -> str:
     script = _asset("report.js")
     digest = base64.b64encode(hashlib.sha256(script.encode("utf-8")).digest()).decode("ascii")
     policy = f"default-src 'none'; img-src data:; style-src 'unsafe-inline'; script-src 'sha256-{digest}'"
-    esc = html.escape
+
+    def esc(text: str) -> str:  # "/" as a character reference too: no URL in the file, whatever the text
+        return html.escape(text).replace("/", "&#47;")
+
     return (
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
         f"<meta http-equiv=\"Content-Security-Policy\" content=\"{policy}\">\n"
