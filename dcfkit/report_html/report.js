@@ -120,9 +120,9 @@
     const svg = s('svg', {viewBox: `0 0 ${W} ${H}`, class: 'chart', role: 'img'});
     for (const v of niceTicks(y0, y1, 5)) {
       s('line', {x1: m.l, x2: W - m.r, y1: py(v), y2: py(v), class: 'grid'}, svg);
-      s('text', {x: m.l - 5, y: py(v) + 3.5, class: 'tick', 'text-anchor': 'end'}, svg).textContent = fmt(v, v % 1 ? 2 : 0);
+      s('text', {x: m.l - 5, y: py(v) + 3.5, class: 'tick', 'text-anchor': 'end'}, svg).textContent = String(+v.toFixed(3));
     }
-    const xticks = spec.xticks || niceTicks(x0, x1, 5).map((v) => [v, String(+v.toFixed(2))]);
+    const xticks = spec.xticks || niceTicks(x0, x1, 5).map((v) => [v, String(+v.toFixed(3))]);
     for (const [v, label] of xticks) {
       s('line', {x1: px(v), x2: px(v), y1: m.t, y2: H - m.b, class: 'grid'}, svg);
       s('text', {x: px(v), y: H - m.b + 14, class: 'tick', 'text-anchor': 'middle'}, svg).textContent = label;
