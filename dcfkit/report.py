@@ -32,12 +32,14 @@ from .results import atomic_write, ensure_writable, import_results, load_results
 
 __all__ = [
     "columns",
+    "default_report_dir",
     "evaluate",
     "format_rows",
     "format_table",
     "gather_results",
     "json_ready",
     "plot_curves",
+    "read_folder",
     "score_and_write",
     "score_folders",
     "score_line",

@@ -8,6 +8,7 @@ from __future__ import annotations
 import base64
 import hashlib
 import json
+import math
 import os
 import platform
 import re
@@ -19,6 +20,7 @@ import numpy as np
 import pytest
 
 from dcfkit import cli
+from dcfkit.ablation import load_spec, sensitivity
 from dcfkit.ablation.page import config_changes
 from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset
@@ -85,10 +87,37 @@ def test_the_crop_holds_every_box_in_the_frames_aspect():
 
 def test_config_changes_name_each_changed_key():
     base = load_config("dr2track")
-    assert config_changes(base, load_config("dr2track", {"label.mu": 0.5, "name": "other"})) == ["label.mu: 0.25 → 0.5"]
+    assert config_changes(base, load_config("dr2track", {"label.mu": 0.5, "name": "x"})) == ["label.mu: 0.25 → 0.5"]
     changed = config_changes(base, load_config("ablations/dr2track_no_ma"))
     assert changed == ["search.name: motion_aware → fixed"]  # motion-aware's own parameters are not listed
     assert config_changes(base, base) == []
+
+
+PRODUCT_SPEC = """
+dataset: otb
+variants:
+  KCF: kcf
+grid:
+  base: KCF
+  mode: product
+  parameters:
+    solver.sigma: {label: s, values: [0.3, 0.5]}
+    solver.lam: {label: l, values: [0.0001, 0.001]}
+"""
+
+
+def test_sensitivity_in_product_mode_is_the_mean_and_range_over_the_other_parameter(tmp_path):
+    (tmp_path / "spec.yaml").write_text(PRODUCT_SPEC, encoding="utf-8")
+    spec = load_spec(tmp_path / "spec.yaml")
+    auc = {"KCF": 0.0, "s=0.3, l=0.0001": 0.1, "s=0.3, l=0.001": 0.3, "s=0.5, l=0.0001": 0.6, "s=0.5, l=0.001": 0.7}
+    overall = [{"variant": v.name, "auc": auc[v.name], "precision": None, "sequences": 2} for v in spec.variants]
+    sigma, lam = sensitivity(spec, overall)
+    assert sigma["x"] == [0.3, 0.5] and sigma["names"] == ["0.3", "0.5"] and sigma["band"]
+    mean, low, high = sigma["metrics"]["auc"]
+    assert mean == pytest.approx([0.2, 0.65]) and low == pytest.approx([0.1, 0.6]) and high == pytest.approx([0.3, 0.7])
+    assert lam["metrics"]["auc"][0] == pytest.approx([0.35, 0.5])
+    assert all(math.isnan(v) for v in lam["metrics"]["precision"][0])  # no precision: nothing to average
+    assert (sigma["base_x"], lam["base_x"]) == (0.5, 0.0001)  # KCF's σ and λ
 
 
 def test_provenance_of_old_and_new_sidecars(tmp_path):

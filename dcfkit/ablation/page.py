@@ -79,10 +79,11 @@ def sensitivity_charts(spec: AblationSpec, overall: list[dict]) -> dict:
                    **({"low": param["metrics"][metric][1], "high": param["metrics"][metric][2]}
                       if param["band"] else {})}
                   for metric, legend, _, _, colour in METRICS]
+        base = param["base_x"]
+        vline = None if base is None else {"x": base, "label": f"dotted: base ({param['base_name']})"}
         charts.append({"title": param["title"], "xlabel": param["axis"], "ylabel": "score", "x": x,
                        "xlim": [min(x) - pad, max(x) + pad], "xticks": [list(t) for t in zip(x, param["names"])],
-                       "series": series, "vline": ({"x": param["base_x"], "label": f"dotted: base ({param['base_name']})"}
-                                                   if param["base_x"] is not None else None)})
+                       "series": series, "vline": vline})
     return {"kind": "charts", "id": "sensitivity", "title": "Sensitivity", "charts": charts}
 
 
@@ -97,10 +98,10 @@ def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[s
         head.append(sensitivity_charts(spec, info["overall"]))
     folders = {v: job_dir(out, spec.dataset, k) for v, k in keys.items()}
     extra = [("spec", str(spec.path)), ("dataset", f"{spec.dataset} at {spec.root}")]
-    return {"title": f"dcfkit ablation {spec.name}: {len(trackers)} variants on {spec.dataset}",
+    return {"title": f"dcfkit ablation {spec.name}: {sections.count(len(trackers), 'variant')} on {spec.dataset}",
             "protocol": get_protocol(scores["protocol"]["name"]).describe(),
-            "subtitle": f"{spec.description + ' · ' if spec.description else ''}{len(sequences)} sequences, "
-                        f"{sum(len(s) for s in sequences)} frames",
+            "subtitle": f"{spec.description + ' · ' if spec.description else ''}"
+                        f"{sections.count(len(sequences), 'sequence')}, {sum(len(s) for s in sequences)} frames",
             "trackers": trackers,
             "sections": [*head, *evaluation_sections(scores, sequences, results, trackers),
                          sections.provenance(folders, [s.name for s in sequences], trackers, this_process(), extra)]}

@@ -137,6 +137,7 @@ def output_names(spec: AblationSpec) -> list[str]:
     """Every file :func:`summarize` writes into the output folder."""
     plots = ([sensitivity_file(key) for key in spec.grid.parameters] if spec.grid is not None else
              [f"{kind}.{ext}" for kind in ("precision", "success") for ext in ("png", "svg")])
-    return [f"{stem}.{ext}" for stem in ("summary", "per_sequence") for ext in ("md", "csv")] + ["summary.json", PAGE] + plots
+    tables = [f"{stem}.{ext}" for stem in ("summary", "per_sequence") for ext in ("md", "csv")]
+    return tables + ["summary.json", PAGE] + plots
 
 

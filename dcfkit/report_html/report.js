@@ -302,7 +302,7 @@
         entry(dl, 'recorded', h('span', {text: 'nothing: result files without dcfkit sidecars (imported)'}));
       } else {
         entry(dl, 'sidecars', h('span', {text: String(tr.sequences)}));
-        entry(dl, 'run key', ...counted(tr.run_keys));
+        entry(dl, 'run key (config hash)', ...counted(tr.run_keys));
         entry(dl, 'dcfkit', ...counted(tr.versions));
         entry(dl, 'plugins', ...counted(tr.plugins));
         entry(dl, 'command', ...counted(tr.commands));

@@ -28,6 +28,11 @@ def _column(key: str, tracker_column: str) -> dict:
     return {"key": key, "label": COLUMN_LABELS.get(key, key), "type": kind, "digits": digits}
 
 
+def count(n: int, noun: str) -> str:
+    """``1 tracker``, ``3 trackers``."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
 def table(section_id: str, title: str, rows: Seq[Mapping], columns: Seq[str], trackers: Seq[str],
           tracker_column: str = "tracker", filterable: bool = False, note: str = "") -> dict:
     """A sortable table (``filterable``: with a filter box) of ``rows`` (dicts) in ``columns``;
@@ -48,7 +53,8 @@ def curve_chart(kind: str, curves: Mapping[str, Mapping], thresholds, trackers: 
     """One OTB plot (``kind`` precision, success or norm_precision): a series per tracker,
     best score first, labelled ``name [score]`` as :func:`dcfkit.report.plot_curves` does."""
     style = PLOT_STYLE[kind]
-    scored = sorted(curves, key=lambda t: -(curves[t][style["score"]] if _finite(curves[t][style["score"]]) else -1))
+    score = {t: curves[t][style["score"]] for t in curves}
+    scored = sorted(curves, key=lambda t: -score[t] if _finite(score[t]) else math.inf)
     series = [{"key": f"t{trackers.index(t)}", "t": trackers.index(t),
                "label": f"{t} [{_score(curves[t][style['score']])}]", "y": curves[t][kind]} for t in scored]
     return {"title": title or style["title"], "xlabel": style["xlabel"], "ylabel": style["ylabel"],

@@ -10,12 +10,15 @@ draws them, and hides a tracker's when its legend entry is clicked.
 from __future__ import annotations
 
 import base64
+import logging
 from typing import Mapping, Sequence as Seq
 
 import cv2
 import numpy as np
 
-from ..datasets import Sequence
+from ..datasets import DatasetError, Sequence
+
+log = logging.getLogger(__name__)
 
 WIDTH = 160          # pixels of every thumbnail's width
 QUALITY = 70         # JPEG quality
@@ -114,8 +117,15 @@ def thumbnail(seq: Sequence, index: int, boxes: Seq[np.ndarray], whole: bool) ->
 
 def sequence_thumbnails(seq: Sequence, results: Mapping[str, Mapping], trackers: Seq[str]) -> list[dict]:
     """The thumbnails of ``seq`` (see the module) with the boxes of ``trackers`` (in that
-    order) from ``results`` (tracker -> sequence name -> result with ``boxes``)."""
+    order) from ``results`` (tracker -> sequence name -> result with ``boxes``). A frame that
+    cannot be read is left out, with a warning: the report goes on without it."""
     boxes = [padded(np.asarray(results[t][seq.name].boxes, dtype=np.float64), len(seq))
              if seq.name in results.get(t, {}) else np.full((len(seq), 4), np.nan) for t in trackers]
-    return [thumbnail(seq, i, boxes, whole=(i == 0)) for i in choose_frames(seq.ground_truth, boxes)]
+    thumbs = []
+    for i in choose_frames(seq.ground_truth, boxes):
+        try:
+            thumbs.append(thumbnail(seq, i, boxes, whole=(i == 0)))
+        except DatasetError as exc:
+            log.warning("report.html: no thumbnail of frame %d of %r: %s", i + 1, seq.name, exc)
+    return thumbs
 
