@@ -9,7 +9,8 @@ column of the CSV tables, ``protocol`` in ``report.json`` and the plot titles. A
 weigh sequences as the protocol does unless ``weighting`` says otherwise. A tracker's
 ``fps`` is the mean over sequences of the per-sequence fps (frames / tracker time in that
 sequence), not total frames / total time. A sequence missing from a tracker's results is
-scored as a total failure and counted in the ``missing`` column.
+scored as a total failure and counted in the ``missing`` column. :mod:`dcfkit.report_html`
+adds one self-contained HTML page of it all (``dcfkit report --html``).
 """
 from __future__ import annotations
 
