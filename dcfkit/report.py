@@ -9,7 +9,8 @@ column of the CSV tables, ``protocol`` in ``report.json`` and the plot titles. A
 weigh sequences as the protocol does unless ``weighting`` says otherwise. A tracker's
 ``fps`` is the mean over sequences of the per-sequence fps (frames / tracker time in that
 sequence), not total frames / total time. A sequence missing from a tracker's results is
-scored as a total failure and counted in the ``missing`` column.
+scored as a total failure and counted in the ``missing`` column. :mod:`dcfkit.report_html`
+adds one self-contained HTML page of it all (``dcfkit report --html``).
 """
 from __future__ import annotations
 
@@ -32,14 +33,19 @@ from .results import atomic_write, ensure_writable, import_results, load_results
 
 __all__ = [
     "columns",
+    "default_report_dir",
     "evaluate",
     "format_rows",
     "format_table",
     "gather_results",
     "json_ready",
     "plot_curves",
+    "read_folder",
     "score_and_write",
+    "score_folders",
     "score_line",
+    "tracker_folders",
+    "write_files",
     "write_report",
 ]
 
@@ -252,12 +258,15 @@ def _is_number(value) -> bool:
     return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool))
 
 
+#: how scores are named in text (a score key of :class:`~dcfkit.protocols.Protocol` -> its name)
+SCORE_LABELS = {"ao": "AO", "sr50": "SR@0.5", "sr75": "SR@0.75", "auc": "AUC", "precision": "precision",
+                "norm_precision": "normalized precision"}
+
+
 def score_line(row: Mapping, protocol: str | Protocol = DEFAULT) -> str:
     """One overall row as ``precision 0.891, AUC 0.520 on 6 sequences (protocol otb)``."""
     proto = get_protocol(protocol)
-    label = {"ao": "AO", "sr50": "SR@0.5", "sr75": "SR@0.75", "auc": "AUC", "precision": "precision",
-             "norm_precision": "normalized precision"}
-    scores = ", ".join(f"{label[k]} {_cell(k, row[k])}" for k in proto.score_keys)
+    scores = ", ".join(f"{SCORE_LABELS[k]} {_cell(k, row[k])}" for k in proto.score_keys)
     return f"{scores} on {row['sequences']} sequences (protocol {proto.name})"
 
 
@@ -272,7 +281,8 @@ def format_table(rows: Seq[Mapping], fmt: str, columns: Seq[str], protocol: str 
 
 # --------------------------------------------------------------------------- plots
 
-_PLOT_STYLE = {
+#: title, axis labels, score and legend place of the plots of each curve kind
+PLOT_STYLE = {
     "precision": dict(title="Precision plots of OPE", xlabel="Location error threshold (pixels)",
                       ylabel="Precision", score="precision_score", loc="lower right"),
     "success": dict(title="Success plots of OPE", xlabel="Overlap threshold",
@@ -297,7 +307,7 @@ def plot_curves(curves: Mapping[str, Mapping], kind: str, path_stem, title: str 
     from matplotlib.figure import Figure  # and only plots need it
 
     proto = get_protocol(protocol)
-    style = _PLOT_STYLE[kind]
+    style = PLOT_STYLE[kind]
     x = _thresholds(proto)[kind]
     fig = Figure(figsize=(5.2, 4.2))
     FigureCanvasAgg(fig)
@@ -339,14 +349,33 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
                    exclude: Iterable[Path] = ()) -> dict[str, dict]:
     """Results of ``trackers`` for a report: tracker name -> sequence -> result.
 
+    Trackers and their names are those of :func:`tracker_folders`. Folders written by
+    :func:`dcfkit.evaluation.run_one_pass` (with ``.json`` sidecars) are read with
+    ``load_results`` (intact results only, timings included); other folders are imported as
+    plain 1-based ``x,y,w,h`` text files.
+    """
+    return {name: read_folder(folder, sequences)
+            for name, folder in tracker_folders(out_dir, sequences, trackers, exclude).items()}
+
+
+def read_folder(folder: Path, sequences: Seq[Sequence]) -> dict:
+    """Sequence name -> result of the tracker in ``folder`` (see :func:`gather_results`)."""
+    names = {s.name for s in sequences}
+    if any((folder / f"{n}.json").is_file() for n in names):
+        return load_results(folder.parent, folder.name, sequences)
+    return {k: v for k, v in import_results(folder).items() if k in names}
+
+
+def tracker_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,
+                    exclude: Iterable[Path] = ()) -> dict[str, Path]:
+    """Tracker name -> results folder, for a report on ``sequences``.
+
     A tracker is a sub-folder name of ``out_dir`` or a path to a folder of result files.
-    Folders written by :func:`dcfkit.evaluation.run_one_pass` (with ``.json`` sidecars)
-    are read with ``load_results`` (intact results only, timings included); other
-    folders are imported as plain 1-based ``x,y,w,h`` text files. ``None`` takes every
-    sub-folder of ``out_dir`` holding a ``<sequence>.txt`` of one of ``sequences``, except
-    the folders in ``exclude`` that hold no tracker results (a report's own folder).
-    A tracker is named by its folder's name, or by ``parent/name`` where two folders share
-    a name (``reference_results/BACF/UAV123_10fps`` and ``.../DR2Track/UAV123_10fps``).
+    ``None`` takes every sub-folder of ``out_dir`` holding a ``<sequence>.txt`` of one of
+    ``sequences``, except the folders in ``exclude`` that hold no tracker results (a
+    report's own folder). A tracker is named by its folder's name, or by ``parent/name``
+    where two folders share a name (``reference_results/BACF/UAV123_10fps`` and
+    ``.../DR2Track/UAV123_10fps``).
     """
     out_dir = Path(out_dir)
     exclude = {Path(p).resolve() for p in exclude}
@@ -367,14 +396,8 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
         folders.setdefault(folder.resolve(), folder)
     shared = {name for name in (f.name for f in folders.values())
               if sum(g.name == name for g in folders.values()) > 1}
-    results = {}
-    for folder in folders.values():
-        if any((folder / f"{n}.json").is_file() for n in names):
-            res = load_results(folder.parent, folder.name, sequences)
-        else:
-            res = {k: v for k, v in import_results(folder).items() if k in names}
-        results[f"{folder.resolve().parent.name}/{folder.name}" if folder.name in shared else folder.name] = res
-    return results
+    return {f"{folder.resolve().parent.name}/{folder.name}" if folder.name in shared else folder.name: folder
+            for folder in folders.values()}
 
 
 def _holds_results(folder: Path, names: set[str]) -> bool:
@@ -403,11 +426,12 @@ def report_file_names(sequences: Seq[Sequence]) -> list[str]:
     """Every file a report on ``sequences`` may write."""
     attributes = sorted({a for s in sequences for a, present in s.attributes.items() if present})
     plots = ["precision", "success"] + [f"success_{a}" for a in attributes]
-    return ([f"{t}.{ext}" for t in REPORT_TABLES for _, ext in TABLE_FORMATS] + ["report.json"]
+    return ([f"{t}.{ext}" for t in REPORT_TABLES for _, ext in TABLE_FORMATS] + ["report.json", "report.html"]
             + [f"{p}.{ext}" for p in plots for ext in ("png", "svg")])
 
 
-def _write(evaluation: dict, report_dir: Path) -> list[Path]:
+def write_files(evaluation: dict, report_dir: Path) -> list[Path]:
+    """The tables, ``report.json`` and plots of :func:`write_report` from ``evaluation``."""
     paths = []
     protocol = evaluation["protocol"]["name"]
 
@@ -449,14 +473,28 @@ def score_and_write(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] |
                     include_first: bool = True, weighting: str | None = None,
                     protocol: str | Protocol = DEFAULT) -> tuple[dict, list[Path]]:
     """:func:`write_report` that also returns what :func:`evaluate` returned: (evaluation, paths)."""
-    out_dir = Path(out_dir)
-    report_dir = Path(report_dir) if report_dir is not None else out_dir / "report"
-    sequences = scored_sequences(sequences)  # a test split stops here, before any folder is made
+    report_dir = default_report_dir(out_dir, report_dir)
+    _, _, evaluation = score_folders(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol)
+    return evaluation, write_files(evaluation, report_dir)
+
+
+def default_report_dir(out_dir, report_dir=None) -> Path:
+    """``report_dir``, by default ``out_dir/report``."""
+    return Path(report_dir) if report_dir is not None else Path(out_dir) / "report"
+
+
+def score_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None, report_dir: Path,
+                  include_first: bool = True, weighting: str | None = None,
+                  protocol: str | Protocol = DEFAULT) -> tuple[dict[str, Path], dict[str, dict], dict]:
+    """(tracker folders, their results, :func:`evaluate` of them) for a report into
+    ``report_dir``, which is checked to take the report's files before the scoring. A test
+    split (ground truth withheld after frame 1) stops here, before any folder is made."""
+    sequences = scored_sequences(sequences)
     if _holds_results(report_dir, {s.name for s in sequences}):
         raise DatasetError(f"{report_dir} holds a tracker's results; write the report elsewhere with --report-dir")
-    results = gather_results(out_dir, sequences, trackers, exclude=[report_dir])
+    folders = tracker_folders(out_dir, sequences, trackers, exclude=[report_dir])
+    results = {name: read_folder(folder, sequences) for name, folder in folders.items()}
     if not results:
         raise DatasetError(f"no tracker results found under {clip(str(out_dir))}")
     ensure_writable(report_dir, report_file_names(sequences), "the report")  # before the scoring
-    evaluation = evaluate(results, sequences, include_first, weighting, protocol)
-    return evaluation, _write(evaluation, report_dir)
+    return folders, results, evaluate(results, sequences, include_first, weighting, protocol)

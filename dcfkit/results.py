@@ -27,6 +27,7 @@ is a :class:`StoreError` naming the file.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import dataclasses
 import functools
 import glob
@@ -34,7 +35,10 @@ import hashlib
 import json
 import logging
 import os
+import platform
 import re
+import shlex
+import sys
 import tempfile
 import traceback
 from datetime import datetime, timezone
@@ -98,6 +102,60 @@ def run_key(config: Mapping, version: str | None = None) -> str:
 
 def now() -> str:
     return datetime.now(timezone.utc).isoformat(timespec="seconds")
+
+
+_COMMAND: contextvars.ContextVar[list | None] = contextvars.ContextVar("dcfkit_command", default=None)
+
+
+@contextlib.contextmanager
+def running_command(argv: list[str]):
+    """Within: :func:`invocation` says ``argv`` (the CLI's ``dcfkit ...`` when its ``main`` is
+    called with arguments, as tests and scripts do, rather than their own process's)."""
+    token = _COMMAND.set(list(argv))
+    try:
+        yield
+    finally:
+        _COMMAND.reset(token)
+
+
+def invocation() -> dict:
+    """How this command was given: ``{"command": argv, "cwd": working directory}``. The
+    process's ``sys.argv`` (with ``python -m PACKAGE`` as the first words when it was run so:
+    ``sys.argv[0]`` is then the path of ``__main__.py``, which does not run alone) unless
+    :func:`running_command` says otherwise. Result sidecars record the client's."""
+    argv = _COMMAND.get()
+    if argv is None:
+        argv = list(sys.argv)
+        spec = getattr(sys.modules.get("__main__"), "__spec__", None)
+        if spec is not None and spec.name.endswith(".__main__"):
+            argv[:1] = ["python", "-m", spec.name.removesuffix(".__main__")]
+        elif argv:
+            argv[0] = os.path.basename(argv[0]) or argv[0]
+    return {"command": argv, "cwd": os.getcwd()}
+
+
+def command_line(record: Mapping) -> str | None:
+    """A sidecar's or :func:`invocation`'s command as one shell line, or None if not recorded."""
+    argv = record.get("command")
+    if not isinstance(argv, list) or not all(isinstance(a, str) for a in argv):
+        return None
+    return shlex.join(argv)
+
+
+@functools.lru_cache(maxsize=1)
+def machine() -> dict:
+    """The machine this process runs on: host name, OS, CPU model, cores, Python version."""
+    return {"host": platform.node(), "system": platform.platform(terse=True), "cpu": _cpu_model(),
+            "cores": os.cpu_count(), "python": platform.python_version()}
+
+
+def _cpu_model() -> str:
+    with contextlib.suppress(OSError):
+        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as info:
+            for line in info:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    return platform.processor() or platform.machine()
 
 
 # --------------------------------------------------------------------------- files

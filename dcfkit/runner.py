@@ -26,7 +26,7 @@ import cv2
 from .datasets import Sequence
 from .errors import DcfkitError, shown
 from .registry import PluginWarning
-from .results import ResultStore, StoreError, dcfkit_version, now, plugin_versions, run_key
+from .results import ResultStore, StoreError, dcfkit_version, invocation, machine, now, plugin_versions, run_key
 from .tracking import TrackerFailure, track
 
 _THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS",
@@ -71,9 +71,12 @@ def _warm_up(task: RunTask) -> None:
         tracker.update(image)
 
 
-def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | None = None) -> dict:
+def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | None = None,
+                 origin: Mapping | None = None) -> dict:
     """Run ``task`` and store its boxes or its failure; returns ``{"sequence", "status",
-    "frames", "error" (failed) or "fps" (done)}``."""
+    "frames", "error" (failed) or "fps" (done)}``. ``origin``: the client's
+    :func:`~dcfkit.results.invocation` (default: this process's), recorded in the sidecar
+    with the machine that ran it."""
     seq, store = task.seq, ResultStore(task.folder)
     _warm_up(task)
     reading = [0]  # the 1-based number of the frame being read, for errors in decoding
@@ -93,7 +96,8 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
     meta = {"sequence": seq.name, "dataset": seq.dataset, "tracker": task.config.get("name"),
             "init_box": [float(v) for v in seq.init_box], "fps": run.fps, "total_time": float(run.times.sum()),
             "run_key": task.key, "dcfkit_version": version, "plugins": plugin_versions(task.config),
-            "time": now(), "config": task.config, "times": run.times.tolist()}
+            "time": now(), **(origin or invocation()), "machine": machine(), "config": task.config,
+            "times": run.times.tolist()}
     store.write(seq, run.boxes, meta, run.times, run.confidence)
     return {"sequence": seq.name, "status": "done", "fps": run.fps, "frames": len(seq)}
 
@@ -165,7 +169,7 @@ def _die_with_parent(parent_pid: int) -> None:
 _worker_ready = False
 
 
-def run_in_worker(task: RunTask, version: str) -> dict:
+def run_in_worker(task: RunTask, version: str, origin: Mapping | None = None) -> dict:
     """:func:`run_sequence` in a pool or dask worker, which must run the client's dcfkit and plugins."""
     global _worker_ready
     if not _worker_ready:  # dask workers have no initializer: one OpenCV thread each
@@ -177,7 +181,7 @@ def run_in_worker(task: RunTask, version: str) -> dict:
     if task.make_tracker is None and run_key(task.config, version) != task.key:
         raise DcfkitError(f"this worker's plugins ({', '.join(plugin_versions(task.config)) or 'none'}) are not "
                           f"the client's: install the same plugin versions on every worker")
-    return run_sequence(task, version)
+    return run_sequence(task, version, origin=origin)
 
 
 def crash_message(seq: Sequence, exc: BaseException) -> str:
@@ -223,7 +227,8 @@ def _deliver(finished: Iterable, key_of: Callable, on_result: Callable, on_crash
         on_result(key, result)
 
 
-def _run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: str, on_result, on_crash) -> None:
+def _run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: str, origin: Mapping, on_result,
+              on_crash) -> None:
     try:
         from distributed import Client, LocalCluster, as_completed as dask_completed  # optional: dcfkit[dask]
     except ImportError:
@@ -237,7 +242,7 @@ def _run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: s
                     n_workers=max(1, min(jobs, len(tasks))), threads_per_worker=1, processes=True,
                     dashboard_address=None))
             client = stack.enter_context(Client(cluster))
-        futures = [client.submit(run_in_worker, t, version, pure=False,
+        futures = [client.submit(run_in_worker, t, version, origin, pure=False,
                                  key=f"dcfkit-{t.key}-{t.seq.dataset}-{t.seq.name}") for t in tasks]
         by_key = {f.key: t for f, t in zip(futures, tasks)}
         try:
@@ -264,6 +269,7 @@ def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None]
     or a ``LocalCluster`` of ``jobs`` single-threaded workers when ``scheduler`` is None."""
     tasks = list(tasks)
     version = version if version is not None else dcfkit_version()
+    origin = invocation()  # the client's command, whichever process or machine runs a task
     if executor not in ("local", "dask"):
         raise DcfkitError(f"executor must be 'local' or 'dask', got {shown(executor)}")
     if jobs < 1:
@@ -277,10 +283,10 @@ def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None]
     if not tasks:
         return
     if executor == "dask":
-        _run_dask(tasks, jobs, scheduler, version, on_result, crashed)
+        _run_dask(tasks, jobs, scheduler, version, origin, on_result, crashed)
     elif jobs == 1 or len(tasks) == 1:
         for task in tasks:
-            on_result(task, run_sequence(task, version, on_frame))
+            on_result(task, run_sequence(task, version, on_frame, origin))
     else:
-        run_pool({i: (run_in_worker, t, version) for i, t in enumerate(tasks)}, jobs,
+        run_pool({i: (run_in_worker, t, version, origin) for i, t in enumerate(tasks)}, jobs,
                  lambda i, result: on_result(tasks[i], result), lambda i, exc: crashed(tasks[i], exc))

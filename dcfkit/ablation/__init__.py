@@ -24,13 +24,17 @@ Runs go to a local process pool (spawned workers, one BLAS/OpenMP/OpenCV thread 
 killed with the parent) or to dask.distributed. Then ``OUT/summary.{md,csv}``,
 ``OUT/per_sequence.{md,csv}``, ``OUT/summary.json`` and, for a grid, one
 ``OUT/sensitivity_<parameter>.png`` per parameter (else ``OUT/precision`` and
-``OUT/success`` plots, PNG and SVG) are written.
+``OUT/success`` plots, PNG and SVG) and ``OUT/report.html`` (:mod:`dcfkit.report_html`: the
+variants with their config changes from the base, sensitivity plots, tables, plots, frames) are
+written.
 """
 from __future__ import annotations
 
 from .run import run_ablation
 from .spec import AblationSpec, Grid, Job, Variant, expand, job_dir, load_spec, variant_names
-from .summary import SEQUENCE_COLUMNS, SUMMARY_COLUMNS, plot_sensitivity, summarize, summary_columns
+from .sensitivity import plot_sensitivity, sensitivity
+from .summary import SEQUENCE_COLUMNS, SUMMARY_COLUMNS, summarize, summary_columns
 
 __all__ = ["AblationSpec", "Grid", "Job", "SEQUENCE_COLUMNS", "SUMMARY_COLUMNS", "Variant", "expand", "job_dir",
-           "load_spec", "plot_sensitivity", "run_ablation", "summarize", "summary_columns", "variant_names"]
+           "load_spec", "plot_sensitivity", "run_ablation", "sensitivity", "summarize", "summary_columns",
+           "variant_names"]

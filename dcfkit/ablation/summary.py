@@ -4,15 +4,16 @@ from __future__ import annotations
 import contextlib
 import json
 import logging
-import math
 from pathlib import Path
-from typing import Any, Mapping
 
 from ..datasets import Sequence
 from ..protocols import DEFAULT, get_protocol
-from ..report import evaluate, format_table, json_ready, plot_curves, save_figure
+from ..report import evaluate, format_table, json_ready, plot_curves
+from ..report_html import PAGE, write_page
 from ..results import ResultStore, atomic_write, read_json
-from .spec import AblationSpec, Job, expand, format_value, job_dir
+from .page import ablation_page
+from .sensitivity import plot_sensitivity, sensitivity_file
+from .spec import AblationSpec, Job, expand, job_dir
 
 SUMMARY_COLUMNS = ("variant", "precision", "auc", "fps", "sequences", "failed")
 SEQUENCE_COLUMNS = ("variant", "sequence", "precision", "auc", "fps", "frames", "status")
@@ -62,6 +63,9 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
                                      for k, (lab, vals) in spec.grid.parameters.items()}}
                      if spec.grid else None)}
     files = _write_files(spec, out, info, scores["curves"], protocol)
+    page = ablation_page(spec, out, info, summary_columns("summary", protocol), scores, sequences,
+                         {variant: stored[key] for variant, key in keys.items()}, keys)
+    files.append(write_page(page, out / PAGE))
     return {"overall": overall, "per_sequence": per_sequence, "jobs": job_rows, "files": files}
 
 
@@ -129,86 +133,11 @@ def _quiet(logger: logging.Logger):
         logger.setLevel(level)
 
 
-def _get_dotted(config: Any, key: str) -> Any:
-    node = config
-    for part in key.split("."):
-        if isinstance(node, list) and part.lstrip("-").isdigit() and -len(node) <= int(part) < len(node):
-            node = node[int(part)]
-        elif isinstance(node, Mapping) and part in node:
-            node = node[part]
-        else:
-            return None
-    return node
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
-
-def plot_sensitivity(spec: AblationSpec, overall: list[dict], out, protocol: str = DEFAULT) -> list[Path]:
-    """Fig. 6 of the paper: per grid parameter, precision and AUC against its value.
-
-    Sweep: the grid points of that parameter (the others at the base). Product: the mean
-    over the other parameters' values, with their min-max as a band. The base value is a
-    dotted vertical line. Writes ``OUT/sensitivity_<key>.png``; returns the paths.
-    """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg  # lazy: matplotlib is slow to import,
-    from matplotlib.figure import Figure  # and only plots need it
-
-    grid = spec.grid
-    rows = {r["variant"]: r for r in overall}
-    points = [v for v in spec.variants if v.values]
-    paths = []
-    for key, (label, values) in grid.parameters.items():
-        numeric = all(_is_number(v) for v in values)
-        names = [format_value(v) for v in values]
-        xs = [float(v) for v in values] if numeric else list(range(len(values)))
-        fig = Figure(figsize=(4.6, 3.6))
-        FigureCanvasAgg(fig)
-        ax = fig.add_subplot(1, 1, 1)
-        for metric, legend, colour, marker in (("precision", "precision@20", "C3", "o"),
-                                               ("auc", "AUC", "C0", "s")):
-            mean, low, high = [], [], []
-            for name in names:
-                scores = [rows[p.name][metric] for p in points
-                          if key in p.values and format_value(p.values[key]) == name]
-                scores = [s for s in scores if s is not None and math.isfinite(s)]
-                mean.append(sum(scores) / len(scores) if scores else math.nan)
-                low.append(min(scores) if scores else math.nan)
-                high.append(max(scores) if scores else math.nan)
-            ax.plot(xs, mean, color=colour, marker=marker, linewidth=1.8, label=legend)
-            if grid.mode == "product" and len(grid.parameters) > 1:
-                ax.fill_between(xs, low, high, color=colour, alpha=0.15, linewidth=0)
-        base = _get_dotted(grid.base_config, key)
-        base_x = (float(base) if numeric and _is_number(base) else
-                  names.index(format_value(base)) if not numeric and format_value(base) in names else None)
-        if base_x is not None:
-            ax.axvline(base_x, color="0.5", linestyle=":", linewidth=1, label=f"base ({format_value(base)})")
-        ax.set_xticks(xs)
-        ax.set_xticklabels(names)
-        ax.set_xlabel(label if label == key else f"{label} ({key})")
-        ax.set_ylabel("score")
-        what = "mean over the other parameters" if grid.mode == "product" and len(grid.parameters) > 1 else \
-            "others at the base"
-        n_seq = overall[0]["sequences"] if overall else 0
-        ax.set_title(f"{label} on {spec.dataset} ({n_seq} sequences), {what} [protocol {protocol}]", fontsize=9)
-        ax.grid(True, linestyle=":", linewidth=0.6)
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        path = Path(out) / _sensitivity_file(key)
-        save_figure(fig, path)
-        paths.append(path)
-    return paths
-
-
-def _sensitivity_file(key: str) -> str:
-    return "sensitivity_" + "".join(c if c.isalnum() or c in "._-" else "_" for c in key) + ".png"
-
-
 def output_names(spec: AblationSpec) -> list[str]:
     """Every file :func:`summarize` writes into the output folder."""
-    plots = ([_sensitivity_file(key) for key in spec.grid.parameters] if spec.grid is not None else
+    plots = ([sensitivity_file(key) for key in spec.grid.parameters] if spec.grid is not None else
              [f"{kind}.{ext}" for kind in ("precision", "success") for ext in ("png", "svg")])
-    return [f"{stem}.{ext}" for stem in ("summary", "per_sequence") for ext in ("md", "csv")] + ["summary.json"] + plots
+    tables = [f"{stem}.{ext}" for stem in ("summary", "per_sequence") for ext in ("md", "csv")]
+    return tables + ["summary.json", PAGE] + plots
 
 

@@ -2,12 +2,14 @@
 library's (:mod:`dcfkit.evaluation`, :mod:`dcfkit.ablation`, :mod:`dcfkit.report`, ...)."""
 from __future__ import annotations
 
+import contextlib
 import errno
 import sys
 import warnings
 
 from ..errors import DcfkitError, clip
 from ..registry import PluginWarning
+from ..results import running_command
 from ..tracking import interrupt_on_termination
 from .parser import build_parser
 
@@ -27,7 +29,8 @@ def _one_line_plugin_warnings(show):
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    with warnings.catch_warnings(), interrupt_on_termination():  # SIGTERM/SIGHUP end a command as Ctrl-C does
+    given = contextlib.nullcontext() if argv is None else running_command(["dcfkit", *argv])
+    with warnings.catch_warnings(), interrupt_on_termination(), given:  # SIGTERM/SIGHUP end a command as Ctrl-C does
         warnings.showwarning = _one_line_plugin_warnings(warnings.showwarning)
         try:
             return args.func(args) or 0

@@ -66,4 +66,5 @@ def run(args: argparse.Namespace) -> int:
     variants = variant_names(res["jobs"])
     for (key, seq), message in res["failed"].items():
         print(f"  FAILED {', '.join(variants.get(key, []))} [{key}] {message}")
+    print(f"open {Path(args.out) / 'report.html'}")
     return 1 if res["failed"] else 0

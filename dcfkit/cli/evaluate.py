@@ -15,6 +15,7 @@ from ..datasets import load_dataset
 from ..errors import ConfigError, shown
 from ..evaluation import check_one_pass, run_one_pass, tracker_name
 from ..report import columns, evaluate, format_table, json_ready, score_and_write, score_line
+from ..report_html import write_html_report
 from ..results import load_results
 from .common import add_dataset_arguments, add_protocol_argument, pixels
 
@@ -96,6 +97,9 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--format", choices=("table", "markdown", "csv"), default="table",
                         help="format of the table printed to stdout")
     parser.add_argument("--report-dir", type=Path, default=None, help="default: OUT/report")
+    parser.add_argument("--html", action="store_true",
+                        help="also write report.html: one self-contained page with sortable tables, interactive "
+                             "plots, each sequence's frames with every tracker's box, and the provenance")
     add_protocol_argument(parser)
     parser.add_argument("--skip-first", action="store_true",
                         help="do not score frame 1 (default: as the protocol; otb scores it with the ground "
@@ -109,13 +113,15 @@ def run_report(args: argparse.Namespace) -> int:
     """Print the overall table and write the report files."""
     sequences = load_dataset(args.dataset, args.root, args.sequences)
     trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
-    evaluation, paths = score_and_write(args.out, sequences, trackers, args.report_dir,
-                                        include_first=not args.skip_first,
-                                        weighting="frame" if args.frame_weighted else None, protocol=args.protocol)
+    write = write_html_report if args.html else score_and_write
+    evaluation, paths = write(args.out, sequences, trackers, args.report_dir, include_first=not args.skip_first,
+                              weighting="frame" if args.frame_weighted else None, protocol=args.protocol)
     print(format_table(evaluation["overall"], args.format, columns("overall", args.protocol), args.protocol),
           end="")
     if args.format == "table":
         print(f"\n{len(paths)} files written to {paths[0].parent}")
+        if args.html:
+            print(f"open {paths[-1]}")
     return 0
 
 
