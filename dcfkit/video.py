@@ -87,11 +87,6 @@ def open_source(video: str | None = None, frames: str | None = None) -> FrameSou
                        fps=_declared_fps(cap))
 
 
-def iter_frames(video: str | None = None, frames: str | None = None) -> Iterator[np.ndarray]:
-    """The frames of :func:`open_source`, opened when the first is asked for."""
-    yield from open_source(video, frames).frames
-
-
 URL = re.compile(r"[A-Za-z][A-Za-z0-9+.-]*://")
 # OpenCV's FFmpeg timeouts for a URL (its defaults, set so that a stall is recognised)
 OPEN_TIMEOUT = READ_TIMEOUT = 30.0  # seconds

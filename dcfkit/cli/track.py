@@ -18,11 +18,21 @@ from ..selection import check_display, select_box
 from ..synthetic import make_sequence
 from ..tracker import load_tracker
 from ..tracking import INTERRUPTS, Step, steps, termination_deferred, track
-from ..video import DEFAULT_FPS, FrameSource, VideoWriter, check_output_file, open_source
+from ..video import DEFAULT_FPS, READ_TIMEOUT, FrameSource, VideoWriter, check_output_file, open_source
 from .common import MAX_DEMO_FRAMES, frame_count, parse_box, seed
 
 
+TRACK_NOTES = f"""--video reads a file, a camera (0 is the first), a stream URL or a named pipe one frame at a
+time, and each box is printed (or written to --out) as soon as its frame is tracked: Ctrl-C or
+SIGTERM ends a run on an endless source and keeps every box. A camera that stops giving frames
+ends the run with an error, and so does a stream that gives none for {READ_TIMEOUT:g} s; a stream that ends
+is said on stderr. The Motion JPEG damage check (docs/architecture.md) reads a file's frames
+twice, so it applies to files only. --select opens a matplotlib window: it needs a display and
+tkinter (on Debian or Ubuntu: apt install python3-tk) or another window backend."""
+
+
 def add_track_arguments(p: argparse.ArgumentParser) -> None:
+    p.epilog = TRACK_NOTES
     p.add_argument("config", help="config file or shipped name (strcf, bacf, dr2track, kcf, dsst)")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--video", help="video file, camera number (0: the first camera), stream URL (rtsp://, "
