@@ -69,7 +69,7 @@ def open_source(video: str | None = None, frames: str | None = None) -> FrameSou
         return FrameSource((read_frame(path, f"frame {i}") for i, path in enumerate(files, start=1)), str(frames),
                            total=len(files))
     if _is_camera(video):
-        return _live_source(_open_camera(int(video)), video)
+        return _live_source(_open_camera(int(video)), video, camera=True)
     if URL.match(video):
         cap = _quietly_opened(video, cv2.CAP_FFMPEG, [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, int(OPEN_TIMEOUT * 1000),
                                                      cv2.CAP_PROP_READ_TIMEOUT_MSEC, int(READ_TIMEOUT * 1000)])
@@ -80,8 +80,8 @@ def open_source(video: str | None = None, frames: str | None = None) -> FrameSou
     if path.is_dir():
         raise InputError(f"--video: {clip(video)} is a folder: --frames reads a folder of images")
     cap = _checked(cv2.VideoCapture(video), video)
-    if not path.is_file():  # a named pipe or a device
-        return _live_source(cap, video)
+    if not path.is_file():  # a named pipe, or a device such as /dev/video0
+        return _live_source(cap, video, camera=path.is_char_device())
     declared = _declared_count(cap)
     return FrameSource(_file_frames(cap, video, declared), _name(video), total=declared or None,
                        fps=_declared_fps(cap))
@@ -208,13 +208,13 @@ def _file_frames(cap: cv2.VideoCapture, video: str, declared: int) -> Iterator[n
         raise InputError(f"--video: {clip(video)} has no readable frames")
 
 
-def _live_source(cap: cv2.VideoCapture, video: str) -> FrameSource:
-    declared = 0 if _is_camera(video) else _declared_count(cap)
-    return FrameSource(_read_in_thread(_live_frames(cap, video, declared)), _name(video), total=declared or None,
-                       fps=_declared_fps(cap), live=True)
+def _live_source(cap: cv2.VideoCapture, video: str, camera: bool = False) -> FrameSource:
+    declared = 0 if camera else _declared_count(cap)
+    return FrameSource(_read_in_thread(_live_frames(cap, video, declared, camera)), _name(video),
+                       total=declared or None, fps=_declared_fps(cap), live=True)
 
 
-def _live_frames(cap: cv2.VideoCapture, video: str, declared: int) -> Iterator[np.ndarray]:
+def _live_frames(cap: cv2.VideoCapture, video: str, declared: int, camera: bool) -> Iterator[np.ndarray]:
     """The frames of a camera, URL or pipe (:func:`_capture_frames`) as they come. Where they
     end without a declared count: an InputError for a camera (it has no end), and for a
     stream that gave no frame for ``READ_TIMEOUT`` (a stall, which OpenCV's FFmpeg reports
@@ -223,7 +223,7 @@ def _live_frames(cap: cv2.VideoCapture, video: str, declared: int) -> Iterator[n
     for count, image in enumerate(_capture_frames(cap, video, declared), start=1):
         yield image
         asked = time.monotonic()
-    if _is_camera(video):
+    if camera:
         raise InputError(f"--video: {name} stopped giving frames after frame {count} (unplugged, or taken by "
                          f"another program?)" if count else f"--video: {name} gave no frame")
     if not declared and time.monotonic() - asked >= 0.9 * READ_TIMEOUT:
