@@ -1,7 +1,8 @@
 """The one frame loop: initialise on the first frame, update on the rest, time, collect boxes.
 
-Every run path uses :func:`track`: ``dcfkit eval`` and ``ablate`` (through
-:mod:`dcfkit.runner`), ``dcfkit track``, the demo and the benchmarks. A
+Every run path uses :func:`steps`, which yields each frame as it is tracked: ``dcfkit track``
+directly (it writes each box as it comes), and through :func:`track`, which collects them,
+``dcfkit eval`` and ``ablate`` (:mod:`dcfkit.runner`), the demo and the benchmarks. A
 tracker is any object with ``init(image, box)`` and ``update(image) -> box``; boxes are
 ``(x, y, w, h)`` floats, **0-based**. Frame numbers in messages are **1-based**, as in the
 benchmarks' file names and annotations.
@@ -13,7 +14,7 @@ import dataclasses
 import os
 import signal
 import time
-from typing import Callable, Iterable
+from typing import Callable, Iterable, Iterator
 
 import numpy as np
 
@@ -66,11 +67,14 @@ class Interrupted(KeyboardInterrupt):
 TERMINATION = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name))
 
 
-def _termination_handled_by(handler):
-    """Handle SIGTERM and SIGHUP with ``handler`` in the block, except a signal ignored when
-    it starts (``nohup`` ignores SIGHUP); yields the handlers it replaced (None off the main
-    thread, where signals are left alone)."""
-    return handlers_replaced(TERMINATION, lambda previous: None if previous is signal.SIG_IGN else handler)
+INTERRUPTS = (signal.SIGINT, *TERMINATION)  # Ctrl-C too
+
+
+def _termination_handled_by(handler, signums=TERMINATION):
+    """Handle ``signums`` (SIGTERM and SIGHUP) with ``handler`` in the block, except a signal
+    ignored when it starts (``nohup`` ignores SIGHUP); yields the handlers it replaced (None
+    off the main thread, where signals are left alone)."""
+    return handlers_replaced(signums, lambda previous: None if previous is signal.SIG_IGN else handler)
 
 
 def _interrupt(signum, frame):
@@ -84,11 +88,12 @@ def interrupt_on_termination():
 
 
 @contextlib.contextmanager
-def termination_deferred():
-    """Hold SIGTERM and SIGHUP back while the block runs (a final write is never cut short);
-    one that arrived meanwhile is handled as it would have been, when the block ends."""
+def termination_deferred(signums=TERMINATION):
+    """Hold ``signums`` (SIGTERM and SIGHUP; :data:`INTERRUPTS` adds Ctrl-C) back while the
+    block runs (a final write is never cut short); one that arrived meanwhile is handled as it
+    would have been, when the block ends."""
     arrived = []
-    with _termination_handled_by(lambda signum, frame: arrived.append(signum)) as saved:
+    with _termination_handled_by(lambda signum, frame: arrived.append(signum), signums) as saved:
         yield
     if arrived and saved is not None:
         handler = saved[arrived[0]]
@@ -107,44 +112,67 @@ def as_box(value, frame: int) -> np.ndarray:
         raise TrackerFailure(frame, f"{what} {shown(value)}, expected 4 numbers (x, y, w, h)") from None
 
 
+@dataclasses.dataclass(frozen=True)
+class Step:
+    """One tracked frame: ``index`` 0-based, the ``image``, its 0-based ``box`` ``(4,)``, the
+    tracker's ``seconds`` on it and its ``confidence`` ``(peak, apce)``."""
+
+    index: int
+    image: np.ndarray
+    box: np.ndarray
+    seconds: float
+    confidence: tuple[float, float]
+
+
+def steps(tracker, frames: Iterable[np.ndarray], init_box) -> Iterator[Step]:
+    """Run ``tracker`` through ``frames``, yielding each frame as it is tracked: ``init`` on the
+    first with ``init_box``, ``update`` on each later one. Each frame's confidence is read from
+    ``tracker.last_confidence`` after the frame's time is taken (:func:`confidence_of`). A
+    tracker exception becomes a :class:`TrackerFailure` naming the frame and the call."""
+    for index, image in enumerate(frames):  # decoding happens here: not timed
+        start = time.perf_counter()
+        try:
+            if index == 0:
+                tracker.init(image, init_box)
+                out = init_box
+            else:
+                out = tracker.update(image)
+        except (KeyboardInterrupt, SystemExit):  # Ctrl-C, SIGTERM (Interrupted) and exit() end the run
+            raise
+        except BaseException as exc:  # a component's own BaseException subclass, too: its frame fails
+            call = "init" if index == 0 else "update"
+            said = str(exc).removeprefix(f"frame {index + 1}: ")  # the tracker's own errors name the frame
+            raise TrackerFailure(index + 1, f"{call} raised {type(exc).__name__}: {said}") from exc
+        seconds = time.perf_counter() - start
+        confidence = confidence_of(tracker)
+        yield Step(index, image, as_box(out, index + 1), seconds, confidence)
+
+
 def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | None = None,
           partial: Track | None = None) -> Track:
-    """Run ``tracker`` through ``frames``: ``init`` on the first with ``init_box``, ``update`` on
-    each later one. ``on_frame(index, image, box, tracker)`` is called after each frame (0-based
-    index; progress bars, video writers). Each frame's confidence is read from
-    ``tracker.last_confidence`` after the frame's time is taken (:func:`confidence_of`).
+    """Run ``tracker`` through ``frames`` (:func:`steps`) and collect the boxes, times and
+    confidence. ``on_frame(index, image, box, tracker)`` is called after each frame (0-based
+    index; progress bars, video writers).
 
     Whatever ends the loop, ``partial`` (if given, an empty :class:`Track`) holds the frames
-    done so far, so a caller can keep them. A tracker exception becomes a
-    :class:`TrackerFailure` naming the frame and the call."""
+    done so far, so a caller can keep them."""
     boxes, times, confidence = [], [], []
     try:
-        for index, image in enumerate(frames):  # decoding happens here: not timed
-            start = time.perf_counter()
-            try:
-                if index == 0:
-                    tracker.init(image, init_box)
-                    out = init_box
-                else:
-                    out = tracker.update(image)
-            except (KeyboardInterrupt, SystemExit):  # Ctrl-C, SIGTERM (Interrupted) and exit() end the run
-                raise
-            except BaseException as exc:  # a component's own BaseException subclass, too: its frame fails
-                call = "init" if index == 0 else "update"
-                said = str(exc).removeprefix(f"frame {index + 1}: ")  # the tracker's own errors name the frame
-                raise TrackerFailure(index + 1, f"{call} raised {type(exc).__name__}: {said}") from exc
-            times.append(time.perf_counter() - start)
-            confidence.append(confidence_of(tracker))
-            boxes.append(as_box(out, index + 1))
+        for step in steps(tracker, frames, init_box):
+            boxes.append(step.box)
+            times.append(step.seconds)
+            confidence.append(step.confidence)
             if on_frame is not None:
-                on_frame(index, image, boxes[-1], tracker)
+                on_frame(step.index, step.image, step.box, tracker)
     finally:
         if partial is not None:
-            partial.boxes = np.array(boxes, dtype=np.float64).reshape(-1, 4)
-            partial.times = np.array(times[:len(boxes)], dtype=np.float64)
-            partial.confidence = np.array(confidence[:len(boxes)], dtype=np.float64).reshape(-1, 2)
-    return Track(np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(times, dtype=np.float64),
-                 np.array(confidence, dtype=np.float64).reshape(-1, 2))
+            partial.boxes, partial.times, partial.confidence = _arrays(boxes, times, confidence)
+    return Track(*_arrays(boxes, times, confidence))
+
+
+def _arrays(boxes: list, times: list, confidence: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return (np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(times, dtype=np.float64),
+            np.array(confidence, dtype=np.float64).reshape(-1, 2))
 
 
 def empty_track() -> Track:

@@ -1,12 +1,18 @@
-"""Reading frames (video file or image folder) and writing annotated videos."""
+"""Reading frames (a video file, camera, stream or image folder) and writing annotated videos."""
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
+import queue
 import re
+import sys
+import threading
+import time
 import warnings
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import Iterator
+from urllib.parse import urlsplit
 
 import cv2
 import numpy as np
@@ -37,14 +43,112 @@ def frame_files(folder: str | Path) -> list[Path]:
     return files
 
 
-def iter_frames(video: str | None = None, frames: str | None = None) -> Iterator[np.ndarray]:
-    """Yield BGR frames from a video file or an image folder (:func:`read_frame`'s checks for
-    each file; :func:`video_frames`' for a video)."""
+@dataclasses.dataclass
+class FrameSource:
+    """Frames to track, read one at a time as they are asked for, and what is known of them
+    before the first: ``total`` (a video's declared frame count or a folder's images; None
+    when the source does not say, as a camera or a live stream does not), ``fps`` (the rate it
+    declares, None if none or an implausible one) and ``name`` (for messages). ``live``: a
+    camera, a URL or a named pipe, whose frames come as they are made."""
+
+    frames: Iterator[np.ndarray]
+    name: str
+    total: int | None = None
+    fps: float | None = None
+    live: bool = False
+
+
+def open_source(video: str | None = None, frames: str | None = None) -> FrameSource:
+    """``--frames``, a folder of images (:func:`read_frame`'s checks for each), or ``--video``:
+    a camera index (``0``), a URL (``rtsp://``, ``http://``, ... as OpenCV's FFmpeg opens it),
+    a video file, or a named pipe or device. A file is read as :func:`_capture_frames` says,
+    its Motion JPEG frames checked for damage (:class:`_JpegPackets`); a live source without
+    that check (it would read the frames a second time), in a thread (:func:`_read_in_thread`)."""
     if frames is not None:
-        for i, path in enumerate(frame_files(frames), start=1):
-            yield read_frame(path, f"frame {i}")
-        return
-    yield from video_frames(video)
+        files = frame_files(frames)
+        return FrameSource((read_frame(path, f"frame {i}") for i, path in enumerate(files, start=1)), str(frames),
+                           total=len(files))
+    if _is_camera(video):
+        return _live_source(_open_camera(int(video)), video, camera=True)
+    if URL.match(video):
+        cap = _quietly_opened(video, cv2.CAP_FFMPEG, [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, int(OPEN_TIMEOUT * 1000),
+                                                     cv2.CAP_PROP_READ_TIMEOUT_MSEC, int(READ_TIMEOUT * 1000)])
+        return _live_source(_checked(cap, video), video)
+    path = Path(video)
+    if not path.exists():
+        raise InputError(f"--video: file not found: {clip(video)} (a camera is a number, 0 the first; a stream a URL)")
+    if path.is_dir():
+        raise InputError(f"--video: {clip(video)} is a folder: --frames reads a folder of images")
+    cap = _checked(cv2.VideoCapture(video), video)
+    if not path.is_file():  # a named pipe, or a device such as /dev/video0
+        return _live_source(cap, video, camera=path.is_char_device())
+    declared = _declared_count(cap)
+    return FrameSource(_file_frames(cap, video, declared), _name(video), total=declared or None,
+                       fps=_declared_fps(cap))
+
+
+URL = re.compile(r"[A-Za-z][A-Za-z0-9+.-]*://")
+# OpenCV's FFmpeg timeouts for a URL (its defaults, set so that a stall is recognised)
+OPEN_TIMEOUT = READ_TIMEOUT = 30.0  # seconds
+MAX_FPS = 1000.0  # a higher declared rate is a time base, not a frame rate
+
+
+def _is_camera(video: str) -> bool:
+    return video.isascii() and video.isdigit()
+
+
+def _name(video: str) -> str:
+    """``--video`` as messages name it: ``camera 0``, a URL with its user and password hidden,
+    a file name; cut to a message's length."""
+    if _is_camera(video):
+        return f"camera {video}"
+    return clip(re.sub(r"^([A-Za-z][A-Za-z0-9+.-]*://)[^/@]*@", r"\1***@", video))
+
+
+def _quietly_opened(*args) -> cv2.VideoCapture:
+    """``cv2.VideoCapture(*args)`` without OpenCV's warnings when it fails (one per backend
+    tried): the error says it."""
+    level = cv2.utils.logging.getLogLevel()
+    cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_ERROR)
+    try:
+        return cv2.VideoCapture(*args)
+    finally:
+        cv2.utils.logging.setLogLevel(level)
+
+
+def _open_camera(index: int) -> cv2.VideoCapture:
+    cap = _quietly_opened(index)
+    if not cap.isOpened():
+        device = Path(f"/dev/video{index}")
+        why = (f" ({device} exists: in use by another program, or no permission?)" if device.exists() else
+               f" (there is no {device})" if sys.platform.startswith("linux") else "")
+        raise InputError(f"--video: cannot open camera {index}{why}")
+    return _checked(cap, str(index))
+
+
+def _checked(cap: cv2.VideoCapture, video: str) -> cv2.VideoCapture:
+    """``cap`` if it opened and its frame size is within ``max_image_pixels()``."""
+    name = _name(video)
+    if not cap.isOpened():
+        raise InputError(f"--video: OpenCV cannot open {name}")
+    width, height = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
+    limit = max_image_pixels()
+    if width * height > limit:
+        cap.release()
+        raise InputError(f"--video: {name} has {width}x{height} = {width * height:.3g} pixel frames, over the "
+                         f"limit of {limit:.3g} (${IMAGE_PIXELS_VARIABLE})")
+    return cap
+
+
+def _declared_count(cap: cv2.VideoCapture) -> int:
+    """The frame count the container declares; 0 if it does not say (OpenCV gives 0 or -1)."""
+    declared = cap.get(cv2.CAP_PROP_FRAME_COUNT)
+    return int(declared) if 0 < declared < math.inf else 0
+
+
+def _declared_fps(cap: cv2.VideoCapture) -> float | None:
+    fps = cap.get(cv2.CAP_PROP_FPS)
+    return fps if 0 < fps <= MAX_FPS else None  # NaN fails too
 
 
 # containers whose frame count is an index of the frames; elsewhere (MKV, WebM, ...) OpenCV
@@ -52,43 +156,124 @@ def iter_frames(video: str | None = None, frames: str | None = None) -> Iterator
 INDEXED_CONTAINERS = (".avi", ".mp4", ".m4v", ".mov")
 
 
-def _stopped_short(video, frame: int, declared: int) -> None:
+def _stopped_short(video: str, frame: int, declared: int) -> None:
     """A video ends at ``frame`` of the ``declared``: an InputError for an indexed container (a
-    truncated file, whose last frame read is partly lost and is not tracked), else a warning."""
-    said = f"--video: {video} stops at frame {frame} of the {declared} its header declares"
-    if Path(video).suffix.lower() in INDEXED_CONTAINERS:
-        raise InputError(f"{said} (a truncated file?); frame {frame}, where its data ends, is not tracked")
+    truncated file or a lost stream, whose last frame read is partly lost and is not tracked),
+    else a warning."""
+    said = f"--video: {_name(video)} stops at frame {frame} of the {declared} its header declares"
+    suffix = PurePosixPath(urlsplit(video).path).suffix if URL.match(video) else Path(video).suffix
+    if suffix.lower() in INDEXED_CONTAINERS:
+        raise InputError(f"{said} (a truncated file or a lost stream?); frame {frame}, where its data ends, "
+                         f"is not tracked")
     warnings.warn(f"{said}; the count of this container is an estimate, so frame {frame} is tracked as the last "
                   f"(if the file is truncated, that frame is partly lost)", RuntimeWarning, stacklevel=3)
 
 
-def video_frames(video: str | os.PathLike) -> Iterator[np.ndarray]:
-    """Yield a video's frames; an InputError before reading if its frames are larger than
-    ``max_image_pixels()``, at the frame where it stops short of the frame count its header
-    declares (:func:`_stopped_short`), and at a damaged frame of a Motion JPEG video
-    (:class:`_JpegPackets`). Frames are read one ahead to know which is the last."""
-    cap = _open_video(video)
-    declared = cap.get(cv2.CAP_PROP_FRAME_COUNT)
-    declared = int(declared) if 0 < declared < math.inf else 0  # 0 (or -1): the container does not say
-    packets, count = None, 0
+def _capture_frames(cap: cv2.VideoCapture, video: str, declared: int, packets: _JpegPackets | None = None):
+    """Yield ``cap``'s frames, then release it; an InputError at the frame where it stops short
+    of the count its header ``declared`` (:func:`_stopped_short`; frames are then read one
+    ahead, to know which is the last: without a count, each is given as soon as it is read),
+    and at a damaged frame (``packets``)."""
+    count = 0
     try:
-        packets = _JpegPackets.of(video, cap)
         ok, image = cap.read()
         while ok:
-            ok, following = cap.read()
-            if not ok and count + 1 < declared:
-                _stopped_short(video, count + 1, declared)
             count += 1
+            if declared:
+                ok, following = cap.read()
+                if not ok and count < declared:
+                    _stopped_short(video, count, declared)
             if packets is not None:
                 packets.check(count)
             yield image
-            image = following
+            ok, image = (ok, following) if declared else cap.read()
     finally:
         cap.release()
         if packets is not None:
             packets.release()
+
+
+def _file_frames(cap: cv2.VideoCapture, video: str, declared: int) -> Iterator[np.ndarray]:
+    """A video file's frames (:func:`_capture_frames`), those of a Motion JPEG video checked
+    (:class:`_JpegPackets`); an InputError if it has none."""
+    count = 0
+    try:
+        packets = _JpegPackets.of(video, cap)
+    except BaseException:
+        cap.release()
+        raise
+    for count, image in enumerate(_capture_frames(cap, video, declared, packets), start=1):
+        yield image
     if count == 0:
-        raise InputError(f"--video: {video} has no readable frames")
+        raise InputError(f"--video: {clip(video)} has no readable frames")
+
+
+def _live_source(cap: cv2.VideoCapture, video: str, camera: bool = False) -> FrameSource:
+    declared = 0 if camera else _declared_count(cap)
+    return FrameSource(_read_in_thread(_live_frames(cap, video, declared, camera)), _name(video),
+                       total=declared or None, fps=_declared_fps(cap), live=True)
+
+
+def _live_frames(cap: cv2.VideoCapture, video: str, declared: int, camera: bool) -> Iterator[np.ndarray]:
+    """The frames of a camera, URL or pipe (:func:`_capture_frames`) as they come. Where they
+    end without a declared count: an InputError for a camera (it has no end), and for a
+    stream that gave no frame for ``READ_TIMEOUT`` (a stall, which OpenCV's FFmpeg reports
+    as an end); else the stream ended (OpenCV does not tell its end from a lost connection)."""
+    name, count, asked = _name(video), 0, time.monotonic()
+    for count, image in enumerate(_capture_frames(cap, video, declared), start=1):
+        yield image
+        asked = time.monotonic()
+    if camera:
+        raise InputError(f"--video: {name} stopped giving frames after frame {count} (unplugged, or taken by "
+                         f"another program?)" if count else f"--video: {name} gave no frame")
+    if not declared and time.monotonic() - asked >= 0.9 * READ_TIMEOUT:
+        raise InputError(f"--video: {name} gave no frame for {READ_TIMEOUT:g} s after frame {count}: the stream "
+                         f"stalled")
+    if count == 0:
+        raise InputError(f"--video: {name} has no readable frames")
+
+
+_END = object()
+
+
+def _read_in_thread(items: Iterator) -> Iterator:
+    """Yield ``items``, read in a thread at most one ahead, so that a run waiting for a frame
+    of a live source ends at once on Ctrl-C or SIGTERM (OpenCV's read of a stalled stream
+    returns only at its timeout). An exception of ``items`` is raised here, in its place;
+    when the caller stops, the thread stops after its current read and closes ``items``."""
+    queue_, stop = queue.Queue(maxsize=1), threading.Event()
+
+    def put(entry) -> bool:
+        while not stop.is_set():
+            try:
+                queue_.put(entry, timeout=0.1)
+                return True
+            except queue.Full:
+                pass
+        return False
+
+    def read():
+        try:
+            for item in items:
+                if not put((item, None)):
+                    return
+            put((_END, None))
+        except BaseException as exc:  # noqa: BLE001 - handed to the caller, raised there
+            put((None, exc))
+        finally:
+            items.close()
+
+    threading.Thread(target=read, name="dcfkit-frames", daemon=True).start()
+    try:
+        while True:
+            item, exc = queue_.get()
+            if exc is not None:
+                raise exc
+            if item is _END:
+                return
+            yield item
+    finally:
+        stop.set()
 
 
 # OpenCV's names (CAP_PROP_FOURCC) of codecs whose frames are each a JPEG
@@ -143,22 +328,6 @@ class _JpegPackets:
         self._raw.release()
 
 
-def _open_video(video) -> cv2.VideoCapture:
-    """An opened capture whose frame size is within ``max_image_pixels()``."""
-    if not Path(video).is_file():
-        raise InputError(f"--video: file not found: {clip(str(video))}")
-    cap = cv2.VideoCapture(str(video))
-    if not cap.isOpened():
-        raise InputError(f"--video: OpenCV cannot open {video}")
-    width, height = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
-    limit = max_image_pixels()
-    if width * height > limit:
-        cap.release()
-        raise InputError(f"--video: {video} has {width}x{height} = {width * height:.3g} pixel frames, over the "
-                         f"limit of {limit:.3g} (${IMAGE_PIXELS_VARIABLE})")
-    return cap
-
-
 def check_output_file(path: str | Path, what: str) -> Path:
     """Create the folder of the file ``path`` and check the file can be written there, before
     any work is done; ``what`` names the argument in the error."""
@@ -176,10 +345,14 @@ def check_output_file(path: str | Path, what: str) -> Path:
 VIDEO_SUFFIXES = (".mp4", ".m4v", ".mov", ".mkv", ".avi")
 
 
-class VideoWriter:
-    """Writes frames with boxes drawn on them (.avi: MJPG, the other VIDEO_SUFFIXES: mp4v)."""
+DEFAULT_FPS = 10.0  # of an annotated video whose frames have no rate of their own
 
-    def __init__(self, path: str | Path, fps: float = 10.0):
+
+class VideoWriter:
+    """Writes frames with boxes drawn on them (.avi: MJPG, the other VIDEO_SUFFIXES: mp4v) at
+    ``fps``, which may be changed until the first frame is written."""
+
+    def __init__(self, path: str | Path, fps: float = DEFAULT_FPS):
         if Path(path).suffix.lower() not in VIDEO_SUFFIXES:
             raise InputError(f"--save-video: cannot write a video named {shown(str(path))}: the name must end in "
                              f"{', '.join(VIDEO_SUFFIXES)}")

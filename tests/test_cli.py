@@ -169,15 +169,20 @@ def test_video_writer_draws_points_in_the_colour_of_their_tracker(tmp_path):
 TERMINATED_AT_FRAME_4 = """
 import os, signal, sys
 import dcfkit.cli.track as track_command
-real = track_command.iter_frames
+real = track_command.open_source
 
-def frames(video, folder):  # the signal arrives while frame 4 is being read, as from `timeout`
-    for i, image in enumerate(real(video, folder)):
+def frames(images):  # the signal arrives while frame 4 is being read, as from `timeout`
+    for i, image in enumerate(images):
         if i == 3:
             os.kill(os.getpid(), getattr(signal, sys.argv[1]))
         yield image
 
-track_command.iter_frames = frames
+def source(video, folder):
+    opened = real(video, folder)
+    opened.frames = frames(opened.frames)
+    return opened
+
+track_command.open_source = source
 from dcfkit.cli import main
 sys.exit(main(sys.argv[2:]))
 """

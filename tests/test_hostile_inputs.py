@@ -24,7 +24,7 @@ from dcfkit.config import load_config
 from dcfkit.datasets import DatasetError, read_frame
 from dcfkit.errors import ConfigError, DcfkitError, InputError
 from dcfkit.synthetic import make_sequence
-from dcfkit.video import iter_frames
+from dcfkit.video import open_source
 
 CONFIGS = ("strcf", "bacf", "dr2track", "kcf", "dsst")
 SEQUENCE = make_sequence(n_frames=2, size=(72, 96), target=(10, 14), distractor=False)
@@ -482,10 +482,10 @@ def test_a_truncated_video_ends_with_an_error_naming_the_frame_where_it_stops(ke
     data = write_video(full, VIDEO_FRAMES.frames)
     cut = tmp_path / "cut.avi"
     cut.write_bytes(data[:int(len(data) * kept)])
-    complete = list(iter_frames(video=str(full)))
+    complete = list(open_source(video=str(full)).frames)
     got = []
     with pytest.raises(InputError, match=r"--video: .*cut\.avi stops at frame (\d) of the 8 its header declares") as e:
-        got.extend(iter_frames(video=str(cut)))
+        got.extend(open_source(video=str(cut)).frames)
     stop = int(e.value.args[0].split("stops at frame ")[1].split()[0])
     assert len(got) == stop - 1 and all(np.array_equal(a, b) for a, b in zip(got, complete))
     out = tmp_path / "boxes.txt"
@@ -515,13 +515,13 @@ def test_a_damaged_frame_of_a_motion_jpeg_video_ends_the_run_naming_it(tmp_path,
     data = write_video(full, VIDEO_FRAMES.frames)
     damaged = tmp_path / "damaged.avi"
     damaged.write_bytes(damage_frame(data, 3))
-    complete = list(iter_frames(video=str(full)))
+    complete = list(open_source(video=str(full)).frames)
     cap = cv2.VideoCapture(str(damaged))
     concealed = [cap.read()[1] for _ in range(8)]
     assert all(image is not None for image in concealed) and not np.array_equal(concealed[2], complete[2])
     got = []
     with pytest.raises(InputError, match=r"--video: .*damaged\.avi: frame 3 is damaged \(corrupt JPEG data: "):
-        got.extend(iter_frames(video=str(damaged)))
+        got.extend(open_source(video=str(damaged)).frames)
     assert len(got) == 2 and all(np.array_equal(a, b) for a, b in zip(got, complete))
     out = tmp_path / "boxes.txt"
     box = ",".join(str(v) for v in VIDEO_FRAMES.ground_truth[0])
@@ -542,8 +542,8 @@ def test_a_motion_jpeg_video_cut_inside_its_last_frame_is_refused_there(tmp_path
     assert cap.get(cv2.CAP_PROP_FRAME_COUNT) == 8 and all(cap.read()[0] for _ in range(8))
     got = []
     with pytest.raises(InputError, match=r"cut\.avi: frame 8 is damaged \(corrupt JPEG data: Premature end of JPEG"):
-        got.extend(iter_frames(video=str(cut)))
-    assert len(got) == 7 and all(np.array_equal(a, b) for a, b in zip(got, iter_frames(video=str(full))))
+        got.extend(open_source(video=str(cut)).frames)
+    assert len(got) == 7 and all(np.array_equal(a, b) for a, b in zip(got, open_source(video=str(full)).frames))
 
 
 def test_video_frames_over_the_image_limit_are_refused_before_reading(tmp_path, monkeypatch):
@@ -552,7 +552,7 @@ def test_video_frames_over_the_image_limit_are_refused_before_reading(tmp_path, 
     monkeypatch.setenv("DCFKIT_MAX_IMAGE_PIXELS", "10000")
     with pytest.raises(InputError, match=r"v\.avi has 128x96 = 1\.23e\+04 pixel frames, over the limit of 1e\+04 "
                                          r"\(\$DCFKIT_MAX_IMAGE_PIXELS\)"):
-        next(iter_frames(video=str(path)))
+        next(open_source(video=str(path)).frames)
 
 
 # --------------------------------------------------------------------------- the demo

@@ -139,6 +139,8 @@ def cli_reference() -> str:
         command.formatter_class = functools.partial(argparse.HelpFormatter, width=88)  # not the terminal's
         out += [f"## dcfkit {name}\n", f"{helps[name]}.\n", f"```text\n{command.format_usage().strip()}\n```\n",
                 _arguments_table(command)]
+        if command.epilog:
+            out.append(" ".join(command.epilog.split()) + "\n")
     out += ["## Environment\n", f"- `{DISABLE_ENV}=1`: load dcfkit's built-in components only, no plugins "
             "(see [plugins.md](plugins.md)).",
             f"- `{VARIANTS_VARIABLE}=N`: the most variants of an ablation spec (default {MAX_VARIANTS}; `ablate "
