@@ -120,7 +120,7 @@ def test_lasot_test_split_is_the_testing_set_file(tmp_path, jpg):
 
 @pytest.mark.parametrize("file, text, message", [
     ("full_occlusion.txt", "0,0,0", r"full_occlusion\.txt: 3 values for 4 frames"),
-    ("out_of_view.txt", "0,0,x,0", r"out_of_view\.txt, line 1: expected whole numbers, one per frame, got 'x'"),
+    ("out_of_view.txt", "0,0,x,0", r"out_of_view\.txt, line 1: expected whole numbers, one per frame, got 'x' for frame 3"),
     ("out_of_view.txt", "0,2,0,0", r"out_of_view\.txt: frame 2 is flagged 2; flags are 0 or 1"),
     ("groundtruth.txt", "11,21,12,10\n11,21,12\n", r"groundtruth\.txt, line 2: expected 4 numbers"),
 ])

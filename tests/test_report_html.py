@@ -21,7 +21,7 @@ import pytest
 
 from dcfkit import cli
 from dcfkit.ablation import load_spec, sensitivity
-from dcfkit.ablation.page import config_changes
+from dcfkit.ablation.page import config_changes, sensitivity_charts
 from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset
 from dcfkit.report_html import render
@@ -118,6 +118,27 @@ def test_sensitivity_in_product_mode_is_the_mean_and_range_over_the_other_parame
     assert lam["metrics"]["auc"][0] == pytest.approx([0.35, 0.5])
     assert all(math.isnan(v) for v in lam["metrics"]["precision"][0])  # no precision: nothing to average
     assert (sigma["base_x"], lam["base_x"]) == (0.5, 0.0001)  # KCF's σ and λ
+
+
+SWEEP_OFF_BASE_SPEC = """
+dataset: otb
+variants:
+  KCF: kcf
+grid:
+  base: KCF
+  parameters:
+    solver.sigma: {label: s, values: [0.1, 0.2]}
+"""
+
+
+def test_the_sensitivity_chart_spans_a_base_value_outside_the_swept_ones(tmp_path):
+    """KCF's σ is 0.5, the sweep 0.1 and 0.2: the dotted base line must fall inside the chart."""
+    (tmp_path / "spec.yaml").write_text(SWEEP_OFF_BASE_SPEC, encoding="utf-8")
+    spec = load_spec(tmp_path / "spec.yaml")
+    overall = [{"variant": v.name, "auc": 0.5, "precision": 0.6, "sequences": 2} for v in spec.variants]
+    chart, = sensitivity_charts(spec, overall)["charts"]
+    low, high = chart["xlim"]
+    assert chart["vline"]["x"] == 0.5 and low < 0.1 and 0.5 < high
 
 
 def test_provenance_of_old_and_new_sidecars(tmp_path):

@@ -73,16 +73,17 @@ def sensitivity_charts(spec: AblationSpec, overall: list[dict]) -> dict:
     charts = []
     for param in sensitivity(spec, overall):
         x = param["x"]
-        pad = (max(x) - min(x)) * 0.06 or 0.5
+        base = param["base_x"]
+        span = x + ([] if base is None else [base])  # a base off the swept values is still drawn
+        pad = (max(span) - min(span)) * 0.06 or 0.5
         series = [{"key": metric, "label": legend, "color": colour, "marker": True,
                    "y": param["metrics"][metric][0],
                    **({"low": param["metrics"][metric][1], "high": param["metrics"][metric][2]}
                       if param["band"] else {})}
                   for metric, legend, _, _, colour in METRICS]
-        base = param["base_x"]
         vline = None if base is None else {"x": base, "label": f"dotted: base ({param['base_name']})"}
         charts.append({"title": param["title"], "xlabel": param["axis"], "ylabel": "score", "x": x,
-                       "xlim": [min(x) - pad, max(x) + pad], "xticks": [list(t) for t in zip(x, param["names"])],
+                       "xlim": [min(span) - pad, max(span) + pad], "xticks": [list(t) for t in zip(x, param["names"])],
                        "series": series, "vline": vline})
     return {"kind": "charts", "id": "sensitivity", "title": "Sensitivity", "charts": charts}
 

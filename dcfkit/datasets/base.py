@@ -348,7 +348,7 @@ def read_frame_values(path: Path, n_frames: int) -> np.ndarray:
                     raise ValueError
             except ValueError:
                 raise DatasetError(f"{path}, line {n + 1}: expected whole numbers, one per frame, "
-                                   f"got {shown(field)}") from None
+                                   f"got {shown(field)} for frame {len(values) + 1}") from None  # LaSOT: 1 line
             values.append(int(value))
     if len(values) != n_frames:
         raise DatasetError(f"{path}: {len(values)} values for {n_frames} frames; one value per frame is required")
