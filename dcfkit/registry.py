@@ -250,13 +250,13 @@ class Registry:
         self._add(kind, name, Entry(cls, self._provider, self._distribution, base.__dict__["contract"]))
         return cls
 
-    def register_dataset(self, name: str, load, description: str, *, detect=None, aliases=()):
+    def register_dataset(self, name: str, load, description: str, *, detect=None, aliases=(), protocol=""):
         """Register a benchmark layout: the arguments of :func:`dcfkit.datasets.register_layout`.
         A name or alias of a layout dcfkit has (or one registered in code) is a RegistryError; one
         that two plugins register is withdrawn, as a component's name. Returns the Layout."""
         layouts = importlib.import_module("dcfkit.datasets.registry")  # named: that module imports this one
         layout = layouts.new_layout(name, load, description, detect=detect, aliases=aliases,
-                                    provider=self._provider)
+                                    provider=self._provider, protocol=protocol)
         for key in (layout.name,) + layout.aliases:
             self._add(DATASET, key, Entry(layout, self._provider, self._distribution))
         return layout

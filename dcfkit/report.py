@@ -26,7 +26,7 @@ from typing import Iterable, Mapping, Sequence as Seq
 import numpy as np
 
 from . import metrics
-from .datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
+from .datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, benchmark_protocol, scored_sequences
 from .errors import clip, shown
 from .protocols import DEFAULT, Protocol, get_protocol
 from .results import atomic_write, ensure_writable, import_results, load_results
@@ -87,8 +87,10 @@ def _mean_or_none(values) -> float | None:
 
 def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
              include_first: bool = True, weighting: str | None = None,
-             protocol: str | Protocol = DEFAULT) -> dict:
-    """Score ``results`` (tracker -> sequence name -> boxes) on ``sequences`` under ``protocol``.
+             protocol: str | Protocol | None = None) -> dict:
+    """Score ``results`` (tracker -> sequence name -> boxes) on ``sequences`` under ``protocol``
+    (by default the rules of the benchmark's published tables,
+    :func:`~dcfkit.datasets.benchmark_protocol`: LaSOT's for LaSOT, the OTB toolkit's for UAV123).
 
     A result is a :class:`dcfkit.results.SequenceResult`, a dict with ``boxes`` (and
     optional ``fps``) or an ``(N, 4)`` array of 0-based boxes. ``weighting`` ``None`` averages
@@ -101,7 +103,8 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
     (test splits) are left out (:func:`~dcfkit.datasets.scored_sequences`: a
     :class:`DatasetError` if that leaves none).
     """
-    proto = get_protocol(protocol)
+    sequences = list(sequences)
+    proto = get_protocol(protocol or benchmark_protocol(sequences))
     weighting = weighting or proto.weighting
     keys = proto.score_keys
     sequences = scored_sequences(sequences)

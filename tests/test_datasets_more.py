@@ -2,6 +2,7 @@
 layout built here in the benchmark's exact file formats (frames: one small JPEG, linked)."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import re
@@ -16,7 +17,7 @@ import pytest
 
 from dcfkit import cli
 from dcfkit import registry as reg
-from dcfkit.datasets import DatasetError, Sequence, detect_dataset, load_dataset
+from dcfkit.datasets import DatasetError, Sequence, benchmark_protocol, detect_dataset, load_dataset
 from dcfkit.datasets.lasot_layout import LASOT_ATTRIBUTES
 from dcfkit.datasets.otb_layout import OTB_ATTRIBUTES
 from dcfkit.datasets.vot_layout import mask_box, polygon_box, region_box
@@ -449,6 +450,25 @@ def test_eval_and_report_on_lasot_give_per_attribute_tables(tmp_path, jpg, capsy
     rows = [r for r in json.loads((out / "report" / "report.json").read_text())["per_attribute"]]
     assert {(r["attribute"], r["sequences"]) for r in rows} == {("IV", 3), ("ARC", 1)}
     assert (out / "report" / "success_IV.png").is_file()
+
+
+def test_a_benchmark_is_scored_by_its_own_toolkit_unless_protocol_says_otherwise(tmp_path, jpg, capsys):
+    root, out = lasot_root(tmp_path, jpg), tmp_path / "out"
+    kcf = str(Path(__file__).resolve().parents[1] / "configs" / "kcf.yaml")
+    assert cli.main(["eval", kcf, "--dataset", "lasot", "--root", str(root), "--out", str(out), "--no-progress"]) == 0
+    assert "(protocol lasot)" in capsys.readouterr().out
+    assert cli.main(["report", str(out), "--dataset", "lasot", "--root", str(root)]) == 0
+    assert cli.main(["report", str(out), "--dataset", "lasot", "--root", str(root), "--protocol", "otb",
+                     "--report-dir", str(tmp_path / "otb")]) == 0
+    default, otb = (json.loads((d / "report.json").read_text()) for d in (out / "report", tmp_path / "otb"))
+    assert default["protocol"]["name"] == "lasot" and otb["protocol"]["name"] == "otb"
+    # the absent frames fail under LaSOT's rules and are skipped under the OTB toolkit's
+    assert default["overall"][0]["precision"] < otb["overall"][0]["precision"]
+    sequences = load_dataset("lasot", root)
+    assert benchmark_protocol(sequences) == "lasot"
+    assert benchmark_protocol([dataclasses.replace(s, dataset="") for s in sequences]) == "otb"
+    with pytest.raises(RegistryError, match="unknown protocol 'nope'; protocols: otb, pysot"):
+        reg.Registry().register_dataset("mine", lambda root, sequences=None: [], "ROOT", protocol="nope")
 
 
 def test_eval_on_a_test_split_runs_and_report_says_there_is_nothing_to_score(tmp_path, jpg, capsys):

@@ -6,8 +6,8 @@ import contextlib
 import json
 from pathlib import Path
 
+from ..datasets import benchmark_protocol
 from ..errors import DcfkitError, shown
-from ..protocols import DEFAULT
 from ..results import LABEL_KEYS, ResultStore, atomic_write, dcfkit_version, ensure_writable, exclusive, read_json
 from ..runner import RunTask, execute, usable_cores
 from .spec import AblationSpec, Job, expand, job_dir, variant_names
@@ -15,9 +15,10 @@ from .summary import output_names, summarize
 
 
 def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str = "local",
-                 scheduler: str | None = None, progress: bool = True, protocol: str = DEFAULT) -> dict:
+                 scheduler: str | None = None, progress: bool = True, protocol: str | None = None) -> dict:
     """Run every job of ``spec`` not already done under ``out``, then write the summary
-    (scored under ``protocol``, see :mod:`dcfkit.protocols`).
+    (scored under ``protocol``, see :mod:`dcfkit.protocols`; by default the rules of the
+    benchmark's published tables, :func:`~dcfkit.datasets.benchmark_protocol`).
 
     ``executor`` is ``"local"`` (``jobs`` spawned worker processes, default: the usable
     cores; ``jobs=1`` runs in this process) or ``"dask"`` (``Client(scheduler)``, or a
@@ -51,7 +52,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
         result = {"jobs": job_list, "runs": len(tasks), "done": [],
                   "skipped": [k for k, t in tasks.items() if t not in todo], "failed": {}}
         _run(spec, result, todo, len(tasks), variant_names(job_list), jobs, executor, scheduler, progress, version)
-        result["summary"] = summarize(spec, out, seqs, job_list, protocol)
+        result["summary"] = summarize(spec, out, seqs, job_list, protocol or benchmark_protocol(seqs))
     return result
 
 

@@ -43,7 +43,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     ``got10k`` also ao, sr50, sr75), fps the mean per-sequence frames per second of tracker
     time (:mod:`dcfkit.report`). A job without result (failed or not run) is scored as a
     total failure and counted in ``failed``. Returns ``{"overall", "per_sequence", "jobs",
-    "files"}``.
+    "files", "protocol"}`` (the protocol's name).
     """
     out = Path(out)
     jobs = jobs if jobs is not None else expand(spec, sequences)
@@ -66,7 +66,8 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     page = ablation_page(spec, out, info, summary_columns("summary", protocol), scores, sequences,
                          {variant: stored[key] for variant, key in keys.items()}, keys)
     files.append(write_page(page, out / PAGE))
-    return {"overall": overall, "per_sequence": per_sequence, "jobs": job_rows, "files": files}
+    return {"overall": overall, "per_sequence": per_sequence, "jobs": job_rows, "files": files,
+            "protocol": scores["protocol"]["name"]}
 
 
 def _stored_runs(spec: AblationSpec, out: Path, sequences: list[Sequence], jobs: list[Job]) -> tuple[dict, dict]:

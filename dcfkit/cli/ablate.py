@@ -59,8 +59,8 @@ def run(args: argparse.Namespace) -> int:
     res = run_ablation(spec, args.out, jobs=args.jobs, executor=executor, scheduler=args.scheduler,
                        progress=not args.no_progress, protocol=args.protocol)
     summary = res["summary"]
-    print(format_table(summary["overall"], "markdown", summary_columns("summary", args.protocol), args.protocol),
-          end="")
+    protocol = summary["protocol"]  # --protocol, else the benchmark's own
+    print(format_table(summary["overall"], "markdown", summary_columns("summary", protocol), protocol), end="")
     print(f"\n{spec.name}: {len(res['jobs'])} jobs ({res['runs']} distinct runs): {len(res['done'])} run, "
           f"{len(res['skipped'])} already done, {len(res['failed'])} failed -> {Path(args.out)}")
     variants = variant_names(res["jobs"])

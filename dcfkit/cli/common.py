@@ -45,9 +45,11 @@ variant_count = _argument_type(int, lambda v: v >= 1, "a whole number of variant
 
 def add_protocol_argument(parser: argparse.ArgumentParser) -> None:
     """``--protocol``, for the commands that print scores."""
-    parser.add_argument("--protocol", choices=tuple(PROTOCOLS), default=DEFAULT,
+    parser.add_argument("--protocol", choices=tuple(PROTOCOLS), default=None,
                         help="scoring rules: otb (the OTB / UAV123 MATLAB toolkit, which computed the published "
                              "UAV123 tables), pysot, got10k or lasot (the LaSOT toolkit: absent frames fail); "
+                             "default: the rules of the benchmark's published tables (lasot for LaSOT, got10k "
+                             f"for GOT-10k, {DEFAULT} for the others, `dcfkit datasets` says which); "
                              "docs/evaluation.md lists the differences")
 
 

@@ -8,6 +8,7 @@ import sys
 import warnings
 
 from ..datasets import layouts
+from ..protocols import DEFAULT
 from ..registry import PluginWarning, get_registry
 
 
@@ -17,9 +18,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def dataset_rows() -> list[dict]:
     """One dict per layout: name, aliases, provider, layout (its folders), detected (whether
-    ``--dataset auto`` considers it)."""
+    ``--dataset auto`` considers it), protocol (the one its scores follow by default)."""
     return [{"name": layout.name, "aliases": list(layout.aliases), "provider": layout.provider or "dcfkit",
-             "layout": layout.description, "detected": layout.detect is not None} for layout in layouts()]
+             "layout": layout.description, "detected": layout.detect is not None,
+             "protocol": layout.protocol or DEFAULT} for layout in layouts()]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -34,7 +36,8 @@ def run(args: argparse.Namespace) -> int:
         for row in rows:
             print(f"{row['name']:<18} {row['layout']}  [{row['provider']}]")
             notes = ([f"also: {', '.join(row['aliases'])}"] if row["aliases"] else []) + \
-                ([] if row["detected"] else ["by name only (not detected)"])
+                ([] if row["detected"] else ["by name only (not detected)"]) + \
+                ([f"scored with --protocol {row['protocol']}"] if row["protocol"] != DEFAULT else [])
             if notes:
                 print(f"{'':<19}{'; '.join(notes)}")
     for failure in registry.failures:

@@ -11,7 +11,7 @@ from typing import Any, Callable, Mapping
 from ..baselines import opencv_tracker
 from ..compare import COLUMNS, compare_folders
 from ..config import load_config, parse_overrides
-from ..datasets import load_dataset
+from ..datasets import benchmark_protocol, load_dataset
 from ..errors import ConfigError, shown
 from ..evaluation import check_one_pass, run_one_pass, tracker_name
 from ..report import columns, evaluate, format_table, json_ready, score_and_write, score_line
@@ -62,6 +62,7 @@ def distinct_names(specs: list[str], resolved: list[tuple[dict, Callable | None]
 def run_eval(args: argparse.Namespace) -> int:
     """Run each config on the dataset and print its scores; exit status 1 if a sequence failed."""
     sequences = load_dataset(args.dataset, args.root, args.sequences)
+    args.protocol = args.protocol or benchmark_protocol(sequences)
     overrides = parse_overrides(args.overrides)
     resolved = distinct_names(args.configs, [_resolve_config(spec, overrides) for spec in args.configs])
     for config, _ in resolved:  # every config's folder and results checked before the first runs
@@ -112,6 +113,7 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
 def run_report(args: argparse.Namespace) -> int:
     """Print the overall table and write the report files."""
     sequences = load_dataset(args.dataset, args.root, args.sequences)
+    args.protocol = args.protocol or benchmark_protocol(sequences)
     trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
     write = write_html_report if args.html else score_and_write
     evaluation, paths = write(args.out, sequences, trackers, args.report_dir, include_first=not args.skip_first,
@@ -141,6 +143,7 @@ def add_compare_arguments(p: argparse.ArgumentParser) -> None:
 def run_compare(args: argparse.Namespace) -> int:
     """Print the per-sequence comparison."""
     sequences = load_dataset(args.dataset, args.root, args.sequences)
+    args.protocol = args.protocol or benchmark_protocol(sequences)
     res = compare_folders(args.results, args.reference, sequences, args.protocol, args.divergence_px)
     if args.format == "json":
         print(json.dumps(json_ready(res), indent=1))

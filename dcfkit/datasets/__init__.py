@@ -20,8 +20,8 @@ another benchmark is added with :func:`register_layout`. See ``docs/evaluation.m
 layouts.
 """
 from .base import ATTRIBUTE_NAMES, DatasetError, Sequence, read_boxes, read_frame, scored_sequences
-from .registry import (DATASETS, Evidence, Layout, canonical_name, detect_dataset, get_layout, layouts,
-                       load_dataset, register_layout, registered_layout, unregister_layout)
+from .registry import (DATASETS, Evidence, Layout, benchmark_protocol, canonical_name, detect_dataset, get_layout,
+                       layouts, load_dataset, register_layout, registered_layout, unregister_layout)
 
 # Importing a layout module registers it; the import order is the order of the names in
 # messages ("valid names: uav123, uav123_10fps, ..."), so it is not alphabetical.
@@ -43,6 +43,7 @@ __all__ = [
     "Evidence",
     "Layout",
     "Sequence",
+    "benchmark_protocol",
     "canonical_name",
     "detect_dataset",
     "dtb70",

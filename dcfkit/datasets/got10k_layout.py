@@ -101,6 +101,9 @@ def _description(split: str) -> str:
             f"ROOT/{split}/list.txt")
 
 
-register_layout("got10k_train", got10k_train, _description("train"), detect=_detector("train"))
-register_layout("got10k_val", got10k_val, _description("val"), detect=_detector("val"))
-register_layout("got10k_test", got10k_test, _description("test"), detect=_detector("test"))
+register_layout("got10k_train", got10k_train, _description("train"), detect=_detector("train"),
+                protocol="got10k")
+register_layout("got10k_val", got10k_val, _description("val"), detect=_detector("val"),
+                protocol="got10k")
+register_layout("got10k_test", got10k_test, _description("test"), detect=_detector("test"),
+                protocol="got10k")

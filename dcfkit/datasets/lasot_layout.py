@@ -142,6 +142,6 @@ def detect_lasot(root: Path) -> Evidence:
 
 register_layout("lasot", lasot, "ROOT/<class>/<class>-<n>/img/%08d.jpg (or flat ROOT/<class>-<n>/), "
                 "groundtruth.txt, full_occlusion.txt, out_of_view.txt beside img/",
-                detect=detect_lasot, aliases=("lasot_extension", "lasot_ext"))
+                detect=detect_lasot, aliases=("lasot_extension", "lasot_ext"), protocol="lasot")
 register_layout("lasot_test", lasot_test, "the sequences of ROOT/testing_set.txt (LaSOT's 280 test sequences) "
-                "in lasot's layout")
+                "in lasot's layout", protocol="lasot")

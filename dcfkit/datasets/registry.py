@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Callable, Iterable, Iterator, Mapping
 
 from ..errors import RegistryError, describe_error, shown
+from ..protocols import DEFAULT, PROTOCOLS
 from ..registry import PluginWarning, get_registry
 from .base import DatasetError, Sequence, require_root
 
@@ -56,6 +57,7 @@ class Layout:
     detect: Detector | None = None
     aliases: tuple[str, ...] = ()
     provider: str = ""  # the plugin that registered it; "" for dcfkit's and those registered in code
+    protocol: str = ""  # the scoring protocol of the benchmark's own toolkit; "" for the OTB toolkit's
 
     def __str__(self) -> str:
         also = f" (also {', '.join(self.aliases)})" if self.aliases else ""
@@ -73,28 +75,32 @@ def _key(name: str) -> str:
 
 
 def register_layout(name: str, load: Loader, description: str, *,
-                    detect: Detector | None = None, aliases: Iterable[str] = ()) -> Layout:
+                    detect: Detector | None = None, aliases: Iterable[str] = (), protocol: str = "") -> Layout:
     """Make ``name`` and its ``aliases`` loadable by :func:`load_dataset` (case-insensitive, ``-``
     read as ``_``).
 
     ``load(root, sequences=None)`` returns the :class:`Sequence` list; ``description`` is
     one line saying what is on disk (``ROOT/<seq>/img/%05d.jpg, ...``); ``detect(root)``
     returns an :class:`Evidence` (or a bool) for :func:`detect_dataset`, which skips layouts
-    without one. A name or alias that is already registered is a :class:`RegistryError`.
+    without one. ``protocol`` names the scoring protocol of the toolkit that published the
+    benchmark's tables (:mod:`dcfkit.protocols`), which scores its sequences unless
+    ``--protocol`` says otherwise; by default the OTB toolkit's. A name or alias that is
+    already registered is a :class:`RegistryError`.
     """
-    layout = new_layout(name, load, description, detect=detect, aliases=aliases)
+    layout = new_layout(name, load, description, detect=detect, aliases=aliases, protocol=protocol)
     _LAYOUTS[layout.name] = layout
     _NAMES.update(dict.fromkeys((layout.name,) + layout.aliases, layout.name))
     return layout
 
 
 def new_layout(name: str, load: Loader, description: str, *, detect: Detector | None = None,
-               aliases: Iterable[str] = (), provider: str = "") -> Layout:
+               aliases: Iterable[str] = (), provider: str = "", protocol: str = "") -> Layout:
     """A checked :class:`Layout`, not yet registered (:func:`register_layout` registers it here, a
     plugin's ``registry.register_dataset`` in :mod:`dcfkit.registry`); a :class:`RegistryError`
     if it is malformed or a name is taken here."""
     layout = Layout(_key(name), load, str(description).strip(), detect,
-                    tuple(dict.fromkeys(_key(a) for a in aliases if _key(a) != _key(name))), provider)
+                    tuple(dict.fromkeys(_key(a) for a in aliases if _key(a) != _key(name))), provider,
+                    str(protocol or ""))
     _check_new_layout(layout)
     return layout
 
@@ -113,6 +119,8 @@ def _check_new_layout(layout: Layout) -> None:
         raise RegistryError(f"{where}: the name {taken!r} is already registered{also}; {fix}")
     if not callable(layout.load) or not (layout.detect is None or callable(layout.detect)):
         raise RegistryError(f"{where}: load and detect must be functions")
+    if layout.protocol and layout.protocol not in PROTOCOLS:
+        raise RegistryError(f"{where}: unknown protocol {shown(layout.protocol)}; protocols: {', '.join(PROTOCOLS)}")
     if not layout.description or "\n" in layout.description:
         raise RegistryError(f"{where}: the description must be one non-empty line, "
                             f"got {shown(layout.description)}")
@@ -131,10 +139,10 @@ def unregister_layout(name: str) -> Layout:
 
 @contextlib.contextmanager
 def registered_layout(name: str, load: Loader, description: str, *,
-                      detect: Detector | None = None,
-                      aliases: Iterable[str] = ()) -> Iterator[Layout]:
+                      detect: Detector | None = None, aliases: Iterable[str] = (),
+                      protocol: str = "") -> Iterator[Layout]:
     """:func:`register_layout` for the duration of a ``with`` block (tests, experiments)."""
-    layout = register_layout(name, load, description, detect=detect, aliases=aliases)
+    layout = register_layout(name, load, description, detect=detect, aliases=aliases, protocol=protocol)
     try:
         yield layout
     finally:
@@ -247,3 +255,15 @@ def _evidence(layout: Layout, root: Path) -> Evidence:
     except (TypeError, ValueError):
         raise RegistryError(f"dataset layout {layout.name!r}: detect({root}) returned {shown(level)}, "
                             f"not an Evidence level (0..{int(Evidence.NAME)}) or a bool") from None
+
+
+def benchmark_protocol(sequences: Iterable[Sequence]) -> str:
+    """The protocol that scored the published tables of the benchmark ``sequences`` come from:
+    their layout's ``protocol`` (LaSOT's toolkit for LaSOT, GOT-10k's for GOT-10k), else the
+    OTB toolkit's (:data:`dcfkit.protocols.DEFAULT`), also for sequences of several benchmarks
+    that disagree."""
+    found = set()
+    for name in {s.dataset for s in sequences}:
+        layout = _find(name) if name else None
+        found.add(layout.protocol if layout is not None and layout.protocol else DEFAULT)
+    return found.pop() if len(found) == 1 else DEFAULT
