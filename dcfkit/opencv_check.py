@@ -13,6 +13,8 @@ behind still imports, empty. :func:`contrib_problem` says so and what to run.
 from __future__ import annotations
 
 import importlib.metadata
+import shlex
+import sys
 from types import ModuleType
 from typing import Mapping
 
@@ -42,11 +44,13 @@ def installed_opencv() -> dict[str, str]:
 
 def repair_command(installed: Mapping[str, str]) -> str:
     """Remove the other OpenCV packages, then rewrite the contrib build's files (at its installed
-    version; ``--no-deps`` leaves numpy alone)."""
+    version; ``--no-deps`` leaves numpy alone). pip is this interpreter's: the ``pip`` first on
+    PATH may be another environment's (vot-toolkit's own, say, which needs its opencv-python)."""
+    pip = f"{shlex.quote(sys.executable)} -m pip"
     others = [name for name in installed if name != CONTRIB]
     wanted = f"{CONTRIB}=={installed[CONTRIB]}" if CONTRIB in installed else CONTRIB_REQUIREMENT
-    remove = f"pip uninstall -y {' '.join(others)} && " if others else ""
-    return f'{remove}pip install --force-reinstall --no-deps "{wanted}"'
+    remove = f"{pip} uninstall -y {' '.join(others)} && " if others else ""
+    return f'{remove}{pip} install --force-reinstall --no-deps "{wanted}"'
 
 
 def contrib_problem(cv2: ModuleType | None = None, installed: Mapping[str, str] | None = None) -> str | None:

@@ -148,32 +148,17 @@ def steps(tracker, frames: Iterable[np.ndarray], init_box) -> Iterator[Step]:
         yield Step(index, image, as_box(out, index + 1), seconds, confidence)
 
 
-def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | None = None,
-          partial: Track | None = None) -> Track:
+def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | None = None) -> Track:
     """Run ``tracker`` through ``frames`` (:func:`steps`) and collect the boxes, times and
     confidence. ``on_frame(index, image, box, tracker)`` is called after each frame (0-based
-    index; progress bars, video writers).
-
-    Whatever ends the loop, ``partial`` (if given, an empty :class:`Track`) holds the frames
-    done so far, so a caller can keep them."""
+    index; progress bars, video writers). A caller that keeps the frames done before an error
+    iterates :func:`steps` itself, as ``dcfkit track`` does."""
     boxes, times, confidence = [], [], []
-    try:
-        for step in steps(tracker, frames, init_box):
-            boxes.append(step.box)
-            times.append(step.seconds)
-            confidence.append(step.confidence)
-            if on_frame is not None:
-                on_frame(step.index, step.image, step.box, tracker)
-    finally:
-        if partial is not None:
-            partial.boxes, partial.times, partial.confidence = _arrays(boxes, times, confidence)
-    return Track(*_arrays(boxes, times, confidence))
-
-
-def _arrays(boxes: list, times: list, confidence: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    return (np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(times, dtype=np.float64),
-            np.array(confidence, dtype=np.float64).reshape(-1, 2))
-
-
-def empty_track() -> Track:
-    return Track(np.zeros((0, 4)), np.zeros(0))
+    for step in steps(tracker, frames, init_box):
+        boxes.append(step.box)
+        times.append(step.seconds)
+        confidence.append(step.confidence)
+        if on_frame is not None:
+            on_frame(step.index, step.image, step.box, tracker)
+    return Track(np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(times, dtype=np.float64),
+                 np.array(confidence, dtype=np.float64).reshape(-1, 2))

@@ -102,7 +102,8 @@ def _name(video: str) -> str:
     a file name; cut to a message's length."""
     if _is_camera(video):
         return f"camera {video}"
-    return clip(re.sub(r"^([A-Za-z][A-Za-z0-9+.-]*://)[^/@]*@", r"\1***@", video))
+    # the user info ends at the last '@' before the path, as FFmpeg splits it: a password may hold '@'
+    return clip(re.sub(r"^([A-Za-z][A-Za-z0-9+.-]*://)[^/?#]*@", r"\1***@", video))
 
 
 def _quietly_opened(*args) -> cv2.VideoCapture:

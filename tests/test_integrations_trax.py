@@ -221,7 +221,7 @@ def test_a_clobbered_opencv_is_warned_of_at_start_up(trax, clobbered_opencv, mon
     assert main(["trax", "strcf"]) == 0
     assert [c["name"] for c in served_configs] == ["strcf"]
     err = capsys.readouterr().err
-    assert err.startswith("dcfkit trax: warning: OpenCV's contrib modules are missing") and "Repair with: pip" in err
+    assert err.startswith("dcfkit trax: warning: OpenCV's contrib modules are missing") and f"Repair with: {sys.executable} -m pip" in err
 
 
 def test_a_client_that_ends_without_quit_ends_the_server_with_a_message(trax):

@@ -190,6 +190,12 @@ def test_a_url_that_does_not_open_is_named_without_its_password(capsys):
     assert f"error: --video: OpenCV cannot open rtsp://***@127.0.0.1:{port}/live" in err and "secret" not in err
 
 
+def test_a_password_with_an_at_sign_is_hidden_whole():
+    # FFmpeg (av_url_split) takes the user info up to the last '@' before the path
+    assert video._name("rtsp://user:p@ss@cam.local:554/live?x=a@b") == "rtsp://***@cam.local:554/live?x=a@b"
+    assert video._name("http://cam.local/a@b") == "http://cam.local/a@b"  # an '@' in the path is no user info
+
+
 class socket_closed:
     """A local port nothing listens on."""
 

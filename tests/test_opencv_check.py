@@ -4,6 +4,8 @@ does it, and ``pip check`` passes): dcfkit says so, with the packages installed 
 from __future__ import annotations
 
 import importlib.metadata
+import shlex
+import sys
 import tomllib
 import types
 from pathlib import Path
@@ -13,7 +15,8 @@ import pytest
 from dcfkit import opencv_check
 from dcfkit.cli import main
 
-REPAIR = ('pip uninstall -y opencv-python && pip install --force-reinstall --no-deps '
+PIP = f"{shlex.quote(sys.executable)} -m pip"  # this interpreter's pip, not whichever is first on PATH
+REPAIR = (f'{PIP} uninstall -y opencv-python && {PIP} install --force-reinstall --no-deps '
           '"opencv-contrib-python-headless==4.14.0.94"')
 
 
@@ -39,13 +42,13 @@ def test_a_clobbered_cv2_is_said_with_the_packages_and_the_repair(clobbered_open
 
 @pytest.mark.parametrize("installed, command", [
     ({"opencv-python": "4.10.0.84"},
-     'pip uninstall -y opencv-python && pip install --force-reinstall --no-deps '
+     f'{PIP} uninstall -y opencv-python && {PIP} install --force-reinstall --no-deps '
      '"opencv-contrib-python-headless>=4.8,<5"'),
     ({"opencv-contrib-python-headless": "4.9.0.80"},
-     'pip install --force-reinstall --no-deps "opencv-contrib-python-headless==4.9.0.80"'),
+     f'{PIP} install --force-reinstall --no-deps "opencv-contrib-python-headless==4.9.0.80"'),
     ({"opencv-python-headless": "4.9.0.80", "opencv-contrib-python": "4.9.0.80",
       "opencv-contrib-python-headless": "4.9.0.80"},
-     'pip uninstall -y opencv-python-headless opencv-contrib-python && pip install --force-reinstall --no-deps '
+     f'{PIP} uninstall -y opencv-python-headless opencv-contrib-python && {PIP} install --force-reinstall --no-deps '
      '"opencv-contrib-python-headless==4.9.0.80"'),
 ])
 def test_the_repair_removes_the_others_then_rewrites_the_contrib_build(installed, command):

@@ -1,4 +1,4 @@
-"""The one frame loop (dcfkit.tracking.track) and the termination signals."""
+"""The one frame loop (dcfkit.tracking.steps, and track, which collects it) and the termination signals."""
 from __future__ import annotations
 
 import os
@@ -7,7 +7,7 @@ import signal
 import numpy as np
 import pytest
 
-from dcfkit.tracking import Interrupted, TrackerFailure, empty_track, interrupt_on_termination, track
+from dcfkit.tracking import Interrupted, TrackerFailure, interrupt_on_termination, steps, track
 
 
 class Stepper:
@@ -40,12 +40,11 @@ def test_track_collects_every_box_and_time():
 
 
 def test_a_failure_names_the_frame_from_1_and_keeps_the_frames_before():
-    done = empty_track()
+    done = []
     with pytest.raises(TrackerFailure, match=r"^frame 4: update raised ValueError: boom$") as caught:
-        track(Stepper(fail_at=4), FRAMES, (1, 2, 3, 4), partial=done)
+        done.extend(steps(Stepper(fail_at=4), FRAMES, (1, 2, 3, 4)))
     assert caught.value.frame == 4 and isinstance(caught.value.__cause__, ValueError)
-    np.testing.assert_array_equal(done.boxes[:, 0], [1, 2, 3])
-    assert done.times.shape == (3,)
+    assert [step.box[0] for step in done] == [1, 2, 3] and [step.index for step in done] == [0, 1, 2]
 
 
 class Abort(BaseException):
@@ -54,10 +53,10 @@ class Abort(BaseException):
 
 @pytest.mark.parametrize("error", [Abort("boom"), GeneratorExit("boom")])
 def test_a_base_exception_of_a_component_fails_its_frame(error):
-    done = empty_track()
+    done = []
     with pytest.raises(TrackerFailure, match=rf"^frame 3: update raised {type(error).__name__}: boom$"):
-        track(Stepper(fail_at=3, error=error), FRAMES, (1, 2, 3, 4), partial=done)
-    assert len(done.boxes) == 2
+        done.extend(steps(Stepper(fail_at=3, error=error), FRAMES, (1, 2, 3, 4)))
+    assert len(done) == 2
 
 
 @pytest.mark.parametrize("error", [KeyboardInterrupt(), SystemExit(3), Interrupted(15)])
@@ -75,7 +74,7 @@ def test_a_non_box_is_a_failure_naming_the_frame():
 def test_termination_signals_interrupt_the_block_like_ctrl_c(signame):
     signum = getattr(signal, signame)
     before = signal.getsignal(signum)
-    done = empty_track()
+    done = []
 
     def frames():
         for i, image in enumerate(FRAMES):
@@ -85,9 +84,9 @@ def test_termination_signals_interrupt_the_block_like_ctrl_c(signame):
 
     with pytest.raises(Interrupted) as caught:
         with interrupt_on_termination():
-            track(Stepper(), frames(), (1, 2, 3, 4), partial=done)
+            done.extend(steps(Stepper(), frames(), (1, 2, 3, 4)))
     assert isinstance(caught.value, KeyboardInterrupt) and caught.value.signum == signum
-    assert len(done.boxes) == 2 and signal.getsignal(signum) == before
+    assert len(done) == 2 and signal.getsignal(signum) == before
 
 
 def test_an_ignored_sighup_stays_ignored_as_under_nohup():
