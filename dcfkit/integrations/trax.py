@@ -58,8 +58,8 @@ def serve(config: Mapping[str, Any]) -> None:
     :class:`~dcfkit.tracker.Tracker` built from ``config`` (a resolved config,
     :func:`dcfkit.load_config`) per ``initialize``. An error on a frame is sent to the client
     as the reason of a ``quit``, then raised; a failed connection raises :class:`ProtocolError`."""
-    Tracker(config)  # every check of the config, before the handshake: an error is said on stderr alone
     with contextlib.redirect_stdout(sys.stderr):  # the protocol's messages are the only output on stdout
+        Tracker(config)  # every check of the config, before the handshake: an error is said on stderr alone
         server = _protocol(lambda: trax.Server(REGION_FORMATS, IMAGE_FORMATS, [CHANNEL], **_metadata(config)),
                            "cannot start the server")
         try:
