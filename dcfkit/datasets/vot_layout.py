@@ -28,7 +28,9 @@ from .registry import Evidence, register_layout
 #: How a polygon becomes a box: ``bounds`` the smallest box holding it (the VOT toolkit's
 #: ``Polygon.convert(RegionType.RECTANGLE)``, pytracking's VOT loader); ``area`` pysot's
 #: ``get_axis_aligned_bbox`` (and the got10k toolkit's VOT corners-to-rectangle): a box centred on
-#: the corners' mean, the bounds scaled to the polygon's area, plus 1 in w and h.
+#: the corners' mean, the bounds scaled to the polygon's area, plus 1 in w and h. Its corner is
+#: got10k's ``_corner2rect`` (``cx - w/2``); pysot's test scripts place it at ``cx - (w-1)/2``,
+#: half a pixel to the right and down.
 POLYGON_RULES = ("bounds", "area")
 _PATTERN = re.compile(r"^[^%]*%0?\d*d[^%]*$")  # one integer field, as in color/%08d.jpg
 _SEPARATORS = re.compile(r"[,\s]+")  # VOT writes commas; some copies have tabs or spaces
