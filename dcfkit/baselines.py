@@ -8,7 +8,7 @@ import cv2
 import numpy as np
 
 from .errors import DcfkitError, shown
-from .opencv_check import contrib_problem
+from .opencv_check import contrib_advice
 
 # Preferred constructor first: legacy trackers take and return float boxes (Rect2d).
 _OPENCV_CONSTRUCTORS = {
@@ -93,6 +93,5 @@ def opencv_tracker(name: str) -> Callable[[Any], OpenCVTracker]:
     if key not in available_opencv_trackers():
         raise OpenCVUnavailable(
             f"OpenCV tracker {key} is not in this OpenCV build (available: "
-            f"{', '.join(available_opencv_trackers()) or 'none'}); "
-            + (contrib_problem(cv2) or "install opencv-contrib-python-headless"))
+            f"{', '.join(available_opencv_trackers()) or 'none'}); {contrib_advice(cv2)}")
     return _OpenCVFactory(key)

@@ -8,7 +8,8 @@ its tracking module (:mod:`dcfkit.features.colornames`), and the CSRT, KCF and M
 last overwrites the others' files while pip keeps every one listed as installed, so ``pip
 check`` sees nothing wrong (``pip install vot-toolkit`` does this: it requires
 ``opencv-python``). The contrib modules are then gone, and a ``cv2/legacy`` folder left
-behind still imports, empty. :func:`contrib_problem` says so and what to run.
+behind still imports, empty. :func:`contrib_problem` says so and what to run; :func:`contrib_advice`
+is what the features that need the contrib build say when it is missing.
 """
 from __future__ import annotations
 
@@ -72,4 +73,10 @@ def contrib_problem(cv2: ModuleType | None = None, installed: Mapping[str, str] 
     if installed_version("vot-toolkit"):
         said += " vot-toolkit requires opencv-python: give it an environment of its own (docs/integrations.md)."
     return f"{said} Repair with: {repair_command(installed)}"
+
+
+def contrib_advice(cv2: ModuleType | None = None) -> str:
+    """What to do when a contrib feature is missing from ``cv2``: :func:`contrib_problem`'s
+    diagnosis and repair when another OpenCV package overwrote it, else install the contrib build."""
+    return contrib_problem(cv2) or f"install {CONTRIB}"
 

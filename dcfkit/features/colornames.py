@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError, clip, shown
-from ..opencv_check import contrib_problem
+from ..opencv_check import contrib_advice
 
 SHAPE = (32768, 10)
 SHA256 = "e6a0a45f68cf5880d018f9e2f82dff180e992296d335b0fa8eb253b9db403ec0"
@@ -64,8 +64,7 @@ def _from_opencv() -> np.ndarray:
             return _verify(table, path)
     where = ", ".join(binaries) or "no cv2 binary"
     raise ConfigError(f"the Color Names table was not found in the installed OpenCV ({where}); "
-                      + (contrib_problem(cv2) or "install opencv-contrib-python-headless")
-                      + " (or set colornames.table_path to a .npy/.mat file)")
+                      f"{contrib_advice(cv2)} (or set colornames.table_path to a .npy/.mat file)")
 
 
 def _expanded(path: str) -> Path | None:
