@@ -4,7 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Iterable, Mapping, Sequence as Seq
 
-from ..datasets import Sequence
+from ..datasets import Sequence, scored_sequences
 from ..protocols import DEFAULT, Protocol, get_protocol
 from ..report import columns, default_report_dir, score_folders, write_files
 from . import sections
@@ -54,9 +54,9 @@ def write_html_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str]
     the tables (sortable, filterable), the plots, every sequence's frames with the boxes, and
     what produced the results. Returns (evaluation, paths), the page last."""
     report_dir = default_report_dir(out_dir, report_dir)
+    sequences = scored_sequences(sequences)  # the page shows the frames of the sequences scored only
     folders, results, evaluation = score_folders(out_dir, sequences, trackers, report_dir, include_first,
                                                  weighting, protocol)
     paths = write_files(evaluation, report_dir)
-    scored = [s for s in sequences if not s.ground_truth_withheld]  # score_folders said which it left out
-    page = report_page(evaluation, scored, results, folders)
+    page = report_page(evaluation, sequences, results, folders)
     return evaluation, paths + [write_page(page, report_dir / PAGE)]
