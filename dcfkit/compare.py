@@ -27,10 +27,10 @@ from typing import Iterable
 import numpy as np
 
 from . import metrics
-from .datasets import DatasetError, Sequence, read_boxes, scored_sequences
+from .datasets import DatasetError, Sequence, benchmark_protocol, read_boxes, scored_sequences
 from .errors import clip, shown
 from .results import ResultStore, result_files
-from .protocols import DEFAULT, Protocol, get_protocol
+from .protocols import Protocol, get_protocol
 
 __all__ = ["COLUMNS", "compare_folders", "first_divergence", "series_iou"]
 
@@ -64,7 +64,7 @@ def _identical(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return ((a == b) | (np.isnan(a) & np.isnan(b))).all(axis=1)
 
 
-def compare_folders(results, reference, sequences: Iterable[Sequence], protocol: str | Protocol = DEFAULT,
+def compare_folders(results, reference, sequences: Iterable[Sequence], protocol: str | Protocol | None = None,
                     divergence_px: float = 2.0) -> dict:
     """Compare the result files of two folders on ``sequences`` (their ground truth).
 
@@ -76,9 +76,11 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     Raises :class:`DatasetError` for a missing folder, a malformed line (naming file and
     line), two files of one sequence with different line counts, or a line count that is
     not the sequence's frame count (naming the sequence). Sequences whose ground truth is
-    withheld after frame 1 (test splits) are left out, as in :func:`dcfkit.report.evaluate`.
+    withheld after frame 1 (test splits) are left out, as in :func:`dcfkit.report.evaluate`,
+    whose default ``protocol`` (the benchmark's) is this one's too.
     """
-    proto = get_protocol(protocol)
+    sequences = list(sequences)
+    proto = get_protocol(protocol or benchmark_protocol(sequences))
     if not divergence_px >= 0:
         raise DatasetError(f"divergence_px must be a number >= 0, got {shown(divergence_px)}")
     (ours, damaged), (theirs, damaged_ref) = _intact_files(results), _intact_files(reference)

@@ -459,9 +459,9 @@ def write_files(evaluation: dict, report_dir: Path) -> list[Path]:
 
 def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,
                  report_dir=None, include_first: bool = True, weighting: str | None = None,
-                 protocol: str | Protocol = DEFAULT) -> list[Path]:
-    """Score every tracker in ``out_dir`` under ``protocol`` and write tables and plots to
-    ``report_dir``.
+                 protocol: str | Protocol | None = None) -> list[Path]:
+    """Score every tracker in ``out_dir`` under ``protocol`` (by default the benchmark's,
+    :func:`evaluate`) and write tables and plots to ``report_dir``.
 
     ``report_dir`` defaults to ``out_dir/report``. Writes ``overall``, ``per_sequence``
     and (when sequences have attributes) ``per_attribute`` tables as ``.txt``, ``.md`` and
@@ -474,7 +474,7 @@ def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | No
 
 def score_and_write(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None, report_dir=None,
                     include_first: bool = True, weighting: str | None = None,
-                    protocol: str | Protocol = DEFAULT) -> tuple[dict, list[Path]]:
+                    protocol: str | Protocol | None = None) -> tuple[dict, list[Path]]:
     """:func:`write_report` that also returns what :func:`evaluate` returned: (evaluation, paths)."""
     report_dir = default_report_dir(out_dir, report_dir)
     _, _, evaluation = score_folders(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol)
@@ -488,7 +488,7 @@ def default_report_dir(out_dir, report_dir=None) -> Path:
 
 def score_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None, report_dir: Path,
                   include_first: bool = True, weighting: str | None = None,
-                  protocol: str | Protocol = DEFAULT) -> tuple[dict[str, Path], dict[str, dict], dict]:
+                  protocol: str | Protocol | None = None) -> tuple[dict[str, Path], dict[str, dict], dict]:
     """(tracker folders, their results, :func:`evaluate` of them) for a report into
     ``report_dir``, which is checked to take the report's files before the scoring. A test
     split (ground truth withheld after frame 1) stops here, before any folder is made."""

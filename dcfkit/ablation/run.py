@@ -6,7 +6,6 @@ import contextlib
 import json
 from pathlib import Path
 
-from ..datasets import benchmark_protocol
 from ..errors import DcfkitError, shown
 from ..results import LABEL_KEYS, ResultStore, atomic_write, dcfkit_version, ensure_writable, exclusive, read_json
 from ..runner import RunTask, execute, usable_cores
@@ -52,7 +51,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
         result = {"jobs": job_list, "runs": len(tasks), "done": [],
                   "skipped": [k for k, t in tasks.items() if t not in todo], "failed": {}}
         _run(spec, result, todo, len(tasks), variant_names(job_list), jobs, executor, scheduler, progress, version)
-        result["summary"] = summarize(spec, out, seqs, job_list, protocol or benchmark_protocol(seqs))
+        result["summary"] = summarize(spec, out, seqs, job_list, protocol)
     return result
 
 

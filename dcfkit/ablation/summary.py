@@ -35,8 +35,9 @@ def _status(folder: Path, seq: Sequence) -> tuple[str, str | None]:
 
 
 def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None = None,
-              protocol: str = DEFAULT) -> dict:
-    """Score the stored results of ``jobs`` under ``protocol`` and write the tables,
+              protocol: str | None = None) -> dict:
+    """Score the stored results of ``jobs`` under ``protocol`` (by default the benchmark's,
+    :func:`dcfkit.report.evaluate`) and write the tables,
     ``summary.json`` and plots, each naming the protocol.
 
     precision is the precision at 20 px, auc the area under the success curve (and under
@@ -51,6 +52,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     status, stored = _stored_runs(spec, out, sequences, jobs)
     with _quiet(logging.getLogger("dcfkit.report")):  # missing runs are counted in 'failed'
         scores = evaluate({variant: stored[key] for variant, key in keys.items()}, sequences, protocol=protocol)
+    protocol = scores["protocol"]["name"]
     overall, per_sequence = _rows(scores, keys, sequences, status, protocol)
     job_rows = [{"variant": j.variant, "sequence": j.sequence, "key": j.key,
                  "status": status[j.key, j.sequence][0], "error": status[j.key, j.sequence][1]} for j in jobs]
@@ -67,7 +69,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
                          {variant: stored[key] for variant, key in keys.items()}, keys)
     files.append(write_page(page, out / PAGE))
     return {"overall": overall, "per_sequence": per_sequence, "jobs": job_rows, "files": files,
-            "protocol": scores["protocol"]["name"]}
+            "protocol": protocol}
 
 
 def _stored_runs(spec: AblationSpec, out: Path, sequences: list[Sequence], jobs: list[Job]) -> tuple[dict, dict]:

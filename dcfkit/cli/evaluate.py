@@ -11,7 +11,7 @@ from typing import Any, Callable, Mapping
 from ..baselines import opencv_tracker
 from ..compare import COLUMNS, compare_folders
 from ..config import load_config, parse_overrides
-from ..datasets import benchmark_protocol, load_dataset
+from ..datasets import load_dataset
 from ..errors import ConfigError, shown
 from ..evaluation import check_one_pass, run_one_pass, tracker_name
 from ..report import columns, evaluate, format_table, json_ready, score_and_write, score_line
@@ -62,7 +62,6 @@ def distinct_names(specs: list[str], resolved: list[tuple[dict, Callable | None]
 def run_eval(args: argparse.Namespace) -> int:
     """Run each config on the dataset and print its scores; exit status 1 if a sequence failed."""
     sequences = load_dataset(args.dataset, args.root, args.sequences)
-    args.protocol = args.protocol or benchmark_protocol(sequences)
     overrides = parse_overrides(args.overrides)
     resolved = distinct_names(args.configs, [_resolve_config(spec, overrides) for spec in args.configs])
     for config, _ in resolved:  # every config's folder and results checked before the first runs
@@ -87,7 +86,7 @@ def _scores(args: argparse.Namespace, tracker: str, sequences: list) -> str:
                 f"(a test split); submit {Path(args.out) / tracker}/<sequence>.txt to the benchmark's server "
                 f"(docs/evaluation.md, 'Test splits')")
     scores = evaluate({tracker: load_results(args.out, tracker, sequences)}, sequences, protocol=args.protocol)
-    return score_line(scores["overall"][0], args.protocol)
+    return score_line(scores["overall"][0], scores["protocol"]["name"])
 
 
 def add_report_arguments(parser: argparse.ArgumentParser) -> None:
@@ -113,13 +112,12 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
 def run_report(args: argparse.Namespace) -> int:
     """Print the overall table and write the report files."""
     sequences = load_dataset(args.dataset, args.root, args.sequences)
-    args.protocol = args.protocol or benchmark_protocol(sequences)
     trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
     write = write_html_report if args.html else score_and_write
     evaluation, paths = write(args.out, sequences, trackers, args.report_dir, include_first=not args.skip_first,
                               weighting="frame" if args.frame_weighted else None, protocol=args.protocol)
-    print(format_table(evaluation["overall"], args.format, columns("overall", args.protocol), args.protocol),
-          end="")
+    protocol = evaluation["protocol"]["name"]  # --protocol, else the benchmark's
+    print(format_table(evaluation["overall"], args.format, columns("overall", protocol), protocol), end="")
     if args.format == "table":
         print(f"\n{len(paths)} files written to {paths[0].parent}")
         if args.html:
@@ -143,12 +141,11 @@ def add_compare_arguments(p: argparse.ArgumentParser) -> None:
 def run_compare(args: argparse.Namespace) -> int:
     """Print the per-sequence comparison."""
     sequences = load_dataset(args.dataset, args.root, args.sequences)
-    args.protocol = args.protocol or benchmark_protocol(sequences)
     res = compare_folders(args.results, args.reference, sequences, args.protocol, args.divergence_px)
     if args.format == "json":
         print(json.dumps(json_ready(res), indent=1))
         return 0
-    print(format_table(res["rows"] + [res["mean"]], args.format, COLUMNS, args.protocol), end="")
+    print(format_table(res["rows"] + [res["mean"]], args.format, COLUMNS, res["protocol"]), end="")
     left = "; ".join(f"{k.replace('_', ' ')}: {', '.join(v)}" for k, v in res["left_out"].items() if v)
     print(f"\nresults: {res['results']}\nreference: {res['reference']}\n"
           f"{res['diverged']} of {len(res['rows'])} sequences diverge (centres more than "

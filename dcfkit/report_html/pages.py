@@ -5,7 +5,7 @@ from pathlib import Path
 from typing import Iterable, Mapping, Sequence as Seq
 
 from ..datasets import Sequence, scored_sequences
-from ..protocols import DEFAULT, Protocol, get_protocol
+from ..protocols import Protocol, get_protocol
 from ..report import columns, default_report_dir, score_folders, write_files
 from . import sections
 from .document import write_page
@@ -49,7 +49,7 @@ def report_page(evaluation: Mapping, sequences: Seq[Sequence], results: Mapping[
 
 def write_html_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None, report_dir=None,
                       include_first: bool = True, weighting: str | None = None,
-                      protocol: str | Protocol = DEFAULT) -> tuple[dict, list[Path]]:
+                      protocol: str | Protocol | None = None) -> tuple[dict, list[Path]]:
     """:func:`dcfkit.report.score_and_write` plus ``report.html``: one self-contained page with
     the tables (sortable, filterable), the plots, every sequence's frames with the boxes, and
     what produced the results. Returns (evaluation, paths), the page last."""
