@@ -24,9 +24,10 @@ from dcfkit.ablation import load_spec, sensitivity
 from dcfkit.ablation.page import config_changes, sensitivity_charts
 from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset
+from dcfkit.metrics import iou
 from dcfkit.report_html import render
 from dcfkit.report_html.provenance import folder_provenance
-from dcfkit.report_html.thumbnails import choose_frames, crop_window, overlaps
+from dcfkit.report_html.thumbnails import choose_frames, crop_window
 from test_ablation import write_otb
 
 HOSTILE = "<img src=x onerror=alert(1)>&amp;</script>"  # user text that must stay text
@@ -56,10 +57,10 @@ def test_user_text_stays_text_and_the_page_holds_no_url():
     assert f"script-src 'sha256-{digest}'" in html and "default-src 'none'" in html
 
 
-def test_overlaps_match_hand_computed_iou():
+def test_the_thumbnails_overlaps_match_hand_computed_iou():
     gt = np.array([[0, 0, 10, 10]] * 4, float)
     boxes = np.array([[5, 0, 10, 10], [0, 0, 10, 10], [20, 20, 5, 5], [np.nan] * 4])
-    assert overlaps(boxes, gt) == pytest.approx([50 / 150, 1, 0, 0])
+    assert iou(boxes, gt) == pytest.approx([50 / 150, 1, 0, 0])
 
 
 def test_frames_are_the_first_and_the_worst_of_each_third():

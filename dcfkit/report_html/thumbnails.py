@@ -17,6 +17,7 @@ import cv2
 import numpy as np
 
 from ..datasets import DatasetError, Sequence
+from ..metrics import as_boxes, iou
 
 log = logging.getLogger(__name__)
 
@@ -26,34 +27,13 @@ SEGMENTS = 3         # frames chosen after frame 1, one per equal part of the se
 MIN_CROP = 320       # narrowest crop in frame pixels: at most 2x zoom, no upscaling blur
 
 
-def overlaps(boxes: np.ndarray, gt: np.ndarray) -> np.ndarray:
-    """IoU of continuous ``(N, 4)`` boxes with ``(N, 4)`` ground truth; 0 where a box is NaN
-    or empty. ``(N,) float64``."""
-    x1 = np.maximum(boxes[:, 0], gt[:, 0])
-    y1 = np.maximum(boxes[:, 1], gt[:, 1])
-    x2 = np.minimum(boxes[:, 0] + boxes[:, 2], gt[:, 0] + gt[:, 2])
-    y2 = np.minimum(boxes[:, 1] + boxes[:, 3], gt[:, 1] + gt[:, 3])
-    inter = np.clip(x2 - x1, 0, None) * np.clip(y2 - y1, 0, None)
-    union = boxes[:, 2] * boxes[:, 3] + gt[:, 2] * gt[:, 3] - inter
-    with np.errstate(invalid="ignore", divide="ignore"):
-        iou = inter / union
-    return np.where(np.isfinite(iou) & (union > 0), iou, 0.0)
-
-
-def padded(boxes: np.ndarray, n: int) -> np.ndarray:
-    """``boxes`` cut or NaN-padded to ``n`` rows (a short result misses its last frames)."""
-    out = np.full((n, 4), np.nan)
-    out[:min(n, len(boxes))] = boxes[:n]
-    return out
-
-
 def choose_frames(gt: np.ndarray, boxes: Seq[np.ndarray]) -> list[int]:
     """0-based frame indices: 0, then per third of frames 1..N-1 the one whose mean IoU over
     ``boxes`` (each ``(N, 4)``) with ``gt`` is lowest, frames without a valid ground truth
     left out (a third without any gives its middle frame)."""
     n = len(gt)
     valid = np.isfinite(gt).all(axis=1) & (gt[:, 2] > 0) & (gt[:, 3] > 0)
-    mean = np.mean([overlaps(b, gt) for b in boxes], axis=0) if len(boxes) else np.ones(n)
+    mean = np.mean([iou(b, gt) for b in boxes], axis=0) if len(boxes) else np.ones(n)  # NaN where gt is
     cost = np.where(valid, mean, np.inf)
     chosen = [0]
     edges = np.linspace(1, n, SEGMENTS + 1).round().astype(int)
@@ -109,17 +89,17 @@ def thumbnail(seq: Sequence, index: int, boxes: Seq[np.ndarray], whole: bool) ->
     x, y, w, h = (int(round(v)) for v in window)
     view = cv2.resize(image[y:y + h, x:x + w], (WIDTH, height), interpolation=cv2.INTER_AREA)
     valid = bool(np.isfinite(gt).all() and gt[2] > 0 and gt[3] > 0)
-    iou = [round(float(v), 3) if valid else None for v in overlaps(rows[1:], np.tile(gt, (len(rows) - 1, 1)))]
+    overlap = [round(float(v), 3) if valid else None for v in iou(rows[1:], np.tile(gt, (len(rows) - 1, 1)))]
     return {"frame": index + 1, "w": WIDTH, "h": height, "zoom": round(image.shape[1] / window[2], 2),
             "jpeg": jpeg_base64(view), "gt": _in_view(gt, window, scale),
-            "boxes": [_in_view(b, window, scale) for b in rows[1:]], "iou": iou}
+            "boxes": [_in_view(b, window, scale) for b in rows[1:]], "iou": overlap}
 
 
 def sequence_thumbnails(seq: Sequence, results: Mapping[str, Mapping], trackers: Seq[str]) -> list[dict]:
     """The thumbnails of ``seq`` (see the module) with the boxes of ``trackers`` (in that
     order) from ``results`` (tracker -> sequence name -> result with ``boxes``). A frame that
     cannot be read is left out, with a warning: the report goes on without it."""
-    boxes = [padded(np.asarray(results[t][seq.name].boxes, dtype=np.float64), len(seq))
+    boxes = [as_boxes(results[t][seq.name].boxes, len(seq))  # a short result misses its last frames
              if seq.name in results.get(t, {}) else np.full((len(seq), 4), np.nan) for t in trackers]
     thumbs = []
     for i in choose_frames(seq.ground_truth, boxes):
