@@ -405,13 +405,21 @@ def count_jpgs(folder: Path, what: str) -> int:
     return sum(1 for f in os.listdir(folder) if f.lower().endswith(".jpg"))
 
 
-def withheld_after_first(boxes: np.ndarray, n_frames: int, anno: Path, frames_desc: str) -> tuple[np.ndarray, bool]:
-    """(ground truth, withheld) of a test split's annotation, which holds one box per frame or,
-    as published, frame 1's only: then rows 2..N are NaN and ``withheld`` is True."""
-    if len(boxes) == 1 and n_frames > 1:
-        return np.vstack([boxes, np.full((n_frames - 1, 4), np.nan)]), True
-    check_box_count(boxes, n_frames, anno, frames_desc + "; a test split's annotation may also hold frame 1's box only")
-    return boxes, False
+def held_out_sequence(name: str, folder: Path, pattern: str, first: int, anno: Path, dataset: str, what: str,
+                      one_based: bool = True) -> Sequence:
+    """A sequence of a test split: every ``.jpg`` of ``folder`` (``pattern`` numbered from
+    ``first``), tracked whole, and the annotation ``anno``, which holds one box per frame or, as
+    published, frame 1's only: then rows 2..N are NaN and ``ground_truth_withheld`` is set."""
+    n_frames = count_jpgs(folder, what)
+    frames = numbered_frames(folder, pattern, first, first + n_frames - 1, what)
+    boxes = read_boxes(anno, one_based=one_based)
+    withheld = len(boxes) == 1 and n_frames > 1
+    if withheld:
+        boxes = np.vstack([boxes, np.full((n_frames - 1, 4), np.nan)])
+    else:
+        check_box_count(boxes, n_frames, anno, f"{n_frames} .jpg files in {folder}; a test split's annotation may "
+                                               f"also hold frame 1's box only")
+    return Sequence(name, frames, boxes, {}, dataset, anno, ground_truth_withheld=withheld)
 
 
 def check_box_count(boxes: np.ndarray, n_frames: int, anno: Path, frames_desc: str) -> None:

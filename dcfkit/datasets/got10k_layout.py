@@ -16,8 +16,8 @@ from typing import Callable
 
 import numpy as np
 
-from .base import (DatasetError, Sequence, annotated_frames, count_jpgs, numbered_frames, read_boxes,
-                   read_frame_values, require_root, select_sequences, withheld_after_first)
+from .base import (DatasetError, Sequence, annotated_frames, held_out_sequence, read_boxes, read_frame_values,
+                   require_root, select_sequences)
 from .registry import Evidence, register_layout
 
 SPLITS = ("train", "val", "test")
@@ -62,11 +62,8 @@ def _annotated(name: str, folder: Path, split: str) -> Sequence:
 
 def _first_box_only(name: str, folder: Path, split: str) -> Sequence:
     """A test sequence: every frame, frame 1's box (or one per frame, should a copy have them)."""
-    anno = folder / "groundtruth.txt"
-    n_frames = count_jpgs(folder, f"GOT-10k {name}")
-    frames = numbered_frames(folder, "%08d.jpg", 1, n_frames, f"GOT-10k {name}")
-    boxes, withheld = withheld_after_first(read_boxes(anno), n_frames, anno, f"{n_frames} .jpg files in {folder}")
-    return Sequence(name, frames, boxes, {}, f"got10k_{split}", anno, ground_truth_withheld=withheld)
+    return held_out_sequence(name, folder, "%08d.jpg", 1, folder / "groundtruth.txt", f"got10k_{split}",
+                             f"GOT-10k {name}")
 
 
 def _loader(split: str) -> Callable[..., list[Sequence]]:

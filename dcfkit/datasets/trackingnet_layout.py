@@ -13,8 +13,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from .base import (DatasetError, Sequence, annotated_frames, count_jpgs, numbered_frames, read_boxes,
-                   require_root, select_sequences, withheld_after_first)
+from .base import (DatasetError, Sequence, annotated_frames, held_out_sequence, read_boxes, require_root,
+                   select_sequences)
 from .registry import Evidence, register_layout
 
 _TRAIN_CHUNK = re.compile(r"^train_\d+$", re.IGNORECASE)
@@ -43,12 +43,8 @@ def _train_sequence(name: str, chunk: Path) -> Sequence:
 
 
 def _test_sequence(name: str, chunk: Path) -> Sequence:
-    anno, folder = chunk / "anno" / f"{name}.txt", chunk / "frames" / name
-    n_frames = count_jpgs(folder, f"TrackingNet {name}")
-    frames = numbered_frames(folder, "%d.jpg", 0, n_frames - 1, f"TrackingNet {name}")
-    boxes, withheld = withheld_after_first(read_boxes(anno, one_based=False), n_frames, anno,
-                                           f"{n_frames} .jpg files in {folder}")
-    return Sequence(name, frames, boxes, {}, "trackingnet", anno, ground_truth_withheld=withheld)
+    return held_out_sequence(name, chunk / "frames" / name, "%d.jpg", 0, chunk / "anno" / f"{name}.txt",
+                             "trackingnet", f"TrackingNet {name}", one_based=False)
 
 
 def _sequences_in(chunks: list[Path]) -> dict[str, Path]:
