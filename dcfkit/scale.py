@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .features.fhog import fhog
+from .features.fhog import ARITHMETICS, fhog
 from .params import param
 from .patches import resize_auto, sample, sampler, whole_pixel_crop
 from .registry import Component, Contract
@@ -116,7 +116,7 @@ class DSST(ScaleEstimator):
                             "ends, or 'hann' hann(S) (the authors')", choices=("hann_interior", "hann"))
         channel_order: str = param("bgr", "colour channel order deciding fHOG's ties (see fhog.channel_order)",
                                    choices=("bgr", "rgb"))
-        fhog_arithmetic: str = param("exact", "fHOG's arithmetic (see fhog.arithmetic)", choices=("exact", "sse"))
+        fhog_arithmetic: str = param("exact", "fHOG's arithmetic (see fhog.arithmetic)", choices=ARITHMETICS)
         model_update: str = param("reextract", "samples the model learns from after a scale change: 'reextract' at "
                                   "the new scale, or 'shift' the search samples moved by the scale change, missing "
                                   "ones extracted (DR²Track's shift_sample_scale, which leaves those at the large "

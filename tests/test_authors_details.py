@@ -24,7 +24,8 @@ from dcfkit.response import _signed_frequencies, newton_peak, shift_spectrum, su
 from dcfkit.scale import DSST
 from dcfkit.solvers import ADMMParams, admm
 
-X86 = platform.machine().lower() in ("x86_64", "amd64")
+X86_ONLY = pytest.mark.skipif(platform.machine().lower() not in ("x86_64", "amd64"),
+                              reason="the processor's own SSE estimates need x86-64")
 
 
 # --------------------------------------------------------------------------------------------
@@ -649,8 +650,7 @@ def tie_image():
     return image
 
 
-@pytest.mark.parametrize("arithmetic", ["exact", pytest.param("sse", marks=pytest.mark.skipif(
-    not X86, reason="Piotr's SSE estimates need x86-64"))])
+@pytest.mark.parametrize("arithmetic", ["exact", "sse", pytest.param("sse_cpu", marks=X86_ONLY)])
 @pytest.mark.parametrize("order, winner", [("bgr", 0), ("rgb", 12)])
 def test_fhog_channel_order_decides_ties(arithmetic, order, winner):
     feats = fhog(tie_image(), 4, channel_order=order, arithmetic=arithmetic)
@@ -680,8 +680,8 @@ def boundary_band(angle):
     return 1e-4 / np.abs(np.sin(angle)) + 4e-4 / np.abs(np.tan(angle)) + 2e-4
 
 
-@pytest.mark.skipif(not X86, reason="Piotr's SSE estimates need x86-64")
-def test_fhog_sse_is_close_to_exact_away_from_bin_boundaries():
+@pytest.mark.parametrize("arithmetic", ["sse", pytest.param("sse_cpu", marks=X86_ONLY)])
+def test_fhog_sse_is_close_to_exact_away_from_bin_boundaries(arithmetic):
     """With no pixel's orientation within the table/estimate uncertainty of a bin boundary (checked
     with the test's own gradients), every pixel lands in the same bin both ways and the features
     differ only by the SSE estimates of the magnitudes (~12 bits)."""
@@ -694,7 +694,7 @@ def test_fhog_sse_is_close_to_exact_away_from_bin_boundaries():
     nearest = boundaries[np.abs(o[..., None] - boundaries).argmin(axis=-1)]
     assert np.all(distance > boundary_band(nearest))  # the precondition, so no bin can flip
     exact = fhog(image, 4)
-    sse = fhog(image, 4, arithmetic="sse")
+    sse = fhog(image, 4, arithmetic=arithmetic)
     assert np.abs(sse - exact).max() < 2e-3
     assert np.abs(sse - exact).max() > 0  # the estimates are not exact arithmetic
 
@@ -714,8 +714,8 @@ def piotr_bin(gx, gy):
     return np.where(b >= 18, 0, b), idx
 
 
-@pytest.mark.skipif(not X86, reason="Piotr's SSE estimates need x86-64")
-def test_fhog_sse_takes_the_acos_table_bin_near_a_boundary():
+@pytest.mark.parametrize("arithmetic", ["sse", pytest.param("sse_cpu", marks=X86_ONLY)])
+def test_fhog_sse_takes_the_acos_table_bin_near_a_boundary(arithmetic):
     """Brute force over integer gradients (gx, gy) for one whose exact orientation is within 1e-4 rad
     of a bin boundary and whose bin by Piotr's table differs from the nearest bin, robustly: every
     table index reachable with a ±4e-4 relative error of the rsqrt estimate gives the same bin. Such
@@ -739,13 +739,13 @@ def test_fhog_sse_takes_the_acos_table_bin_near_a_boundary():
         yy, xx = np.mgrid[0:8, 0:8]
         image = (a * xx + b * yy - min(0, 7 * b) - min(0, 7 * a)).astype(np.float32)
         exact = fhog(image, 4)[:18].sum(axis=(1, 2))
-        sse = fhog(image, 4, arithmetic="sse")[:18].sum(axis=(1, 2))
+        sse = fhog(image, 4, arithmetic=arithmetic)[:18].sum(axis=(1, 2))
         assert np.flatnonzero(exact).tolist() == [exact_bin[k]], (a, b)
         assert np.flatnonzero(sse).tolist() == [table_bin[k]], (a, b)
 
 
-@pytest.mark.skipif(not X86, reason="Piotr's SSE estimates need x86-64")
-def test_fhog_sse_flat_image_has_the_magnitude_floor():
+@pytest.mark.parametrize("arithmetic", ["sse", pytest.param("sse_cpu", marks=X86_ONLY)])
+def test_fhog_sse_flat_image_has_the_magnitude_floor(arithmetic):
     """gradientMex.cpp:82-84: M = rcp(min(rsqrt(0) = inf, 1e10)) ≈ 1e-10 (an estimate: ±4e-4), not 0,
     and cos = 0 -> acos(0) = π/2 -> trunc(4.5 + 0.5) = bin 5. Every cell's histogram is then M (the
     bilinear weights of cell² pixels over cell², Piotr's 8/7 restoring a border cell's outer half);
@@ -754,7 +754,7 @@ def test_fhog_sse_flat_image_has_the_magnitude_floor():
     0.2357 · 3200 M. The exact fhog of a flat image is zero."""
     flat = np.full((12, 16, 3), 77, np.uint8)
     assert not fhog(flat, 4).any()
-    feats = fhog(flat, 4, arithmetic="sse")
+    feats = fhog(flat, 4, arithmetic=arithmetic)
     orient = feats[:27].reshape(27, -1)
     assert np.flatnonzero(orient.any(axis=1)).tolist() == [5, 23]
     np.testing.assert_allclose(feats[[5, 23]], 6.4e-7, rtol=1e-3)

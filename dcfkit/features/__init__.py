@@ -17,7 +17,7 @@ from ..errors import TrackingError, blamed_on
 from ..params import param
 from ..registry import Component, Contract
 from .colornames import load_table, table_path_problem
-from .fhog import fhog
+from .fhog import ARITHMETICS, fhog
 
 
 def cell_average(x: np.ndarray, cell_size: int) -> np.ndarray:
@@ -71,8 +71,10 @@ class Gray(Feature):
 
     def extract(self, patch, cell_size):
         if self.params.conversion == "matlab":
-            r, g, b = MATLAB_GRAY_WEIGHTS
-            gray = patch.astype(np.float32) @ np.array([b, g, r], np.float32)
+            # products summed in one fixed order (a BLAS matmul's order depends on the processor)
+            r, g, b = (np.float32(w) for w in MATLAB_GRAY_WEIGHTS)
+            pixels = patch.astype(np.float32)
+            gray = (pixels[..., 0] * b + pixels[..., 1] * g) + pixels[..., 2] * r
         else:
             gray = cv2.cvtColor(patch, cv2.COLOR_BGR2GRAY).astype(np.float32)
         gray *= 1.0 / 255.0
@@ -96,14 +98,15 @@ class FHOG(Feature):
         channel_order: str = param("bgr", "which colour channel's gradient a pixel takes when two are equally "
                                    "strong: the first of 'bgr' (OpenCV's order) or of 'rgb' (MATLAB's: the "
                                    "authors' code)", choices=("bgr", "rgb"))
-        arithmetic: str = param("exact", "'exact' square roots and arctan, or 'sse' the estimates and acos table "
-                                "of Piotr's compiled gradientMex that the authors' MATLAB runs (x86 only)",
-                                choices=("exact", "sse"))
+        arithmetic: str = param("exact", "'exact' square roots and arctan, or the estimates and acos table of "
+                                "Piotr's compiled gradientMex that the authors' MATLAB runs: 'sse' the same on every "
+                                "machine, 'sse_cpu' this processor's (x86 only)", choices=ARITHMETICS)
 
         def validate(self):
-            """arithmetic 'sse' only with soft_orientation false."""
-            if self.arithmetic == "sse" and self.soft_orientation:
-                return "arithmetic 'sse' (Piotr's gradientMex) bins orientations hard: set soft_orientation false"
+            """gradientMex's arithmetic only with soft_orientation false."""
+            if self.arithmetic != "exact" and self.soft_orientation:
+                return (f"arithmetic {self.arithmetic!r} (Piotr's gradientMex) bins orientations hard: "
+                        "set soft_orientation false")
 
     def channels(self) -> int:
         return 3 * self.params.n_orients + 4

@@ -44,7 +44,10 @@ from functools import lru_cache
 
 import numpy as np
 
-__all__ = ["fhog", "fhog_channels"]
+__all__ = ["ARITHMETICS", "fhog", "fhog_channels"]
+
+# exact arithmetic, or gradientMex's estimates: the same on every machine, or this processor's
+ARITHMETICS = ("exact", "sse", "sse_cpu")
 
 _TEXTURE_SCALE = 0.2357  # Piotr's constant for the 4 texture channels
 
@@ -86,10 +89,11 @@ def fhog(
             which channel's gradient a pixel takes when two are equally strong
             (the first): 'bgr' (OpenCV's images) or 'rgb' (MATLAB's, which makes
             a BGR array's red channel win, as in the authors' trackers).
-        arithmetic: 'exact' (square roots and arctan) or 'sse': the estimates
-            and lookup table of Piotr's compiled gradientMex, which the
-            authors' MATLAB runs (:mod:`dcfkit.features.fhog_sse`; x86 only,
-            ``soft_orientation`` not available).
+        arithmetic: 'exact' (square roots and arctan), or the estimates and
+            lookup table of Piotr's compiled gradientMex, which the authors'
+            MATLAB runs (:mod:`dcfkit.features.fhog_sse`; ``soft_orientation``
+            not available): 'sse' computes them the same way on every
+            machine, 'sse_cpu' takes this processor's (x86 only).
 
     Returns:
         ``(3 * n_orients + 4, H // cell_size, W // cell_size)`` float32,
@@ -104,16 +108,16 @@ def fhog(
     _check_params(cell_size, n_orients, clip)
     if channel_order not in ("bgr", "rgb"):
         raise ValueError(f"fhog: channel_order must be 'bgr' or 'rgb', got {channel_order!r}")
-    if arithmetic not in ("exact", "sse"):
-        raise ValueError(f"fhog: arithmetic must be 'exact' or 'sse', got {arithmetic!r}")
+    if arithmetic not in ARITHMETICS:
+        raise ValueError(f"fhog: arithmetic must be one of {', '.join(ARITHMETICS)}, got {arithmetic!r}")
     imgs = _as_stack(image, batch, cell_size)
-    if arithmetic == "sse":
+    if arithmetic != "exact":
         if soft_orientation:
-            raise ValueError("fhog: arithmetic 'sse' (Piotr's gradientMex) bins orientations hard; "
+            raise ValueError(f"fhog: arithmetic {arithmetic!r} (Piotr's gradientMex) bins orientations hard; "
                              "soft_orientation is not available with it")
         from .fhog_sse import fhog_sse  # lazy: numba, compiled on first use
 
-        out = fhog_sse(imgs, cell_size, n_orients, clip, channel_order == "rgb")
+        out = fhog_sse(imgs, cell_size, n_orients, clip, channel_order == "rgb", arithmetic)
         return out if batch else out[0]
     if imgs.shape[0] == 0:
         hb, wb = imgs.shape[1] // cell_size, imgs.shape[2] // cell_size
@@ -279,10 +283,13 @@ def _normalise(hist: np.ndarray, n_orients: int, clip: float, cell_size: int, ws
     eps = np.float32(1e-4 / 4 / cell_size**4)  # Piotr's eps on this scale
     kernels.normalise(hist, clip, eps, out[:no].reshape(no, n, hb, wb),
                       clipped.reshape(4, 2 * n_orients, n, hb, wb))
-    # the texture channel of a normalisation: 0.2357 times the sum of its clipped sensitive
-    # channels, by numpy's matmul as before (its summation order decides the last bit)
-    texture_weights = np.full((1, 2 * n_orients), _TEXTURE_SCALE, np.float32)
+    # the texture channel of a normalisation: the sum of its clipped sensitive channels times
+    # 0.2357, added in channel order (a BLAS matmul's order depends on the processor)
+    weight = np.float32(_TEXTURE_SCALE)
     for k in range(4):
-        np.matmul(texture_weights, clipped[k], out=out[no + k : no + k + 1])
+        texture = out[no + k]
+        np.multiply(clipped[k, 0], weight, out=texture)
+        for o in range(1, 2 * n_orients):
+            texture += clipped[k, o] * weight
     out = out.reshape(no + 4, n, hb, wb)
     return out[:, 0][None] if n == 1 else np.ascontiguousarray(out.transpose(1, 0, 2, 3))

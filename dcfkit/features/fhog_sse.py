@@ -5,72 +5,48 @@ trackers compile: its SSE estimates and its lookup table, not exact square roots
 gradient magnitude as ``rcp(min(rsqrt(M²), 1e10))`` (the SSE reciprocal and reciprocal-
 square-root estimates, ~12 bits) and the orientation from a 20,020-entry ``acos`` table
 indexed by ``trunc(10000 gx rsqrt(M²))``; a pixel near a bin boundary then falls into the
-other bin (on a 38x11 scale sample of DR²Track's DSST one such pixel moved a feature by
-0.08). Here every operation of ``gradMag``, ``gradHist`` (hard orientation bins, bilinear
+other bin. Here every operation of ``gradMag``, ``gradHist`` (hard orientation bins, bilinear
 cell weights, 8/7 on the border), ``hogNormMatrix`` and ``hogChannels`` is repeated in
-float32 in the same order, the estimates taken from the processor's own instructions
-(x86 only; the values are the CPU vendor's: MATLAB on an AMD processor gives others) and
-the table from the C library's ``acosf``.
+float32 in the same order.
+
+The estimates are specified only by their error bound, and each processor family has its own:
+on an AMD Zen 5 half of all inputs get other values than on the machine that made dcfkit's
+first reference runs, and one pixel moving to another bin can move a box. Arithmetic 'sse'
+therefore computes them by table (:mod:`dcfkit.features.sse_estimates`) and takes a correctly
+rounded acos table: the same features on every machine. 'sse_cpu' runs this processor's own
+instructions and the C library's ``acosf``, as a MATLAB run compiled on this machine does.
 """
 from __future__ import annotations
 
 import ctypes
 import ctypes.util
 import functools
-import platform
+import math
 
 import numba
 import numpy as np
-from llvmlite import ir
-from numba import types
-from numba.extending import intrinsic
+
+from . import sse_estimates
 
 _PI = np.float32(3.14159265)  # Piotr's PI, a float
 _TABLE_N, _TABLE_B = 10000, 10
 
 
-def available() -> bool:
-    """Whether this machine has the SSE estimate instructions (x86-64)."""
-    return platform.machine().lower() in ("x86_64", "amd64", "i686", "x86")
-
-
-def _sse_scalar(name: str):
-    """A float32 -> float32 intrinsic applying the SSE instruction ``name`` to lane 0."""
-    @intrinsic
-    def call(typingctx, x):  # pragma: no cover - compiled
-        sig = types.float32(types.float32)
-
-        def codegen(context, builder, signature, args):
-            f32 = ir.FloatType()
-            v4 = ir.VectorType(f32, 4)
-            fn = builder.module.declare_intrinsic(name, fnty=ir.FunctionType(v4, [v4]))
-            zero = ir.Constant(ir.IntType(32), 0)
-            vec = builder.insert_element(ir.Constant(v4, ir.Undefined), args[0], zero)
-            return builder.extract_element(builder.call(fn, [vec]), zero)
-
-        return sig, codegen
-
-    return call
-
-
-_rsqrt = _sse_scalar("llvm.x86.sse.rsqrt.ss")
-_rcp = _sse_scalar("llvm.x86.sse.rcp.ss")
-
-
-@functools.lru_cache(maxsize=1)
-def acos_table() -> np.ndarray:
-    """Piotr's ``acosTable``: a[i + 10010] = acosf(i / 10000f) for i in [-10000, 10000), π below,
-    0 above, capped at π - 1e-6 up to i = 1000. float32 (20020,)."""
+@functools.lru_cache(maxsize=2)
+def acos_table(c_library: bool = False) -> np.ndarray:
+    """Piotr's ``acosTable``: a[i + 10010] = acos(i / 10000f) for i in [-10000, 10000), π below,
+    0 above, capped at π - 1e-6 up to i = 1000. float32 (20020,). The values are correctly
+    rounded, or with ``c_library`` the C library's ``acosf``, as the mex file compiled on this
+    machine takes them (glibc 2.36's differs from the correctly rounded value on 1,583 of them)."""
     n, b = _TABLE_N, _TABLE_B
     i = np.arange(-n - b, n + b)
     x = (i[b:b + 2 * n].astype(np.float32) / np.float32(n)).astype(np.float32)
-    libm = ctypes.util.find_library("m")
-    if libm:  # the C library's acosf, as the mex file's
-        acosf = ctypes.CDLL(libm).acosf
+    if c_library and ctypes.util.find_library("m"):
+        acosf = ctypes.CDLL(ctypes.util.find_library("m")).acosf
         acosf.restype, acosf.argtypes = ctypes.c_float, [ctypes.c_float]
         core = np.array([acosf(float(v)) for v in x], np.float32)
-    else:  # pragma: no cover - no C math library: the correctly rounded value
-        core = np.arccos(x.astype(np.float64)).astype(np.float32)
+    else:  # a double acos within an ulp rounds to the nearest float
+        core = np.array([math.acos(float(v)) for v in x]).astype(np.float32)
     table = np.concatenate([np.full(b, _PI, np.float32), core, np.zeros(b, np.float32)])
     cap = np.float32(_PI - np.float32(1e-6))
     head = i < n // 10
@@ -80,12 +56,11 @@ def acos_table() -> np.ndarray:
 
 
 @numba.njit(cache=True, nogil=True)
-def _grad_mag(img, reverse, table, mag, orient):  # pragma: no cover - compiled
-    """gradMag(I, 0, full=1): per pixel of (H, W, C) float32, the strongest channel's gradient
-    (first on ties, in RGB order when ``reverse`` for a BGR image), its magnitude estimate and
-    orientation in [0, 2π)."""
+def _strongest_gradient(img, reverse, m2, gx, gy):  # pragma: no cover - compiled
+    """gradMag's per-pixel gradient of (H, W, C) float32: the strongest channel's (first on
+    ties, in RGB order when ``reverse`` for a BGR image) squared magnitude and components."""
     h, w, channels = img.shape
-    half, one, acmult = np.float32(0.5), np.float32(1.0), np.float32(10000.0)
+    half, one = np.float32(0.5), np.float32(1.0)
     for x in range(w):
         xp, xn, rx = x - 1, x + 1, half
         if x == 0:
@@ -101,20 +76,31 @@ def _grad_mag(img, reverse, table, mag, orient):  # pragma: no cover - compiled
             best, bx, by = np.float32(0), np.float32(0), np.float32(0)
             for k in range(channels):
                 c = channels - 1 - k if reverse else k
-                gx = (img[y, xn, c] - img[y, xp, c]) * rx
-                gy = (img[yn, x, c] - img[yp, x, c]) * ry
-                m2 = gx * gx + gy * gy
-                if k == 0 or m2 > best:
-                    best, bx, by = m2, gx, gy
-            r = min(_rsqrt(best), np.float32(1e10))
-            mag[y, x] = _rcp(r)
-            cosine = (bx * r) * acmult
-            if by < 0:
-                cosine = -cosine
-            o = table[int(cosine) + 10010]
-            if by < 0:
-                o = o + np.float32(3.14159265)
-            orient[y, x] = o
+                dx = (img[y, xn, c] - img[y, xp, c]) * rx
+                dy = (img[yn, x, c] - img[yp, x, c]) * ry
+                d2 = dx * dx + dy * dy
+                if k == 0 or d2 > best:
+                    best, bx, by = d2, dx, dy
+            m2[y, x], gx[y, x], gy[y, x] = best, bx, by
+
+
+def _grad_mag(img, reverse, arithmetic, mag, orient):
+    """gradMag(I, 0, full=1): the magnitude estimate ``rcp(min(rsqrt(M²), 1e10))`` and the
+    orientation in [0, 2π) from the acos table at ``trunc(10000 gx rsqrt(M²))``."""
+    m2, gx, gy = (np.empty_like(mag) for _ in range(3))
+    _strongest_gradient(img, reverse, m2, gx, gy)
+    if arithmetic == "sse_cpu":
+        rsqrt, rcp, table = sse_estimates.cpu_rsqrt, sse_estimates.cpu_rcp, acos_table(c_library=True)
+    else:
+        rsqrt, rcp, table = sse_estimates.rsqrt, sse_estimates.rcp, acos_table()
+    r = np.minimum(rsqrt(m2), np.float32(1e10))
+    mag[...] = rcp(r)
+    below = gy < 0
+    cosine = (gx * r) * np.float32(10000.0)
+    cosine[below] = -cosine[below]
+    index = np.clip(cosine.astype(np.int64) + (_TABLE_N + _TABLE_B), 0, table.size - 1)  # trunc, as (int)
+    orient[...] = table[index]
+    orient[below] += _PI
 
 
 @numba.njit(cache=True, nogil=True)
@@ -258,12 +244,11 @@ def _fhog_channels(r1, n_orients, cell, clip, out):  # pragma: no cover - compil
                     k += 1
 
 
-def fhog_sse(imgs: np.ndarray, cell_size: int, n_orients: int, clip: float, reverse: bool) -> np.ndarray:
+def fhog_sse(imgs: np.ndarray, cell_size: int, n_orients: int, clip: float, reverse: bool,
+             arithmetic: str = "sse") -> np.ndarray:
     """(N, H, W[, 3]) images -> (N, 3 n_orients + 4, H // cell, W // cell) float32, as gradientMex's
-    ``fhog(single(I), cell_size, n_orients, clip)`` without its zero last channel."""
-    if not available():
-        raise RuntimeError("fhog arithmetic 'sse' needs an x86-64 processor (SSE rsqrt/rcp estimates)")
-    table = acos_table()
+    ``fhog(single(I), cell_size, n_orients, clip)`` without its zero last channel; ``arithmetic``
+    'sse' (estimates and acos the same everywhere) or 'sse_cpu' (this machine's)."""
     n = imgs.shape[0]
     if imgs.ndim == 3:
         imgs = imgs[..., None]
@@ -274,7 +259,7 @@ def fhog_sse(imgs: np.ndarray, cell_size: int, n_orients: int, clip: float, reve
     orient = np.empty((h, w), np.float32)
     hist = np.empty((2 * n_orients, wb, hb), np.float32)
     for i in range(n):
-        _grad_mag(np.ascontiguousarray(imgs[i], np.float32), reverse, table, mag, orient)
+        _grad_mag(np.ascontiguousarray(imgs[i], np.float32), reverse, arithmetic, mag, orient)
         hist[:] = 0
         _grad_hist(mag, orient, cell_size, 2 * n_orients, hist)
         _fhog_channels(hist, n_orients, cell_size, np.float32(clip), out[i])

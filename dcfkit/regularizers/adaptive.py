@@ -71,7 +71,8 @@ class LocalVariation(BoxWindow):
         variation = np.fft.fftshift(response_variation(previous, detection))  # circshift(floor(size / 2))
         w2 = w2.copy()
         with np.errstate(over="ignore"):  # Π = inf (a zero in the last response): w = inf, h = 0 there
-            w2[self.mask] = (self.params.delta * np.log(variation[self.mask] + 1)) ** 2
+            # log in float64: numpy's float32 log is the processor's (SIMD) estimate
+            w2[self.mask] = (self.params.delta * np.log(variation[self.mask].astype(np.float64) + 1)) ** 2
         return w2
 
 
