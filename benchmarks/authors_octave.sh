@@ -41,7 +41,16 @@
 #  - AutoTrack: its feature/ lacks sse.hpp and wrappers.hpp, which come from DR2Track1/feature
 #    (the same toolbox files; its fhog.m and gradientMex.cpp are DR2Track1's); mexResize.mex
 #    and the shims go into its utils/; run_AutoTrack.m runs as it is (visualization already 0).
+#  - gradientMex's SSE estimates (rcpps, rsqrtps) and its acos table are the ones of dcfkit's fhog
+#    arithmetic 'sse' (benchmarks/octave/portable_estimates.hpp; acos in double, rounded to float),
+#    which every processor computes alike. With SSE_ESTIMATES=sse_cpu the processor's own
+#    instructions and the C library's acosf stay, as in a MATLAB run on this machine (dcfkit's
+#    'sse_cpu'): their values differ between processor families (docs/architecture.md).
 set -euo pipefail
+# Octave's BLAS (OpenBLAS) picks its kernels by processor, and they sum in different orders
+# (rgb2gray's product differs in the last bit on a quarter of the pixels between Haswell and
+# SkylakeX kernels): one kernel everywhere keeps the runs the same on every x86-64 machine with AVX2
+export OPENBLAS_CORETYPE=${OPENBLAS_CORETYPE:-Haswell}
 [ $# -ge 3 ] || { sed -n '2,12p' "$0"; exit 2; }
 case $1 in strcf|dr2track|bacf|arcf|autotrack) ;; *) echo "tracker must be strcf, dr2track, bacf, arcf or autotrack"; exit 2 ;; esac
 TRK=$1; ROOT=$(cd "$2" && pwd); mkdir -p "$3"; OUT=$(cd "$3" && pwd); shift 3
@@ -53,11 +62,22 @@ command -v mkoctfile >/dev/null || { echo "needs: apt-get install -y octave libo
 build_mexresize() {
   mkoctfile --mex -O2 -I/usr/include/opencv4 -o "$1" "$HERE/octave/mexResize.cpp" -lopencv_imgproc -lopencv_core
 }
+# gradientMex with dcfkit's portable estimates and acos table (unless SSE_ESTIMATES=sse_cpu); $1: its folder
+portable_estimates() {
+  case ${SSE_ESTIMATES:-sse} in sse_cpu) return ;; sse) ;; *) echo "SSE_ESTIMATES must be sse or sse_cpu"; exit 2 ;; esac
+  sed -i "s|^#include <emmintrin.h>.*|&\n#include \"$HERE/octave/portable_estimates.hpp\"|
+          s|return _mm_rcp_ps(x);|return dcfkit_estimates::each<dcfkit_estimates::rcp>(x);|
+          s|return _mm_rsqrt_ps(x);|return dcfkit_estimates::each<dcfkit_estimates::rsqrt>(x);|" "$1/sse.hpp"
+  sed -i 's|a1\[i\]=float(acos(i/float(n)));|a1[i]=float(acos(double(i/float(n))));|' "$1/gradientMex.cpp"
+  grep -q dcfkit_estimates::rsqrt "$1/sse.hpp" && grep -q 'acos(double(' "$1/gradientMex.cpp" \
+    || { echo "could not put the portable estimates into $1"; exit 1; }
+}
 # the portability patches the copies share (gradientMex folder, mexResize.mex path, mtimesx
 # folder, shim folder)
 port_lineage() {
   sed -i '1i #include <cstdlib>\n#include <cstddef>' "$1/wrappers.hpp"
   sed -i 's/const int dims\[3\]={h,w,d}, n=h\*w\*d;/const mwSize dims[3]={(mwSize)h,(mwSize)w,(mwSize)d}; const int n=h*w*d;/; s/  const int \*dims; int nDims;/  const mwSize *dims; int nDims;/' "$1/gradientMex.cpp"
+  portable_estimates "$1"
   (cd "$1" && mkoctfile --mex -O2 -DMATLAB_MEX_FILE -o gradientMex.mex gradientMex.cpp)
   build_mexresize "$2"
   mv "$3/mtimesx.m" "$3/mtimesx_mex_help.txt"
@@ -66,7 +86,9 @@ port_lineage() {
 case $TRK in
   dr2track)
     bash "$REF/octave/setup_dr2track.sh" "$BUILD/code"
-    rm -f "$BUILD/code/utils/mexResize.mex"; build_mexresize "$BUILD/code/utils/mexResize.mex" ;;
+    rm -f "$BUILD/code/utils/mexResize.mex"; build_mexresize "$BUILD/code/utils/mexResize.mex"
+    portable_estimates "$BUILD/code/feature"
+    (cd "$BUILD/code/feature" && mkoctfile --mex -O2 -DMATLAB_MEX_FILE -o gradientMex.mex gradientMex.cpp) ;;
   strcf)
     C=$BUILD/code; P=$C/external_libs/pdollar_toolbox/channels
     rm -rf "$C"; cp -r "$REF/STRCF" "$C"; mkdir -p "$P"
