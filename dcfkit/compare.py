@@ -15,7 +15,10 @@ given dataset, and returns one row per sequence:
   ``divergence_px`` apart (a box NaN in one file only counts as apart), or None.
 
 The ``mean`` row averages precision and AUC as the protocol averages sequences, and the
-per-sequence IoUs with equal weights. Sequences found in only one folder, in both but not
+per-sequence IoUs with equal weights. ``platforms`` lists each folder's platforms as their
+sidecars record them (:mod:`dcfkit.platforms`; "not recorded" for files without one) and
+``platform_differences`` what differs between the two: boxes from different platforms can
+part where a float decision is close (docs/architecture.md). Sequences found in only one folder, in both but not
 in the dataset, or whose dcfkit sidecar says the file is damaged, are listed in ``left_out``.
 """
 from __future__ import annotations
@@ -26,7 +29,7 @@ from typing import Iterable
 
 import numpy as np
 
-from . import metrics
+from . import metrics, platforms
 from .datasets import DatasetError, Sequence, benchmark_protocol, read_boxes, scored_sequences
 from .errors import clip, shown
 from .results import ResultStore, result_files
@@ -104,9 +107,27 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
                          first_divergence(a, b, divergence_px)))
     mean = _row("mean", sum(r["frames"] for r in rows), metrics.average(scores, protocol=proto),
                 metrics.average(scores_ref, protocol=proto), float(np.mean([r["iou"] for r in rows])), None)
+    names = [s.name for s in both]
+    ours_platforms, theirs_platforms = _platforms(results, names), _platforms(reference, names)
     return {"protocol": proto.name, "divergence_px": float(divergence_px), "results": str(results),
             "reference": str(reference), "rows": rows, "mean": mean,
-            "diverged": sum(r["diverges_at"] is not None for r in rows), "left_out": left_out}
+            "diverged": sum(r["diverges_at"] is not None for r in rows), "left_out": left_out,
+            "platforms": {"results": sorted({platforms.describe(p) for p in ours_platforms}),
+                          "reference": sorted({platforms.describe(p) for p in theirs_platforms})},
+            "platform_differences": sorted({d for a in ours_platforms for b in theirs_platforms
+                                            for d in platforms.differences(a, b)})}
+
+
+def _platforms(folder, names: list[str]) -> list:
+    """The platform records of the sidecars of ``names`` in ``folder`` (None where not recorded)."""
+    store = ResultStore(folder)
+    records = []
+    for name in names:
+        meta = store.sidecar(name)
+        record = meta.get("platform") if isinstance(meta, dict) else None
+        if record not in records:
+            records.append(record)
+    return records
 
 
 def _intact_files(folder) -> tuple[dict[str, Path], list[str]]:

@@ -20,12 +20,13 @@ import json
 import logging
 import math
 import os
+from collections import Counter
 from pathlib import Path
 from typing import Iterable, Mapping, Sequence as Seq
 
 import numpy as np
 
-from . import metrics
+from . import metrics, platforms
 from .datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, benchmark_protocol, scored_sequences
 from .errors import clip, shown
 from .protocols import DEFAULT, Protocol, get_protocol
@@ -99,7 +100,8 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
     ``got10k``, else AUC), ``curves`` (tracker -> averaged ``precision``/``success``/
     ``norm_precision`` curves), ``attribute_curves`` (attribute -> tracker -> curves),
     ``attributes`` (attribute -> number of sequences), ``thresholds``, ``protocol`` (name,
-    title, source) and ``settings``. Sequences whose ground truth is withheld after frame 1
+    title, source), ``settings`` and ``platforms`` (tracker -> ``[[platform, sequences], ...]``,
+    :func:`dcfkit.platforms.describe` of the runs' records). Sequences whose ground truth is withheld after frame 1
     (test splits) are left out (:func:`~dcfkit.datasets.scored_sequences`: a
     :class:`DatasetError` if that leaves none).
     """
@@ -138,7 +140,14 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
         "attributes": {a: len(n) for a, n in attributes.items()},
         "thresholds": _thresholds(proto),
         "settings": {"protocol": proto.name, "include_first": include_first, "weighting": weighting},
+        "platforms": {t: _platforms(res.values()) for t, res in results.items()},
     }
+
+
+def _platforms(results: Iterable) -> list[list]:
+    """``[[platform line, sequences], ...]`` of one tracker's results (imports: none recorded)."""
+    return [[line, n] for line, n in Counter(
+        platforms.describe(getattr(r, "platform", None)) for r in results).most_common()]
 
 
 def _score_tracker(tracker: str, res: Mapping, sequences: list[Sequence], include_first: bool,

@@ -51,6 +51,7 @@ from . import __version__
 from .config import components
 from .datasets import DatasetError, Sequence, read_boxes
 from .errors import DcfkitError, clip, shown
+from .platforms import cpu_model
 from .registry import get_registry
 
 log = logging.getLogger(__name__)
@@ -145,17 +146,8 @@ def command_line(record: Mapping) -> str | None:
 @functools.lru_cache(maxsize=1)
 def machine() -> dict:
     """The machine this process runs on: host name, OS, CPU model, cores, Python version."""
-    return {"host": platform.node(), "system": platform.platform(terse=True), "cpu": _cpu_model(),
+    return {"host": platform.node(), "system": platform.platform(terse=True), "cpu": cpu_model(),
             "cores": os.cpu_count(), "python": platform.python_version()}
-
-
-def _cpu_model() -> str:
-    with contextlib.suppress(OSError):
-        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as info:
-            for line in info:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    return platform.processor() or platform.machine()
 
 
 # --------------------------------------------------------------------------- files
@@ -290,12 +282,14 @@ def checksum(data: bytes) -> str:
 @dataclasses.dataclass(frozen=True, eq=False)
 class SequenceResult:
     """A tracker's result on one sequence: ``boxes`` ``(N, 4) float64`` 0-based;
-    ``times`` ``(N,) float64`` seconds per frame and ``fps`` when known (None for imports)."""
+    ``times`` ``(N,) float64`` seconds per frame and ``fps`` when known (None for imports);
+    ``platform`` the :func:`dcfkit.platforms.record` of the run when its sidecar has one."""
 
     boxes: np.ndarray
     times: np.ndarray | None = None
     fps: float | None = None
     run_key: str | None = None
+    platform: dict | None = None
 
 
 class ResultStore:
@@ -418,7 +412,8 @@ class ResultStore:
                 continue
             key = meta.get("run_key", meta.get("config_hash"))  # config_hash: dcfkit < 0.4
             results[name] = SequenceResult(read_boxes(self.boxes_path(name)), _times(meta),
-                                           None if meta.get("fps") is None else float(meta["fps"]), key)
+                                           None if meta.get("fps") is None else float(meta["fps"]), key,
+                                           meta.get("platform") if isinstance(meta.get("platform"), dict) else None)
             keys.setdefault(key, []).append(name)
         if len(keys) > 1:
             detail = "; ".join(f"{k}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}" for k, v in keys.items())

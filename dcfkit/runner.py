@@ -23,6 +23,7 @@ from typing import Any, Callable, Iterable, Mapping
 
 import cv2
 
+from . import platforms
 from .datasets import Sequence
 from .errors import DcfkitError, shown
 from .registry import PluginWarning
@@ -96,7 +97,8 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
     meta = {"sequence": seq.name, "dataset": seq.dataset, "tracker": task.config.get("name"),
             "init_box": [float(v) for v in seq.init_box], "fps": run.fps, "total_time": float(run.times.sum()),
             "run_key": task.key, "dcfkit_version": version, "plugins": plugin_versions(task.config),
-            "time": now(), **(origin or invocation()), "machine": machine(), "config": task.config,
+            "time": now(), **(origin or invocation()), "machine": machine(), "platform": platforms.record(),
+            "config": task.config,
             "times": run.times.tolist()}
     store.write(seq, run.boxes, meta, run.times, run.confidence)
     return {"sequence": seq.name, "status": "done", "fps": run.fps, "frames": len(seq)}

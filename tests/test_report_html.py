@@ -26,6 +26,7 @@ from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset
 from dcfkit.metrics import iou
 from dcfkit.report_html import render
+from dcfkit import platforms as dcfkit_platforms
 from dcfkit.report_html.provenance import folder_provenance
 from dcfkit.report_html.thumbnails import choose_frames, crop_window
 from test_ablation import write_otb
@@ -154,6 +155,7 @@ def test_provenance_of_old_and_new_sidecars(tmp_path):
     assert prov["sequences"] == 2 and prov["run_keys"] == [["k1", 2]]
     assert sorted(prov["commands"]) == [["cd /w && dcfkit eval 'my config.yaml'", 1], ["not recorded", 1]]
     assert ["h: C, 8 cores, Linux, Python 3.11", 1] in prov["machines"]
+    assert prov["platforms"] == [["not recorded", 2]]  # sidecars older than 0.6.0 hold none
     assert folder_provenance(tmp_path, ["a"]) == {"folder": str(tmp_path), "sequences": 0}
 
 
@@ -295,6 +297,7 @@ def test_report_page_of_a_synthetic_run_in_chromium(tmp_path, browser, capsys):
     assert sidecar["machine"]["cores"] == os.cpu_count() and sidecar["machine"]["host"] == platform.node()
     page, problems = open_page(browser, path)
     assert HOSTILE_NAME in page.locator("#overall-table").inner_text() and not problems
+    assert page.locator("#provenance").inner_text().count(dcfkit_platforms.describe(sidecar["platform"])) >= 2
 
 
 def test_report_page_of_a_real_run_in_chromium(tmp_path, browser, shared_data):

@@ -119,6 +119,12 @@ def run_report(args: argparse.Namespace) -> int:
     protocol = evaluation["protocol"]["name"]  # --protocol, else the benchmark's
     print(format_table(evaluation["overall"], args.format, columns("overall", protocol), protocol), end="")
     if args.format == "table":
+        for tracker, rows in evaluation["platforms"].items():
+            print(f"{tracker} platform: {'; '.join(f'{line} ({n} sequences)' if len(rows) > 1 else line for line, n in rows)}")
+        recorded = {line for rows in evaluation["platforms"].values() for line, _ in rows} - {"not recorded"}
+        if len(recorded) > 1:
+            print(f"warning: these results come from {len(recorded)} platforms; their boxes may part where a float "
+                  f"decision is close (docs/architecture.md)", file=sys.stderr)
         print(f"\n{len(paths)} files written to {paths[0].parent}")
         if args.html:
             print(f"open {paths[-1]}")
@@ -151,4 +157,10 @@ def run_compare(args: argparse.Namespace) -> int:
           f"{res['diverged']} of {len(res['rows'])} sequences diverge (centres more than "
           f"{args.divergence_px:g} px apart); d_ = results minus reference\n"
           f"left out: {left or 'none'}", file=sys.stderr if args.format == "csv" else sys.stdout)
+    for side in ("results", "reference"):
+        print(f"{side} platform: {'; '.join(res['platforms'][side])}",
+              file=sys.stderr if args.format == "csv" else sys.stdout)
+    if res["platform_differences"]:
+        print(f"warning: the two folders come from different platforms ({'; '.join(res['platform_differences'])}); "
+              f"their boxes may part where a float decision is close (docs/architecture.md)", file=sys.stderr)
     return 0

@@ -1,5 +1,6 @@
 """What produced a report's results, read from the result sidecars (:mod:`dcfkit.results`):
-commands, dcfkit and plugin versions, run keys (config hashes), machines, times, config.
+commands, dcfkit and plugin versions, run keys (config hashes), machines, platforms
+(:mod:`dcfkit.platforms`), times, config.
 
 Sidecars written before dcfkit recorded the command and the machine lack them; they are
 then "not recorded", and imported result files (no sidecars) have nothing recorded.
@@ -10,6 +11,7 @@ from collections import Counter
 from pathlib import Path
 from typing import Iterable, Mapping
 
+from .. import platforms
 from ..results import ResultStore, command_line, dcfkit_version, invocation, machine, now
 
 NOT_RECORDED = "not recorded"
@@ -43,7 +45,7 @@ def _command(meta: Mapping) -> str:
 def folder_provenance(folder: Path, names: Iterable[str]) -> dict:
     """What the sidecars of sequences ``names`` in ``folder`` record: ``folder``,
     ``sequences`` (sidecars read), ``run_keys``, ``versions``, ``plugins``, ``commands``,
-    ``machines`` (each ``[[value, sequences], ...]``), ``times`` (first, last) and
+    ``machines``, ``platforms`` (each ``[[value, sequences], ...]``), ``times`` (first, last) and
     ``config`` (the first sidecar's)."""
     store = ResultStore(folder)
     metas = [m for m in (store.sidecar(n) for n in names) if m is not None]
@@ -58,6 +60,7 @@ def folder_provenance(folder: Path, names: Iterable[str]) -> dict:
         "plugins": _counted(", ".join(map(str, m.get("plugins") or [])) or "none" for m in metas),
         "commands": _counted(_command(m) for m in metas),
         "machines": _counted(describe_machine(m.get("machine")) for m in metas),
+        "platforms": _counted(platforms.describe(m.get("platform")) for m in metas),
         "times": [times[0], times[-1]] if times else [],
         "config": metas[0].get("config"),
     }
@@ -67,4 +70,4 @@ def this_process() -> dict:
     """The command, dcfkit version, machine and time of the process writing the report."""
     here = invocation()
     return {"command": _command(here), "dcfkit": dcfkit_version(), "machine": describe_machine(machine()),
-            "time": now()}
+            "platform": platforms.describe(platforms.record()), "time": now()}

@@ -292,6 +292,7 @@
     entry(here, 'command', h('code', {text: spec.report.command}));
     entry(here, 'dcfkit', h('code', {text: spec.report.dcfkit}));
     entry(here, 'machine', h('code', {text: spec.report.machine}));
+    entry(here, 'platform', h('code', {text: spec.report.platform}));
     entry(here, 'written', h('code', {text: spec.report.time}));
     for (const [label, value] of spec.extra) entry(here, label, h('code', {text: value}));
     out.append(h('h3', {text: 'This page'}), here);
@@ -307,6 +308,7 @@
         entry(dl, 'plugins', ...counted(tr.plugins));
         entry(dl, 'command', ...counted(tr.commands));
         entry(dl, 'machine', ...counted(tr.machines));
+        entry(dl, 'platform', ...counted(tr.platforms || []));
         entry(dl, 'run', h('code', {text: tr.times.join(' to ')}));
         if (tr.config) {
           entry(dl, 'config', h('details', {}, h('summary', {text: 'resolved config'}),
