@@ -10,10 +10,21 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from .fft import multiply
+
 
 def response(hf: np.ndarray, sf: np.ndarray, shape: tuple[int, int], fft) -> np.ndarray:
     """Eq. (12): (C, H, Wr) filter and (..., C, H, Wr) samples -> (..., H, W) float32 response."""
     return fft.irfft2(np.einsum("chw,...chw->...hw", hf.conj(), sf), shape).astype(np.float32, copy=False)
+
+
+_DOT = {(1, 2): "i,ij->j", (2, 1): "ij,j->i", (1, 1): "i,i->"}
+
+
+def dot(a: np.ndarray, b: np.ndarray):
+    """``a @ b`` of vectors and matrices, summed by numpy's own loops: a BLAS sums in the order of
+    its processor kernel, which moves the last bits of the peak from machine to machine."""
+    return np.einsum(_DOT[a.ndim, b.ndim], a, b)
 
 
 def wrap(index, size: int):
@@ -39,11 +50,11 @@ def subpixel_peak(r: np.ndarray, iterations: int = 5) -> tuple[float, float, flo
     y, x = y0, x0
     for _ in range(iterations):
         ey, ex = np.exp(ky * y), np.exp(kx * x)
-        gy = ((ky * ey) @ spectrum @ ex).real
-        gx = (ey @ spectrum @ (kx * ex)).real
-        hyy = ((ky * ky * ey) @ spectrum @ ex).real
-        hxx = (ey @ spectrum @ (kx * kx * ex)).real
-        hxy = ((ky * ey) @ spectrum @ (kx * ex)).real
+        gy = dot(dot(ky * ey, spectrum), ex).real
+        gx = dot(dot(ey, spectrum), kx * ex).real
+        hyy = dot(dot(ky * ky * ey, spectrum), ex).real
+        hxx = dot(dot(ey, spectrum), kx * kx * ex).real
+        hxy = dot(dot(ky * ey, spectrum), kx * ex).real
         det = hyy * hxx - hxy * hxy
         if not (det > 0 and hyy < 0):  # not a local maximum of the interpolant: stop
             break
@@ -51,7 +62,7 @@ def subpixel_peak(r: np.ndarray, iterations: int = 5) -> tuple[float, float, flo
         x -= (hyy * gx - hxy * gy) / det
     if abs(y - y0) > 1 or abs(x - x0) > 1:
         return y0, x0, best
-    value = float((np.exp(ky * y) @ spectrum @ np.exp(kx * x)).real)
+    value = float(dot(dot(np.exp(ky * y), spectrum), np.exp(kx * x)).real)
     return (y, x, value) if value >= best else (y0, x0, best)
 
 
@@ -88,18 +99,18 @@ def newton_peak(maps: np.ndarray, iterations: int = 5) -> tuple[int, float, floa
         y, x = y0, x0
         ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
         for _ in range(iterations):
-            y_resp, resp_x = ey @ spectrum, spectrum @ ex
-            grad_y = -((ky * ey) @ resp_x).imag
-            grad_x = -(y_resp @ (kx * ex)).imag
-            ival = 1j * (ey @ resp_x)
-            h_yy = (-((ky * ky * ey) @ resp_x) + ival).real
-            h_xx = (-(y_resp @ (kx * kx * ex)) + ival).real
-            h_xy = (-((ky * ey) @ (spectrum @ (kx * ex)))).real
+            y_resp, resp_x = dot(ey, spectrum), dot(spectrum, ex)
+            grad_y = -dot(ky * ey, resp_x).imag
+            grad_x = -dot(y_resp, kx * ex).imag
+            ival = 1j * dot(ey, resp_x)
+            h_yy = (-dot(ky * ky * ey, resp_x) + ival).real
+            h_xx = (-dot(y_resp, kx * kx * ex) + ival).real
+            h_xy = (-dot(ky * ey, dot(spectrum, kx * ex))).real
             det = h_yy * h_xx - h_xy * h_xy
             with np.errstate(divide="ignore", invalid="ignore"):
                 y, x = y - (h_xx * grad_y - h_xy * grad_x) / det, x - (h_yy * grad_x - h_xy * grad_y) / det
             ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
-        value = float((ey @ spectrum @ ex).real) / (h * w)
+        value = float(dot(dot(ey, spectrum), ex).real) / (h * w)
         if not value >= init_value:  # lower (or NaN): the grid maximum
             y, x, value = y0, x0, init_value
         if value > best[3]:
@@ -134,4 +145,4 @@ def shift_spectrum(xf: np.ndarray, dy: float, dx: float, shape: tuple[int, int])
     ky = (_signed_frequencies(shape[0]) / shape[0])[:, None]
     kx = np.fft.rfftfreq(shape[1])[None, :]
     phase = np.exp(2j * np.pi * (ky * dy + kx * dx)).astype(np.complex64)
-    return xf * phase
+    return multiply(xf, phase)

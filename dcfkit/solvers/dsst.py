@@ -24,6 +24,7 @@ import dataclasses
 
 import numpy as np
 
+from ..fft import multiply
 from ..params import param
 from .base import Solver, running_average
 
@@ -49,7 +50,7 @@ class Ridge(Solver):
         self.den = None  # B, (H, Wr) float32
 
     def train(self, xf, yf, w2, theta, fft):
-        num = np.conj(yf)[None] * xf
+        num = multiply(np.conj(yf)[None], xf)
         den = np.einsum("chw,chw->hw", xf.real, xf.real) + np.einsum("chw,chw->hw", xf.imag, xf.imag)
         eta = self.params.learning_rate
         self.num = running_average(self.num, num, eta, np.complex64)

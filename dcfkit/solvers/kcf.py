@@ -53,7 +53,8 @@ def squared_norm(xf: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
     parts = xf.view(xf.real.dtype)  # (..., C, H, 2 Wr): re, im interleaved
     # per column Σ_c Σ_h (re² + im²), accumulated in float64 without a float64 copy of the spectra
     columns = np.einsum("...chw,...chw->...w", parts, parts, dtype=np.float64)
-    return columns @ np.repeat(parseval_weights(shape[1]), 2) / (shape[0] * shape[1])
+    # weighted by numpy's own loops: a BLAS matmul sums in the order of its processor kernel
+    return np.einsum("...w,w->...", columns, np.repeat(parseval_weights(shape[1]), 2)) / (shape[0] * shape[1])
 
 
 def kernel_correlation(xf: np.ndarray, zf: np.ndarray, shape: tuple[int, int], p, fft) -> np.ndarray:
