@@ -18,13 +18,13 @@ def response(hf: np.ndarray, sf: np.ndarray, shape: tuple[int, int], fft) -> np.
     return fft.irfft2(np.einsum("chw,...chw->...hw", hf.conj(), sf), shape).astype(np.float32, copy=False)
 
 
-_DOT = {(1, 2): "i,ij->j", (2, 1): "ij,j->i", (1, 1): "i,i->"}
+def _moments(spectrum, ey, ex, fy, fx) -> tuple[complex, ...]:
+    """:func:`dcfkit.peak_kernels.moments`: the interpolant's value and derivative sums, in a fixed
+    order (a BLAS would sum in the order of its processor kernel)."""
+    from . import peak_kernels  # lazy: numba, compiled on first use
 
-
-def dot(a: np.ndarray, b: np.ndarray):
-    """``a @ b`` of vectors and matrices, summed by numpy's own loops: a BLAS sums in the order of
-    its processor kernel, which moves the last bits of the peak from machine to machine."""
-    return np.einsum(_DOT[a.ndim, b.ndim], a, b)
+    return peak_kernels.moments(spectrum, np.ascontiguousarray(ey, np.complex128),
+                                np.ascontiguousarray(ex, np.complex128), fy, fx)
 
 
 def wrap(index, size: int):
@@ -45,16 +45,14 @@ def subpixel_peak(r: np.ndarray, iterations: int = 5) -> tuple[float, float, flo
     if iterations <= 0 or h < 3 or w < 3:
         return y0, x0, best
     spectrum = np.fft.fft2(r.astype(np.float64)) / (h * w)
-    ky = 2j * np.pi * np.fft.fftfreq(h)  # d/dy of exp(2πi ky y / H), per unit of y
-    kx = 2j * np.pi * np.fft.fftfreq(w)
+    fy, fx = np.fft.fftfreq(h), np.fft.fftfreq(w)
+    c = 2j * np.pi  # d/dy of exp(2πi f y), per unit of y, is 2πi f
+    ky, kx = c * fy, c * fx
     y, x = y0, x0
     for _ in range(iterations):
-        ey, ex = np.exp(ky * y), np.exp(kx * x)
-        gy = dot(dot(ky * ey, spectrum), ex).real
-        gx = dot(dot(ey, spectrum), kx * ex).real
-        hyy = dot(dot(ky * ky * ey, spectrum), ex).real
-        hxx = dot(dot(ey, spectrum), kx * kx * ex).real
-        hxy = dot(dot(ky * ey, spectrum), kx * ex).real
+        _, m10, m01, m20, m02, m11 = _moments(spectrum, np.exp(ky * y), np.exp(kx * x), fy, fx)
+        gy, gx = (c * m10).real, (c * m01).real
+        hyy, hxx, hxy = (c * c * m20).real, (c * c * m02).real, (c * c * m11).real
         det = hyy * hxx - hxy * hxy
         if not (det > 0 and hyy < 0):  # not a local maximum of the interpolant: stop
             break
@@ -62,7 +60,7 @@ def subpixel_peak(r: np.ndarray, iterations: int = 5) -> tuple[float, float, flo
         x -= (hyy * gx - hxy * gy) / det
     if abs(y - y0) > 1 or abs(x - x0) > 1:
         return y0, x0, best
-    value = float(dot(dot(np.exp(ky * y), spectrum), np.exp(kx * x)).real)
+    value = float(_moments(spectrum, np.exp(ky * y), np.exp(kx * x), fy, fx)[0].real)
     return (y, x, value) if value >= best else (y0, x0, best)
 
 
@@ -99,18 +97,15 @@ def newton_peak(maps: np.ndarray, iterations: int = 5) -> tuple[int, float, floa
         y, x = y0, x0
         ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
         for _ in range(iterations):
-            y_resp, resp_x = dot(ey, spectrum), dot(spectrum, ex)
-            grad_y = -dot(ky * ey, resp_x).imag
-            grad_x = -dot(y_resp, kx * ex).imag
-            ival = 1j * dot(ey, resp_x)
-            h_yy = (-dot(ky * ky * ey, resp_x) + ival).real
-            h_xx = (-dot(y_resp, kx * kx * ex) + ival).real
-            h_xy = (-dot(ky * ey, dot(spectrum, kx * ex))).real
+            m00, m10, m01, m20, m02, m11 = _moments(spectrum, ey, ex, ky, kx)
+            grad_y, grad_x = -m10.imag, -m01.imag
+            ival = 1j * m00
+            h_yy, h_xx, h_xy = (-m20 + ival).real, (-m02 + ival).real, (-m11).real
             det = h_yy * h_xx - h_xy * h_xy
             with np.errstate(divide="ignore", invalid="ignore"):
                 y, x = y - (h_xx * grad_y - h_xy * grad_x) / det, x - (h_yy * grad_x - h_xy * grad_y) / det
             ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
-        value = float(dot(dot(ey, spectrum), ex).real) / (h * w)
+        value = float(_moments(spectrum, ey, ex, ky, kx)[0].real) / (h * w)
         if not value >= init_value:  # lower (or NaN): the grid maximum
             y, x, value = y0, x0, init_value
         if value > best[3]:

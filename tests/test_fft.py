@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from dcfkit.fft import make_fft
+from dcfkit.fft import make_fft, multiply
 
 
 @pytest.mark.parametrize("backend", ["scipy", "pyfftw"])
@@ -20,3 +20,19 @@ def test_round_trip_matches_numpy_and_leaves_inputs_alone(backend, shape):
         np.testing.assert_allclose(xf, np.fft.rfft2(x.astype(np.float64)), atol=1e-4)
         np.testing.assert_allclose(back, x, atol=1e-5)
     assert not np.shares_memory(fft.rfft2(x), fft.rfft2(x))  # results are not the plan's buffer
+
+
+def test_multiply_rounds_each_product():
+    """fft.multiply: (ar br - ai bi) + i(ar bi + ai br) with every product rounded to the array's
+    precision, broadcast; by hand and against float64 products rounded the same way."""
+    assert multiply(np.array([1 + 2j], np.complex64), np.array([3 + 4j], np.complex64)).tolist() == [-5 + 10j]
+    rng = np.random.default_rng(4)
+    a = (rng.standard_normal((3, 4, 5)) + 1j * rng.standard_normal((3, 4, 5))).astype(np.complex64)
+    b = (rng.standard_normal((4, 5)) + 1j * rng.standard_normal((4, 5))).astype(np.complex64)
+    out = multiply(a, b)
+    assert out.dtype == np.complex64 and out.shape == (3, 4, 5)
+    f32 = np.float32
+    re = (a.real.astype(f32) * b.real).astype(f32) - (a.imag * b.imag).astype(f32)
+    im = (a.real * b.imag).astype(f32) + (a.imag * b.real).astype(f32)
+    assert np.array_equal(out.real, re) and np.array_equal(out.imag, im)
+    np.testing.assert_allclose(out, a.astype(np.complex128) * b, rtol=1e-5, atol=1e-6)

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from dcfkit.fft import make_fft
+from dcfkit import peak_kernels
 from dcfkit.response import local_maxima, response, subpixel_peak, wrap
 
 
@@ -85,3 +86,18 @@ def test_subpixel_peak_of_a_map_whose_hessian_has_a_cross_term():
     got_y, got_x, value = subpixel_peak(r.astype(np.float32))
     assert got_y == pytest.approx(y0, abs=1e-3) and got_x == pytest.approx(x0, abs=1e-3)
     assert value == pytest.approx(3.0, rel=1e-4)
+
+
+def test_peak_moments_are_the_matrix_products():
+    """peak_kernels.moments (compiled, summed in index order) against numpy's matrix products:
+    m_ab = (fy^a ey) @ S @ (fx^b ex); and a 2x2 case by hand."""
+    rng = np.random.default_rng(3)
+    s = rng.standard_normal((7, 5)) + 1j * rng.standard_normal((7, 5))
+    ey, ex = np.exp(1j * rng.standard_normal(7)), np.exp(1j * rng.standard_normal(5))
+    fy, fx = rng.standard_normal(7), rng.standard_normal(5)
+    got = peak_kernels.moments(s, ey, ex, fy, fx)
+    want = [(fy**a * ey) @ s @ (fx**b * ex) for a, b in ((0, 0), (1, 0), (0, 1), (2, 0), (0, 2), (1, 1))]
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+    one = np.ones(2, complex)
+    m = peak_kernels.moments(np.array([[1, 2j], [3, 4]]), one, one, np.array([0.0, 1.0]), np.array([2.0, 3.0]))
+    assert m[0] == 8 + 2j and m[1] == 7 and m[2] == 2 * 1 + 3 * 2j + 2 * 3 + 3 * 4  # Σ S, row 1, fx-weighted

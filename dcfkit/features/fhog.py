@@ -283,13 +283,7 @@ def _normalise(hist: np.ndarray, n_orients: int, clip: float, cell_size: int, ws
     eps = np.float32(1e-4 / 4 / cell_size**4)  # Piotr's eps on this scale
     kernels.normalise(hist, clip, eps, out[:no].reshape(no, n, hb, wb),
                       clipped.reshape(4, 2 * n_orients, n, hb, wb))
-    # the texture channel of a normalisation: the sum of its clipped sensitive channels times
-    # 0.2357, added in channel order (a BLAS matmul's order depends on the processor)
-    weight = np.float32(_TEXTURE_SCALE)
-    for k in range(4):
-        texture = out[no + k]
-        np.multiply(clipped[k, 0], weight, out=texture)
-        for o in range(1, 2 * n_orients):
-            texture += clipped[k, o] * weight
+    # in channel order, not by a BLAS matmul, whose order depends on the processor
+    kernels.texture(clipped, np.float32(_TEXTURE_SCALE), out[no:])
     out = out.reshape(no + 4, n, hb, wb)
     return out[:, 0][None] if n == 1 else np.ascontiguousarray(out.transpose(1, 0, 2, 3))

@@ -84,23 +84,48 @@ def _strongest_gradient(img, reverse, m2, gx, gy):  # pragma: no cover - compile
             m2[y, x], gx[y, x], gy[y, x] = best, bx, by
 
 
+@numba.njit(inline="always", nogil=True)
+def _orientation(gx, gy, r, table):  # pragma: no cover - compiled
+    """gradMag's orientation in [0, 2π): the acos table at trunc(10000 gx r), r the rsqrt estimate."""
+    cosine = (gx * r) * np.float32(10000.0)
+    if gy < 0:
+        cosine = -cosine
+    o = table[int(cosine) + 10010]
+    if gy < 0:
+        o = o + np.float32(3.14159265)
+    return o
+
+
+@numba.njit(cache=True, nogil=True)
+def _by_table(m2, gx, gy, table, rcp_table, rsqrt_table, mag, orient):  # pragma: no cover - compiled
+    """Magnitude rcp(min(rsqrt(M²), 1e10)) and orientation per pixel, the estimates by table."""
+    h, w = m2.shape
+    for y in range(h):
+        for x in range(w):
+            r = min(sse_estimates.rsqrt_one(m2[y, x], rsqrt_table), np.float32(1e10))
+            mag[y, x] = sse_estimates.rcp_one(r, rcp_table)
+            orient[y, x] = _orientation(gx[y, x], gy[y, x], r, table)
+
+
+@numba.njit(cache=True, nogil=True)
+def _orientations(gx, gy, r, table, orient):  # pragma: no cover - compiled
+    h, w = gx.shape
+    for y in range(h):
+        for x in range(w):
+            orient[y, x] = _orientation(gx[y, x], gy[y, x], r[y, x], table)
+
+
 def _grad_mag(img, reverse, arithmetic, mag, orient):
     """gradMag(I, 0, full=1): the magnitude estimate ``rcp(min(rsqrt(M²), 1e10))`` and the
-    orientation in [0, 2π) from the acos table at ``trunc(10000 gx rsqrt(M²))``."""
+    orientation from the acos table at ``trunc(10000 gx rsqrt(M²))``."""
     m2, gx, gy = (np.empty_like(mag) for _ in range(3))
     _strongest_gradient(img, reverse, m2, gx, gy)
-    if arithmetic == "sse_cpu":
-        rsqrt, rcp, table = sse_estimates.cpu_rsqrt, sse_estimates.cpu_rcp, acos_table(c_library=True)
+    if arithmetic == "sse_cpu":  # the processor's instructions, compiled apart (x86 only)
+        r = np.minimum(sse_estimates.cpu_rsqrt(m2), np.float32(1e10))
+        mag[...] = sse_estimates.cpu_rcp(r)
+        _orientations(gx, gy, r, acos_table(c_library=True), orient)
     else:
-        rsqrt, rcp, table = sse_estimates.rsqrt, sse_estimates.rcp, acos_table()
-    r = np.minimum(rsqrt(m2), np.float32(1e10))
-    mag[...] = rcp(r)
-    below = gy < 0
-    cosine = (gx * r) * np.float32(10000.0)
-    cosine[below] = -cosine[below]
-    index = np.clip(cosine.astype(np.int64) + (_TABLE_N + _TABLE_B), 0, table.size - 1)  # trunc, as (int)
-    orient[...] = table[index]
-    orient[below] += _PI
+        _by_table(m2, gx, gy, acos_table(), *sse_estimates.estimate_tables(), mag, orient)
 
 
 @numba.njit(cache=True, nogil=True)

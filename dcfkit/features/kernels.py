@@ -221,3 +221,16 @@ def colornames_cells(bgr, table, cell_size, out):  # pragma: no cover - compiled
                     total[k] = total[k] + row[k]
             for k in range(d):
                 out[k, r, c] = total[k] * scale
+
+
+@numba.njit(cache=True, nogil=True)
+def texture(clipped, weight, out):  # pragma: no cover - compiled
+    """fhog's texture channels: out[k] = Σ_o clipped[k, o] · weight over the 2n clipped sensitive
+    channels of normalisation k, added in channel order. clipped (4, 2n, cells), out (4, cells)."""
+    blocks, n2, cells = clipped.shape
+    for k in range(blocks):
+        for p in range(cells):
+            t = clipped[k, 0, p] * weight
+            for o in range(1, n2):
+                t = t + clipped[k, o, p] * weight
+            out[k, p] = t

@@ -19,10 +19,7 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-__all__ = ["cpu_available", "cpu_rcp", "cpu_rsqrt", "estimate_tables", "rcp", "rsqrt"]
-
-_SIGN, _EXP, _MANT = np.uint32(0x80000000), np.uint32(0x7F800000), np.uint32(0x007FFFFF)
-
+__all__ = ["cpu_available", "cpu_rcp", "cpu_rsqrt", "estimate_tables", "rcp", "rcp_one", "rsqrt", "rsqrt_one"]
 
 @functools.lru_cache(maxsize=1)
 def estimate_tables() -> tuple[np.ndarray, np.ndarray]:
@@ -40,38 +37,82 @@ def estimate_tables() -> tuple[np.ndarray, np.ndarray]:
     return rcp_table, rsqrt_table
 
 
-def _float32(x) -> tuple[np.ndarray, np.ndarray]:
-    a = np.array(x, np.float32, ndmin=1, order="C")
-    return a, a.view(np.uint32)
+@intrinsic
+def _bits(typingctx, x):  # pragma: no cover - compiled
+    """The bits of a float32 as a uint32."""
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.IntType(32))
+
+    return types.uint32(types.float32), codegen
 
 
-def rcp(x: np.ndarray) -> np.ndarray:
+@intrinsic
+def _float(typingctx, b):  # pragma: no cover - compiled
+    """The float32 whose bits are the uint32 ``b``."""
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.FloatType())
+
+    return types.float32(types.uint32), codegen
+
+
+@numba.njit(inline="always", nogil=True)
+def rcp_one(x, table):  # pragma: no cover - compiled
+    """``rcpss`` of one float32 by ``table`` (:func:`estimate_tables`)."""
+    b = _bits(x)
+    sign, exp = b & np.uint32(0x80000000), np.int64((b >> np.uint32(23)) & np.uint32(0xFF))
+    if exp == 255:
+        return x if (b & np.uint32(0x7FFFFF)) != 0 else _float(sign)  # NaN stays, ±inf -> ±0
+    if exp == 0:
+        return _float(sign | np.uint32(0x7F800000))  # ±0 and subnormals -> ±inf
+    if exp > 252:
+        return _float(sign)  # below the normal range: flushed
+    return _float(sign | np.uint32((253 - exp) << 23) | table[(b >> np.uint32(12)) & np.uint32(0x7FF)])
+
+
+@numba.njit(inline="always", nogil=True)
+def rsqrt_one(x, table):  # pragma: no cover - compiled
+    """``rsqrtss`` of one float32 by ``table`` (:func:`estimate_tables`)."""
+    b = _bits(x)
+    exp = np.int64((b >> np.uint32(23)) & np.uint32(0xFF))
+    if x != x or (exp > 0 and x < 0):
+        return np.float32(np.nan)
+    if exp == 0:
+        return _float((b & np.uint32(0x80000000)) | np.uint32(0x7F800000))  # ±0, subnormals -> ±inf
+    if exp == 255:
+        return np.float32(0.0)
+    out_exp = np.uint32(0x7E - ((exp - 0x7F) >> 1))
+    return _float((out_exp << np.uint32(23)) | table[exp & 1, (b >> np.uint32(13)) & np.uint32(0x3FF)])
+
+
+@numba.njit(nogil=True, cache=True)
+def _rcp_all(x, table, out):  # pragma: no cover - compiled
+    for i in range(x.size):
+        out[i] = rcp_one(x[i], table)
+
+
+@numba.njit(nogil=True, cache=True)
+def _rsqrt_all(x, table, out):  # pragma: no cover - compiled
+    for i in range(x.size):
+        out[i] = rsqrt_one(x[i], table)
+
+
+def _each(kernel, table, x) -> np.ndarray:
+    a = np.ascontiguousarray(x, np.float32)
+    out = np.empty_like(a)
+    kernel(a.reshape(-1), table, out.reshape(-1))
+    return out.reshape(np.shape(x))
+
+
+def rcp(x) -> np.ndarray:
     """``rcpps`` of float32 ``x``, elementwise: ±0 and subnormals give ±inf, ±inf gives ±0,
     results below the normal range are flushed to ±0, NaN stays NaN."""
-    a, b = _float32(x)
-    exp = ((b & _EXP) >> np.uint32(23)).astype(np.int64)
-    out_exp = 253 - exp
-    normal = (exp > 0) & (exp < 255) & (out_exp > 0)
-    mant = estimate_tables()[0][(b >> np.uint32(12)) & np.uint32(0x7FF)]
-    out = (b & _SIGN) | np.where(normal, (out_exp.astype(np.uint32) << np.uint32(23)) | mant, np.uint32(0))
-    out = out.view(np.float32)
-    out[exp == 0] = np.copysign(np.inf, a[exp == 0])
-    out[np.isnan(a)] = np.nan
-    return out.reshape(np.shape(x))
+    return _each(_rcp_all, estimate_tables()[0], x)
 
 
-def rsqrt(x: np.ndarray) -> np.ndarray:
+def rsqrt(x) -> np.ndarray:
     """``rsqrtps`` of float32 ``x``, elementwise: ±0 and subnormals give ±inf, +inf gives 0,
     negative numbers and NaN give NaN."""
-    a, b = _float32(x)
-    exp = ((b & _EXP) >> np.uint32(23)).astype(np.int64)
-    out_exp = 0x7E - ((exp - 0x7F) >> 1)
-    mant = estimate_tables()[1][exp & 1, (b >> np.uint32(13)) & np.uint32(0x3FF)]
-    out = ((out_exp.astype(np.uint32) << np.uint32(23)) | mant).view(np.float32)
-    out[exp == 0] = np.copysign(np.inf, a[exp == 0])
-    out[exp == 255] = 0.0
-    out[(a < 0) | np.isnan(a)] = np.nan
-    return out.reshape(np.shape(x))
+    return _each(_rsqrt_all, estimate_tables()[1], x)
 
 
 def cpu_available() -> bool:
@@ -93,7 +134,7 @@ def _on_this_cpu(kernel, x) -> np.ndarray:
     if not cpu_available():
         raise RuntimeError("fhog arithmetic 'sse_cpu' needs an x86 processor (SSE rsqrt/rcp instructions); "
                            "'sse' computes the same estimates on any machine")
-    a = np.array(x, np.float32, ndmin=1, order="C")
+    a = np.ascontiguousarray(x, np.float32)
     return kernel(a.reshape(-1)).reshape(np.shape(x))
 
 
@@ -117,17 +158,16 @@ def _sse_scalar(name: str):
 _rcp_ss, _rsqrt_ss = _sse_scalar("llvm.x86.sse.rcp.ss"), _sse_scalar("llvm.x86.sse.rsqrt.ss")
 
 
-@numba.njit(nogil=True)
-def _cpu_rcp(x):  # pragma: no cover - compiled
-    out = np.empty_like(x)
-    for i in range(x.size):
-        out[i] = _rcp_ss(x[i])
-    return out
+def _elementwise(instruction):
+    """A compiled loop applying ``instruction`` to each element of a float32 array."""
+    @numba.njit(nogil=True)
+    def apply(x):  # pragma: no cover - compiled
+        out = np.empty_like(x)
+        for i in range(x.size):
+            out[i] = instruction(x[i])
+        return out
+
+    return apply
 
 
-@numba.njit(nogil=True)
-def _cpu_rsqrt(x):  # pragma: no cover - compiled
-    out = np.empty_like(x)
-    for i in range(x.size):
-        out[i] = _rsqrt_ss(x[i])
-    return out
+_cpu_rcp, _cpu_rsqrt = _elementwise(_rcp_ss), _elementwise(_rsqrt_ss)
