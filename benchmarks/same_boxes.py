@@ -64,6 +64,7 @@ def main():
     for key, now in boxes.items():
         if key not in before.files:
             print(f"{key:<28} not in {args.compare}")
+            changed += 1
             continue
         old = before[key]
         if old.shape == now.shape and np.array_equal(old, now):

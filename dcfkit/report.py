@@ -100,9 +100,9 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
     ``got10k``, else AUC), ``curves`` (tracker -> averaged ``precision``/``success``/
     ``norm_precision`` curves), ``attribute_curves`` (attribute -> tracker -> curves),
     ``attributes`` (attribute -> number of sequences), ``thresholds``, ``protocol`` (name,
-    title, source), ``settings`` and ``platforms`` (tracker -> ``[[platform, sequences], ...]``,
-    :func:`dcfkit.platforms.describe` of the runs' records). Sequences whose ground truth is withheld after frame 1
-    (test splits) are left out (:func:`~dcfkit.datasets.scored_sequences`: a
+    title, source), ``settings`` and ``platforms`` (tracker -> ``[[platform, sequences], ...]``
+    of :func:`dcfkit.platforms.describe`). Sequences whose ground truth is withheld after
+    frame 1 (test splits) are left out (:func:`~dcfkit.datasets.scored_sequences`: a
     :class:`DatasetError` if that leaves none).
     """
     sequences = list(sequences)

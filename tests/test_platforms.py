@@ -17,8 +17,9 @@ from dcfkit.results import load_results
 
 from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixture)
 
-RECORD = {"arch": "x86_64", "cpu": "Some CPU (cpu family 6, model 85)", "simd": "X86_V2 X86_V3", "blas": "openblas 0.3 Haswell",
-          "libc": "glibc 2.36", "libraries": {"numpy": "2.4.6", "scipy": "1.17.1"}, "switches": {}}
+RECORD = {"arch": "x86_64", "cpu": "Some CPU (cpu family 6, model 85)", "simd": "X86_V2 X86_V3",
+          "blas": "openblas 0.3 Haswell", "libc": "glibc 2.36", "libraries": {"numpy": "2.4.6", "scipy": "1.17.1"},
+          "switches": {}}
 
 
 def test_record_names_this_process():

@@ -120,7 +120,8 @@ def run_report(args: argparse.Namespace) -> int:
     print(format_table(evaluation["overall"], args.format, columns("overall", protocol), protocol), end="")
     if args.format == "table":
         for tracker, rows in evaluation["platforms"].items():
-            print(f"{tracker} platform: {'; '.join(f'{line} ({n} sequences)' if len(rows) > 1 else line for line, n in rows)}")
+            lines = [f"{line} ({n} sequences)" if len(rows) > 1 else line for line, n in rows]
+            print(f"{tracker} platform: {'; '.join(lines)}")
         recorded = {line for rows in evaluation["platforms"].values() for line, _ in rows} - {"not recorded"}
         if len(recorded) > 1:
             print(f"warning: these results come from {len(recorded)} platforms; their boxes may part where a float "
