@@ -15,11 +15,12 @@ given dataset, and returns one row per sequence:
   ``divergence_px`` apart (a box NaN in one file only counts as apart), or None.
 
 The ``mean`` row averages precision and AUC as the protocol averages sequences, and the
-per-sequence IoUs with equal weights. ``platforms`` lists each folder's platforms as their
-sidecars record them (:mod:`dcfkit.platforms`; "not recorded" for files without one) and
-``platform_differences`` what differs between the two: boxes from different platforms can
-part where a float decision is close (docs/architecture.md). Sequences found in only one folder, in both but not
+per-sequence IoUs with equal weights. Sequences found in only one folder, in both but not
 in the dataset, or whose dcfkit sidecar says the file is damaged, are listed in ``left_out``.
+``platforms`` lists each folder's platforms as their sidecars record them
+(:mod:`dcfkit.platforms`; "not recorded" for files without one) and ``platform_differences``
+what differs between the two: boxes from different platforms can part where a float decision
+is close (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -30,7 +30,7 @@ OPENCV_WHEELS = ("opencv-contrib-python-headless", "opencv-contrib-python", "ope
                  "opencv-python")
 # environment variables that switch SIMD paths or BLAS kernels
 SWITCHES = ("NPY_DISABLE_CPU_FEATURES", "NPY_ENABLE_CPU_FEATURES", "OPENBLAS_CORETYPE", "OPENCV_CPU_DISABLE",
-            "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES", "GLIBC_TUNABLES")
+            "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES", "GLIBC_TUNABLES", "JSIMD_FORCENONE")
 
 
 def cpu_model() -> str:

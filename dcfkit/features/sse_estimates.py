@@ -21,6 +21,7 @@ from numba.extending import intrinsic
 
 __all__ = ["cpu_available", "cpu_rcp", "cpu_rsqrt", "estimate_tables", "rcp", "rcp_one", "rsqrt", "rsqrt_one"]
 
+
 @functools.lru_cache(maxsize=1)
 def estimate_tables() -> tuple[np.ndarray, np.ndarray]:
     """``(rcp, rsqrt)`` mantissa tables, uint32 result fraction bits in place (``<< 23`` form):
