@@ -1,7 +1,7 @@
 """ARCF's and AutoTrack's new parts, each against an independent reference: the authors' filter
 updates (ARCF's tracker_HOGCN.m, AutoTrack's AutoTrack_optimized.m) re-run in numpy on full
 complex spectra, as MATLAB computes them, a hand-computed response variation, and the tracker's
-handling of what adaptive components return. Paths are to /work/shared/reference/{ARCF,AutoTrack}.
+handling of what adaptive components return. Paths are to ../shared/reference/{ARCF,AutoTrack}.
 """
 import pathlib
 

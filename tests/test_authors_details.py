@@ -1,8 +1,8 @@
 """The options that reproduce details of the authors' MATLAB (DR²Track's DR2Track1 release and
 STRCF), each against an independent reference: the MATLAB line it mirrors worked out by hand or
 re-run in numpy, a brute-force loop, or a dense solve. Citations file.m:line are to
-/work/shared/reference/DR2Track/DR2Track1 (implementation/, utils/, feature/) unless STRCF's
-(/work/shared/reference/STRCF) is named. MATLAB indices are 1-based and its arrays column-major;
+../shared/reference/DR2Track/DR2Track1 (implementation/, utils/, feature/) unless STRCF's
+(../shared/reference/STRCF) is named. MATLAB indices are 1-based and its arrays column-major;
 where that matters the reference below works in MATLAB's indices and converts at the end.
 """
 import collections
