@@ -87,7 +87,8 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     proto = get_protocol(protocol or benchmark_protocol(sequences))
     if not divergence_px >= 0:
         raise DatasetError(f"divergence_px must be a number >= 0, got {shown(divergence_px)}")
-    (ours, damaged), (theirs, damaged_ref) = _intact_files(results), _intact_files(reference)
+    (ours, damaged, our_platforms), (theirs, damaged_ref, their_platforms) = (_intact_files(results),
+                                                                              _intact_files(reference))
     sequences = scored_sequences(sequences)
     known = {s.name for s in sequences}
     both = [s for s in sequences if s.name in ours and s.name in theirs]
@@ -108,8 +109,8 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
                          first_divergence(a, b, divergence_px)))
     mean = _row("mean", sum(r["frames"] for r in rows), metrics.average(scores, protocol=proto),
                 metrics.average(scores_ref, protocol=proto), float(np.mean([r["iou"] for r in rows])), None)
-    names = [s.name for s in both]
-    ours_platforms, theirs_platforms = _platforms(results, names), _platforms(reference, names)
+    ours_platforms = _distinct(our_platforms[s.name] for s in both)
+    theirs_platforms = _distinct(their_platforms[s.name] for s in both)
     return {"protocol": proto.name, "divergence_px": float(divergence_px), "results": str(results),
             "reference": str(reference), "rows": rows, "mean": mean,
             "diverged": sum(r["diverges_at"] is not None for r in rows), "left_out": left_out,
@@ -119,30 +120,30 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
                                             for d in platforms.differences(a, b)})}
 
 
-def _platforms(folder, names: list[str]) -> list:
-    """The platform records of the sidecars of ``names`` in ``folder`` (None where not recorded)."""
-    store = ResultStore(folder)
-    records = []
-    for name in names:
-        meta = store.sidecar(name)
-        record = meta.get("platform") if isinstance(meta, dict) else None
-        if record not in records:
-            records.append(record)
-    return records
+def _distinct(records: Iterable) -> list:
+    """The different records, each once (dicts: not hashable)."""
+    out = []
+    for record in records:
+        if record not in out:
+            out.append(record)
+    return out
 
 
-def _intact_files(folder) -> tuple[dict[str, Path], list[str]]:
-    """The result files of ``folder`` and, apart, the sequences whose dcfkit sidecar says the
-    file is damaged (never compared; each logged). Files without a sidecar are taken as they are."""
+def _intact_files(folder) -> tuple[dict[str, Path], list[str], dict[str, dict | None]]:
+    """The result files of ``folder``, apart the sequences whose dcfkit sidecar says the file is
+    damaged (never compared; each logged), and each file's platform record (None without one).
+    Files without a sidecar are taken as they are."""
     files, store = result_files(folder), ResultStore(folder)
-    damaged = []
+    damaged, platform_records = [], {}
     for name in list(files):
         meta = store.sidecar(name)
+        record = meta.get("platform") if isinstance(meta, dict) else None
+        platform_records[name] = record if isinstance(record, dict) else None
         problem = store.problem(name, meta) if meta is not None else None
         if problem is not None:
             log.warning("%s: left out of the comparison", problem)
             damaged.append(files.pop(name))
-    return files, [p.stem for p in damaged]
+    return files, [p.stem for p in damaged], platform_records
 
 
 def _boxes(seq: Sequence, path: Path, path_ref: Path) -> tuple[np.ndarray, np.ndarray]:

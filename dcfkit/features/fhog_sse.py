@@ -41,8 +41,9 @@ def acos_table(c_library: bool = False) -> np.ndarray:
     n, b = _TABLE_N, _TABLE_B
     i = np.arange(-n - b, n + b)
     x = (i[b:b + 2 * n].astype(np.float32) / np.float32(n)).astype(np.float32)
-    if c_library and ctypes.util.find_library("m"):
-        acosf = ctypes.CDLL(ctypes.util.find_library("m")).acosf
+    libm = ctypes.util.find_library("m") if c_library else None
+    if libm:
+        acosf = ctypes.CDLL(libm).acosf
         acosf.restype, acosf.argtypes = ctypes.c_float, [ctypes.c_float]
         core = np.array([acosf(float(v)) for v in x], np.float32)
     else:  # a double acos within an ulp rounds to the nearest float
