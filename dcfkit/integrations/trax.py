@@ -10,7 +10,8 @@ Regions: a TraX rectangle is ``left, top, width, height`` in 0-based pixels, dcf
 in-memory convention, so boxes pass unchanged (vot-toolkit's dummy sequence pastes its target
 at pixel ``(x, y)`` and annotates ``Rectangle(x, y, w, h)``; it rasterises a rectangle as the
 pixels ``x .. x + w - 1``). A polygon (VOT's rotated boxes) initialises with its axis-aligned
-bounding box, as vot-toolkit's ``Rectangle.convert`` makes it; replies are rectangles.
+bounding box, as vot-toolkit's ``Rectangle.convert`` makes it, and a mask with the box of its
+pixels (libtrax's conversion); replies are rectangles.
 Images: ``path`` (read by :func:`dcfkit.datasets.read_frame`, with its checks) and ``memory``
 (``rgb`` or ``gray8``), on the ``color`` channel.
 
@@ -38,19 +39,16 @@ from ..datasets import read_frame
 from ..errors import DcfkitError, InputError, MissingDependency
 from ..tracker import Tracker
 from ..tracking import track
+from .trax_stream import ProtocolError, framed_connection
 
 try:
     import trax  # vot-trax: the optional dependency this module exists for
 except ImportError as exc:
     raise MissingDependency('the TraX server needs the vot-trax package: pip install "dcfkit[trax]"') from exc
 
-REGION_FORMATS = [trax.Region.RECTANGLE, trax.Region.POLYGON]
+REGION_FORMATS = [trax.Region.RECTANGLE, trax.Region.POLYGON, trax.Region.MASK]
 IMAGE_FORMATS = [trax.Image.PATH, trax.Image.MEMORY]
 CHANNEL = trax.ImageChannel.COLOR
-
-
-class ProtocolError(DcfkitError):
-    """The TraX connection failed (the client went away, or sent what libtrax cannot read)."""
 
 
 def serve(config: Mapping[str, Any]) -> None:
@@ -60,15 +58,17 @@ def serve(config: Mapping[str, Any]) -> None:
     as the reason of a ``quit``, then raised; a failed connection raises :class:`ProtocolError`."""
     with contextlib.redirect_stdout(sys.stderr):  # the protocol's messages are the only output on stdout
         Tracker(config)  # every check of the config, before the handshake: an error is said on stderr alone
-        server = _protocol(lambda: trax.Server(REGION_FORMATS, IMAGE_FORMATS, [CHANNEL], **_metadata(config)),
-                           "cannot start the server")
-        try:
-            _session(server, config)
-        except DcfkitError as exc:
-            if not isinstance(exc, ProtocolError):
-                _protocol(lambda: server.quit(reason=ascii_text(str(exc))), "cannot send quit")
-            raise
-        _protocol(server.quit, "cannot send quit")
+        with framed_connection() as framing:
+            link = _Link(framing)
+            server = link.call(lambda: trax.Server(REGION_FORMATS, IMAGE_FORMATS, [CHANNEL], **_metadata(config)),
+                               "cannot start the server")
+            try:
+                _session(server, link, config)
+            except DcfkitError as exc:
+                if not isinstance(exc, ProtocolError):
+                    link.call(lambda: server.quit(reason=ascii_text(str(exc))), "cannot send quit")
+                raise
+            link.call(server.quit, "cannot send quit")
 
 
 def _metadata(config: Mapping[str, Any]) -> dict:
@@ -85,28 +85,34 @@ def ascii_text(text: str) -> str:
     return "".join(letters).encode("ascii", "replace").decode("ascii")
 
 
-def _protocol(call, failure: str):
-    """``call()``, a failure of the connection said as a :class:`ProtocolError`: ``failure``,
-    then libtrax's words."""
-    try:
-        return call()
-    except trax.TraxException as exc:
-        raise ProtocolError(f"TraX: {failure} ({exc})") from None
+class _Link:
+    """Calls into libtrax, a failure said as a :class:`ProtocolError`: what failed, then why
+    (the framing's words when it refused the client's stream, else libtrax's)."""
+
+    def __init__(self, framing):
+        self.framing = framing
+
+    def call(self, call, failure: str):
+        try:
+            return call()
+        except trax.TraxException as exc:
+            if self.framing.error:
+                raise ProtocolError(f"TraX: {self.framing.error}") from None
+            raise ProtocolError(f"TraX: {failure} ({exc})") from None
+
+    def wait(self, server):
+        """The client's next request."""
+        return self.call(server.wait, "no request from the client: it closed the connection without sending quit, "
+                                      "or sent what the protocol does not allow")
 
 
-def _wait(server):
-    """The client's next request."""
-    return _protocol(server.wait, "no request from the client: it closed the connection without sending quit, "
-                                  "or sent what the protocol does not allow")
-
-
-def _session(server, config: Mapping[str, Any]) -> None:
+def _session(server, link: _Link, config: Mapping[str, Any]) -> None:
     """Track each object the client initialises until it quits."""
-    request = _wait(server)
+    request = link.wait(server)
     while request.type != trax.TraxStatus.QUIT:
         if request.type != trax.TraxStatus.INITIALIZE:
             raise DcfkitError("TraX: the client sent a frame before initializing an object")
-        run = _Run(server, request)
+        run = _Run(server, link, request)
         track(Tracker(config), run.images(), run.box, on_frame=run.reply)
         request = run.next_request
 
@@ -116,8 +122,8 @@ class _Run:
     :func:`dcfkit.tracking.track` reads them (numbered from 1, the initialising frame), and the
     replies it sends."""
 
-    def __init__(self, server, request):
-        self.server = server
+    def __init__(self, server, link: _Link, request):
+        self.server, self.link = server, link
         self.first = request
         (region, _properties), = request.objects  # the server is single-object: libtrax sends one
         self.box = region_box(region)
@@ -127,24 +133,32 @@ class _Run:
         request, frame = self.first, 1
         while True:
             yield read_image(request.image, f"frame {frame}")
-            request, frame = _wait(self.server), frame + 1
+            request, frame = self.link.wait(self.server), frame + 1
             if request.type != trax.TraxStatus.FRAME:
                 self.next_request = request
                 return
 
     def reply(self, index: int, image: np.ndarray, box: np.ndarray, tracker) -> None:
         region = trax.Rectangle.create(*(float(v) for v in box))
-        _protocol(lambda: self.server.status([(region, confidence_properties(tracker))]), "cannot reply")
+        self.link.call(lambda: self.server.status([(region, confidence_properties(tracker))]), "cannot reply")
 
 
 def region_box(region) -> tuple[float, float, float, float]:
-    """A TraX rectangle as ``(x, y, w, h)``; a polygon as its axis-aligned bounding box."""
+    """A TraX rectangle as ``(x, y, w, h)``; a polygon as its axis-aligned bounding box; a mask
+    as the box of its set pixels."""
     if region.type == trax.Region.RECTANGLE:
         return tuple(float(v) for v in region.bounds())
     if region.type == trax.Region.POLYGON:
         points = np.array(list(region), dtype=np.float64)
         (left, top), (right, bottom) = points.min(axis=0), points.max(axis=0)
         return float(left), float(top), float(right - left), float(bottom - top)
+    if region.type == trax.Region.MASK:
+        rows, columns = np.nonzero(region.array())
+        if rows.size == 0:
+            raise InputError("frame 1: the TraX mask has no pixel set; dcfkit needs a target to track")
+        x, y = region.offset()
+        return (float(x + columns.min()), float(y + rows.min()),
+                float(columns.max() - columns.min() + 1), float(rows.max() - rows.min() + 1))
     raise InputError(f"frame 1: a TraX {region.type} region; dcfkit takes a rectangle or a polygon")
 
 
