@@ -103,8 +103,9 @@ def _numpy_simd() -> str:
 
 def _blas() -> str:
     """numpy's BLAS (loaded with numpy) as threadpoolctl reads it: name, version, kernel."""
-    blas = [i for i in threadpool_info() if i.get("user_api") == "blas"]
+    blas = sorted((i for i in threadpool_info() if i.get("user_api") == "blas"),
+                  key=lambda i: ("numpy" not in str(i.get("filepath", "")), str(i.get("filepath", ""))))
     if not blas:
         return "unknown"
-    info = blas[0]
+    info = blas[0]  # numpy's: scipy, OpenCV and others may load BLAS libraries of their own, in any order
     return " ".join(str(p) for p in (info.get("internal_api"), info.get("version"), info.get("architecture")) if p)

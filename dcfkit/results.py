@@ -4,18 +4,22 @@
     one ``x,y,w,h`` line per frame, ``%.3f``, **1-based** (1 is added to x and y), so the
     MATLAB OTB/UAV123 toolkit and pysot read it unchanged. Frame 1 holds the initial
     ground-truth box; a lost target is ``nan,nan,nan,nan``.
-``FOLDER/<sequence>_time.txt``
+``FOLDER/<sequence>.time``
     tracker seconds per frame, one ``%.8f`` a line (decoding excluded; frame 1 is ``init``),
-    as the OTB and GOT-10k toolkits read them.
-``FOLDER/<sequence>_confidence.txt``
+    as the OTB and GOT-10k toolkits' ``_time.txt`` files hold them.
+``FOLDER/<sequence>.confidence``
     one ``peak,apce`` line per frame (:mod:`dcfkit.confidence`), ``%.6g``; ``nan,nan`` for
     frame 1 (``init``: no response), frames held as blank, and trackers without a confidence.
 ``FOLDER/<sequence>.json``
     sidecar: the run key (:func:`run_key`), the SHA-256 of the ``.txt`` as written (and of
     the time and confidence files), per-frame tracker seconds, fps, the config, the dcfkit
     and plugin versions. Written last: it marks the sequence as done.
-``FOLDER/<sequence>.error.json``
-    instead, when the tracker raised: frame (1-based), error, traceback.
+``FOLDER/<sequence>.error``
+    instead, when the tracker raised: frame (1-based), error, traceback, as JSON.
+
+Each kind of file has its own ending, and only boxes end in ``.txt``: any sequence name has
+files of its own (were ``car``'s time file ``car_time.txt``, it would be the boxes file of a
+sequence ``car_time``).
 
 Every file is written to a temporary file in the same folder and moved into place with
 ``os.replace``. A result is used only when its sidecar is well formed and its ``.txt``
@@ -57,7 +61,9 @@ from .registry import get_registry
 log = logging.getLogger(__name__)
 
 LABEL_KEYS = ("name", "description")  # config keys that never change a box
-TIME_SUFFIX, CONFIDENCE_SUFFIX = "_time", "_confidence"  # <sequence>_time.txt, <sequence>_confidence.txt
+# the endings of a sequence's files in a store; none is an ending of another
+BOXES_END, SIDECAR_END, ERROR_END, TIME_END, CONFIDENCE_END = ".txt", ".json", ".error", ".time", ".confidence"
+TOOLKIT_TIME_SUFFIX, TOOLKIT_CONFIDENCE_SUFFIX = "_time", "_confidence"  # <sequence>_time.txt, as toolkits write
 
 
 # --------------------------------------------------------------------------- identity
@@ -293,25 +299,25 @@ class SequenceResult:
 
 
 class ResultStore:
-    """The result files of one tracker configuration: ``folder/<sequence>.{txt,json,error.json}``."""
+    """The result files of one tracker configuration: ``folder/<sequence>.{txt,json,time,confidence,error}``."""
 
     def __init__(self, folder):
         self.folder = Path(folder)
 
     def boxes_path(self, name: str) -> Path:
-        return self.folder / f"{name}.txt"
+        return self.folder / f"{name}{BOXES_END}"
 
     def sidecar_path(self, name: str) -> Path:
-        return self.folder / f"{name}.json"
+        return self.folder / f"{name}{SIDECAR_END}"
 
     def error_path(self, name: str) -> Path:
-        return self.folder / f"{name}.error.json"
+        return self.folder / f"{name}{ERROR_END}"
 
     def time_path(self, name: str) -> Path:
-        return self.folder / f"{name}{TIME_SUFFIX}.txt"
+        return self.folder / f"{name}{TIME_END}"
 
     def confidence_path(self, name: str) -> Path:
-        return self.folder / f"{name}{CONFIDENCE_SUFFIX}.txt"
+        return self.folder / f"{name}{CONFIDENCE_END}"
 
     def _written(self, name: str) -> tuple[Path, ...]:
         """The files a finished run writes besides its sidecar."""
@@ -457,14 +463,15 @@ def load_results(out_dir, tracker_name: str, sequences: Iterable[Sequence | str]
 
 
 def result_files(folder) -> dict[str, Path]:
-    """``{sequence: folder/<sequence>.txt}``, leaving out ``*_time.txt`` (timings, written by
-    dcfkit and some toolkits) and ``*_confidence.txt`` (dcfkit's per-frame confidence); a
-    :class:`DatasetError` if ``folder`` is not a folder."""
+    """``{sequence: folder/<sequence>.txt}``; a ``*_time.txt`` or ``*_confidence.txt`` (the
+    timings and confidences of some toolkits and of dcfkit < 0.7) is left out unless a dcfkit
+    sidecar says it is a sequence's boxes. A :class:`DatasetError` if ``folder`` is not a folder."""
     folder = Path(folder)
     if not folder.is_dir():
         raise DatasetError(f"results folder not found: {clip(str(folder))}")
-    return {p.stem: p for p in sorted(folder.glob("*.txt"))
-            if not p.stem.endswith((TIME_SUFFIX, CONFIDENCE_SUFFIX))}
+    return {p.stem: p for p in sorted(folder.glob(f"*{BOXES_END}"))
+            if not p.stem.endswith((TOOLKIT_TIME_SUFFIX, TOOLKIT_CONFIDENCE_SUFFIX))
+            or p.with_suffix(SIDECAR_END).is_file()}
 
 
 def import_results(folder) -> dict[str, SequenceResult]:

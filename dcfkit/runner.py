@@ -4,7 +4,7 @@ process pool or on dask.distributed. ``dcfkit eval`` (:mod:`dcfkit.evaluation`) 
 
 Each run is :func:`dcfkit.tracking.track` on a fresh tracker, written to a
 :class:`dcfkit.results.ResultStore`; a tracker exception fails only its run (an
-``.error.json`` naming the 1-based frame and its file). Workers have one BLAS/OpenMP/OpenCV
+``.error`` naming the 1-based frame and its file). Workers have one BLAS/OpenMP/OpenCV
 thread each and die with the parent.
 """
 from __future__ import annotations

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 import os
 import queue
@@ -71,17 +72,19 @@ def open_source(video: str | None = None, frames: str | None = None) -> FrameSou
     if _is_camera(video):
         return _live_source(_open_camera(int(video)), video, camera=True)
     if URL.match(video):
-        cap = _quietly_opened(video, cv2.CAP_FFMPEG, [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, int(OPEN_TIMEOUT * 1000),
-                                                     cv2.CAP_PROP_READ_TIMEOUT_MSEC, int(READ_TIMEOUT * 1000)])
+        cap = _opened_in_thread(video, lambda: _quietly_opened(
+            video, cv2.CAP_FFMPEG, [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, int(OPEN_TIMEOUT * 1000),
+                                    cv2.CAP_PROP_READ_TIMEOUT_MSEC, int(READ_TIMEOUT * 1000)]))
         return _live_source(_checked(cap, video), video)
     path = Path(video)
     if not path.exists():
         raise InputError(f"--video: file not found: {clip(video)} (a camera is a number, 0 the first; a stream a URL)")
     if path.is_dir():
         raise InputError(f"--video: {clip(video)} is a folder: --frames reads a folder of images")
-    cap = _checked(cv2.VideoCapture(video), video)
     if not path.is_file():  # a named pipe, or a device such as /dev/video0
+        cap = _checked(_opened_in_thread(video, lambda: cv2.VideoCapture(video)), video)
         return _live_source(cap, video, camera=path.is_char_device())
+    cap = _checked(cv2.VideoCapture(video), video)
     declared = _declared_count(cap)
     return FrameSource(_file_frames(cap, video, declared), _name(video), total=declared or None,
                        fps=_declared_fps(cap))
@@ -90,6 +93,7 @@ def open_source(video: str | None = None, frames: str | None = None) -> FrameSou
 URL = re.compile(r"[A-Za-z][A-Za-z0-9+.-]*://")
 # OpenCV's FFmpeg timeouts for a URL (its defaults, set so that a stall is recognised)
 OPEN_TIMEOUT = READ_TIMEOUT = 30.0  # seconds
+WATCHDOG_MARGIN = 5.0  # dcfkit's own wait beyond them, for what FFmpeg's timeouts do not cover (named pipes)
 MAX_FPS = 1000.0  # a higher declared rate is a time base, not a frame rate
 
 
@@ -98,12 +102,15 @@ def _is_camera(video: str) -> bool:
 
 
 def _name(video: str) -> str:
-    """``--video`` as messages name it: ``camera 0``, a URL with its user and password hidden,
-    a file name; cut to a message's length."""
+    """``--video`` as messages name it: ``camera 0``, a URL with its user and password and the
+    values of its query (``?token=...``) hidden, a file name; cut to a message's length."""
     if _is_camera(video):
         return f"camera {video}"
+    if not URL.match(video):
+        return clip(video)
     # the user info ends at the last '@' before the path, as FFmpeg splits it: a password may hold '@'
-    return clip(re.sub(r"^([A-Za-z][A-Za-z0-9+.-]*://)[^/?#]*@", r"\1***@", video))
+    hidden = re.sub(r"^([A-Za-z][A-Za-z0-9+.-]*://)[^/?#]*@", r"\1***@", video)
+    return clip(re.sub(r"([?&;][^=&;#]*=)[^&;#]*", r"\1***", hidden))
 
 
 def _quietly_opened(*args) -> cv2.VideoCapture:
@@ -115,6 +122,29 @@ def _quietly_opened(*args) -> cv2.VideoCapture:
         return cv2.VideoCapture(*args)
     finally:
         cv2.utils.logging.setLogLevel(level)
+
+
+def _opened_in_thread(video: str, open_capture) -> cv2.VideoCapture:
+    """``open_capture()`` run in a thread, so that Ctrl-C or SIGTERM end the wait (OpenCV's
+    open of a named pipe blocks until a program opens it for writing, and FFmpeg's of a URL
+    until its timeout); a source not open within ``OPEN_TIMEOUT + WATCHDOG_MARGIN`` is an InputError."""
+    opened = queue.Queue(maxsize=1)
+
+    def run():
+        try:
+            opened.put((open_capture(), None))
+        except BaseException as exc:  # noqa: BLE001 - handed to the caller, raised there
+            opened.put((None, exc))
+
+    threading.Thread(target=run, name="dcfkit-open", daemon=True).start()
+    try:
+        cap, exc = opened.get(timeout=OPEN_TIMEOUT + WATCHDOG_MARGIN)
+    except queue.Empty:
+        raise InputError(f"--video: {_name(video)} did not open within {OPEN_TIMEOUT + WATCHDOG_MARGIN:g} s (a named pipe "
+                         f"opens when a program opens it for writing)") from None
+    if exc is not None:
+        raise exc
+    return cap
 
 
 def _open_camera(index: int) -> cv2.VideoCapture:
@@ -211,7 +241,7 @@ def _file_frames(cap: cv2.VideoCapture, video: str, declared: int) -> Iterator[n
 
 def _live_source(cap: cv2.VideoCapture, video: str, camera: bool = False) -> FrameSource:
     declared = 0 if camera else _declared_count(cap)
-    return FrameSource(_read_in_thread(_live_frames(cap, video, declared, camera)), _name(video),
+    return FrameSource(_read_in_thread(_live_frames(cap, video, declared, camera), _name(video)), _name(video),
                        total=declared or None, fps=_declared_fps(cap), live=True)
 
 
@@ -237,13 +267,34 @@ def _live_frames(cap: cv2.VideoCapture, video: str, declared: int, camera: bool)
 _END = object()
 
 
-def _read_in_thread(items: Iterator) -> Iterator:
+def _read_in_thread(items: Iterator, name: str) -> Iterator:
     """Yield ``items``, read in a thread at most one ahead, so that a run waiting for a frame
     of a live source ends at once on Ctrl-C or SIGTERM (OpenCV's read of a stalled stream
-    returns only at its timeout). An exception of ``items`` is raised here, in its place;
-    when the caller stops, the thread stops after its current read and closes ``items``."""
+    returns only at its timeout, of a stalled named pipe never). An exception of ``items`` is
+    raised here, in its place, and no item for ``READ_TIMEOUT + WATCHDOG_MARGIN`` is an
+    InputError naming ``name``; when the caller stops, the thread stops after its current read
+    and closes ``items``."""
     queue_, stop = queue.Queue(maxsize=1), threading.Event()
+    threading.Thread(target=_read_into, args=(items, queue_, stop), name="dcfkit-frames", daemon=True).start()
+    try:
+        for count in itertools.count():
+            try:
+                item, exc = queue_.get(timeout=READ_TIMEOUT + WATCHDOG_MARGIN)
+            except queue.Empty:
+                raise InputError(f"--video: {name} gave no frame for {READ_TIMEOUT + WATCHDOG_MARGIN:g} s after "
+                                 f"frame {count}: the stream stalled") from None
+            if exc is not None:
+                raise exc
+            if item is _END:
+                return
+            yield item
+    finally:
+        stop.set()
 
+
+def _read_into(items: Iterator, queue_: queue.Queue, stop: threading.Event) -> None:
+    """The reading thread of :func:`_read_in_thread`: ``(item, None)`` for each item, then
+    ``(_END, None)`` or ``(None, exception)``, until ``stop`` is set; then ``items`` is closed."""
     def put(entry) -> bool:
         while not stop.is_set():
             try:
@@ -253,28 +304,15 @@ def _read_in_thread(items: Iterator) -> Iterator:
                 pass
         return False
 
-    def read():
-        try:
-            for item in items:
-                if not put((item, None)):
-                    return
-            put((_END, None))
-        except BaseException as exc:  # noqa: BLE001 - handed to the caller, raised there
-            put((None, exc))
-        finally:
-            items.close()
-
-    threading.Thread(target=read, name="dcfkit-frames", daemon=True).start()
     try:
-        while True:
-            item, exc = queue_.get()
-            if exc is not None:
-                raise exc
-            if item is _END:
+        for item in items:
+            if not put((item, None)):
                 return
-            yield item
+        put((_END, None))
+    except BaseException as exc:  # noqa: BLE001 - handed to the caller, raised there
+        put((None, exc))
     finally:
-        stop.set()
+        items.close()
 
 
 # OpenCV's names (CAP_PROP_FOURCC) of codecs whose frames are each a JPEG

@@ -238,7 +238,7 @@ def test_cli_names_the_variants_of_a_failed_run(tmp_path, data, capsys):
 def done_sidecars(out: Path) -> dict[Path, tuple]:
     """Sidecars of finished runs -> (inode, mtime_ns, content)."""
     return {p: (p.stat().st_ino, p.stat().st_mtime_ns, p.read_bytes())
-            for p in out.glob("jobs/*/*/*.json") if not p.name.endswith(".error.json")}
+            for p in out.glob("jobs/*/*/*.json")}
 
 
 def children(pid: int) -> list[int]:
@@ -377,7 +377,7 @@ variants: {s: {config: strcf, overrides: {scale.n_scales: 3}}}
     assert sorted(res["done"]) == [(key, "seqA"), (key, "seqC")]
     assert list(res["failed"]) == [(key, "seqB")]
     assert "0005.jpg" in res["failed"][key, "seqB"] and "not a readable image" in res["failed"][key, "seqB"]
-    record = json.loads((out / "jobs" / "otb" / key / "seqB.error.json").read_text())
+    record = json.loads((out / "jobs" / "otb" / key / "seqB.error").read_text())
     assert record["frame"] == 5 and record["frame_file"] == str(broken.resolve())
     assert not (out / "jobs" / "otb" / key / "seqB.txt").exists()
     rows = {r["sequence"]: r for r in res["summary"]["per_sequence"]}
@@ -421,8 +421,8 @@ variants:
         dask = run_ablation(spec, tmp_path / "dask", executor="dask", scheduler=cluster.scheduler_address,
                             progress=False)
     assert len(local["done"]) == len(dask["done"]) == 4 and not local["failed"] and not dask["failed"]
-    files = sorted(p.relative_to(tmp_path / "local") for p in (tmp_path / "local").glob("jobs/*/*/*.txt")
-                   if not p.stem.endswith("_time"))  # the boxes and the confidence; timings differ
+    files = sorted(p.relative_to(tmp_path / "local") for pattern in ("jobs/*/*/*.txt", "jobs/*/*/*.confidence")
+                   for p in (tmp_path / "local").glob(pattern))  # the boxes and the confidence; timings differ
     assert len(files) == 8
     for rel in files:
         assert (tmp_path / "dask" / rel).read_text() == (tmp_path / "local" / rel).read_text(), rel

@@ -125,17 +125,17 @@ def test_eval_writes_time_and_confidence_files_beside_the_boxes(tmp_path):
     config = {**load_tracker("strcf").config, "name": "strcf"}
     assert run_one_pass(config, [sequence], tmp_path / "out", progress=False)["done"] == ["syn"]
     d = tmp_path / "out" / "strcf"
-    times, confidence = np.loadtxt(d / "syn_time.txt"), np.loadtxt(d / "syn_confidence.txt", delimiter=",")
+    times, confidence = np.loadtxt(d / "syn.time"), np.loadtxt(d / "syn.confidence", delimiter=",")
     assert times.shape == (10,) and (times > 0).all()
     assert confidence.shape == (10, 2) and np.isnan(confidence[0]).all() and (confidence[1:, 1] > 1).all()
     meta = json.loads((d / "syn.json").read_text())
     np.testing.assert_allclose(times, meta["times"], atol=1e-8)
-    assert meta["time_sha256"] == checksum((d / "syn_time.txt").read_bytes())
-    assert meta["confidence_sha256"] == checksum((d / "syn_confidence.txt").read_bytes())
+    assert meta["time_sha256"] == checksum((d / "syn.time").read_bytes())
+    assert meta["confidence_sha256"] == checksum((d / "syn.confidence").read_bytes())
     # the same boxes as track() gives, and the extra files are never taken for results
     run = track(load_tracker("strcf"), seq.frames, seq.ground_truth[0])
     np.testing.assert_allclose(load_results(tmp_path / "out", "strcf", [sequence])["syn"].boxes, run.boxes, atol=6e-4)
     np.testing.assert_allclose(confidence[1:], run.confidence[1:], rtol=1e-5)
     assert list(result_files(d)) == ["syn"]
     ResultStore(d).write_failure(sequence, {"run_key": "x"}, ValueError("boom"))  # a failure removes them all
-    assert sorted(p.name for p in d.iterdir() if p.name != ".locks") == ["syn.error.json"]
+    assert sorted(p.name for p in d.iterdir() if p.name != ".locks") == ["syn.error"]

@@ -101,7 +101,7 @@ def test_result_files_are_one_based_with_sidecar(tmp_path, seqs):
     summary = run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
     assert summary["done"] == ["a", "b", "c"] and not summary["failed"] and not summary["skipped"]
     d = tmp_path / "out" / "drift"
-    assert files(d) == {f"{n}{end}" for n in "abc" for end in (".txt", ".json", "_time.txt", "_confidence.txt")}
+    assert files(d) == {f"{n}{end}" for n in "abc" for end in (".txt", ".json", ".time", ".confidence")}
     lines = (d / "a.txt").read_text().splitlines()
     assert lines[0] == "3.000,4.000,5.000,6.000"  # 0-based (2, 3) written 1-based
     assert lines[5] == "8.000,4.000,5.000,6.000"
@@ -109,10 +109,10 @@ def test_result_files_are_one_based_with_sidecar(tmp_path, seqs):
     assert meta["run_key"] == run_key(CONFIG) == summary["run_key"]
     assert meta["dcfkit_version"] == results.dcfkit_version()
     assert len(meta["times"]) == N_FRAMES and meta["fps"] > 0 and meta["config"] == CONFIG
-    times = np.loadtxt(d / "a_time.txt")  # the toolkits' time file: one float a line
+    times = np.loadtxt(d / "a.time")  # the toolkits' time file: one float a line
     np.testing.assert_allclose(times, meta["times"], atol=1e-8)
     # DriftTracker has no last_confidence: every line nan,nan
-    assert (d / "a_confidence.txt").read_text() == "nan,nan\n" * N_FRAMES
+    assert (d / "a.confidence").read_text() == "nan,nan\n" * N_FRAMES
     res = load_results(tmp_path / "out", "drift", seqs)
     np.testing.assert_allclose(res["b"].boxes, gt_boxes())
     assert res["b"].times.shape == (N_FRAMES,) and res["b"].fps > 0
@@ -275,7 +275,7 @@ def test_default_trackers_are_warmed_up_once_per_process_and_config(tmp_path, se
     # an unreadable first frame is reported as frame 1 of its file, warm-up or not
     seqs[0].frames[0].write_bytes(b"not an image")
     summary = run_one_pass({**CONFIG, "drift": 4.0}, seqs[:1], tmp_path, progress=False)
-    record = json.loads((tmp_path / "drift" / "a.error.json").read_text())
+    record = json.loads((tmp_path / "drift" / "a.error").read_text())
     assert record["frame"] == 1 and record["frame_file"] == str(seqs[0].frames[0])
     assert "cannot read frame 1 " in summary["failed"]["a"]
 
@@ -284,7 +284,7 @@ def test_crash_mid_sequence_leaves_no_partial_result(tmp_path, seqs):
     with pytest.raises(Crash):
         run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter({2: (3, Crash)}), progress=False)
     d = tmp_path / "drift"
-    assert files(d) == {"a.txt", "a.json", "a_time.txt", "a_confidence.txt"}  # no half file, no temp file
+    assert files(d) == {"a.txt", "a.json", "a.time", "a.confidence"}  # no half file, no temp file
     rerun = Counter()
     summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=rerun, progress=False)
     assert rerun.made == 2 and summary["done"] == ["b", "c"] and summary["skipped"] == ["a"]
@@ -332,12 +332,12 @@ def test_tracker_failure_is_isolated_and_retried(tmp_path, seqs, caplog):
     assert "'b'" in message and "frame 3 of 6" in message and "00003.jpg" in message and "boom" in message
     assert "frame 3 of 6" in caplog.text
     d = tmp_path / "drift"
-    record = json.loads((d / "b.error.json").read_text())
+    record = json.loads((d / "b.error").read_text())
     assert record["frame"] == 3 and record["type"] == "ValueError" and "boom" in record["traceback"]
     assert not (d / "b.txt").exists() and set(load_results(tmp_path, "drift", seqs)) == {"a", "c"}
     rerun = Counter()
     summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=rerun, progress=False)
-    assert rerun.made == 1 and summary["done"] == ["b"] and not (d / "b.error.json").exists()
+    assert rerun.made == 1 and summary["done"] == ["b"] and not (d / "b.error").exists()
 
 
 def test_bad_box_and_factory_errors_are_failures(tmp_path, seqs):
@@ -506,7 +506,7 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
     assert cli_evaluate.run_eval(args) == 0
     assert seen["overrides"] == {"drift": 0.5}
     assert files(tmp_path / "out" / "fast") == {f"{n}{end}" for n in "ac"
-                                                for end in (".txt", ".json", "_time.txt", "_confidence.txt")}
+                                                for end in (".txt", ".json", ".time", ".confidence")}
     printed = capsys.readouterr().out
     assert "fast: 2 run, 0 already done, 0 failed" in printed
     # the drift tracker lags the ground truth by 0.5k px on frame k (boxes 5x6): IoU (5-0.5k)/(5+0.5k) =
@@ -590,7 +590,7 @@ def test_a_dead_worker_fails_its_sequences_with_error_records(tmp_path, seqs):
     summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=make_dying, jobs=2, progress=False)
     assert "b" in summary["failed"] and "a worker process died" in summary["failed"]["b"]
     for name in summary["failed"]:
-        record = json.loads((tmp_path / "drift" / f"{name}.error.json").read_text())
+        record = json.loads((tmp_path / "drift" / f"{name}.error").read_text())
         assert record["type"] == "BrokenProcessPool" and record["sequence"] == name
     assert set(summary["failed"]) | set(summary["done"]) == {"a", "b", "c"}
 

@@ -1,5 +1,6 @@
 """Live and streamed input of `dcfkit track`: streams, URLs, cameras and pipes read a frame at
 a time, boxes out as each frame is tracked, the saved video's rate, interruptions, progress."""
+import contextlib
 import functools
 import http.server
 import io
@@ -149,6 +150,64 @@ def test_a_named_pipe_gives_the_frames_of_the_file(tmp_path):
     assert len(frames) == 20
 
 
+def test_a_named_pipe_nobody_writes_to_is_an_error_and_sigterm_ends_the_wait(tmp_path, monkeypatch):
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    monkeypatch.setattr(video, "OPEN_TIMEOUT", 0.5)
+    monkeypatch.setattr(video, "WATCHDOG_MARGIN", 0.5)
+    with pytest.raises(InputError, match=r"--video: .*pipe did not open within 1 s \(a named pipe opens when"):
+        open_source(str(pipe))
+    os.close(os.open(pipe, os.O_WRONLY))  # the open left waiting gets its writer, then the end: OpenCV is free
+    run = subprocess.Popen([sys.executable, "-m", "dcfkit.cli", "track", "kcf", "--video", str(pipe),
+                            "--box", "1,1,9,9"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    waiting_for_a_writer(run.pid)
+    run.send_signal(signal.SIGTERM)
+    try:
+        _, err = run.communicate(timeout=20)
+    finally:
+        run.kill()
+    assert run.returncode == 128 + signal.SIGTERM and err.endswith("dcfkit track: interrupted (SIGTERM)\n")
+
+
+def waiting_for_a_writer(pid: int, seconds: float = 60) -> None:
+    """Return once a thread of process ``pid`` waits in the open of a named pipe (Linux's
+    ``wait_for_partner``), where the command used to hang through SIGTERM."""
+    tasks = Path(f"/proc/{pid}/task")
+    if not tasks.is_dir():
+        pytest.skip("needs Linux's /proc to see where the process waits")
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        with contextlib.suppress(OSError):
+            if any((task / "wchan").read_text() == "wait_for_partner" for task in tasks.iterdir()):
+                return
+        time.sleep(0.1)
+    pytest.fail("the command never waited in the open of the named pipe")
+
+
+def test_a_named_pipe_whose_writer_stalls_mid_clip_ends_the_run(tmp_path, monkeypatch):
+    clip = write_video(tmp_path / "clip.avi").read_bytes()
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    release = threading.Event()
+
+    def write_half():
+        with open(pipe, "wb") as f:
+            f.write(clip[:len(clip) // 2])
+            f.flush()
+            release.wait(30)  # the pipe stays open, nothing more comes
+
+    threading.Thread(target=write_half, daemon=True).start()
+    monkeypatch.setattr(video, "READ_TIMEOUT", 0.5)
+    monkeypatch.setattr(video, "WATCHDOG_MARGIN", 0.5)
+    got = []
+    try:
+        with pytest.raises(InputError, match=r"pipe gave no frame for 1 s after frame \d+: the stream stalled"):
+            got.extend(open_source(str(pipe)).frames)
+    finally:
+        release.set()
+    assert 0 < len(got) < 20
+
+
 def test_a_stalled_stream_ends_the_run_naming_the_last_frame(monkeypatch):
     """No frame for READ_TIMEOUT: OpenCV's read gives up and reports an end, which is told
     from the end of a stream by the time it waited."""
@@ -192,7 +251,7 @@ def test_a_url_that_does_not_open_is_named_without_its_password(capsys):
 
 def test_a_password_with_an_at_sign_is_hidden_whole():
     # FFmpeg (av_url_split) takes the user info up to the last '@' before the path
-    assert video._name("rtsp://user:p@ss@cam.local:554/live?x=a@b") == "rtsp://***@cam.local:554/live?x=a@b"
+    assert video._name("rtsp://user:p@ss@cam.local:554/live?x=a@b") == "rtsp://***@cam.local:554/live?x=***"
     assert video._name("http://cam.local/a@b") == "http://cam.local/a@b"  # an '@' in the path is no user info
 
 
@@ -287,7 +346,7 @@ def test_frames_read_in_a_thread_come_in_order_with_the_error_in_its_place():
 
     got = []
     with pytest.raises(InputError, match="frame 3 is damaged"):
-        got.extend(video._read_in_thread(items()))
+        got.extend(video._read_in_thread(items(), "clip"))
     assert got == [1, 2]
 
 
@@ -300,7 +359,7 @@ def test_a_caller_that_stops_stops_the_thread_which_closes_the_frames():
         finally:
             closed.set()
 
-    frames = video._read_in_thread(items())
+    frames = video._read_in_thread(items(), "clip")
     assert next(frames) == 0
     frames.close()
     assert closed.wait(10)

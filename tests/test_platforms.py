@@ -130,3 +130,17 @@ def test_report_command_names_each_trackers_platform(tmp_path, seqs, capsys):  #
     assert "warning: these results come from 2 platforms" in err
     saved = json.loads((tmp_path / "report" / "report.json").read_text())
     assert saved["platforms"]["elsewhere"] == [[platforms.describe(RECORD), 3]]
+
+
+def test_the_blas_recorded_is_numpys_whichever_library_loaded_first(monkeypatch):
+    """A worker that imports scipy or OpenCV first lists their BLAS first: the record must not
+    change with it (eval --jobs 2 once warned of two platforms on one machine)."""
+    from dcfkit import platforms
+
+    numpy_blas = {"user_api": "blas", "internal_api": "openblas", "version": "0.3.31", "architecture": "Haswell",
+                  "filepath": "/site-packages/numpy.libs/libscipy_openblas64_.so"}
+    other_blas = {"user_api": "blas", "internal_api": "openblas", "version": "0.3.15", "architecture": "Haswell",
+                  "filepath": "/usr/lib/libopenblas.so.0"}
+    for order in ([numpy_blas, other_blas], [other_blas, numpy_blas]):
+        monkeypatch.setattr(platforms, "threadpool_info", lambda order=order: order)
+        assert platforms._blas() == "openblas 0.3.31 Haswell"

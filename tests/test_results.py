@@ -221,7 +221,7 @@ def test_a_terminated_eval_keeps_finished_sequences_and_leaves_no_partial_file(t
         with interrupt_on_termination():
             run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Terminated, progress=False)
     assert sorted(load_results(tmp_path, "drift", seqs)) == ["a"]
-    assert sorted(p.name for p in (tmp_path / "drift").iterdir()) == [".locks", "a.json", "a.txt", "a_confidence.txt", "a_time.txt"]
+    assert sorted(p.name for p in (tmp_path / "drift").iterdir()) == [".locks", "a.confidence", "a.json", "a.time", "a.txt"]
 
 
 def test_finished_results_in_a_read_only_folder_are_still_scored(tmp_path, seqs, monkeypatch):
@@ -255,3 +255,40 @@ def test_an_imported_tracker_folder_named_report_is_refused_as_report_folder(tmp
                                                                    .read_text())
     with pytest.raises(DcfkitError, match=r"report holds a tracker's results"):
         report.write_report(tmp_path / "out", seqs)
+
+
+def test_any_sequence_names_have_files_of_their_own(tmp_path, capsys):
+    """``car``, ``car_time``, ``car_confidence`` and ``car.error`` in one OTB root, run with two
+    workers: each sequence's files are those of its run alone, byte for byte, and ``report``
+    and ``compare`` score all four."""
+    import cv2
+
+    from dcfkit.cli import main
+    from dcfkit.synthetic import make_sequence
+
+    names = ["car", "car_time", "car_confidence", "car.error"]
+    root = tmp_path / "data"
+    for seed, name in enumerate(names):
+        seq = make_sequence(n_frames=8, size=(96, 128), target=(14, 18), seed=seed)
+        (root / name / "img").mkdir(parents=True)
+        for k, frame in enumerate(seq.frames):
+            cv2.imwrite(str(root / name / "img" / f"{k + 1:04d}.jpg"), frame)
+        (root / name / "groundtruth_rect.txt").write_text(
+            "".join("%g,%g,%g,%g\n" % tuple(b) for b in seq.ground_truth + [1, 1, 0, 0]))
+    eval_args = ["eval", "kcf", "--dataset", "otb", "--root", str(root), "--no-progress"]
+    assert main([*eval_args, "--out", str(tmp_path / "together"), "--jobs", "2"]) == 0
+    for name in names:
+        assert main([*eval_args, "--out", str(tmp_path / "alone" / name), "--sequences", name]) == 0
+    together = tmp_path / "together" / "kcf"
+    for name in names:
+        alone = tmp_path / "alone" / name / "kcf"
+        for end in (".txt", ".confidence"):
+            assert (together / f"{name}{end}").read_bytes() == (alone / f"{name}{end}").read_bytes(), (name, end)
+    capsys.readouterr()
+    assert main(["report", str(tmp_path / "together"), "--dataset", "otb", "--root", str(root)]) == 0
+    out = capsys.readouterr()
+    assert not out.err and re.search(r"\nkcf +[\d.]+ +[\d.]+ +[\d.]+ +[\d.]+ +4 +0\n", out.out), out
+    assert main(["compare", str(together), str(together), "--dataset", "otb", "--root", str(root),
+                 "--format", "csv"]) == 0
+    rows = capsys.readouterr().out.strip().splitlines()[1:]
+    assert sorted(row.split(",")[0] for row in rows) == sorted(names + ["mean"])

@@ -8,10 +8,10 @@ resolved config of :func:`dcfkit.config.load_config`.
 Results are stored per *run*, keyed by what determines the boxes::
 
     OUT/jobs/<dataset>/<key>/<sequence>.txt          1-based x,y,w,h per frame
-    OUT/jobs/<dataset>/<key>/<sequence>_time.txt     seconds per frame (as dcfkit eval)
-    OUT/jobs/<dataset>/<key>/<sequence>_confidence.txt  peak,apce per frame (as dcfkit eval)
+    OUT/jobs/<dataset>/<key>/<sequence>.time         seconds per frame (as dcfkit eval)
+    OUT/jobs/<dataset>/<key>/<sequence>.confidence   peak,apce per frame (as dcfkit eval)
     OUT/jobs/<dataset>/<key>/<sequence>.json         sidecar (times, fps, config hash); marks done
-    OUT/jobs/<dataset>/<key>/<sequence>.error.json   instead, when the tracker raised
+    OUT/jobs/<dataset>/<key>/<sequence>.error        instead, when the tracker raised
     OUT/configs/<key>.json                           the config behind <key>
 
 ``key`` is :func:`dcfkit.results.run_key` of the resolved config (``dcfkit eval`` uses the

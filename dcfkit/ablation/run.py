@@ -23,7 +23,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     cores; ``jobs=1`` runs in this process) or ``"dask"`` (``Client(scheduler)``, or a
     ``LocalCluster`` of ``jobs`` single-threaded worker processes when ``scheduler`` is
     None; workers need the dataset and ``out`` at the same paths). A failing job is
-    recorded (``.error.json``) and does not stop the others.
+    recorded (``.error``) and does not stop the others.
 
     Returns a plain dict: ``jobs`` (the :class:`Job` list), ``runs`` (distinct
     (key, sequence) pairs), ``done`` / ``skipped`` / ``failed`` (run -> message) and

@@ -13,7 +13,8 @@ import numpy as np
 from ..config import parse_overrides
 from ..errors import clip
 from ..metrics import score_sequence
-from ..results import CONFIDENCE_SUFFIX, TIME_SUFFIX, StoreError, format_boxes, format_confidence, format_times
+from ..results import (TOOLKIT_CONFIDENCE_SUFFIX, TOOLKIT_TIME_SUFFIX, StoreError, format_boxes,
+                       format_confidence, format_times)
 from ..selection import check_display, select_box
 from ..synthetic import make_sequence
 from ..tracker import load_tracker
@@ -131,7 +132,7 @@ class BoxLines:
 
     def __init__(self, out: Path | None, offset: float):
         self.out, self.offset = out, offset
-        self.paths = [out, beside(out, CONFIDENCE_SUFFIX), beside(out, TIME_SUFFIX)] if out else []
+        self.paths = [out, beside(out, TOOLKIT_CONFIDENCE_SUFFIX), beside(out, TOOLKIT_TIME_SUFFIX)] if out else []
         for path in self.paths[1:]:
             check_output_file(path, "--out")
         self.files, self.count, self.seconds, self.bar = [], 0, 0.0, None
