@@ -54,15 +54,3 @@ def describe_error(exc: BaseException) -> str:
         return f"{text} (at {exc.filename}:{exc.lineno})"
     frames = traceback.extract_tb(exc.__traceback__)
     return f"{text} (at {frames[-1].filename}:{frames[-1].lineno})" if frames else text
-
-
-@contextlib.contextmanager
-def blamed_on(what: str):
-    """Inside, an unexpected exception (a component's bug) becomes a :class:`TrackingError`
-    ``"<what> raised <Type: message (at file:line)>"``; dcfkit's own errors pass through."""
-    try:
-        yield
-    except DcfkitError:
-        raise
-    except Exception as exc:
-        raise TrackingError(f"{what} raised {describe_error(exc)}") from exc

@@ -26,6 +26,7 @@ import dataclasses
 
 import numpy as np
 
+from .contracts import array, pair, within_grid
 from .params import param
 from .patches import round_half_away
 from .registry import Component, Contract
@@ -65,7 +66,9 @@ class Label(Component):
     target), then ``make`` once per training frame: ``detection`` None on the first."""
 
     kind = "label"
-    contract = Contract(required={"make": ("g", "detection")}, optional={"reset": ()})
+    contract = Contract(required={"make": ("g", "detection")}, optional={"reset": ()},
+                        returns={"make": pair(array(lambda args, label: args[0].shape), within_grid,
+                                              ("y", "offsets"))})
 
     def make(self, g: np.ndarray, detection: Detection | None) -> tuple[np.ndarray, np.ndarray]:
         """Training label from the base Gaussian ``g`` and the last detection.

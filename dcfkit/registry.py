@@ -22,10 +22,11 @@ import signal
 import types
 import typing
 import warnings
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import pluggy
 
+from .contracts import checked
 from .errors import ConfigError, DcfkitError, RegistryError, clip, describe_error, shown
 from .params import NoParams, check_schema, closest, parse_params
 from .signals import handlers_replaced
@@ -76,11 +77,18 @@ class Contract:
     ``params``: ``Params`` fields the tracker reads, name -> (type, lowest, highest): the field
     must exist with that annotation, and a value outside the range is a ConfigError whenever
     the component is built (the arithmetic that receives it needs the range).
+    ``returns``: method -> the check of what it returns (:mod:`dcfkit.contracts`), run on every
+    call of a built component.
     """
 
     required: Mapping[str, tuple[str, ...]] = dataclasses.field(default_factory=dict)
     optional: Mapping[str, tuple[str, ...]] = dataclasses.field(default_factory=dict)
     params: Mapping[str, tuple[type, float, float]] = dataclasses.field(default_factory=dict)
+    returns: Mapping[str, Callable] = dataclasses.field(default_factory=dict)
+
+    def hooks(self) -> dict[str, Callable | None]:
+        """Every method the tracker calls -> its return check (None: none)."""
+        return {m: self.returns.get(m) for m in (*self.required, *self.optional)}
 
 
 def base_classes(kind: str) -> tuple[type, ...]:
@@ -327,7 +335,7 @@ class Registry:
         where = f"{where} ({kind} '{name}')"
         params = parse_params(entry.cls.Params, values, where)
         check_contract_values(entry.contract, params, where)
-        return entry.cls(params)
+        return checked(entry.cls(params), entry.provider, entry.contract.hooks())
 
     def _check_kind(self, kind: str) -> dict[str, Entry]:
         if kind not in self._entries:

@@ -14,10 +14,21 @@ import math
 
 import numpy as np
 
+from .contracts import positive_vector, scalar
 from .features.fhog import ARITHMETICS, fhog
 from .params import param
 from .patches import resize_auto, sample, sampler, whole_pixel_crop
 from .registry import Component, Contract
+
+
+def _within_limits(value, args, estimator) -> str | None:
+    """``update``'s scale: a number > 0, within the ``limits`` ``init`` gave the estimator
+    (when it keeps them, as the base class does)."""
+    problem = scalar(0, math.inf, above=True)(value, args, estimator)
+    limits = getattr(estimator, "limits", None)
+    if problem is None and limits is not None and not limits[0] * (1 - 1e-9) <= float(value) <= limits[1] * (1 + 1e-9):
+        problem = f"{float(value)!r}, outside the limits [{limits[0]:g}, {limits[1]:g}] init gave it"
+    return problem
 
 
 class ScaleEstimator(Component):
@@ -27,7 +38,8 @@ class ScaleEstimator(Component):
 
     kind = "scale"
     contract = Contract(optional={"init": ("image", "centre", "base_target", "scale", "limits"),
-                                  "search_factors": (), "update": ("image", "centre", "scale")})
+                                  "search_factors": (), "update": ("image", "centre", "scale")},
+                        returns={"search_factors": positive_vector, "update": _within_limits})
 
     def init(self, image: np.ndarray, centre: np.ndarray, base_target: np.ndarray, scale: float,
              limits: tuple[float, float]) -> None:

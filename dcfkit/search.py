@@ -5,6 +5,7 @@ import dataclasses
 
 import numpy as np
 
+from .contracts import array
 from .params import param
 from .registry import Component, Contract
 
@@ -15,7 +16,8 @@ class Search(Component):
     is found on it (not on a held blank frame). Positions are (y, x) image pixels, finite."""
 
     kind = "search"
-    contract = Contract(optional={"reset": ("position",), "centre": (), "observe": ("position",)})
+    contract = Contract(optional={"reset": ("position",), "centre": (), "observe": ("position",)},
+                        returns={"centre": array((2,), kinds="iuf")})
 
     def reset(self, position: np.ndarray) -> None:
         """Start at the first frame's target centre (y, x)."""

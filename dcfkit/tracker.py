@@ -22,14 +22,14 @@ import numpy as np
 
 from .confidence import Confidence
 from .config import TrackerParams, load_config
-from .errors import ConfigError, InputError, TrackingError, blamed_on, shown
+from .contracts import naming_the_frame
+from .errors import ConfigError, InputError, TrackingError, shown
 from .features import extract_stack
 from .fft import make_fft
 from .labels import Detection, gaussian_label
 from .limits import SAMPLE_PIXELS_VARIABLE, sample_budget
 from .patches import box_to_centre_size, centre_size_to_box, cropper, round_half_away, sampler, whole_pixel_sampler
 from .registry import get_registry
-from .regularizers import MAX_THETA
 from .response import newton_peak, shift_spectrum, subpixel_peak
 from .scale import DSST, scale_limits
 
@@ -210,7 +210,7 @@ class Tracker:
 
     def _spectrum(self, patch: np.ndarray) -> np.ndarray:
         """(C, H, Wr) complex64 spectrum of the windowed features of a search patch."""
-        x = extract_stack(self.features, patch, self.geometry.cell_size, f"frame {self.frame}: ")
+        x = extract_stack(self.features, patch, self.geometry.cell_size)
         return self.fft.rfft2(x * self.window).astype(np.complex64, copy=False)
 
     def _sample(self, image: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
@@ -223,6 +223,7 @@ class Tracker:
         return std if std < self.params.blank_std else None
 
     # -- Algorithm 1 ------------------------------------------------------------------------
+    @naming_the_frame(lambda tracker: 1)
     def init(self, image: np.ndarray, box) -> None:
         """Frame 1: learn the first filter at ``box`` (x, y, w, h)."""
         image = check_image(image, 1)
@@ -299,6 +300,7 @@ class Tracker:
         else:
             sampler(shape, centre, region, np.full(2, np.ceil(2 * d.cell_size * span)))
 
+    @naming_the_frame(lambda tracker: tracker.frame)
     def update(self, image: np.ndarray) -> tuple[float, float, float, float]:
         """Frame t > 1: locate the target, return its box (x, y, w, h), and learn from it."""
         if self.frame == 0:
@@ -344,43 +346,19 @@ class Tracker:
         return self.box
 
     def _response(self, samples: np.ndarray) -> np.ndarray:
-        """The solver's (S, H, W) response maps of the (S, C, H, Wr) search samples, checked."""
-        expected = (len(samples), *self.geometry.filter_size)
-        with blamed_on(f"frame {self.frame}: solver '{self.solver.name}'"):
-            maps = np.asarray(self.solver.response(self.hf, samples, self.geometry.filter_size, self.fft))
-        if maps.shape != expected:
-            raise TrackingError(f"frame {self.frame}: solver '{self.solver.name}' response() returned shape "
-                                f"{maps.shape}, expected {expected}")
-        return maps
+        """The solver's (S, H, W) response maps of the (S, C, H, Wr) search samples."""
+        return self.solver.response(self.hf, samples, self.geometry.filter_size, self.fft)
 
     def _observe(self, detection: Detection) -> None:
         """Give the detection to the components that adapt to it: the solver, and the spatial
         regularizer, whose w² it returns is used from this frame on."""
-        with blamed_on(f"frame {self.frame}: solver '{self.solver.name}'"):
-            self.solver.observe(detection)
-        if self.spatial is None:
-            return
-        what = f"frame {self.frame}: spatial regularizer '{self.spatial.name}'"
-        with blamed_on(what):
-            w2 = np.asarray(self.spatial.adapt(self.w2, detection))
-        if w2.shape != self.w2.shape or w2.dtype.kind not in "iuf":
-            raise TrackingError(f"{what}: adapt() must return real w² of shape {self.w2.shape}, got "
-                                f"shape {w2.shape} of dtype {w2.dtype}")
-        if np.isnan(w2).any() or (w2 < 0).any():
-            raise TrackingError(f"{what}: adapt() returned w² with NaN or negative values (it must be >= 0; "
-                                f"inf is allowed)")
-        self.w2 = w2.astype(np.float32, copy=False)
+        self.solver.observe(detection)
+        if self.spatial is not None:
+            self.w2 = self.spatial.adapt(self.w2, detection).astype(np.float32, copy=False)
 
     def _theta(self, detection: Detection | None) -> float:
         """θ of this frame's training (0 without a temporal term; ``inf``: keep the last filter)."""
-        if self.temporal is None:
-            return 0.0
-        what = f"frame {self.frame}: temporal regularizer '{self.temporal.name}'"
-        with blamed_on(what):
-            theta = float(self.temporal.weight(detection))
-        if not (0 <= theta <= MAX_THETA or theta == np.inf):
-            raise TrackingError(f"{what}: weight() returned θ = {theta!r}, expected [0, {MAX_THETA:g}] or inf")
-        return theta
+        return 0.0 if self.temporal is None else float(self.temporal.weight(detection))
 
     def _peak(self, maps: np.ndarray) -> tuple[int, float, float]:
         """The search scale whose response is best and its peak as a (dy, dx) offset in cells."""
@@ -407,23 +385,9 @@ class Tracker:
             np.zeros((0, 2))
 
     def _label(self, detection: Detection | None) -> tuple[np.ndarray, np.ndarray]:
-        """The label component's ``(y, offsets)``, with what a (plugin) label got wrong said as a
-        TrackingError naming the frame."""
-        what = f"frame {self.frame}: label '{self.label.name}'"
-        with blamed_on(what):
-            out = self.label.make(self.base_label, detection)
-        if not (isinstance(out, tuple) and len(out) == 2):
-            raise TrackingError(f"{what}: make() must return (y, offsets), got {type(out).__name__}")
-        y, offsets = np.asarray(out[0]), np.asarray(out[1])
-        if y.shape != self.base_label.shape:
-            raise TrackingError(f"{what} returned y of shape {y.shape}, expected g's {self.base_label.shape}")
-        if not np.isfinite(y).all():
-            raise TrackingError(f"{what} returned NaN or infinite values")
-        if offsets.size == 0:
-            offsets = np.zeros((0, 2), int)
-        elif offsets.ndim != 2 or offsets.shape[1] != 2:
-            raise TrackingError(f"{what} returned offsets of shape {offsets.shape}, expected (N, 2) (dy, dx) cells")
-        return y.astype(np.float32, copy=False), offsets
+        """The label component's ``(y, offsets)``: y as float32, no offsets as ``(0, 2)``."""
+        y, offsets = self.label.make(self.base_label, detection)
+        return y.astype(np.float32, copy=False), offsets if offsets.size else np.zeros((0, 2), int)
 
     def _clamp(self, centre: np.ndarray, shape) -> np.ndarray:
         """Keep the centre on the image (``tracker.clamp_position``)."""

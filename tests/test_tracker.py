@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 
 import dcfkit
+from dcfkit.contracts import checked
 from dcfkit.errors import InputError, TrackingError
 from dcfkit.features import Feature
 from dcfkit.labels import Label, gaussian_label
@@ -265,18 +266,18 @@ class _BadLabel(Label):
 
 
 @pytest.mark.parametrize("make, frame, match", [
-    (lambda g, d: g, 1, r"make\(\) must return \(y, offsets\), got ndarray"),
+    (lambda g, d: g, 1, r"returned a ndarray, expected a tuple \(y, offsets\)"),
     (lambda g, d: (np.zeros((g.shape[0], g.shape[1] + 1)), np.zeros((0, 2))), 1,
-     r"returned y of shape \(\d+, \d+\), expected g's \(\d+, \d+\)"),
-    (lambda g, d: (g * (np.nan if d is not None else 1), np.zeros((0, 2))), 2, r"returned NaN or infinite values"),
+     r"returned y of shape \(\d+, \d+\), expected \(\d+, \d+\)"),
+    (lambda g, d: (g * (np.nan if d is not None else 1), np.zeros((0, 2))), 2, r"returned y: NaN or infinite values"),
     (lambda g, d: (g, np.zeros(4)), 1, r"returned offsets of shape \(4,\), expected \(N, 2\)"),
     (lambda g, d: (g.__setitem__((1, 1), 0), g)[1:] * 2, 1,
      r"raised ValueError: assignment destination is read-only \(at .*test_tracker.py:\d+\)"),
 ])
 def test_a_label_returning_the_wrong_thing_is_named_with_the_frame(make, frame, match, sequence):
     tracker = dcfkit.load_tracker("strcf")
-    tracker.label = _BadLabel(make)
-    with pytest.raises(TrackingError, match=rf"^frame {frame}: label 'bad_label'.*" + match):
+    tracker.label = checked(_BadLabel(make), "tests", Label.contract.hooks())
+    with pytest.raises(TrackingError, match=rf"^frame {frame}: label 'bad_label' \(from tests\): make\(\) " + match):
         run(tracker, sequence.frames[:4], sequence.ground_truth[0])
 
 
@@ -293,17 +294,16 @@ class _BadFeature(Feature):
 
 @pytest.mark.parametrize("extract, match", [
     (lambda p, c: np.zeros((2, p.shape[0] // c, p.shape[1] // c + 1), np.float32),
-     r"returned shape \(2, \d+, \d+\) for a \d+x\d+ patch, expected \(channels\(\), H // cell_size, "
-     r"W // cell_size\) = \(2, \d+, \d+\)"),
-    (lambda p, c: [0.0], r"returned list for a"),
+     r"returned shape \(2, \d+, \d+\), expected \(2, \d+, \d+\)"),
+    (lambda p, c: [0.0], r"returned a list, expected a numpy array of real floats"),
     (lambda p, c: np.full((2, p.shape[0] // c, p.shape[1] // c), np.inf, np.float32),
      r"returned NaN or infinite values"),
     (lambda p, c: p.reshape(-1, 7), r"raised ValueError: cannot reshape"),
 ])
 def test_a_feature_returning_the_wrong_thing_is_named_with_the_frame(extract, match, sequence):
     tracker = dcfkit.load_tracker("strcf")
-    tracker.features.append(_BadFeature(extract))
-    with pytest.raises(TrackingError, match=r"^frame 1: feature 'bad_feature' " + match):
+    tracker.features.append(checked(_BadFeature(extract), "tests", Feature.contract.hooks()))
+    with pytest.raises(TrackingError, match=r"^frame 1: feature 'bad_feature' \(from tests\): extract\(\) " + match):
         tracker.init(sequence.frames[0], sequence.ground_truth[0])
 
 

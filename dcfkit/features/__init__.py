@@ -13,7 +13,7 @@ import math
 import cv2
 import numpy as np
 
-from ..errors import TrackingError, blamed_on
+from ..contracts import array, scalar
 from ..params import param
 from ..registry import Component, Contract
 from .colornames import load_table, table_path_problem
@@ -34,7 +34,10 @@ class Feature(Component):
     (a new target), then ``extract`` on each patch; ``channels()`` whenever it checks a map."""
 
     kind = "feature"
-    contract = Contract(required={"channels": (), "extract": ("patch", "cell_size")}, optional={"reset": ()})
+    contract = Contract(required={"channels": (), "extract": ("patch", "cell_size")}, optional={"reset": ()},
+                        returns={"channels": scalar(1, math.inf, integer=True),
+                                 "extract": array(lambda args, feature: (feature.channels(), args[0].shape[0] // args[1],
+                                                                         args[0].shape[1] // args[1]))})
 
     def channels(self) -> int:
         """C, the number of channels ``extract`` returns (at least 1)."""
@@ -144,30 +147,9 @@ class ColorNames(Feature):
 BUILTIN = (Gray, FHOG, ColorNames)
 
 
-def checked_map(feature: Feature, patch: np.ndarray, cell_size: int, where: str) -> np.ndarray:
-    """``feature.extract``, with an exception or a map of the wrong shape said as a TrackingError
-    naming the feature (NaN is checked once on the stack, by :func:`extract_stack`)."""
-    what = f"{where}feature '{feature.name}'"
-    with blamed_on(what):
-        fmap = feature.extract(patch, cell_size)
-    expected = (feature.channels(), patch.shape[0] // cell_size, patch.shape[1] // cell_size)
-    shape = getattr(fmap, "shape", None)
-    if shape != expected:
-        got = f"shape {shape}" if shape is not None else type(fmap).__name__
-        raise TrackingError(f"{what} returned {got} for a {patch.shape[0]}x{patch.shape[1]} patch, expected "
-                            f"(channels(), H // cell_size, W // cell_size) = {expected}")
-    return fmap
-
-
-def extract_stack(features, patch: np.ndarray, cell_size: int, where: str = "") -> np.ndarray:
-    """Concatenate every feature's map of ``patch`` (gray patches are treated as BGR);
-    ``where`` (e.g. 'frame 3: ') prefixes errors."""
+def extract_stack(features, patch: np.ndarray, cell_size: int) -> np.ndarray:
+    """Concatenate every feature's map of ``patch`` (gray patches are treated as BGR)."""
     if patch.ndim == 2:
         patch = cv2.cvtColor(patch, cv2.COLOR_GRAY2BGR)
-    maps = [checked_map(f, patch, cell_size, where) for f in features]
-    stack = (maps[0] if len(maps) == 1 else np.concatenate(maps, axis=0)).astype(np.float32, copy=False)
-    if not math.isfinite(float(stack.sum())):  # one pass over the stack; then find the culprit
-        for feature, fmap in zip(features, maps):
-            if not np.isfinite(fmap).all():
-                raise TrackingError(f"{where}feature '{feature.name}' returned NaN or infinite values")
-    return stack
+    maps = [f.extract(patch, cell_size) for f in features]
+    return (maps[0] if len(maps) == 1 else np.concatenate(maps, axis=0)).astype(np.float32, copy=False)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..contracts import array, scalar
 from ..registry import Component, Contract
 
 
@@ -45,7 +46,11 @@ class SpatialRegularizer(Component):
     kind = "regularizer"
     role = "spatial"
     contract = Contract(required={"weights_squared": ("shape", "target_cells")},
-                        optional={"reset": (), "adapt": ("w2", "detection")})
+                        optional={"reset": (), "adapt": ("w2", "detection")},
+                        returns={"weights_squared": array(lambda args, r: tuple(args[0]), kinds="iuf", finite=False,
+                                                          nonnegative=True),
+                                 "adapt": array(lambda args, r: args[0].shape, kinds="iuf", finite=False,
+                                                nonnegative=True)})
 
     def weights_squared(self, shape: tuple[int, int], target_cells: tuple[float, float]) -> np.ndarray:
         """w² over the (H, W) filter grid, centred layout: (H, W) float32, >= 0, ``inf`` where h must be 0."""
@@ -70,7 +75,8 @@ class TemporalRegularizer(Component):
     kind = "regularizer"
     role = "temporal"
     contract = Contract(params={"theta": (float, 0.0, MAX_THETA)},
-                        optional={"reset": (), "weight": ("detection",)})
+                        optional={"reset": (), "weight": ("detection",)},
+                        returns={"weight": scalar(0.0, MAX_THETA, inf=True)})
 
     def reset(self) -> None:
         """Forget what earlier targets left (the fixed term keeps nothing)."""

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..contracts import array, finite_arrays
 from ..registry import Component, Contract
 from ..response import response as linear_response
 
@@ -36,7 +37,10 @@ class Solver(Component):
     kind = "solver"
     terms: tuple[str, ...] = ("spatial", "temporal")
     contract = Contract(required={"reset": (), "train": ("xf", "yf", "w2", "theta", "fft")},
-                        optional={"response": ("hf", "samples", "shape", "fft"), "observe": ("detection",)})
+                        optional={"response": ("hf", "samples", "shape", "fft"), "observe": ("detection",)},
+                        # a response that is not finite is the tracker's to say: the filter overflowed
+                        returns={"train": finite_arrays,
+                                 "response": array(lambda args, s: (len(args[1]), *args[2]), finite=False)})
 
     def __init__(self, params=None):
         super().__init__(params)
