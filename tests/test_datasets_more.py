@@ -650,3 +650,43 @@ def test_the_dataset_plugin_of_the_tutorial_runs(tmp_path, jpg, monkeypatch, cap
     with pytest.raises(DatasetError, match=r"Airport_ce_gt\.txt: 3 annotation lines but 4 frames \(frames 2\.\.5\)"):
         load_dataset("tc128", root)
     monkeypatch.setattr(reg, "_REGISTRY", None)
+
+
+# --------------------------------------------------------------------------- hostile annotation files
+
+
+def replace_file(path: Path, kind: str, text: str = "") -> None:
+    """``path`` as a FIFO, a link to /dev/zero, or holding ``text``."""
+    path.unlink()
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "zero":
+        os.symlink("/dev/zero", path)
+    else:
+        path.write_text(text)
+
+
+@pytest.mark.parametrize("layout, file, kind, text, said", [
+    ("lasot", "airplane/airplane-2/full_occlusion.txt", "text", "0,0,1e30,0", r"got '1e30' for frame 3"),
+    ("lasot", "airplane/airplane-2/full_occlusion.txt", "text", "0,0,0", r"more values than its 2 frames"),
+    ("lasot", "airplane/airplane-2/out_of_view.txt", "fifo", "", r"out_of_view\.txt \(not a regular file\)"),
+    ("lasot", "airplane/airplane-2/full_occlusion.txt", "zero", "", r"full_occlusion\.txt \(not a regular file\)"),
+    ("lasot", "airplane/airplane-2/groundtruth.txt", "text", "1," * 3_000_000, r"line 1: 6000000 characters, too long"),
+    ("lasot", "airplane/airplane-2/groundtruth.txt", "text", "1,2,3,٣\n1,2,3,4\n", r"line 1: expected 4 numbers"),
+    ("lasot", "airplane/airplane-2/groundtruth.txt", "text", "1,2,3,2_0\n1,2,3,4\n", r"line 1: expected 4 numbers"),
+    ("got10k_val", "val/GOT-10k_Val_000001/cover.label", "text", "8\n1e19\n5\n", r"got '1e19' for frame 2"),
+    ("vot", "ants1/groundtruth.txt", "text", "m0,0,10,10,99999999999999999999999,3\n",
+     r"line 1: expected a region .*at most 10 digits"),
+    ("vot", "ants1/sequence", "text", "channels.color=color/%0999999999d.jpg\n", r"is not a frame pattern"),
+    ("vot", "ants1/sequence", "text", "channels.color=color/%099999999999999999999d.jpg\n", r"is not a frame pattern"),
+    ("otb", "Basketball/groundtruth_rect.txt", "text", "", r"sequence 'Basketball' has no frames"),
+])
+def test_hostile_annotation_files_are_one_line_errors(layout, file, kind, text, said, tmp_path, jpg):
+    """Each broke the loader with OverflowError, MemoryError, IndexError, or a hang."""
+    root = {"lasot": lasot_root, "got10k_val": got_root, "vot": vot_root, "otb": otb_root}[layout](tmp_path, jpg)
+    replace_file(root / file, kind, text)
+    if layout == "otb":  # an empty img/ too
+        for image in (root / "Basketball" / "img").iterdir():
+            image.unlink()
+    with pytest.raises(DatasetError, match=said):
+        load_dataset(layout, root)

@@ -81,6 +81,9 @@ class Sequence:
         if len(gt) != len(self.frames):
             raise DatasetError(
                 f"sequence {self.name!r}: {len(self.frames)} frames but {len(gt)} boxes")
+        if not self.frames:
+            raise DatasetError(f"sequence {self.name!r} has no frames"
+                               + (f" ({self.annotation} holds no box)" if self.annotation else ""))
         gt.setflags(write=False)
         object.__setattr__(self, "ground_truth", gt)
         object.__setattr__(self, "frames", tuple(Path(f) for f in self.frames))
@@ -295,18 +298,49 @@ def _missing_end_marker(data: bytes) -> bool:
 # --------------------------------------------------------------------------- annotation files
 
 _SEPARATORS = re.compile(r"[,\s]+")
+MAX_TEXT_BYTES = 64 * 2**20  # an annotation file: LaSOT's longest is under 1 MB, a VOT mask file tens of MB
+MAX_LINE_CHARS = 4096  # a line of boxes or flags (a VOT mask line is read by its own layout)
+# a number as the toolkits write one: ASCII digits only (float() also takes '٣' and '2_0')
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?:nan|inf|infinity)", re.IGNORECASE | re.ASCII)
 
 
 def read_text(path: Path) -> str:
-    """A benchmark text file (UTF-8, optional BOM); :class:`DatasetError` naming it otherwise."""
+    """A benchmark text file (UTF-8, optional BOM): a regular file (a FIFO would block,
+    /dev/zero never end) of at most :data:`MAX_TEXT_BYTES`; :class:`DatasetError` naming it
+    otherwise."""
     try:
-        return path.read_text(encoding="utf-8-sig")
+        info = os.stat(path)
+        if not stat.S_ISREG(info.st_mode):
+            raise DatasetError(f"cannot read {path} (not a regular file)")
+        if info.st_size > MAX_TEXT_BYTES:
+            raise DatasetError(f"cannot read {path} ({info.st_size:.3g} bytes: an annotation file of more than "
+                               f"{MAX_TEXT_BYTES:.3g} bytes is not one)")
+        with open(path, "rb") as file:
+            data = file.read(MAX_TEXT_BYTES + 1)  # a file growing meanwhile is cut: its size was checked
+        return data.decode("utf-8-sig")
     except FileNotFoundError:
         raise DatasetError(f"annotation file not found: {path}") from None
     except UnicodeDecodeError as exc:
         raise DatasetError(f"{path}: not a text annotation file (byte {exc.start} is not UTF-8)") from None
     except OSError as exc:
         raise DatasetError(f"cannot read {path}: {exc.strerror}") from None
+
+
+def parse_number(field: str) -> float:
+    """A number of an annotation file (ASCII digits, ``nan`` and ``inf`` as written); ValueError
+    for anything else Python's ``float`` would take."""
+    if not _NUMBER.fullmatch(field):
+        raise ValueError(f"could not convert {field[:40]!r} to a number")
+    return float(field)
+
+
+def _fields(line: str, path: Path, n: int) -> list[str]:
+    """The values of line ``n`` (0-based) of ``path``; a line too long to be one is refused
+    before it is split."""
+    if len(line) > MAX_LINE_CHARS:
+        raise DatasetError(f"{path}, line {n + 1}: {len(line)} characters, too long for a line of boxes or flags "
+                           f"(at most {MAX_LINE_CHARS})")
+    return [f for f in _SEPARATORS.split(line.strip()) if f]
 
 
 def read_boxes(path: str | os.PathLike, one_based: bool = True) -> np.ndarray:
@@ -320,11 +354,11 @@ def read_boxes(path: str | os.PathLike, one_based: bool = True) -> np.ndarray:
     lines = read_text(path).rstrip().splitlines()
     boxes = np.empty((len(lines), 4), dtype=np.float64)
     for n, line in enumerate(lines):
-        fields = [f for f in _SEPARATORS.split(line.strip()) if f]
+        fields = _fields(line, path, n)
         try:
             if len(fields) != 4:
                 raise ValueError
-            boxes[n] = [float(f) for f in fields]
+            boxes[n] = [parse_number(f) for f in fields]
         except ValueError:
             raise DatasetError(
                 f"{path}, line {n + 1}: expected 4 numbers 'x,y,w,h' separated by commas, "
@@ -334,6 +368,10 @@ def read_boxes(path: str | os.PathLike, one_based: bool = True) -> np.ndarray:
     return boxes
 
 
+_FIELD = re.compile(r"[^,\s]+")
+MAX_FRAME_VALUE = 2**31 - 1  # flags and cover levels are small; a larger value is no flag
+
+
 def read_frame_values(path: Path, n_frames: int) -> np.ndarray:
     """One whole number per frame, separated by commas, spaces or new lines (LaSOT's
     ``full_occlusion.txt`` holds one line, GOT-10k's ``.label`` files one value a line), as
@@ -341,15 +379,18 @@ def read_frame_values(path: Path, n_frames: int) -> np.ndarray:
     not a whole number, or the count when it is not ``n_frames``."""
     values = []
     for n, line in enumerate(read_text(path).splitlines()):
-        for field in (f for f in _SEPARATORS.split(line.strip()) if f):
+        for match in _FIELD.finditer(line):  # one at a time: LaSOT's single line may be long
+            field = match.group()
             try:
-                value = float(field)
-                if not value.is_integer():
+                value = parse_number(field)
+                if not value.is_integer() or abs(value) > MAX_FRAME_VALUE:
                     raise ValueError
             except ValueError:
-                raise DatasetError(f"{path}, line {n + 1}: expected whole numbers, one per frame, "
-                                   f"got {shown(field)} for frame {len(values) + 1}") from None  # LaSOT: 1 line
+                raise DatasetError(f"{path}, line {n + 1}: expected whole numbers, one per frame, got {shown(field)} "
+                                   f"for frame {len(values) + 1}") from None
             values.append(int(value))
+            if len(values) > n_frames:
+                raise DatasetError(f"{path}: more values than its {n_frames} frames; one value per frame is required")
     if len(values) != n_frames:
         raise DatasetError(f"{path}: {len(values)} values for {n_frames} frames; one value per frame is required")
     return np.array(values, dtype=np.int64)
@@ -357,7 +398,7 @@ def read_frame_values(path: Path, n_frames: int) -> np.ndarray:
 
 def read_flags(path: Path, names: tuple[str, ...]) -> dict[str, bool]:
     """One line of 0/1 flags, one per name in ``names`` (e.g. a UAV123 att file)."""
-    fields = [f for f in _SEPARATORS.split(read_text(path).strip()) if f]
+    fields = _fields(read_text(path).strip(), path, 0)
     if len(fields) != len(names) or any(f not in ("0", "1") for f in fields):
         raise DatasetError(
             f"{path}, line 1: expected {len(names)} 0/1 flags ({' '.join(names)}), "

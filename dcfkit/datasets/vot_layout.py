@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import shown
-from .base import DatasetError, Sequence, annotated_frames, read_text, require_root, select_sequences
+from .base import DatasetError, Sequence, annotated_frames, parse_number, read_text, require_root, select_sequences
 from .registry import Evidence, register_layout
 
 #: How a polygon becomes a box: ``bounds`` the smallest box holding it (the VOT toolkit's
@@ -32,7 +32,8 @@ from .registry import Evidence, register_layout
 #: got10k's ``_corner2rect`` (``cx - w/2``); pysot's test scripts place it at ``cx - (w-1)/2``,
 #: half a pixel to the right and down.
 POLYGON_RULES = ("bounds", "area")
-_PATTERN = re.compile(r"^[^%]*%0?\d*d[^%]*$")  # one integer field, as in color/%08d.jpg
+_PATTERN = re.compile(r"^[^%]*%(?:0?\d{1,2})?d[^%]*$")  # one integer field of at most 99 digits, as in color/%08d.jpg
+_MASK = re.compile(r"-?\d{1,10}(?:,-?\d{1,10}){3,}", re.ASCII)  # x0,y0,w,h,runs...: int64 holds their sums
 _SEPARATORS = re.compile(r"[,\s]+")  # VOT writes commas; some copies have tabs or spaces
 _GOT10K_FILES = ("meta_info.ini", "absence.label", "cover.label")  # GOT-10k's folders are otherwise VOT-like
 
@@ -60,9 +61,9 @@ def mask_box(text: str) -> np.ndarray:
     alternate, row by row, in the ``w`` x ``h`` region at ``(x0, y0)``. The box holds every
     pixel set: ``x = x0 + first column``, ``w = last - first column + 1`` (the VOT toolkit's
     ``Mask.convert`` gives ``last - first``). NaN if none is set; ValueError if malformed."""
+    if not _MASK.fullmatch(text):
+        raise ValueError("a mask is whole numbers x0,y0,w,h,runs... of at most 10 digits each")
     fields = [int(f) for f in text.split(",")]
-    if len(fields) < 4:
-        raise ValueError("a mask starts with x0,y0,w,h")
     x0, y0, width, height = fields[:4]
     runs = np.array(fields[4:], dtype=np.int64)
     if width < 0 or height < 0 or (runs < 0).any():
@@ -87,7 +88,7 @@ def region_box(line: str, rule: str = "bounds") -> np.ndarray:
     text = line.strip()
     if text.startswith("m"):
         return mask_box(text[1:])
-    values = [float(f) for f in _SEPARATORS.split(text) if f]
+    values = [parse_number(f) for f in _SEPARATORS.split(text) if f]
     if len(values) == 4:
         return np.array(values, dtype=np.float64)
     if len(values) >= 6 and len(values) % 2 == 0:
