@@ -143,11 +143,17 @@ def pair(first: Check, second: Check, names: tuple[str, str]) -> Check:
     return check
 
 
-def positive_vector(value, args, component) -> str | None:
-    """One or more finite numbers > 0 in a 1-d array (the scales to search)."""
+MAX_FACTOR = 10.0  # a search factor: the built-in estimators span at most x10 each way
+
+
+def search_factors(value, args, component) -> str | None:
+    """One or more finite numbers in [1/MAX_FACTOR, MAX_FACTOR] in a 1-d array (the scales to
+    search, relative to the current one)."""
     problem = array((None,), kinds="iuf")(value, args, component)
-    if problem is None and not (value.size and (value > 0).all()):
-        problem = f"{shown(value)}, expected one or more numbers > 0"
+    tolerance = 1 + 1e-9  # step ** k of the built-ins may round past 10
+    if problem is None and not (value.size and ((value * MAX_FACTOR * tolerance >= 1)
+                                                & (value <= MAX_FACTOR * tolerance)).all()):
+        problem = f"{shown(value)}, expected one or more numbers in [{1 / MAX_FACTOR:g}, {MAX_FACTOR:g}]"
     return problem
 
 

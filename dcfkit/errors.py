@@ -31,6 +31,14 @@ class MissingDependency(DcfkitError, ImportError):
     """An optional package is not installed (the message names the extra that installs it)."""
 
 
+class DcfkitWarning(UserWarning):
+    """Base class of every warning dcfkit gives on purpose (the CLI prints each as one line)."""
+
+
+class InputWarning(DcfkitWarning, RuntimeWarning):
+    """An input dcfkit reads, but maybe not as its author meant (the message says how)."""
+
+
 def shown(value: Any) -> str:
     """``repr(value)`` in at most :data:`SHOWN_CHARS` characters, whatever the value's size or depth."""
     short = reprlib.Repr()  # its limits are per level: a few items, a few levels, a few characters each

@@ -27,7 +27,7 @@ from typing import Any, Callable, Mapping
 import pluggy
 
 from .contracts import checked
-from .errors import ConfigError, DcfkitError, RegistryError, clip, describe_error, shown
+from .errors import ConfigError, DcfkitError, DcfkitWarning, RegistryError, clip, describe_error, shown
 from .params import NoParams, check_schema, closest, parse_params
 from .signals import handlers_replaced
 
@@ -209,7 +209,7 @@ def _raise_if_signalled(exc: BaseException, signalled: list) -> None:
         raise exc
 
 
-class PluginWarning(RuntimeWarning):
+class PluginWarning(DcfkitWarning, RuntimeWarning):
     """A plugin was skipped, or a name it registers withdrawn (also in ``Registry.failures``)."""
 
 

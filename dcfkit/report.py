@@ -229,7 +229,10 @@ def _cell(key: str, value, full: bool = False) -> str:
         if full:
             return repr(value)
         return f"{value:.1f}" if key == "fps" else f"{value:.3f}"
-    return str(value)
+    if full:
+        return str(value)
+    # a sequence or tracker is named by a folder, whose name may hold a line break or a '|'
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode() for c in str(value))
 
 
 def format_rows(rows: Seq[Mapping], fmt: str = "table", columns: Seq[str] | None = None) -> str:
@@ -254,7 +257,7 @@ def format_rows(rows: Seq[Mapping], fmt: str = "table", columns: Seq[str] | None
     if fmt == "markdown":
         lines = ["| " + " | ".join(columns) + " |",
                  "|" + "|".join("---:" if n else ":---" for n in numeric) + "|"]
-        lines += ["| " + " | ".join(r) + " |" for r in cells]
+        lines += ["| " + " | ".join(c.replace("|", "\\|") for c in r) + " |" for r in cells]
         return "\n".join(lines) + "\n"
     widths = [max([len(c)] + [len(r[i]) for r in cells]) for i, c in enumerate(columns)]
 

@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .contracts import positive_vector, scalar
+from .contracts import scalar, search_factors
 from .features.fhog import ARITHMETICS, fhog
 from .params import param
 from .patches import resize_auto, sample, sampler, whole_pixel_crop
@@ -39,7 +39,7 @@ class ScaleEstimator(Component):
     kind = "scale"
     contract = Contract(optional={"init": ("image", "centre", "base_target", "scale", "limits"),
                                   "search_factors": (), "update": ("image", "centre", "scale")},
-                        returns={"search_factors": positive_vector, "update": _within_limits})
+                        returns={"search_factors": search_factors, "update": _within_limits})
 
     def init(self, image: np.ndarray, centre: np.ndarray, base_target: np.ndarray, scale: float,
              limits: tuple[float, float]) -> None:

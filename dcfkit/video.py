@@ -11,16 +11,15 @@ import sys
 import threading
 import time
 import warnings
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 from typing import Iterator
-from urllib.parse import urlsplit
 
 import cv2
 import numpy as np
 
 from .datasets import read_frame
 from .datasets.base import jpeg_damage, jpeg_decodable
-from .errors import InputError, clip, shown
+from .errors import InputError, InputWarning, clip, shown
 from .limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff")
@@ -188,16 +187,15 @@ INDEXED_CONTAINERS = (".avi", ".mp4", ".m4v", ".mov")
 
 
 def _stopped_short(video: str, frame: int, declared: int) -> None:
-    """A video ends at ``frame`` of the ``declared``: an InputError for an indexed container (a
-    truncated file or a lost stream, whose last frame read is partly lost and is not tracked),
-    else a warning."""
+    """A video ends at ``frame`` of the ``declared``: an InputError for a URL (a lost stream,
+    whatever its name says) and a file of an indexed container (truncated), whose last frame
+    read is partly lost and is not tracked; else a warning."""
     said = f"--video: {_name(video)} stops at frame {frame} of the {declared} its header declares"
-    suffix = PurePosixPath(urlsplit(video).path).suffix if URL.match(video) else Path(video).suffix
-    if suffix.lower() in INDEXED_CONTAINERS:
+    if URL.match(video) or Path(video).suffix.lower() in INDEXED_CONTAINERS:
         raise InputError(f"{said} (a truncated file or a lost stream?); frame {frame}, where its data ends, "
                          f"is not tracked")
     warnings.warn(f"{said}; the count of this container is an estimate, so frame {frame} is tracked as the last "
-                  f"(if the file is truncated, that frame is partly lost)", RuntimeWarning, stacklevel=3)
+                  f"(if the file is truncated, that frame is partly lost)", InputWarning, stacklevel=3)
 
 
 def _capture_frames(cap: cv2.VideoCapture, video: str, declared: int, packets: _JpegPackets | None = None):

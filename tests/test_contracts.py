@@ -65,7 +65,10 @@ CASES = [  # (base, kind, hook, returned(args, component), the error after "<hoo
     (Pyramid, "scale", "update", lambda a, c: [1, 2], r"returned \[1, 2\], expected a real number in \(0, inf\]"),
     (Pyramid, "scale", "update", lambda a, c: float("nan"), r"returned nan, expected \(0, inf\]"),
     (Pyramid, "scale", "search_factors", lambda a, c: np.array([1.0, -0.5]), r"returned array\(\[ 1\. , -0\.5\]\), "
-                                                                              r"expected one or more numbers > 0"),
+                                                                              r"expected one or more numbers in "
+                                                                              r"\[0\.1, 10\]"),
+    (Pyramid, "scale", "search_factors", lambda a, c: np.array([2386.0]), r"returned array\(\[2386\.\]\), expected one "
+                                                                          r"or more numbers in"),
     (Pyramid, "scale", "search_factors", lambda a, c: np.ones((2, 2)), "returned " + SHAPE),
     (Gaussian, "label", "make", lambda a, c: (a[0].astype(np.complex64), np.zeros((0, 2), int)),
      r"returned y of dtype complex64, expected real floats"),

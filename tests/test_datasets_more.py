@@ -14,6 +14,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 
 from dcfkit import cli
 from dcfkit import registry as reg
@@ -690,3 +691,31 @@ def test_hostile_annotation_files_are_one_line_errors(layout, file, kind, text, 
             image.unlink()
     with pytest.raises(DatasetError, match=said):
         load_dataset(layout, root)
+
+
+ANNOTATION_PIECES = [b"0", b"1", b"7", b"12.5", b"-3", b"1e30", b"1e19", b"9" * 30, b"nan", b"inf", b"NaN", b",", b" ",
+                     b"\t", b"\n", b"\r\n", b".", b"e", b"-", b"_", "٣".encode(), b"m", b"m0,0,2,2,1,2", b"\xff",
+                     b"\xef\xbb\xbf", b"\x00"]
+
+
+@settings(max_examples=150, deadline=None)
+@given(data=st.lists(st.sampled_from(ANNOTATION_PIECES), max_size=60), n_frames=st.integers(1, 6))
+def test_fuzzed_annotation_files_read_or_say_why(tmp_path_factory, data, n_frames):
+    """Whatever bytes an annotation file holds, each reader returns what it promises (shape,
+    dtype) or raises a DatasetError naming the file; never another exception."""
+    from dcfkit.datasets.base import read_boxes, read_flags, read_frame_values
+    from dcfkit.datasets.vot_layout import read_regions
+
+    path = tmp_path_factory.mktemp("fuzz") / "annotation.txt"
+    path.write_bytes(b"".join(data))
+    readers = [(lambda: read_boxes(path), lambda out: out.dtype == np.float64 and out.shape[1:] == (4,)),
+               (lambda: read_regions(path), lambda out: out.dtype == np.float64 and out.shape[1:] == (4,)),
+               (lambda: read_frame_values(path, n_frames), lambda out: out.shape == (n_frames,) and out.dtype == np.int64),
+               (lambda: read_flags(path, ("SV", "OCC")), lambda out: set(out) == {"SV", "OCC"})]
+    for read, promised in readers:
+        try:
+            out = read()
+        except DatasetError as exc:
+            assert str(path) in str(exc) and "\n" not in str(exc)
+            continue
+        assert promised(out), out

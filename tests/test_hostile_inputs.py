@@ -9,6 +9,7 @@ from __future__ import annotations
 import struct
 import time
 import tracemalloc
+import warnings
 import zlib
 
 import cv2
@@ -599,14 +600,18 @@ def test_many_feature_channels_are_refused_at_load():
 
 
 def test_a_short_video_is_an_error_only_where_the_frame_count_is_an_index():
-    """MKV and WebM counts are duration x fps estimates: a complete file may fall short of them."""
-    from dcfkit.errors import InputError
+    """MKV and WebM counts are duration x fps estimates: a complete file may fall short of them;
+    a URL that stops short lost its stream, whatever its name says."""
+    from dcfkit.errors import InputError, InputWarning
     from dcfkit.video import _stopped_short
 
     with pytest.raises(InputError, match=r"cut\.avi stops at frame 8 of the 10 .*not tracked"):
         _stopped_short("cut.avi", 8, 10)
-    with pytest.warns(RuntimeWarning, match=r"long\.mkv stops at frame 8 of the 10 .*tracked as the last"):
+    with pytest.warns(InputWarning, match=r"long\.mkv stops at frame 8 of the 10 .*tracked as the last"):
         _stopped_short("long.mkv", 8, 10)
+    for url in ("http://cam.local/live", "http://cam.local/clip.mkv", "rtsp://cam.local/1?token=x"):
+        with pytest.raises(InputError, match=r"stops at frame 8 of the 10 .*not tracked"):
+            _stopped_short(url, 8, 10)
 
 
 # --------------------------------------------------------------------------- long values in messages
@@ -670,8 +675,8 @@ def test_long_values_in_files_and_variables_are_shown_short(tmp_path, monkeypatc
     from dcfkit.evaluation import tracker_name
     from dcfkit.limits import max_image_pixels
 
-    (tmp_path / "gt.txt").write_text("1,1,2,2\n" + "9," * 100_000 + "\n")
-    (tmp_path / "att.txt").write_text("1 " * 100_000)
+    (tmp_path / "gt.txt").write_text("1,1,2,2\n" + "9," * 2000 + "\n")  # a longer line is refused unsplit
+    (tmp_path / "att.txt").write_text("1 " * 2000)
     monkeypatch.setenv("DCFKIT_MAX_IMAGE_PIXELS", LONG)
     for call, said in [(lambda: read_boxes(tmp_path / "gt.txt"), "gt.txt, line 2: expected 4 numbers"),
                        (lambda: read_flags(tmp_path / "att.txt", ("SV", "ARC")), "att.txt, line 1: expected 2"),
@@ -747,3 +752,58 @@ def test_the_raw_capture_of_a_motion_jpeg_check_is_released_when_reading_it_fail
     with pytest.raises(OSError, match="device gone"):
         video._JpegPackets.of("clip.avi", Decoding())
     assert released == [True]
+
+
+# --------------------------------------------------------------------------- round 3: the low items
+
+
+def test_a_config_name_with_a_control_character_is_a_config_error(tmp_path, otb_root, capsys):
+    from dcfkit import cli
+
+    config = tmp_path / "nul.yaml"
+    config.write_text('base: kcf\nname: "a\\0b"\n')
+    assert cli.main(["eval", str(config), "--dataset", "otb", "--root", str(otb_root), "--out",
+                     str(tmp_path / "out"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err == ("dcfkit eval: error: config 'name' 'a\\x00b' must be usable as a folder name (no / \\ :, no "
+                   "control character such as a null byte or a line break)\n")
+
+
+def test_a_name_cannot_add_rows_to_a_markdown_or_text_table():
+    from dcfkit.report import format_rows
+
+    rows = [{"sequence": "car\n| fake | 1.000 |", "auc": 0.5}, {"sequence": "a|b", "auc": 0.25}]
+    markdown = format_rows(rows, "markdown").splitlines()
+    assert len(markdown) == 4 and markdown[2] == "| car\\n\\| fake \\| 1.000 \\| | 0.500 |"
+    assert markdown[3] == "| a\\|b | 0.250 |"
+    assert len(format_rows(rows, "table").splitlines()) == 4
+
+
+def test_twelve_bit_data_in_sixteen_bit_pngs_is_warned_of(tmp_path):
+    from dcfkit.datasets import DatasetWarning, read_frame
+
+    rng = np.random.default_rng(0)
+    twelve = tmp_path / "12" / "0001.png"
+    full = tmp_path / "16" / "0001.png"
+    for path, top in ((twelve, 4096), (full, 65536)):
+        path.parent.mkdir()
+        assert cv2.imwrite(str(path), rng.integers(0, top, (12, 16, 3)).astype(np.uint16))
+    with pytest.warns(DatasetWarning, match=r"12: 16-bit frames whose values stay below 16384 keep fewer than 64"):
+        image = read_frame(twelve)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        read_frame(twelve)  # once a folder
+    assert image.dtype == np.uint8 and image.max() <= 15  # OpenCV's conversion, unchanged
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert np.array_equal(read_frame(full), cv2.imread(str(full)))
+
+
+def test_boxes_of_absurd_size_score_without_a_numpy_warning():
+    from dcfkit.metrics import score_sequence
+
+    gt = np.array([[10, 10, 20, 20], [10, 10, -20, -20], [1e300, 10, 1e300, 20]], float)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for protocol in ("otb", "pysot", "got10k", "lasot"):
+            assert 0 < score_sequence(gt, gt, protocol=protocol)["auc"] < 1

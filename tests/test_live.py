@@ -169,6 +169,26 @@ def test_a_named_pipe_nobody_writes_to_is_an_error_and_sigterm_ends_the_wait(tmp
     assert run.returncode == 128 + signal.SIGTERM and err.endswith("dcfkit track: interrupted (SIGTERM)\n")
 
 
+def test_sigterm_ends_the_wait_for_a_url_that_does_not_answer():
+    """A server that accepts the connection and says nothing: FFmpeg's open waits for its 30 s
+    timeout, through SIGTERM, unless it runs in a thread."""
+    import socket
+
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        server.settimeout(60)
+        url = f"http://127.0.0.1:{server.getsockname()[1]}/clip.avi"
+        run = subprocess.Popen([sys.executable, "-m", "dcfkit.cli", "track", "kcf", "--video", url, "--box", "1,1,9,9"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            connection, _ = server.accept()  # the command is in FFmpeg's open, waiting for an answer
+            with connection:
+                run.send_signal(signal.SIGTERM)
+                _, err = run.communicate(timeout=20)
+        finally:
+            run.kill()
+    assert run.returncode == 128 + signal.SIGTERM and err.endswith("dcfkit track: interrupted (SIGTERM)\n"), err
+
+
 def waiting_for_a_writer(pid: int, seconds: float = 60) -> None:
     """Return once a thread of process ``pid`` waits in the open of a named pipe (Linux's
     ``wait_for_partner``), where the command used to hang through SIGTERM."""

@@ -7,8 +7,7 @@ import errno
 import sys
 import warnings
 
-from ..errors import DcfkitError, clip
-from ..registry import PluginWarning
+from ..errors import DcfkitError, DcfkitWarning, clip
 from ..results import running_command
 from ..tracking import interrupt_on_termination
 from .parser import build_parser
@@ -16,11 +15,11 @@ from .parser import build_parser
 __all__ = ["build_parser", "main"]
 
 
-def _one_line_plugin_warnings(show):
-    """``warnings.showwarning`` for the CLI: a plugin problem is one ``warning: ...`` line,
-    not a source location inside dcfkit's registry."""
+def _one_line_warnings(show):
+    """``warnings.showwarning`` for the CLI: a warning of dcfkit's (a plugin problem, an input
+    read with a caveat) is one ``warning: ...`` line, not a source location inside dcfkit."""
     def showwarning(message, category, filename, lineno, file=None, line=None):
-        if issubclass(category, PluginWarning):
+        if issubclass(category, DcfkitWarning):
             print(f"warning: {message}", file=sys.stderr)
         else:
             show(message, category, filename, lineno, file, line)
@@ -31,7 +30,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     given = contextlib.nullcontext() if argv is None else running_command(["dcfkit", *argv])
     with warnings.catch_warnings(), interrupt_on_termination(), given:  # SIGTERM/SIGHUP end a command as Ctrl-C does
-        warnings.showwarning = _one_line_plugin_warnings(warnings.showwarning)
+        warnings.showwarning = _one_line_warnings(warnings.showwarning)
         try:
             return args.func(args) or 0
         except DcfkitError as exc:

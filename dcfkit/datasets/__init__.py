@@ -19,7 +19,7 @@ itself in :mod:`~dcfkit.datasets.registry` (name, aliases, loader, detection, de
 another benchmark is added with :func:`register_layout`. See ``docs/evaluation.md`` for the
 layouts.
 """
-from .base import ATTRIBUTE_NAMES, DatasetError, Sequence, read_boxes, read_frame, scored_sequences
+from .base import ATTRIBUTE_NAMES, DatasetError, DatasetWarning, Sequence, read_boxes, read_frame, scored_sequences
 from .registry import (DATASETS, Evidence, Layout, benchmark_protocol, canonical_name, detect_dataset, get_layout,
                        layouts, load_dataset, register_layout, registered_layout, unregister_layout)
 
@@ -40,6 +40,7 @@ __all__ = [
     "ATTRIBUTE_NAMES",
     "DATASETS",
     "DatasetError",
+    "DatasetWarning",
     "Evidence",
     "Layout",
     "Sequence",

@@ -18,7 +18,7 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
-from ..errors import DcfkitError, clip, shown
+from ..errors import DcfkitError, InputWarning, clip, shown
 from ..limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 log = logging.getLogger(__name__)
@@ -136,14 +136,18 @@ def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
     JPEG whose data libjpeg reports corrupt (``cv2.imread`` would return it with a warning, part
     of it grey or wrong), or a TIFF whose data libtiff cannot decode (likewise). A JPEG that
     lacks just its end-of-image marker, or has zero bytes before it, common defects, is read as
-    imread would. Decoding is OpenCV's, unchanged."""
+    imread would. Decoding is OpenCV's, unchanged: a 16-bit image keeps its high byte, with a
+    warning when that leaves fewer than 64 grey levels (12-bit data in a 16-bit PNG keeps 16)."""
     import cv2  # deferred: listing sequences needs no OpenCV
 
     data = _read_image_bytes(path, what)
     _check_size(data, path, what)
     if data.startswith(_TIFF_SIGNATURES):
         _check_tiff_data(data, path, what)
-    image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+    image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH)
+    if image is not None and image.dtype != np.uint8:
+        _warn_if_few_levels(image, path)
+        image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)  # OpenCV's own 8-bit conversion
     if image is None and _missing_end_marker(data):
         data += _JPEG_END
         image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
@@ -155,6 +159,23 @@ def read_frame(path: str | os.PathLike, what: str = "frame") -> np.ndarray:
     if data.startswith(b"\xff\xd8"):
         _check_jpeg_data(data, path, what)
     return image
+
+
+_FEW_LEVELS_WARNED: set[str] = set()
+
+
+def _warn_if_few_levels(image: np.ndarray, path) -> None:
+    """Warn when a 16-bit image read as 8 bits (its high byte) keeps fewer than 64 grey levels."""
+    folder = str(Path(path).parent)
+    if image.dtype == np.uint16 and int(image.max()) >> 8 < 64 and folder not in _FEW_LEVELS_WARNED:
+        _FEW_LEVELS_WARNED.add(folder)  # once a folder: warnings' own once-only is reset whenever a filter changes
+        warnings.warn(f"{folder}: 16-bit frames whose values stay below {64 << 8} keep fewer than 64 "
+                      f"grey levels read as 8 bits (12-bit data keeps 16); convert them to 8 bits, scaled to "
+                      f"their range, to track them", DatasetWarning, stacklevel=3)
+
+
+class DatasetWarning(InputWarning):
+    """A benchmark file dcfkit reads, but maybe not as its author meant."""
 
 
 def _check_size(data: bytes, path, what: str) -> None:
