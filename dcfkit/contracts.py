@@ -20,7 +20,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from .errors import DcfkitError, TrackingError, describe_error, shown
+from .errors import DcfkitError, RegistryError, TrackingError, describe_error, shown
 
 Check = Callable[[Any, tuple, Any], "str | None"]
 
@@ -57,7 +57,11 @@ def checked(component: Any, provider: str, hooks: Mapping[str, Check | None]) ->
     where = f"{component.kind} '{component.name}' (from {provider})"
     for hook, check in hooks.items():
         if callable(getattr(component, hook, None)) and not isinstance(getattr(component, hook), Hook):
-            setattr(component, hook, Hook(component, hook, check, where))
+            try:
+                setattr(component, hook, Hook(component, hook, check, where))
+            except AttributeError:  # __slots__, or a read-only property in its place
+                raise RegistryError(f"{where}: dcfkit cannot check its {hook}(): its instances take no attribute "
+                                    f"{hook!r} (drop __slots__)") from None
     return component
 
 
@@ -91,7 +95,8 @@ def array(shape: Callable[[tuple, Any], tuple] | tuple | None = None, *, kinds: 
         expected = shape(args, component) if callable(shape) else shape
         if expected is not None and (value.ndim != len(expected) or any(
                 e is not None and s != e for s, e in zip(value.shape, expected))):
-            return f"shape {value.shape}, expected ({', '.join('N' if e is None else str(e) for e in expected)}{',' * (len(expected) == 1)})"
+            sizes = ", ".join("N" if e is None else str(e) for e in expected)
+            return f"shape {value.shape}, expected ({sizes}{',' * (len(expected) == 1)})"
         if value.dtype.kind not in kinds:
             return f"dtype {value.dtype}, expected {KIND_NAMES.get(kinds, kinds)}"
         return _values_problem(value, finite, nonnegative)

@@ -1,5 +1,4 @@
 """Exceptions raised by dcfkit. Each names what was wrong and where."""
-import contextlib
 import reprlib
 import traceback
 from typing import Any

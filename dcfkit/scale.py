@@ -26,7 +26,9 @@ def _within_limits(value, args, estimator) -> str | None:
     (when it keeps them, as the base class does)."""
     problem = scalar(0, math.inf, above=True)(value, args, estimator)
     limits = getattr(estimator, "limits", None)
-    if problem is None and limits is not None and not limits[0] * (1 - 1e-9) <= float(value) <= limits[1] * (1 + 1e-9):
+    tolerance = 1e-9  # the built-ins clip to the limits; a rounding may land a hair outside
+    if problem is None and limits is not None and not (limits[0] * (1 - tolerance) <= float(value)
+                                                       <= limits[1] * (1 + tolerance)):
         problem = f"{float(value)!r}, outside the limits [{limits[0]:g}, {limits[1]:g}] init gave it"
     return problem
 

@@ -80,7 +80,8 @@ CASES = [  # (base, kind, hook, returned(args, component), the error after "<hoo
      r"returned dtype complex64, expected real floats"),
     (ADMMStrcf, "solver", "train", lambda a, c: a[0] * np.nan, "returned NaN or infinite values"),
     (BoxWindow, "regularizer", "weights_squared", lambda a, c: np.ones(7, np.float32), "returned " + SHAPE),
-    (BoxWindow, "regularizer", "weights_squared", lambda a, c: np.full(a[0], np.nan, np.float32), "returned NaN values"),
+    (BoxWindow, "regularizer", "weights_squared", lambda a, c: np.full(a[0], np.nan, np.float32),
+     "returned NaN values"),
     (BoxWindow, "regularizer", "weights_squared", lambda a, c: -np.ones(a[0], np.float32), "returned negative values"),
     (MotionAware, "search", "centre", lambda a, c: np.array([np.nan, 1.0]), "returned NaN or infinite values"),
     (Gray, "feature", "extract", lambda a, c: np.zeros((1, 8, 8), np.complex64), "returned dtype complex64"),
@@ -157,3 +158,23 @@ def test_whatever_a_hook_returns_ends_in_good_boxes_or_the_named_hook(base, kind
         assert f"{kind} 'evil_{kind}' (from {PROVIDER}): {hook}() " in str(exc), str(exc)
         return
     assert np.isfinite(boxes).all() and (boxes[:, 2:] > 0).all(), boxes
+
+
+def test_a_component_whose_hooks_cannot_be_wrapped_is_refused_by_name():
+    class Slotted(Pyramid):
+        __slots__ = ()
+        name = "slotted"
+
+    class NoDict:  # what __slots__ all the way down gives: no instance attributes
+        __slots__ = ("params",)
+        kind, name = "scale", "slotted"
+
+        def update(self, image, centre, scale):
+            return scale
+
+    from dcfkit.contracts import Hook, checked
+    from dcfkit.errors import RegistryError
+
+    with pytest.raises(RegistryError, match=r"scale 'slotted' \(from p\): dcfkit cannot check its update\(\)"):
+        checked(NoDict(), "p", {"update": None})
+    assert isinstance(checked(Slotted(), "p", {"update": None}).update, Hook)  # a base with a __dict__: wrapped

@@ -708,8 +708,8 @@ def test_fuzzed_annotation_files_read_or_say_why(tmp_path_factory, data, n_frame
 
     path = tmp_path_factory.mktemp("fuzz") / "annotation.txt"
     path.write_bytes(b"".join(data))
-    readers = [(lambda: read_boxes(path), lambda out: out.dtype == np.float64 and out.shape[1:] == (4,)),
-               (lambda: read_regions(path), lambda out: out.dtype == np.float64 and out.shape[1:] == (4,)),
+    boxes = lambda out: out.dtype == np.float64 and out.shape[1:] == (4,)  # noqa: E731
+    readers = [(lambda: read_boxes(path), boxes), (lambda: read_regions(path), boxes),
                (lambda: read_frame_values(path, n_frames), lambda out: out.shape == (n_frames,) and out.dtype == np.int64),
                (lambda: read_flags(path, ("SV", "OCC")), lambda out: set(out) == {"SV", "OCC"})]
     for read, promised in readers:

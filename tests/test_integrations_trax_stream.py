@@ -8,24 +8,32 @@ import subprocess
 import sys
 from pathlib import Path
 
+import cv2
+import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
 import dcfkit
 from dcfkit.integrations.trax_stream import FramingError, check_message
 
-trax = pytest.importorskip("trax", reason="vot-trax is not installed (pip install \"dcfkit[trax]\"; the test extra has it)")
+trax = pytest.importorskip("trax", reason='vot-trax is not installed (pip install "dcfkit[trax]"; the test extra has it)')
 
 SERVER = [sys.executable, "-m", "dcfkit.cli", "trax", "kcf"]
 MEMORY_LIMIT = 3 * 2**30
 
 
-def served_stream(stream: bytes, tmp_path: Path) -> subprocess.CompletedProcess:
-    """``dcfkit trax kcf`` reading ``stream`` then the end of its stdin, under a memory limit
-    (libtrax's misreads grew to gigabytes) and a time limit."""
+def server_env() -> dict:
+    """A server process's environment: it imports the dcfkit under test, on stdin and stdout."""
     root = str(Path(dcfkit.__file__).resolve().parents[1])
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [root, os.environ.get("PYTHONPATH")]))}
     env.pop("TRAX_SOCKET", None)
+    return env
+
+
+def served_stream(stream: bytes, tmp_path: Path) -> subprocess.CompletedProcess:
+    """``dcfkit trax kcf`` reading ``stream`` then the end of its stdin, under a memory limit
+    (libtrax's misreads grew to gigabytes) and a time limit."""
+    env = server_env()
 
     def limited():
         resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
@@ -83,22 +91,20 @@ def test_messages_libtrax_reads_as_written_pass(line):
     (b'@@TRAX:initialize "mask:0,0,-5,5,1"', "-5x5 pixels"),
 ])
 def test_messages_libtrax_would_misread_are_refused(line, says):
-    with pytest.raises(FramingError, match=None) as caught:
+    with pytest.raises(FramingError) as caught:
         check_message(line)
     assert says in str(caught.value)
 
 
 def test_a_mask_initialises_on_the_box_of_its_pixels(tmp_path):
-    import numpy as np
     from trax.client import Client
 
     image = tmp_path / "frame.png"
-    import cv2
     assert cv2.imwrite(str(image), np.random.default_rng(0).integers(0, 256, (100, 100, 3), np.uint8))
     mask = np.zeros((60, 60), np.uint8)
     mask[30:40, 20:40] = 1
     process = subprocess.Popen(SERVER, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                               bufsize=0, env={**os.environ, "PYTHONPATH": str(Path(dcfkit.__file__).resolve().parents[1])})
+                               bufsize=0, env=server_env())
     try:
         client = Client(stream=(process.stdin.fileno(), process.stdout.fileno()), log=lambda line: None)
         assert "mask" in client.region_formats

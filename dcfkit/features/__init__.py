@@ -29,15 +29,19 @@ def cell_average(x: np.ndarray, cell_size: int) -> np.ndarray:
     return cv2.resize(whole, (w, h), interpolation=cv2.INTER_AREA)
 
 
+def _map_shape(args, feature) -> tuple[int, int, int]:
+    """(C, H // cell_size, W // cell_size) of ``extract(patch, cell_size)``."""
+    patch, cell_size = args
+    return feature.channels(), patch.shape[0] // cell_size, patch.shape[1] // cell_size
+
+
 class Feature(Component):
     """Maps search patches to feature maps. The tracker calls ``reset()`` at every ``init``
     (a new target), then ``extract`` on each patch; ``channels()`` whenever it checks a map."""
 
     kind = "feature"
     contract = Contract(required={"channels": (), "extract": ("patch", "cell_size")}, optional={"reset": ()},
-                        returns={"channels": scalar(1, math.inf, integer=True),
-                                 "extract": array(lambda args, feature: (feature.channels(), args[0].shape[0] // args[1],
-                                                                         args[0].shape[1] // args[1]))})
+                        returns={"channels": scalar(1, math.inf, integer=True), "extract": array(_map_shape)})
 
     def channels(self) -> int:
         """C, the number of channels ``extract`` returns (at least 1)."""

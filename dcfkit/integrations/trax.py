@@ -159,7 +159,7 @@ def region_box(region) -> tuple[float, float, float, float]:
         x, y = region.offset()
         return (float(x + columns.min()), float(y + rows.min()),
                 float(columns.max() - columns.min() + 1), float(rows.max() - rows.min() + 1))
-    raise InputError(f"frame 1: a TraX {region.type} region; dcfkit takes a rectangle or a polygon")
+    raise InputError(f"frame 1: a TraX {region.type} region; dcfkit takes a rectangle, a polygon or a mask")
 
 
 def read_image(images: Mapping[str, Any], what: str) -> np.ndarray:

@@ -181,7 +181,6 @@ class Framing:
 
     def _pass_on(self, lines: bytes) -> None:
         """Check each line of ``lines`` (whole lines), then write them to the sink."""
-        start = 0
         for line in lines.split(b"\n")[:-1]:
             if len(line) > MAX_MESSAGE_BYTES:
                 raise FramingError(f"a line longer than {MAX_MESSAGE_BYTES} bytes")
