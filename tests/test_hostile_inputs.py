@@ -803,7 +803,9 @@ def test_boxes_of_absurd_size_score_without_a_numpy_warning():
     from dcfkit.metrics import score_sequence
 
     gt = np.array([[10, 10, 20, 20], [10, 10, -20, -20], [1e300, 10, 1e300, 20]], float)
+    pred = np.array([[10, 10, 20, 20]] * 3, float)  # 1e300 away from the last box: an infinite error
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         for protocol in ("otb", "pysot", "got10k", "lasot"):
-            assert 0 < score_sequence(gt, gt, protocol=protocol)["auc"] < 1
+            scores = score_sequence(pred, gt, protocol=protocol)
+            assert 0 <= scores["auc"] < 1 and 0 <= scores["precision"] < 1, (protocol, scores)
