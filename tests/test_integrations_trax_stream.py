@@ -11,7 +11,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import example, given, settings, strategies as st
 
 import dcfkit
 from dcfkit.integrations.trax_stream import FramingError, check_message
@@ -53,6 +53,9 @@ def served_stream(stream: bytes, tmp_path: Path) -> subprocess.CompletedProcess:
     (b'@@TRAX:initialize "m50,50,10,10,5,73"\n', "VOT's mask files write m; TraX writes mask:"),
     (b'@@TRAX:initialize "mask:0,0,50000,50000,1"\n', "dcfkit takes masks of at most"),
     (b'@@TRAX:initialize "rect:1,2,3"\n', "has 3 numbers"),
+    (b'@@TRAX:initialize "1,1,2,2"\n@@TRAX:frame "image:1;1431655766;rgb;AAA="\n', "a 1x1431655766 memory image: over"),
+    (b'@@TRAX:initialize "1,1,2,2"\n@@TRAX:frame "image:2;2;rgb;AAAA"\n', "of 12 bytes whose data holds 3"),
+    (b'@@TRAX:initialize "1,1,2,2"\n@@TRAX:frame\n', "a frame message with 0 images; the server reads 1"),
 ])
 def test_a_stream_libtrax_would_misread_ends_in_one_protocol_error(stream, says, tmp_path):
     run = served_stream(stream, tmp_path)
@@ -60,6 +63,29 @@ def test_a_stream_libtrax_would_misread_ends_in_one_protocol_error(stream, says,
     assert run.returncode == 2, err
     assert err.startswith("dcfkit trax: error: TraX: message ") and says in err, err
     assert err.count("\n") == 1 and "Traceback" not in err
+
+
+@pytest.mark.parametrize("stream", [
+    b'@@TRAX:initialize "1,1,2,2"\n', b"@@TRAX:initialize\n", b"@@TRAX:hello\n", b'@@TRAX:state "1,1,2,2"\n',
+    b'@@TRAX:initialize "1,1,2,2" "a=b"\nnot a message\n',
+])
+def test_a_stream_that_ends_after_a_whole_message_ends_the_session(stream, tmp_path):
+    """libtrax read the end as more of the last message's type: it grew (initialize) or spun
+    (hello) for ever."""
+    run = served_stream(stream, tmp_path)
+    err = run.stderr.decode()
+    assert run.returncode == 2 and err.startswith("dcfkit trax: error: TraX: no request from the client: it closed "
+                                                  "the connection without sending quit"), err
+
+
+def test_trax_socket_must_be_a_port_in_ascii_digits(monkeypatch):
+    from dcfkit.integrations.trax_stream import ProtocolError, framed_connection
+
+    for port in ("٣٣", "0", "70000", "x"):
+        monkeypatch.setenv("TRAX_SOCKET", port)
+        with pytest.raises(ProtocolError, match=r"\$TRAX_SOCKET is .*, not a port number"):
+            with framed_connection():
+                pass
 
 
 def test_whole_messages_pass_and_the_session_ends_cleanly(tmp_path):
@@ -126,6 +152,8 @@ TOKENS = [b"@@TRAX:", b"initialize", b"frame", b"quit", b" ", b'"', b"\\", b"\n"
 
 @settings(max_examples=60, deadline=None)
 @given(st.lists(st.sampled_from(TOKENS), max_size=40))
+@example([b"@@TRAX:", b"initialize", b" ", b'"', b"1,2,3,4", b'"', b"\n"])  # whole, then the end: libtrax grew
+@example([b"@@TRAX:", b"quit", b" ", b"x", b"\n", b"@@TRAX:", b"frame", b"\n"])
 def test_fuzzed_streams_through_libtrax_end_without_hanging(monkeypatch, pieces):
     """Any stream of protocol fragments, framed then read by libtrax in this process: every
     wait returns (a request or libtrax's error) and the session ends within a bounded number

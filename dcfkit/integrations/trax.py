@@ -159,7 +159,8 @@ def region_box(region) -> tuple[float, float, float, float]:
         x, y = region.offset()
         return (float(x + columns.min()), float(y + rows.min()),
                 float(columns.max() - columns.min() + 1), float(rows.max() - rows.min() + 1))
-    raise InputError(f"frame 1: a TraX {region.type} region; dcfkit takes a rectangle, a polygon or a mask")
+    raise InputError(f"frame 1: a TraX {region.type} region (libtrax makes a special one of a region holding NaN, "
+                     f"or of one number); dcfkit takes a rectangle, a polygon or a mask")
 
 
 def read_image(images: Mapping[str, Any], what: str) -> np.ndarray:

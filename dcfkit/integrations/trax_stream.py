@@ -32,12 +32,17 @@ import time
 from typing import Iterator
 
 from ..errors import DcfkitError
+from ..limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 PREFIX = b"@@TRAX:"
 MAX_MESSAGE_BYTES = 256 * 2**20  # an 8K RGB frame as a base64 memory image is 133 MB
 MAX_MASK_PIXELS = 2**28
 CHUNK_BYTES = 2**20
 CONNECT_SECONDS = 30.0  # libtrax retries a refused $TRAX_SOCKET connection for ever
+# written after the client's last message: libtrax reads the end of its input as the end of a
+# message of the last type it read (after a whole "initialize" or "hello" it loops for ever,
+# growing); a line of a type it does not know resets that, so the end is an end
+END_OF_STREAM = PREFIX + b"dcfkitend\n"  # letters alone: another character ends the type, not the message
 
 _TYPE = re.compile(rb"[A-Za-z0-9]*")
 _UNQUOTED_SPECIAL = re.compile(rb"[ \\]")
@@ -46,6 +51,9 @@ _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?:nan|inf|infinity)"
 _REGION = re.compile(rf"(?:(rect|rectangle|poly|polygon|mask|special):)?((?:{_NUMBER})(?:,(?:{_NUMBER}))*)",
                      re.IGNORECASE)
 _KEYWORD = re.compile(rb"[A-Za-z0-9_.]+=")
+_MEMORY_IMAGE = re.compile(rb"image:([0-9]{1,10});([0-9]{1,10});(rgb|gray8|gray16);")
+_BYTES_PER_PIXEL = {b"rgb": 3, b"gray8": 1, b"gray16": 2}
+CHANNELS = 1  # images a frame message carries: the server asks for the color channel alone
 _COUNTS = {"rect": lambda n: n == 4, "poly": lambda n: n >= 6 and n % 2 == 0, "mask": lambda n: n > 4,
            "spec": lambda n: n == 1}  # libtrax's assertions, per region type
 
@@ -66,24 +74,49 @@ def check_message(line: bytes) -> None:
     i = _TYPE.match(line, len(PREFIX)).end()
     if i < len(line) and line[i:i + 1] != b" ":
         raise FramingError(f"the message type is followed by {_char(line, i)}, not a space")
-    initialize = line[len(PREFIX):i] == b"initialize"
+    kind, positional = line[len(PREFIX):i], 0
     while i < len(line):
         c = line[i:i + 1]
         if c in (b" ", b"\r"):
             i += 1
             continue
         start, i = i, _quoted_end(line, i + 1) if c == b'"' else _unquoted_end(line, i + 1)
-        if initialize:
-            _check_region(line[start:i])
+        text = line[start + 1:i - 1] if c == b'"' else line[start:i]
+        if _KEYWORD.match(text):
+            continue  # a property
+        positional += 1
+        if kind == b"initialize":
+            _check_region(text)
+        elif kind == b"frame":
+            _check_image(text)
     # falling off the end of the line: the message ends at its line break
+    if kind == b"frame" and positional != CHANNELS:
+        raise FramingError(f"a frame message with {positional} images; the server reads {CHANNELS} (color)")
 
 
-def _check_region(argument: bytes) -> None:
-    """Raise :class:`FramingError` if ``argument`` of an ``initialize`` (the region, or a
-    ``key=value`` property) is a region libtrax would misread."""
-    text = argument[1:-1] if argument.startswith(b'"') else argument
-    if _KEYWORD.match(text):
-        return  # a property
+def _check_image(text: bytes) -> None:
+    """Raise :class:`FramingError` if a ``frame``'s memory image (``image:W;H;FORMAT;BASE64``)
+    is larger than dcfkit takes, or its data is not of its size (libtrax compares the two in an
+    ``int``, and vot-trax then allocates what the header says)."""
+    if not text.startswith(b"image:"):
+        return
+    header = _MEMORY_IMAGE.match(text)
+    if header is None:
+        raise FramingError(f"the memory image {_start(text)}... is not image:WIDTH;HEIGHT;rgb|gray8|gray16;BASE64")
+    width, height, fmt = int(header.group(1)), int(header.group(2)), header.group(3)
+    data = len(text) - header.end()
+    decoded = data // 4 * 3 - text[-2:].count(b"=") if data % 4 == 0 else -1
+    size = width * height * _BYTES_PER_PIXEL[fmt]
+    if not 0 < width * height <= max_image_pixels():
+        raise FramingError(f"a {width}x{height} memory image: over the limit of {max_image_pixels():.3g} pixels "
+                           f"(${IMAGE_PIXELS_VARIABLE})")
+    if decoded != size:
+        raise FramingError(f"a {width}x{height} {fmt.decode()} memory image of {size} bytes whose data holds "
+                           f"{max(decoded, 0)}")
+
+def _check_region(text: bytes) -> None:
+    """Raise :class:`FramingError` if ``text``, an ``initialize``'s region, is one libtrax
+    would misread."""
     region = _REGION.fullmatch(text.decode("ascii"))
     if region is None:
         raise FramingError(f"the region {_start(text)} is not numbers separated by commas, with an optional "
@@ -158,6 +191,8 @@ class Framing:
         except OSError as exc:
             self.error = f"cannot read from the client ({exc.strerror or exc})"
         finally:
+            with contextlib.suppress(OSError):  # libtrax may have stopped reading: the pipe is closed
+                _write_all(self.sink, END_OF_STREAM)
             os.close(self.sink)
 
     def _copy_messages(self) -> None:
@@ -236,6 +271,8 @@ def framed_connection(environ=os.environ) -> Iterator[Framing]:
 def _connected(port_text: str) -> Iterator[socket.socket]:
     """A TCP connection to the client listening on ``$TRAX_SOCKET`` (a port on localhost)."""
     try:
+        if not (port_text.isascii() and port_text.isdigit()):
+            raise ValueError
         port = int(port_text)
         if not 0 < port < 65536:
             raise ValueError
@@ -246,11 +283,14 @@ def _connected(port_text: str) -> Iterator[socket.socket]:
         try:
             client = socket.create_connection(("127.0.0.1", port), timeout=CONNECT_SECONDS)
             break
-        except OSError as exc:
+        except ConnectionRefusedError as exc:  # the client is not listening yet; anything else is an answer
             if time.monotonic() > deadline:
                 raise ProtocolError(f"TraX: cannot connect to the client at $TRAX_SOCKET={port} "
                                    f"for {CONNECT_SECONDS:.0f} s ({exc.strerror or exc})") from None
             time.sleep(0.2)
+        except OSError as exc:
+            raise ProtocolError(f"TraX: cannot connect to the client at $TRAX_SOCKET={port} "
+                                f"({exc.strerror or exc})") from None
     client.settimeout(None)
     client.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
     with client:
