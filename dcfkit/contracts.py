@@ -85,12 +85,13 @@ KIND_NAMES = {"f": "real floats", "iu": "integers", "iuf": "real numbers", "c": 
 
 
 def array(shape: Callable[[tuple, Any], tuple] | tuple | None = None, *, kinds: str = "f", finite: bool = True,
-          nonnegative: bool = False) -> Check:
-    """An ndarray (a list is not one) of ``shape`` (a tuple, None for any size along an axis,
-    or a function of the hook's arguments and the component), of a dtype kind in ``kinds``,
-    finite (``finite``; else at least not NaN) and >= 0 (``nonnegative``)."""
+          nonnegative: bool = False, largest: float = math.inf) -> Check:
+    """An ndarray (not a list, nor a subclass such as a masked array, whose hidden values numpy
+    still computes with) of ``shape`` (a tuple, None for any size along an axis, or a function
+    of the hook's arguments and the component), of a dtype kind in ``kinds``, finite
+    (``finite``; else at least not NaN), >= 0 (``nonnegative``) and at most ``largest`` in size."""
     def check(value, args, component):
-        if not isinstance(value, np.ndarray):
+        if type(value) is not np.ndarray:
             return f"a {type(value).__name__}, expected a numpy array of {KIND_NAMES.get(kinds, kinds)}"
         expected = shape(args, component) if callable(shape) else shape
         if expected is not None and (value.ndim != len(expected) or any(
@@ -99,7 +100,10 @@ def array(shape: Callable[[tuple, Any], tuple] | tuple | None = None, *, kinds: 
             return f"shape {value.shape}, expected ({sizes}{',' * (len(expected) == 1)})"
         if value.dtype.kind not in kinds:
             return f"dtype {value.dtype}, expected {KIND_NAMES.get(kinds, kinds)}"
-        return _values_problem(value, finite, nonnegative)
+        problem = _values_problem(value, finite, nonnegative)
+        if problem is None and largest < math.inf and value.size and np.abs(value).max() > largest:
+            problem = f"values as large as {np.abs(value).max():.3g}, expected at most {largest:g} in size"
+        return problem
     return check
 
 
@@ -121,7 +125,7 @@ def scalar(lowest: float, highest: float, *, above: bool = False, inf: bool = Fa
     interval = f"{'(' if above else '['}{lowest:g}, {highest:g}]{' or inf' if inf else ''}"
 
     def check(value, args, component):
-        if isinstance(value, np.ndarray) and value.ndim == 0:
+        if type(value) is np.ndarray and value.ndim == 0:
             value = value[()]
         wanted = numbers.Integral if integer else numbers.Real
         if isinstance(value, bool) or not isinstance(value, wanted):

@@ -37,9 +37,9 @@ def tracker_name(config: Mapping) -> str:
     name = config.get("name") if isinstance(config, Mapping) else None
     if not isinstance(name, str) or not name.strip():
         raise ConfigError("config has no top-level 'name' (the tracker name used for the output folder)")
-    if name in (".", "..") or any(c in name for c in "/\\:") or not name.isprintable():
-        raise ConfigError(f"config 'name' {shown(name)} must be usable as a folder name (no / \\ :, no control "
-                          f"character such as a null byte or a line break)")
+    if name.startswith(".") or any(c in name for c in "/\\:") or not name.isprintable():
+        raise ConfigError(f"config 'name' {shown(name)} must be usable as a folder name that report lists (no / \\ :, "
+                          f"no leading dot, no control character such as a null byte or a line break)")
     return name
 
 

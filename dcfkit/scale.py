@@ -21,15 +21,20 @@ from .patches import resize_auto, sample, sampler, whole_pixel_crop
 from .registry import Component, Contract
 
 
+def _note_limits(value, args, estimator) -> None:
+    """``init``'s check: nothing to check in what it returns; it notes the limits the tracker
+    gave, which ``update``'s scale must respect (:func:`_within_limits`)."""
+    estimator.__dict__["_contract_limits"] = tuple(float(v) for v in args[4])
+
+
 def _within_limits(value, args, estimator) -> str | None:
-    """``update``'s scale: a number > 0, within the ``limits`` ``init`` gave the estimator
-    (when it keeps them, as the base class does)."""
+    """``update``'s scale: a number > 0, within the ``limits`` ``init`` was given."""
     problem = scalar(0, math.inf, above=True)(value, args, estimator)
-    limits = getattr(estimator, "limits", None)
+    limits = estimator.__dict__.get("_contract_limits")
     tolerance = 1e-9  # the built-ins clip to the limits; a rounding may land a hair outside
     if problem is None and limits is not None and not (limits[0] * (1 - tolerance) <= float(value)
                                                        <= limits[1] * (1 + tolerance)):
-        problem = f"{float(value)!r}, outside the limits [{limits[0]:g}, {limits[1]:g}] init gave it"
+        problem = f"{float(value)!r}, outside the limits [{limits[0]:g}, {limits[1]:g}] given to init"
     return problem
 
 
@@ -41,7 +46,7 @@ class ScaleEstimator(Component):
     kind = "scale"
     contract = Contract(optional={"init": ("image", "centre", "base_target", "scale", "limits"),
                                   "search_factors": (), "update": ("image", "centre", "scale")},
-                        returns={"search_factors": search_factors, "update": _within_limits})
+                        returns={"init": _note_limits, "search_factors": search_factors, "update": _within_limits})
 
     def init(self, image: np.ndarray, centre: np.ndarray, base_target: np.ndarray, scale: float,
              limits: tuple[float, float]) -> None:

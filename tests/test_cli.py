@@ -33,9 +33,9 @@ def test_track_frames_writes_one_box_per_frame(clip, tmp_path, capsys):
     centre = lambda b: b[:, :2] + b[:, 2:] / 2  # noqa: E731
     assert np.hypot(*(centre(boxes) - centre(seq.ground_truth)).T).max() < 10
     assert "12 frames" in capsys.readouterr().err
-    confidence = np.loadtxt(tmp_path / "boxes_confidence.txt", delimiter=",")  # peak,apce beside the boxes
+    confidence = np.loadtxt(tmp_path / "boxes.confidence", delimiter=",")  # peak,apce beside the boxes
     assert confidence.shape == (12, 2) and np.isnan(confidence[0]).all() and (confidence[1:, 1] > 1).all()
-    times = np.loadtxt(tmp_path / "boxes_time.txt")
+    times = np.loadtxt(tmp_path / "boxes.time")
     assert times.shape == (12,) and (times > 0).all()
 
 
@@ -79,6 +79,8 @@ def test_track_video_and_annotated_output(clip, tmp_path):
     (["--box", "10,10,20,20", "--set", "label.mue=1"], "unknown parameter 'mue'"),
     (["--box", "10,10,20,20", "--set", "labelmu"], "--set expects KEY=VALUE"),
     (["--box", "10,10,20,20", "--save-video", "out.gif"], "cannot write a video named 'out.gif'"),
+    (["--box", "10,10,20,20", "--out", "boxes.time"], "--out: boxes.time ends in .time, the ending of the file "
+                                                       "written beside the boxes; give them another one"),
 ])
 def test_track_errors_are_one_line_messages(clip, args, message, capsys):
     _, frames = clip
@@ -203,6 +205,6 @@ def test_track_keeps_its_boxes_when_terminated(clip, tmp_path, signame):
     assert f"dcfkit track: interrupted ({signame})" in run.stderr and "Traceback" not in run.stderr
     boxes = np.loadtxt(out, delimiter=",")
     assert boxes.shape == (3, 4)  # frames 1-3, tracked before the signal
-    assert np.loadtxt(tmp_path / "partial_confidence.txt", delimiter=",").shape == (3, 2)
-    assert np.loadtxt(tmp_path / "partial_time.txt").shape == (3,)
+    assert np.loadtxt(tmp_path / "partial.confidence", delimiter=",").shape == (3, 2)
+    assert np.loadtxt(tmp_path / "partial.time").shape == (3,)
     np.testing.assert_allclose(boxes[0], seq.ground_truth[0], atol=1e-3)

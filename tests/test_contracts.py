@@ -86,6 +86,11 @@ CASES = [  # (base, kind, hook, returned(args, component), the error after "<hoo
     (MotionAware, "search", "centre", lambda a, c: np.array([np.nan, 1.0]), "returned NaN or infinite values"),
     (Gray, "feature", "extract", lambda a, c: np.zeros((1, 8, 8), np.complex64), "returned dtype complex64"),
     (Gray, "feature", "channels", lambda a, c: 0, r"returned 0\.0, expected \[1, inf\]"),
+    (Gray, "feature", "extract", lambda a, c: np.full((1, a[0].shape[0] // a[1], a[0].shape[1] // a[1]), 3e38,
+                                                      np.float32), r"returned values as large as 3e\+38"),
+    (Pyramid, "scale", "search_factors", lambda a, c: np.ma.array([1.0, np.nan], mask=[0, 1]),
+     "returned a MaskedArray, expected a numpy array"),
+    (MotionAware, "search", "centre", lambda a, c: np.ma.array([1.0, 2.0]), "returned a MaskedArray"),
 ]
 
 
@@ -97,6 +102,27 @@ def test_a_hook_that_breaks_its_contract_is_named_with_its_provider(base, kind, 
     assert caught.type is TrackerFailure or hook == "channels", caught.value  # channels: at load, the budget
     message = str(caught.value)
     assert re.search(rf"{kind} 'evil_{kind}' \(from {PROVIDER}\): {re.escape(hook)}\(\) {said}", message), message
+
+
+def test_a_scale_is_held_to_the_limits_given_to_init_whatever_the_estimator_keeps():
+    class Forgetful(Pyramid):  # keeps no limits of its own
+        name = "forgetful"
+
+        def init(self, image, centre, base_target, scale, limits):
+            self.base_target = base_target
+
+        def update(self, image, centre, scale):
+            return 1e-300
+
+    registry = reg.get_registry()
+    registry._provider = PROVIDER
+    try:
+        registry.register(Forgetful)
+    finally:
+        registry._provider = "?"
+    with pytest.raises(TrackerFailure, match=r"scale 'forgetful' \(from evil-plugin\): update\(\) returned 1e-300, "
+                                             r"outside the limits \[[\d.e+-]+, [\d.e+-]+\] given to init"):
+        tracked({"scale": {"name": "forgetful"}})
 
 
 def test_a_hook_that_raises_is_named_with_its_provider():

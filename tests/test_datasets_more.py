@@ -719,3 +719,53 @@ def test_fuzzed_annotation_files_read_or_say_why(tmp_path_factory, data, n_frame
             assert str(path) in str(exc) and "\n" not in str(exc)
             continue
         assert promised(out), out
+
+
+def test_two_otb_targets_of_one_name_are_an_error_naming_both_files(tmp_path, jpg):
+    root = otb_root(tmp_path, jpg)  # Jogging holds targets 1 and 2: Jogging-1, Jogging-2
+    write(root / "Jogging-1" / "groundtruth_rect.txt", lines([[11, 21, 12, 10]] * 2))
+    frames(root / "Jogging-1" / "img", ["0001.jpg", "0002.jpg"], jpg)
+    with pytest.raises(DatasetError, match=r"two targets are named 'Jogging-1': .*Jogging/groundtruth_rect\.1\.txt "
+                                           r"and .*Jogging-1/groundtruth_rect\.txt"):
+        load_dataset("otb", root)
+
+
+def test_only_numbered_files_are_targets_of_a_multi_target_folder(tmp_path, jpg):
+    root = otb_root(tmp_path, jpg)
+    write(root / "Jogging" / "groundtruth_rect.1.old.txt", lines([[1, 1, 5, 5]] * 2))  # a backup, not a target
+    sequences = {s.name: s for s in load_dataset("otb", root)}
+    assert sorted(sequences) == ["Basketball", "Jogging-1", "Jogging-2"]
+    assert sequences["Jogging-1"].annotation.name == "groundtruth_rect.1.txt"
+
+
+@pytest.mark.parametrize("kind", ["fifo", "zero", "folder"])
+def test_a_sequence_whose_annotation_cannot_be_read_is_named_not_dropped(kind, tmp_path, jpg):
+    root = otb_root(tmp_path, jpg)
+    annotation = root / "Basketball" / "groundtruth_rect.txt"
+    if kind == "folder":
+        annotation.unlink()
+        annotation.mkdir()
+    else:
+        replace_file(annotation, kind)
+    with pytest.raises(DatasetError, match=r"Basketball/groundtruth_rect\.txt \(not a regular file\)"):
+        load_dataset("otb", root)
+
+
+@pytest.mark.parametrize("text, said", [
+    ("1,2,3,4\n1e309,2,3,4\n", r"line 2: .*got '1e309,2,3,4'"),
+    ("1,2,3,4\x0c\n1,2,3,x\n", r"line 2: .*got '1,2,3,x'"),  # a form feed is no line break
+    ("1,2,3,4\u2028\n1,2,3,x\n", r"line 2: .*got '1,2,3,x'"),
+])
+def test_numbers_out_of_range_and_line_numbers_of_odd_files(text, said, tmp_path):
+    from dcfkit.datasets import read_boxes
+
+    path = write(tmp_path / "groundtruth.txt", text)
+    with pytest.raises(DatasetError, match=said):
+        read_boxes(path)
+
+
+def test_a_vot_frame_pattern_takes_ascii_digits_only(tmp_path, jpg):
+    root = vot_root(tmp_path, jpg)
+    write(root / "ants1" / "sequence", "channels.color=color/%0\u0668d.jpg\n")  # an Arabic-Indic eight
+    with pytest.raises(DatasetError, match=r"is not a frame pattern"):
+        load_dataset("vot", root)

@@ -765,8 +765,13 @@ def test_a_config_name_with_a_control_character_is_a_config_error(tmp_path, otb_
     assert cli.main(["eval", str(config), "--dataset", "otb", "--root", str(otb_root), "--out",
                      str(tmp_path / "out"), "--no-progress"]) == 2
     err = capsys.readouterr().err
-    assert err == ("dcfkit eval: error: config 'name' 'a\\x00b' must be usable as a folder name (no / \\ :, no "
-                   "control character such as a null byte or a line break)\n")
+    assert err == ("dcfkit eval: error: config 'name' 'a\\x00b' must be usable as a folder name that report lists "
+                   "(no / \\ :, no leading dot, no control character such as a null byte or a line break)\n")
+    from dcfkit.evaluation import tracker_name
+
+    for name in (".mine", ".locks", "..", "a\nb"):
+        with pytest.raises(ConfigError, match="must be usable as a folder name"):
+            tracker_name({"name": name})
 
 
 def test_a_name_cannot_add_rows_to_a_markdown_or_text_table():

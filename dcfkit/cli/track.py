@@ -11,10 +11,9 @@ from typing import Iterator
 import numpy as np
 
 from ..config import parse_overrides
-from ..errors import clip
+from ..errors import InputError, clip
 from ..metrics import score_sequence
-from ..results import (TOOLKIT_CONFIDENCE_SUFFIX, TOOLKIT_TIME_SUFFIX, StoreError, format_boxes,
-                       format_confidence, format_times)
+from ..results import CONFIDENCE_END, TIME_END, StoreError, format_boxes, format_confidence, format_times
 from ..selection import check_display, select_box
 from ..synthetic import make_sequence
 from ..tracker import load_tracker
@@ -45,9 +44,9 @@ def add_track_arguments(p: argparse.ArgumentParser) -> None:
     first.add_argument("--select", action="store_true", help="draw the initial box on the first frame in a window "
                        "(needs a display; the box drawn is printed on stderr)")
     p.add_argument("--one-based", action="store_true", help="--box and --out use 1-based (OTB toolkit) pixels")
-    p.add_argument("--out", help="write one x,y,w,h line per frame here, and beside it OUT_confidence (peak,apce "
-                   "per frame) and OUT_time (seconds per frame) with OUT's suffix (default: x,y,w,h,peak,apce "
-                   "lines on stdout); each line is written as its frame is tracked")
+    p.add_argument("--out", help="write one x,y,w,h line per frame here, and beside it OUT's name with the "
+                   "endings .confidence (peak,apce per frame) and .time (seconds per frame), as dcfkit eval names "
+                   "them (default: x,y,w,h,peak,apce lines on stdout); each line is written as its frame is tracked")
     p.add_argument("--save-video", help="write an annotated video (.mp4, .avi, .mkv, .mov or .m4v) at the source's "
                    f"frame rate ({DEFAULT_FPS:g} fps for a folder of frames or a video that declares none)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar (shown on stderr when it is a "
@@ -117,9 +116,13 @@ def _keep_rate(writer: VideoWriter, source: FrameSource, video: str | None) -> N
               file=sys.stderr)
 
 
-def beside(out: Path, tag: str) -> Path:
-    """``boxes.txt`` -> ``boxes_confidence.txt``: a file written with ``--out``."""
-    return out.with_name(f"{out.stem}{tag}{out.suffix}")
+def beside(out: Path, ending: str) -> Path:
+    """``boxes.txt`` -> ``boxes.confidence``: a file written with ``--out``; an ``--out`` with
+    that ending would be its own companion."""
+    if out.suffix == ending:
+        raise InputError(f"--out: {clip(str(out))} ends in {ending}, the ending of the file written beside the "
+                         f"boxes; give them another one, such as .txt")
+    return out.with_suffix(ending)
 
 
 class BoxLines:
@@ -132,7 +135,7 @@ class BoxLines:
 
     def __init__(self, out: Path | None, offset: float):
         self.out, self.offset = out, offset
-        self.paths = [out, beside(out, TOOLKIT_CONFIDENCE_SUFFIX), beside(out, TOOLKIT_TIME_SUFFIX)] if out else []
+        self.paths = [out, beside(out, CONFIDENCE_END), beside(out, TIME_END)] if out else []
         for path in self.paths[1:]:
             check_output_file(path, "--out")
         self.files, self.count, self.seconds, self.bar = [], 0, 0.0, None

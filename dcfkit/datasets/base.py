@@ -7,6 +7,7 @@ import dataclasses
 import difflib
 import io
 import logging
+import math
 import os
 import re
 import stat
@@ -347,12 +348,28 @@ def read_text(path: Path) -> str:
         raise DatasetError(f"cannot read {path}: {exc.strerror}") from None
 
 
+def listed(annotation: Path) -> bool:
+    """Whether a sequence's annotation file is there (a folder of a benchmark lists the
+    sequence): whatever it is, a FIFO or a link to /dev/zero too, so that reading it says what
+    is wrong instead of the sequence vanishing from the list."""
+    return os.path.lexists(annotation)
+
+
 def parse_number(field: str) -> float:
     """A number of an annotation file (ASCII digits, ``nan`` and ``inf`` as written); ValueError
     for anything else Python's ``float`` would take."""
     if not _NUMBER.fullmatch(field):
         raise ValueError(f"could not convert {field[:40]!r} to a number")
-    return float(field)
+    value = float(field)
+    if math.isinf(value) and "inf" not in field.lower():
+        raise ValueError(f"{field[:40]!r} is beyond the range of a float")
+    return value
+
+
+def annotation_lines(text: str) -> list[str]:
+    """The lines of an annotation file, broken at line feeds alone (``str.splitlines`` also
+    breaks at form feeds and U+2028, and messages would name the wrong line)."""
+    return [line.removesuffix("\r") for line in text.split("\n")]
 
 
 def _fields(line: str, path: Path, n: int) -> list[str]:
@@ -372,7 +389,8 @@ def read_boxes(path: str | os.PathLike, one_based: bool = True) -> np.ndarray:
     or malformed line inside the file is a :class:`DatasetError` naming file and line.
     """
     path = Path(path)
-    lines = read_text(path).rstrip().splitlines()
+    text = read_text(path).rstrip()
+    lines = annotation_lines(text) if text else []
     boxes = np.empty((len(lines), 4), dtype=np.float64)
     for n, line in enumerate(lines):
         fields = _fields(line, path, n)
@@ -399,7 +417,7 @@ def read_frame_values(path: Path, n_frames: int) -> np.ndarray:
     ``(n_frames,) int64``; :class:`DatasetError` naming the file and the line of a value that is
     not a whole number, or the count when it is not ``n_frames``."""
     values = []
-    for n, line in enumerate(read_text(path).splitlines()):
+    for n, line in enumerate(annotation_lines(read_text(path))):
         for match in _FIELD.finditer(line):  # one at a time: LaSOT's single line may be long
             field = match.group()
             try:

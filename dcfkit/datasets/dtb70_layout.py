@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .base import (Sequence, annotated_frames, first_frame_digits, image_sequence_folders, read_boxes,
+from .base import (Sequence, annotated_frames, first_frame_digits, image_sequence_folders, listed, read_boxes,
                    require_root, select_sequences)
 from .registry import Evidence, register_layout
 
@@ -11,7 +11,7 @@ from .registry import Evidence, register_layout
 def dtb70(root, sequences=None) -> list[Sequence]:
     """DTB70: ``ROOT/<seq>/img/%05d.jpg`` and ``ROOT/<seq>/groundtruth_rect.txt``."""
     root = require_root(root, "DTB70")
-    available = sorted(p.name for p in root.iterdir() if (p / "groundtruth_rect.txt").is_file())
+    available = sorted(p.name for p in root.iterdir() if listed(p / "groundtruth_rect.txt"))
     out = []
     for name in select_sequences(available, sequences, f"DTB70 at {root}"):
         anno = root / name / "groundtruth_rect.txt"

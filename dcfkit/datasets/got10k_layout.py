@@ -16,8 +16,8 @@ from typing import Callable
 
 import numpy as np
 
-from .base import (DatasetError, Sequence, annotated_frames, held_out_sequence, read_boxes, read_frame_values,
-                   require_root, select_sequences)
+from .base import (DatasetError, Sequence, annotated_frames, held_out_sequence, listed, read_boxes,
+                   read_frame_values, require_root, select_sequences)
 from .registry import Evidence, register_layout
 
 SPLITS = ("train", "val", "test")
@@ -71,7 +71,7 @@ def _loader(split: str) -> Callable[..., list[Sequence]]:
 
     def load(root, sequences=None) -> list[Sequence]:
         folder = split_folder(root, split)
-        available = sorted(p.name for p in folder.iterdir() if (p / "groundtruth.txt").is_file())
+        available = sorted(p.name for p in folder.iterdir() if listed(p / "groundtruth.txt"))
         return [load_one(name, folder / name, split)
                 for name in select_sequences(available, sequences, f"GOT-10k {split} at {folder}")]
     load.__doc__ = f"GOT-10k's {split} split: ``ROOT/{split}/<seq>/%08d.jpg``, ``groundtruth.txt``."

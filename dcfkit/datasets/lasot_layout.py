@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import (DatasetError, Sequence, numbered_frames, read_boxes, read_flags, read_frame_values, read_text,
-                   require_root, select_sequences)
+from .base import (DatasetError, Sequence, listed, numbered_frames, read_boxes, read_flags, read_frame_values,
+                   read_text, require_root, select_sequences)
 from .registry import Evidence, register_layout
 
 #: Column order of the toolkit's att files (``att_fig_name`` of run_tracker_performance_evaluation.m).
@@ -32,7 +32,7 @@ _SEQUENCE_NAME = re.compile(r"^(.+)-(\d+)$")  # <class>-<n>
 
 
 def _is_sequence(folder: Path) -> bool:
-    return _SEQUENCE_NAME.match(folder.name) is not None and (folder / "groundtruth.txt").is_file()
+    return _SEQUENCE_NAME.match(folder.name) is not None and listed(folder / "groundtruth.txt")
 
 
 def _class_members(folder: Path) -> list[Path]:

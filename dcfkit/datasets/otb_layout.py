@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import shown
-from .base import (DatasetError, Sequence, check_box_count, first_frame_digits, image_sequence_folders,
+from .base import (DatasetError, Sequence, check_box_count, first_frame_digits, image_sequence_folders, listed,
                    read_boxes, read_flags, read_text, require_root, select_sequences)
 from .registry import Evidence, register_layout
 
@@ -34,21 +35,31 @@ _TOOLKIT_FRAME_RANGES = {
 }
 
 
+_TARGET_FILE = re.compile(r"groundtruth_rect\.([0-9]+)\.txt")  # one target of a multi-target folder
+
+
 def _targets(root: Path) -> dict[str, Path]:
     """Sequence name -> annotation file; multi-target folders give ``Name-1``, ``Name-2``."""
-    targets = {}
+    targets: dict[str, Path] = {}
+
+    def add(name: str, annotation: Path) -> None:
+        if name in targets:
+            raise DatasetError(f"two targets are named {name!r}: {targets[name]} and {annotation}; rename one")
+        targets[name] = annotation
+
     for folder in sorted(p for p in root.iterdir() if p.is_dir()):
-        if (folder / "groundtruth_rect.txt").is_file():
-            targets[folder.name] = folder / "groundtruth_rect.txt"
+        if listed(folder / "groundtruth_rect.txt"):
+            add(folder.name, folder / "groundtruth_rect.txt")
             continue
         numbered = sorted(
-            (p for p in folder.glob("groundtruth_rect.*.txt") if read_text(p).strip()),  # OTB-100 has empty ones
-            key=lambda p: p.name)
+            (p for p in folder.glob("groundtruth_rect.*.txt")
+             if _TARGET_FILE.fullmatch(p.name) and read_text(p).strip()),  # OTB-100 has empty ones
+            key=lambda p: int(_TARGET_FILE.fullmatch(p.name).group(1)))
         if len(numbered) == 1:
-            targets[folder.name] = numbered[0]
+            add(folder.name, numbered[0])
         else:
             for p in numbered:
-                targets[f"{folder.name}-{p.name.split('.')[1]}"] = p
+                add(f"{folder.name}-{_TARGET_FILE.fullmatch(p.name).group(1)}", p)
     return targets
 
 

@@ -13,7 +13,7 @@ import io
 from pathlib import Path
 from typing import Callable
 
-from .base import (DatasetError, Sequence, check_box_count, numbered_frames, read_boxes, read_flags,
+from .base import (DatasetError, Sequence, check_box_count, listed, numbered_frames, read_boxes, read_flags,
                    read_text, require_root, select_sequences)
 from .registry import Evidence, register_layout
 
@@ -89,7 +89,7 @@ def _load_subset(subset: str, dataset: str, root, sequences) -> list[Sequence]:
     root = require_root(root, subset)
     anno_dir, data_dir = _subset_folders(root, subset)
     table = uav123_sequence_table()[subset]
-    available = [name for name in table if (anno_dir / f"{name}.txt").is_file()]
+    available = [name for name in table if listed(anno_dir / f"{name}.txt")]
     absent = {name: anno_dir / f"{name}.txt" for name in table if name not in available}
     out = []
     for name in select_sequences(available, sequences, f"{subset} at {root}", absent):

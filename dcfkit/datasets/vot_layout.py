@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import shown
-from .base import DatasetError, Sequence, annotated_frames, parse_number, read_text, require_root, select_sequences
+from .base import (DatasetError, Sequence, annotated_frames, annotation_lines, listed, parse_number, read_text,
+                   require_root, select_sequences)
 from .registry import Evidence, register_layout
 
 #: How a polygon becomes a box: ``bounds`` the smallest box holding it (the VOT toolkit's
@@ -32,7 +33,7 @@ from .registry import Evidence, register_layout
 #: got10k's ``_corner2rect`` (``cx - w/2``); pysot's test scripts place it at ``cx - (w-1)/2``,
 #: half a pixel to the right and down.
 POLYGON_RULES = ("bounds", "area")
-_PATTERN = re.compile(r"^[^%]*%(?:0?\d{1,2})?d[^%]*$")  # one integer field of at most 99 digits, as in color/%08d.jpg
+_PATTERN = re.compile(r"^[^%]*%(?:0?\d{1,2})?d[^%]*$", re.ASCII)  # one integer field of at most 99 digits, as in color/%08d.jpg
 _MASK = re.compile(r"-?\d{1,10}(?:,-?\d{1,10}){3,}", re.ASCII)  # x0,y0,w,h,runs...: int64 holds their sums
 _SEPARATORS = re.compile(r"[,\s]+")  # VOT writes commas; some copies have tabs or spaces
 _GOT10K_FILES = ("meta_info.ini", "absence.label", "cover.label")  # GOT-10k's folders are otherwise VOT-like
@@ -99,7 +100,8 @@ def region_box(line: str, rule: str = "bounds") -> np.ndarray:
 def read_regions(path: Path, rule: str = "bounds") -> np.ndarray:
     """``(N, 4) float64`` boxes of a VOT ``groundtruth.txt``; :class:`DatasetError` naming file
     and line for a line that is no region."""
-    lines = read_text(path).rstrip().splitlines()
+    text = read_text(path).rstrip()
+    lines = annotation_lines(text) if text else []
     boxes = np.empty((len(lines), 4), dtype=np.float64)
     for n, line in enumerate(lines):
         try:
@@ -148,7 +150,7 @@ def _load_sequence(name: str, folder: Path, rule: str, dataset: str) -> Sequence
 
 def _load(root, sequences, rule: str, dataset: str) -> list[Sequence]:
     root = require_root(root, "VOT")
-    available = sorted(p.name for p in root.iterdir() if (p / "groundtruth.txt").is_file())
+    available = sorted(p.name for p in root.iterdir() if listed(p / "groundtruth.txt"))
     return [_load_sequence(name, root / name, rule, dataset)
             for name in select_sequences(available, sequences, f"VOT at {root}")]
 

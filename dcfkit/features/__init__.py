@@ -29,6 +29,9 @@ def cell_average(x: np.ndarray, cell_size: int) -> np.ndarray:
     return cv2.resize(whole, (w, h), interpolation=cv2.INTER_AREA)
 
 
+MAX_FEATURE_VALUE = 1e6  # the built-ins' maps stay within ±1; beyond this the solvers' float32 sums overflow
+
+
 def _map_shape(args, feature) -> tuple[int, int, int]:
     """(C, H // cell_size, W // cell_size) of ``extract(patch, cell_size)``."""
     patch, cell_size = args
@@ -41,7 +44,8 @@ class Feature(Component):
 
     kind = "feature"
     contract = Contract(required={"channels": (), "extract": ("patch", "cell_size")}, optional={"reset": ()},
-                        returns={"channels": scalar(1, math.inf, integer=True), "extract": array(_map_shape)})
+                        returns={"channels": scalar(1, math.inf, integer=True),
+                                 "extract": array(_map_shape, largest=MAX_FEATURE_VALUE)})
 
     def channels(self) -> int:
         """C, the number of channels ``extract`` returns (at least 1)."""
