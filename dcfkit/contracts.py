@@ -159,6 +159,10 @@ def search_factors(value, args, component) -> str | None:
     """One or more finite numbers in [1/MAX_FACTOR, MAX_FACTOR] in a 1-d array (the scales to
     search, relative to the current one)."""
     problem = array((None,), kinds="iuf")(value, args, component)
+    if problem is None:  # the sample budget was checked for the first call's count
+        first = component.__dict__.setdefault("_contract_factor_count", value.size)
+        if value.size > first:
+            return f"{value.size} factors, more than the {first} of its first call (the memory budget's)"
     tolerance = 1 + 1e-9  # step ** k of the built-ins may round past 10
     if problem is None and not (value.size and ((value * MAX_FACTOR * tolerance >= 1)
                                                 & (value <= MAX_FACTOR * tolerance)).all()):
@@ -183,6 +187,8 @@ def within_grid(value, args, component) -> str | None:
     problem = array((None, 2), kinds="iu")(value, args, component)
     if problem is None and value.size:
         height, width = args[0].shape
-        if np.abs(value[:, 0]).max() >= height or np.abs(value[:, 1]).max() >= width:
-            problem = f"offsets beyond the {height}x{width} grid (max |dy|, |dx| = {np.abs(value).max(axis=0)})"
+        dy, dx = value[:, 0], value[:, 1]  # compared, not abs(): abs of the most negative int64 is negative
+        if ((dy <= -height) | (dy >= height) | (dx <= -width) | (dx >= width)).any():
+            far = np.abs(value.astype(np.float64)).max(axis=0)
+            problem = f"offsets beyond the {height}x{width} grid (max |dy|, |dx| = {far[0]:.3g}, {far[1]:.3g})"
     return problem

@@ -10,6 +10,9 @@ from .params import param
 from .registry import Component, Contract
 
 
+MAX_COORDINATE = 2.0**31  # a centre (y, x) in pixels: no image is that large, and int32 holds it
+
+
 class Search(Component):
     """Where the next search area is centred. The tracker calls ``reset`` at every ``init`` (a
     new target), ``centre()`` at the start of every later frame, and ``observe`` once the target
@@ -17,7 +20,7 @@ class Search(Component):
 
     kind = "search"
     contract = Contract(optional={"reset": ("position",), "centre": (), "observe": ("position",)},
-                        returns={"centre": array((2,), kinds="iuf")})
+                        returns={"centre": array((2,), kinds="iuf", largest=MAX_COORDINATE)})
 
     def reset(self, position: np.ndarray) -> None:
         """Start at the first frame's target centre (y, x)."""

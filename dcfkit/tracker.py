@@ -22,7 +22,7 @@ import numpy as np
 
 from .confidence import Confidence
 from .config import TrackerParams, load_config
-from .contracts import naming_the_frame
+from .contracts import ContractViolation, naming_the_frame
 from .errors import ConfigError, InputError, TrackingError, shown
 from .features import extract_stack
 from .fft import make_fft
@@ -77,6 +77,14 @@ def check_box(box: Any, image_shape: tuple[int, ...]) -> np.ndarray:
     if x + w <= 0 or y + h <= 0 or x >= width or y >= height:
         raise InputError(f"initial box {(x, y, w, h)} lies outside the {width}x{height} image")
     return b
+
+
+def _read_only(w2: np.ndarray) -> np.ndarray:
+    """``w2``, which every component reads and none may change (a solver that wrote into it
+    would be caught by the regularizer's check, and the regularizer blamed), made read-only."""
+    w2 = np.array(w2, dtype=np.float32)  # a copy: the regularizer's own array stays writable for it
+    w2.setflags(write=False)
+    return w2
 
 
 def hann2d(shape: tuple[int, int], interior: bool = True) -> np.ndarray:
@@ -141,7 +149,11 @@ class Tracker:
         """The relative scales of the search samples (one sample each per frame)."""
         try:
             return np.asarray(self.scale_estimator.search_factors(), dtype=float).reshape(-1)
-        except Exception:  # an estimator that needs init first: budgeted as one scale, copies checked anyway
+        except ContractViolation as exc:
+            if exc.__cause__ is None:  # what it returned, not an exception it raised: said
+                raise
+            return np.ones(1)  # an estimator that needs init first: budgeted as one scale, copies checked anyway
+        except Exception:  # likewise, from an estimator no registry built
             return np.ones(1)
 
     def _check_config_budget(self) -> None:
@@ -254,8 +266,8 @@ class Tracker:
         regularizers = [r for r in (self.spatial, self.temporal) if r is not None]
         for component in (*self.features, self.label, self.solver, *regularizers):  # a new target: nothing kept
             component.reset()
-        self.w2 = (self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
-                   else np.zeros(g.filter_size, np.float32))
+        self.w2 = _read_only(self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
+                             else np.zeros(g.filter_size, np.float32))
         self.search.reset(centre)
         self.scale_estimator.init(image, centre, g.base_target, self.scale, self.limits)
         self.position = centre
@@ -311,10 +323,10 @@ class Tracker:
             raise InputError(f"frame {self.frame}: the image is {image.shape[1]}x{image.shape[0]}, but the "
                              f"sequence's first frame was {self.image_size[1]}x{self.image_size[0]}")
         g, p = self.geometry, self.params
-        centre = self._clamp(self.search.centre(), image.shape)  # Eq. (14)
+        centre = self._clamp(np.array(self.search.centre(), dtype=float), image.shape)  # Eq. (14); a copy
         if p.sampling == "whole_pixel":  # the patch is centred on a whole pixel, and so are displacements
             centre = round_half_away(centre)
-        factors = self.scale_estimator.search_factors()
+        factors = np.array(self.scale_estimator.search_factors(), dtype=float)  # copies: a plugin may change its own
         if self._blank(image[::4, ::4]) is not None:  # a dropped frame: hold, learn nothing
             self.last_response, self.last_search_box, self.last_distractors = None, None, np.zeros((0, 2))
             self.held_frames.append(self.frame)
@@ -331,7 +343,7 @@ class Tracker:
         if p.translation == "whole_pixel":
             move = round_half_away(move)
         self.position = self._clamp(centre + move, image.shape)
-        self.scale = self.scale_estimator.update(image, self.position, self.scale * factors[best])
+        self.scale = float(self.scale_estimator.update(image, self.position, self.scale * factors[best]))
         self.search.observe(self.position)  # Eq. (13)
         peak = np.unravel_index(int(np.argmax(maps[best])), g.filter_size)
         self.last_response = np.fft.fftshift(maps[best])
@@ -354,7 +366,7 @@ class Tracker:
         regularizer, whose w² it returns is used from this frame on."""
         self.solver.observe(detection)
         if self.spatial is not None:
-            self.w2 = self.spatial.adapt(self.w2, detection).astype(np.float32, copy=False)
+            self.w2 = _read_only(self.spatial.adapt(self.w2, detection).astype(np.float32, copy=False))
 
     def _theta(self, detection: Detection | None) -> float:
         """θ of this frame's training (0 without a temporal term; ``inf``: keep the last filter)."""

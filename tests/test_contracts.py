@@ -91,6 +91,9 @@ CASES = [  # (base, kind, hook, returned(args, component), the error after "<hoo
     (Pyramid, "scale", "search_factors", lambda a, c: np.ma.array([1.0, np.nan], mask=[0, 1]),
      "returned a MaskedArray, expected a numpy array"),
     (MotionAware, "search", "centre", lambda a, c: np.ma.array([1.0, 2.0]), "returned a MaskedArray"),
+    (MotionAware, "search", "centre", lambda a, c: np.array([1e300, 1e300]), r"returned values as large as 1e\+300"),
+    (Gaussian, "label", "make", lambda a, c: (a[0], np.array([[-2**63, -2**63]], np.int64)),  # abs() of it is < 0
+     r"returned offsets: offsets beyond"),
 ]
 
 
@@ -99,7 +102,8 @@ def test_a_hook_that_breaks_its_contract_is_named_with_its_provider(base, kind, 
     overrides = plugin(base, kind, hook, returned)
     with pytest.raises((TrackerFailure, ContractViolation)) as caught:
         tracked(overrides)
-    assert caught.type is TrackerFailure or hook == "channels", caught.value  # channels: at load, the budget
+    # channels and search_factors: at load too, where the sample budget is checked
+    assert caught.type is TrackerFailure or hook in ("channels", "search_factors"), caught.value
     message = str(caught.value)
     assert re.search(rf"{kind} 'evil_{kind}' \(from {PROVIDER}\): {re.escape(hook)}\(\) {said}", message), message
 
@@ -123,6 +127,46 @@ def test_a_scale_is_held_to_the_limits_given_to_init_whatever_the_estimator_keep
     with pytest.raises(TrackerFailure, match=r"scale 'forgetful' \(from evil-plugin\): update\(\) returned 1e-300, "
                                              r"outside the limits \[[\d.e+-]+, [\d.e+-]+\] given to init"):
         tracked({"scale": {"name": "forgetful"}})
+
+
+def growing(args, estimator):
+    """One factor on the first call (what the sample budget is checked for), then more."""
+    calls = estimator.__dict__.setdefault("calls", [])
+    calls.append(0)
+    return np.ones(len(calls))
+
+
+def test_more_search_factors_than_budgeted_are_refused():
+    with pytest.raises(TrackerFailure, match=r"scale 'evil_scale' \(from evil-plugin\): search_factors\(\) returned "
+                                             r"\d+ factors, more than the 1 of its first call"):
+        tracked(plugin(Pyramid, "scale", "search_factors", growing))
+
+
+def test_a_scale_the_estimator_changes_after_returning_it_changes_nothing():
+    def update(args, estimator):
+        estimator.given = np.array(float(args[2]))  # a 0-d array, which it changes on its next call
+        return estimator.given
+
+    def factors(args, estimator):
+        if hasattr(estimator, "given"):
+            estimator.given[()] = -1.0
+        return np.ones(1)
+
+    overrides = plugin(Pyramid, "scale", "update", update)
+    cls = reg.get_registry().entry("scale", "evil_scale").cls
+    cls.search_factors = lambda self: factors((), self)
+    boxes = tracked(overrides)
+    assert np.isfinite(boxes).all() and (boxes[:, 2:] > 0).all()
+
+
+def test_a_solver_that_writes_into_w2_is_named_not_the_regularizer():
+    def train(args, solver):
+        args[2][0, 0] = np.nan  # w2
+        return args[0]
+
+    with pytest.raises(TrackerFailure, match=r"solver 'evil_solver' \(from evil-plugin\): train\(\) raised "
+                                             r"ValueError: assignment destination is read-only"):
+        tracked(plugin(ADMMStrcf, "solver", "train", train))
 
 
 def test_a_hook_that_raises_is_named_with_its_provider():
@@ -153,7 +197,7 @@ def test_the_builtins_keep_their_contracts_on_every_shipped_config():
     (array(lambda a, c: a[0]), np.zeros((2, 3)), ((2, 4),), "shape (2, 3), expected (2, 4)"),
     (array(finite=False, nonnegative=True), np.array([np.inf, 0.0]), (), None),
     (pair(array(), array(), ("a", "b")), (np.zeros(1),), (), "a tuple, expected a tuple (a, b)"),
-    (within_grid, np.array([[2, -3]]), (np.zeros((3, 3)),), "offsets beyond the 3x3 grid (max |dy|, |dx| = [2 3])"),
+    (within_grid, np.array([[2, -3]]), (np.zeros((3, 3)),), "offsets beyond the 3x3 grid (max |dy|, |dx| = 2, 3)"),
     (within_grid, np.zeros((0,)), (np.zeros((3, 3)),), None),
 ])
 def test_checks_by_hand(check, value, args, problem):
@@ -180,7 +224,7 @@ def test_whatever_a_hook_returns_ends_in_good_boxes_or_the_named_hook(base, kind
     monkeypatch.setattr(reg, "_REGISTRY", reg.build_registry(external=False))
     try:
         boxes = tracked(plugin(base, kind, hook, lambda a, c: value))
-    except TrackerFailure as exc:
+    except (TrackerFailure, ContractViolation) as exc:  # ContractViolation: at load, search_factors' budget
         assert f"{kind} 'evil_{kind}' (from {PROVIDER}): {hook}() " in str(exc), str(exc)
         return
     assert np.isfinite(boxes).all() and (boxes[:, 2:] > 0).all(), boxes

@@ -30,10 +30,10 @@ def server_env() -> dict:
     return env
 
 
-def served_stream(stream: bytes, tmp_path: Path) -> subprocess.CompletedProcess:
+def served_stream(stream: bytes, tmp_path: Path, **variables: str) -> subprocess.CompletedProcess:
     """``dcfkit trax kcf`` reading ``stream`` then the end of its stdin, under a memory limit
-    (libtrax's misreads grew to gigabytes) and a time limit."""
-    env = server_env()
+    (libtrax's misreads grew to gigabytes) and a time limit, with environment ``variables``."""
+    env = {**server_env(), **variables}
 
     def limited():
         resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
@@ -56,6 +56,11 @@ def served_stream(stream: bytes, tmp_path: Path) -> subprocess.CompletedProcess:
     (b'@@TRAX:initialize "1,1,2,2"\n@@TRAX:frame "image:1;1431655766;rgb;AAA="\n', "a 1x1431655766 memory image: over"),
     (b'@@TRAX:initialize "1,1,2,2"\n@@TRAX:frame "image:2;2;rgb;AAAA"\n', "of 12 bytes whose data holds 3"),
     (b'@@TRAX:initialize "1,1,2,2"\n@@TRAX:frame\n', "a frame message with 0 images; the server reads 1"),
+    # libtrax passes over a line of an unknown type and over the line after it: a frame lost, exit 0
+    (b'@@TRAX:bogus\n@@TRAX:initialize "1,1,2,2"\n', "an unknown message type 'bogus'"),
+    (b'@@TRAX:\n@@TRAX:quit\n', "an unknown message type ''"),
+    (b'@@TRAX:dcfkitend\n@@TRAX:quit\n', "an unknown message type 'dcfkitend'"),  # the framing's own end
+    (b'@@TRAX:initialize "1,1,2,2"\n@@TRAX:FRAME "image:2;2;rgb;AAAA"\n', "of 12 bytes whose data holds 3"),
 ])
 def test_a_stream_libtrax_would_misread_ends_in_one_protocol_error(stream, says, tmp_path):
     run = served_stream(stream, tmp_path)
@@ -76,6 +81,19 @@ def test_a_stream_that_ends_after_a_whole_message_ends_the_session(stream, tmp_p
     err = run.stderr.decode()
     assert run.returncode == 2 and err.startswith("dcfkit trax: error: TraX: no request from the client: it closed "
                                                   "the connection without sending quit"), err
+
+
+@pytest.mark.parametrize("stream, variables, said", [
+    (b'@@TRAX:initialize "1,1,2,2"\n@@TRAX:initialize "1,1,2,2"\n@@TRAX:frame "x"\n', {},
+     "TraX: the client initialised 2 objects at once; the server tracks one"),  # was a traceback
+    (b"@@TRAX:quit\n", {"TRAX_IN": "3"}, "TraX: $TRAX_IN is '3', not an open file descriptor"),  # was a hang
+    (b"@@TRAX:quit\n", {"TRAX_OUT": "abc"}, "TraX: $TRAX_OUT is 'abc', not an open file descriptor"),
+    (b"@@TRAX:quit\n", {"DCFKIT_MAX_IMAGE_PIXELS": "abc"}, "$DCFKIT_MAX_IMAGE_PIXELS must be a number"),
+])
+def test_what_the_client_or_the_environment_gets_wrong_is_said(stream, variables, said, tmp_path):
+    run = served_stream(stream, tmp_path, **variables)
+    err = run.stderr.decode()
+    assert run.returncode == 2 and err.startswith(f"dcfkit trax: error: {said}") and err.count("\n") == 1, err
 
 
 def test_trax_socket_must_be_a_port_in_ascii_digits(monkeypatch):

@@ -125,7 +125,11 @@ class _Run:
     def __init__(self, server, link: _Link, request):
         self.server, self.link = server, link
         self.first = request
-        (region, _properties), = request.objects  # the server is single-object: libtrax sends one
+        if len(request.objects) != 1:  # libtrax joins consecutive initialize lines into one request
+            raise ProtocolError(f"TraX: the client initialised {len(request.objects)} objects at once; the server "
+                                f"tracks one (an initialize without arguments, then one with the region, then the "
+                                f"frame, for each new object)")
+        (region, _properties), = request.objects
         self.box = region_box(region)
         self.next_request = None
 

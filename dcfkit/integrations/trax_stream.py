@@ -31,7 +31,7 @@ import threading
 import time
 from typing import Iterator
 
-from ..errors import DcfkitError
+from ..errors import DcfkitError, describe_error
 from ..limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 PREFIX = b"@@TRAX:"
@@ -50,7 +50,8 @@ _QUOTED_SPECIAL = re.compile(rb'["\\]')
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?:nan|inf|infinity)"
 _REGION = re.compile(rf"(?:(rect|rectangle|poly|polygon|mask|special):)?((?:{_NUMBER})(?:,(?:{_NUMBER}))*)",
                      re.IGNORECASE)
-_KEYWORD = re.compile(rb"[A-Za-z0-9_.]+=")
+_KEYWORD = re.compile(rb"[A-Za-z0-9_.]{1,64}=")  # libtrax's keys: 64 characters at most (else an argument)
+TYPES = (b"hello", b"initialize", b"state", b"status", b"frame", b"quit")  # libtrax's, in any case
 _MEMORY_IMAGE = re.compile(rb"image:([0-9]{1,10});([0-9]{1,10});(rgb|gray8|gray16);")
 _BYTES_PER_PIXEL = {b"rgb": 3, b"gray8": 1, b"gray16": 2}
 CHANNELS = 1  # images a frame message carries: the server asks for the color channel alone
@@ -66,15 +67,19 @@ class FramingError(ValueError):
     """A message libtrax would misread (the text says what is wrong with it)."""
 
 
-def check_message(line: bytes) -> None:
+def check_message(line: bytes, image_pixels: int | None = None) -> None:
     """Raise :class:`FramingError` if ``line`` (one line without its line break) is a TraX
-    message that libtrax would read past its line break or not at all."""
+    message that libtrax would read past its line break or not at all, or would misread
+    (``image_pixels``: the most pixels of a memory image, :func:`max_image_pixels` if None)."""
     if not line.startswith(PREFIX):
         return  # not a message: libtrax passes over the line
     i = _TYPE.match(line, len(PREFIX)).end()
     if i < len(line) and line[i:i + 1] != b" ":
         raise FramingError(f"the message type is followed by {_char(line, i)}, not a space")
-    kind, positional = line[len(PREFIX):i], 0
+    kind, positional = line[len(PREFIX):i].lower(), 0
+    if kind not in TYPES:  # libtrax would pass over it, and over the line after it too
+        raise FramingError(f"an unknown message type {_start(line[len(PREFIX):i])}; TraX's are "
+                           f"{', '.join(t.decode() for t in TYPES)}")
     while i < len(line):
         c = line[i:i + 1]
         if c in (b" ", b"\r"):
@@ -88,13 +93,13 @@ def check_message(line: bytes) -> None:
         if kind == b"initialize":
             _check_region(text)
         elif kind == b"frame":
-            _check_image(text)
+            _check_image(text, max_image_pixels() if image_pixels is None else image_pixels)
     # falling off the end of the line: the message ends at its line break
     if kind == b"frame" and positional != CHANNELS:
         raise FramingError(f"a frame message with {positional} images; the server reads {CHANNELS} (color)")
 
 
-def _check_image(text: bytes) -> None:
+def _check_image(text: bytes, limit: int) -> None:
     """Raise :class:`FramingError` if a ``frame``'s memory image (``image:W;H;FORMAT;BASE64``)
     is larger than dcfkit takes, or its data is not of its size (libtrax compares the two in an
     ``int``, and vot-trax then allocates what the header says)."""
@@ -107,8 +112,8 @@ def _check_image(text: bytes) -> None:
     data = len(text) - header.end()
     decoded = data // 4 * 3 - text[-2:].count(b"=") if data % 4 == 0 else -1
     size = width * height * _BYTES_PER_PIXEL[fmt]
-    if not 0 < width * height <= max_image_pixels():
-        raise FramingError(f"a {width}x{height} memory image: over the limit of {max_image_pixels():.3g} pixels "
+    if not 0 < width * height <= limit:
+        raise FramingError(f"a {width}x{height} memory image: over the limit of {limit:.3g} pixels "
                            f"(${IMAGE_PIXELS_VARIABLE})")
     if decoded != size:
         raise FramingError(f"a {width}x{height} {fmt.decode()} memory image of {size} bytes whose data holds "
@@ -173,8 +178,8 @@ class Framing:
     """Copies whole, checked messages from ``source`` to ``sink`` (file descriptors) on a
     thread; closes ``sink`` at the end of the stream or at the first message it refuses."""
 
-    def __init__(self, source: int, sink: int):
-        self.source, self.sink = source, sink
+    def __init__(self, source: int, sink: int, image_pixels: int):
+        self.source, self.sink, self.image_pixels = source, sink, image_pixels
         self.error: str | None = None
         self.messages = 0
         self._thread = threading.Thread(target=self._copy, name="dcfkit-trax-framing", daemon=True)
@@ -190,6 +195,8 @@ class Framing:
             self.error = f"message {self.messages + 1} from the client: {exc}"
         except OSError as exc:
             self.error = f"cannot read from the client ({exc.strerror or exc})"
+        except Exception as exc:  # a bug of the framing's own: said, not lost in the thread
+            self.error = f"the framing of the client's stream failed: {describe_error(exc)}"
         finally:
             with contextlib.suppress(OSError):  # libtrax may have stopped reading: the pipe is closed
                 _write_all(self.sink, END_OF_STREAM)
@@ -223,7 +230,7 @@ class Framing:
                 offset = next(i for i, b in enumerate(line) if b > 127)
                 raise FramingError(f"byte 0x{line[offset]:02x} at character {offset + 1} of {_start(line)}...: "
                                    "libtrax reads a byte over 127 as the end of the stream")
-            check_message(line)
+            check_message(line, self.image_pixels)
             if line.startswith(PREFIX):
                 self.messages += 1
         _write_all(self.sink, lines)
@@ -250,11 +257,11 @@ def framed_connection(environ=os.environ) -> Iterator[Framing]:
             client = stack.enter_context(_connected(saved["TRAX_SOCKET"]))
             source = output = client.fileno()
         else:
-            source = int(saved["TRAX_IN"] or 0)
-            output = int(saved["TRAX_OUT"] or 1)
+            source, output = _open_fd(saved["TRAX_IN"], "TRAX_IN", 0), _open_fd(saved["TRAX_OUT"], "TRAX_OUT", 1)
+        image_pixels = max_image_pixels()  # here: a bad $DCFKIT_MAX_IMAGE_PIXELS is said now, not in the thread
         read_end, write_end = os.pipe()
         stack.callback(os.close, read_end)
-        framing = Framing(source, write_end).start()
+        framing = Framing(source, write_end, image_pixels).start()
         environ.pop("TRAX_SOCKET", None)
         environ["TRAX_IN"], environ["TRAX_OUT"] = str(read_end), str(output)
         try:
@@ -265,6 +272,19 @@ def framed_connection(environ=os.environ) -> Iterator[Framing]:
                     environ.pop(key, None)
                 else:
                     environ[key] = value
+
+
+def _open_fd(text: str | None, variable: str, default: int) -> int:
+    """The file descriptor ``$variable`` names (``default`` when unset): a number of an open one."""
+    if text is None:
+        return default
+    try:
+        if not (text.isascii() and text.isdigit()):
+            raise ValueError
+        os.fstat(int(text))
+        return int(text)
+    except (ValueError, OSError):
+        raise ProtocolError(f"TraX: ${variable} is {text[:40]!r}, not an open file descriptor") from None
 
 
 @contextlib.contextmanager
