@@ -33,9 +33,9 @@ def test_track_frames_writes_one_box_per_frame(clip, tmp_path, capsys):
     centre = lambda b: b[:, :2] + b[:, 2:] / 2  # noqa: E731
     assert np.hypot(*(centre(boxes) - centre(seq.ground_truth)).T).max() < 10
     assert "12 frames" in capsys.readouterr().err
-    confidence = np.loadtxt(tmp_path / "boxes.confidence", delimiter=",")  # peak,apce beside the boxes
+    confidence = np.loadtxt(tmp_path / "boxes.txt.confidence", delimiter=",")  # peak,apce beside the boxes
     assert confidence.shape == (12, 2) and np.isnan(confidence[0]).all() and (confidence[1:, 1] > 1).all()
-    times = np.loadtxt(tmp_path / "boxes.time")
+    times = np.loadtxt(tmp_path / "boxes.txt.time")
     assert times.shape == (12,) and (times > 0).all()
 
 
@@ -79,8 +79,7 @@ def test_track_video_and_annotated_output(clip, tmp_path):
     (["--box", "10,10,20,20", "--set", "label.mue=1"], "unknown parameter 'mue'"),
     (["--box", "10,10,20,20", "--set", "labelmu"], "--set expects KEY=VALUE"),
     (["--box", "10,10,20,20", "--save-video", "out.gif"], "cannot write a video named 'out.gif'"),
-    (["--box", "10,10,20,20", "--out", "boxes.time"], "--out: boxes.time ends in .time, the ending of the file "
-                                                       "written beside the boxes; give them another one"),
+    (["--box", "10,10,20,20", "--out", ""], "--out: an empty file name"),
 ])
 def test_track_errors_are_one_line_messages(clip, args, message, capsys):
     _, frames = clip
@@ -88,6 +87,34 @@ def test_track_errors_are_one_line_messages(clip, args, message, capsys):
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err
     assert "frames," not in err  # no "dr2track: 0 frames, 0.0 fps" summary: nothing was tracked
+
+
+def test_out_files_of_two_names_never_collide_and_odd_ones_are_refused_unwritten(clip, tmp_path, capsys):
+    """``--out a.txt`` and ``--out a.csv`` once shared ``a.time``; a dangling link or a FIFO
+    among the three files failed after the others were emptied; /dev/full gave a traceback."""
+    import os
+
+    seq, frames = clip
+    run = lambda out: cli.main(["track", "kcf", "--frames", str(frames), "--box", box_arg(seq.ground_truth[0]),  # noqa: E731
+                                "--out", str(out)])
+    assert run(tmp_path / "a.txt") == 0 and run(tmp_path / "a.csv") == 0
+    assert sorted(p.name for p in tmp_path.glob("a.*")) == ["a.csv", "a.csv.confidence", "a.csv.time", "a.txt",
+                                                              "a.txt.confidence", "a.txt.time"]
+    before = {p.name: p.read_bytes() for p in tmp_path.glob("a.txt*")}
+    (tmp_path / "a.txt.time").unlink()
+    os.symlink(tmp_path / "nowhere" / "x", tmp_path / "a.txt.time")
+    capsys.readouterr()
+    assert run(tmp_path / "a.txt") == 2
+    assert "a.txt.time is a link to nothing" in capsys.readouterr().err
+    assert (tmp_path / "a.txt").read_bytes() == before["a.txt"]  # untouched
+    os.mkfifo(tmp_path / "b.txt.confidence")
+    assert run(tmp_path / "b.txt") == 2 and "b.txt.confidence is not a regular file" in capsys.readouterr().err
+    if os.path.exists("/dev/full"):  # the boxes may go to a device; its companions in /dev may not be made
+        os.symlink("/dev/full", tmp_path / "full.txt")
+        for name in ("full.txt.confidence", "full.txt.time"):
+            (tmp_path / name).touch()
+        assert run(tmp_path / "full.txt") == 2
+        assert "--out: cannot write " in capsys.readouterr().err
 
 
 def test_unreadable_frame_names_the_frame(clip, tmp_path, capsys):
@@ -205,6 +232,6 @@ def test_track_keeps_its_boxes_when_terminated(clip, tmp_path, signame):
     assert f"dcfkit track: interrupted ({signame})" in run.stderr and "Traceback" not in run.stderr
     boxes = np.loadtxt(out, delimiter=",")
     assert boxes.shape == (3, 4)  # frames 1-3, tracked before the signal
-    assert np.loadtxt(tmp_path / "partial.confidence", delimiter=",").shape == (3, 2)
-    assert np.loadtxt(tmp_path / "partial.time").shape == (3,)
+    assert np.loadtxt(tmp_path / "partial.txt.confidence", delimiter=",").shape == (3, 2)
+    assert np.loadtxt(tmp_path / "partial.txt.time").shape == (3,)
     np.testing.assert_allclose(boxes[0], seq.ground_truth[0], atol=1e-3)

@@ -330,7 +330,7 @@ def test_a_run_stopped_while_it_waits_for_frames_keeps_whole_lines(signame, tmp_
     said = f"dcfkit track: interrupted{' (SIGTERM)' if signame == 'SIGTERM' else ''}"
     assert err.splitlines()[-1] == said and "Traceback" not in err
     assert "kcf: 6 frames" in err  # the frames tracked, said before
-    texts = [path.read_text() for path in (out, tmp_path / "boxes.confidence", tmp_path / "boxes.time")]
+    texts = [path.read_text() for path in (out, tmp_path / "boxes.txt.confidence", tmp_path / "boxes.txt.time")]
     assert all(text.endswith("\n") and len(text.splitlines()) == 6 for text in texts)
     assert np.loadtxt(out, delimiter=",").shape == (6, 4)
 

@@ -44,9 +44,9 @@ def add_track_arguments(p: argparse.ArgumentParser) -> None:
     first.add_argument("--select", action="store_true", help="draw the initial box on the first frame in a window "
                        "(needs a display; the box drawn is printed on stderr)")
     p.add_argument("--one-based", action="store_true", help="--box and --out use 1-based (OTB toolkit) pixels")
-    p.add_argument("--out", help="write one x,y,w,h line per frame here, and beside it OUT's name with the "
-                   "endings .confidence (peak,apce per frame) and .time (seconds per frame), as dcfkit eval names "
-                   "them (default: x,y,w,h,peak,apce lines on stdout); each line is written as its frame is tracked")
+    p.add_argument("--out", help="write one x,y,w,h line per frame here, and beside it OUT.confidence (peak,apce "
+                   "per frame) and OUT.time (seconds per frame) (default: x,y,w,h,peak,apce lines on stdout); each "
+                   "line is written as its frame is tracked")
     p.add_argument("--save-video", help="write an annotated video (.mp4, .avi, .mkv, .mov or .m4v) at the source's "
                    f"frame rate ({DEFAULT_FPS:g} fps for a folder of frames or a video that declares none)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar (shown on stderr when it is a "
@@ -61,7 +61,9 @@ def run_track(args: argparse.Namespace) -> int:
     tracker = load_tracker(args.config, overrides=parse_overrides(args.set))
     offset = 1.0 if args.one_based else 0.0
     init_box = None if args.select else _shifted(parse_box(args.box), -offset)
-    lines = BoxLines(check_output_file(args.out, "--out") if args.out else None, offset)
+    if args.out == "":
+        raise InputError("--out: an empty file name (leave --out out to print the boxes)")
+    lines = BoxLines(check_output_file(args.out, "--out") if args.out is not None else None, offset)
     writer = VideoWriter(args.save_video, DEFAULT_FPS) if args.save_video else None
     if args.select:
         check_display()  # before a camera or stream is opened
@@ -117,12 +119,19 @@ def _keep_rate(writer: VideoWriter, source: FrameSource, video: str | None) -> N
 
 
 def beside(out: Path, ending: str) -> Path:
-    """``boxes.txt`` -> ``boxes.confidence``: a file written with ``--out``; an ``--out`` with
-    that ending would be its own companion."""
-    if out.suffix == ending:
-        raise InputError(f"--out: {clip(str(out))} ends in {ending}, the ending of the file written beside the "
-                         f"boxes; give them another one, such as .txt")
-    return out.with_suffix(ending)
+    """``boxes.txt`` -> ``boxes.txt.confidence``: a file written with ``--out``, named after the
+    whole name, so that two ``--out`` names never share one."""
+    return out.with_name(out.name + ending)
+
+
+def check_out(path: Path, companion: bool) -> None:
+    """Refuse an ``--out`` file that would fail or block at its open after the other files of
+    the run were emptied: a dangling link; for a ``companion``, written beside the boxes
+    unasked, anything but a regular file (the boxes may go to a FIFO or /dev/stdout)."""
+    if path.is_symlink() and not path.exists():
+        raise InputError(f"--out: {clip(str(path))} is a link to nothing")
+    if companion and path.exists() and not path.is_file():
+        raise InputError(f"--out: {clip(str(path))} is not a regular file")
 
 
 class BoxLines:
@@ -136,8 +145,9 @@ class BoxLines:
     def __init__(self, out: Path | None, offset: float):
         self.out, self.offset = out, offset
         self.paths = [out, beside(out, CONFIDENCE_END), beside(out, TIME_END)] if out else []
-        for path in self.paths[1:]:
+        for i, path in enumerate(self.paths):
             check_output_file(path, "--out")
+            check_out(path, companion=i > 0)
         self.files, self.count, self.seconds, self.bar = [], 0, 0.0, None
 
     def add(self, step: Step) -> None:
@@ -168,8 +178,11 @@ class BoxLines:
 
     def close(self, name: str) -> None:
         """Close the files and say how many frames were tracked (nothing if none were)."""
-        for file in self.files:
-            file.close()
+        for path, file in zip(self.paths, self.files):
+            try:
+                file.close()
+            except OSError as exc:  # the last buffered line, on a full disk
+                raise StoreError(f"--out: cannot write {clip(str(path))}: {exc.strerror or exc}") from None
         if self.count:
             where = f"; boxes in {self.out}" if self.out else ""
             print(f"{name}: {self.count} frames, {self.count / max(self.seconds, 1e-9):.1f} fps{where}",
