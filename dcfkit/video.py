@@ -139,8 +139,8 @@ def _opened_in_thread(video: str, open_capture) -> cv2.VideoCapture:
     try:
         cap, exc = opened.get(timeout=OPEN_TIMEOUT + WATCHDOG_MARGIN)
     except queue.Empty:
-        raise InputError(f"--video: {_name(video)} did not open within {OPEN_TIMEOUT + WATCHDOG_MARGIN:g} s (a named pipe "
-                         f"opens when a program opens it for writing)") from None
+        raise InputError(f"--video: {_name(video)} did not open within {OPEN_TIMEOUT + WATCHDOG_MARGIN:g} s "
+                         f"(a named pipe opens when a program opens it for writing)") from None
     if exc is not None:
         raise exc
     return cap

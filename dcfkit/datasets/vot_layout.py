@@ -33,7 +33,8 @@ from .registry import Evidence, register_layout
 #: got10k's ``_corner2rect`` (``cx - w/2``); pysot's test scripts place it at ``cx - (w-1)/2``,
 #: half a pixel to the right and down.
 POLYGON_RULES = ("bounds", "area")
-_PATTERN = re.compile(r"^[^%]*%(?:0?\d{1,2})?d[^%]*$", re.ASCII)  # one integer field of at most 99 digits, as in color/%08d.jpg
+# one integer field of at most 99 digits, as in color/%08d.jpg
+_PATTERN = re.compile(r"^[^%]*%(?:0?\d{1,2})?d[^%]*$", re.ASCII)
 _MASK = re.compile(r"-?\d{1,10}(?:,-?\d{1,10}){3,}", re.ASCII)  # x0,y0,w,h,runs...: int64 holds their sums
 _SEPARATORS = re.compile(r"[,\s]+")  # VOT writes commas; some copies have tabs or spaces
 _GOT10K_FILES = ("meta_info.ini", "absence.label", "cover.label")  # GOT-10k's folders are otherwise VOT-like
