@@ -96,6 +96,15 @@ def test_what_the_client_or_the_environment_gets_wrong_is_said(stream, variables
     assert run.returncode == 2 and err.startswith(f"dcfkit trax: error: {said}") and err.count("\n") == 1, err
 
 
+def test_the_messages_before_a_refused_one_are_served_however_the_stream_was_read(tmp_path):
+    image = tmp_path / "frame.png"
+    assert cv2.imwrite(str(image), np.random.default_rng(0).integers(0, 256, (100, 100, 3), np.uint8))
+    stream = b'@@TRAX:initialize "10,10,20,20"\n@@TRAX:frame "file://%s"\n@@TRAX:bogus\n' % bytes(image)
+    run = served_stream(stream, tmp_path)  # one read holds all three lines
+    assert run.returncode == 2 and "message 3 from the client: an unknown message type" in run.stderr.decode()
+    assert run.stdout.decode().count("@@TRAX:state ") == 1  # the frame before it was answered
+
+
 def test_trax_socket_must_be_a_port_in_ascii_digits(monkeypatch):
     from dcfkit.integrations.trax_stream import ProtocolError, framed_connection
 

@@ -17,9 +17,15 @@ libtrax's parser (``message.c``, ``read_message``):
 - every byte is ASCII;
 - after the type comes a space or the line break; a quoted argument closes on its own line
   and is followed by a space or the line break; no backslash ends a line;
+- the type is one libtrax knows (it passes over a line of another type, and the next line);
 - an ``initialize`` region is numbers libtrax parses as they are written (``atof`` reads
   ``m50`` as 0), and a mask (``mask:x,y,w,h,runs...``) has at most :data:`MAX_MASK_PIXELS`
-  pixels (libtrax allocates them in an ``int``-sized buffer).
+  pixels (libtrax allocates them in an ``int``-sized buffer);
+- a ``frame`` carries one image, and a memory image (``image:W;H;FORMAT;BASE64``) holds at
+  most ``$DCFKIT_MAX_IMAGE_PIXELS`` pixels and exactly the bytes its header says (libtrax
+  compares them in an ``int``; vot-trax then allocates what the header says).
+
+After the client's last message, :data:`END_OF_STREAM` makes the end of the stream an end.
 """
 from __future__ import annotations
 
@@ -222,18 +228,26 @@ class Framing:
                                "without finishing the message")
 
     def _pass_on(self, lines: bytes) -> None:
-        """Check each line of ``lines`` (whole lines), then write them to the sink."""
-        for line in lines.split(b"\n")[:-1]:
-            if len(line) > MAX_MESSAGE_BYTES:
-                raise FramingError(f"a line longer than {MAX_MESSAGE_BYTES} bytes")
-            if not line.isascii():
-                offset = next(i for i, b in enumerate(line) if b > 127)
-                raise FramingError(f"byte 0x{line[offset]:02x} at character {offset + 1} of {_start(line)}...: "
-                                   "libtrax reads a byte over 127 as the end of the stream")
-            check_message(line, self.image_pixels)
-            if line.startswith(PREFIX):
-                self.messages += 1
-        _write_all(self.sink, lines)
+        """Write the whole lines of ``lines`` to the sink, each once it is checked: the lines
+        before a refused one pass, however the stream was cut into reads."""
+        start = 0
+        try:
+            for line in lines.split(b"\n")[:-1]:
+                self._check(line)
+                start += len(line) + 1
+        finally:
+            _write_all(self.sink, lines[:start])
+
+    def _check(self, line: bytes) -> None:
+        if len(line) > MAX_MESSAGE_BYTES:
+            raise FramingError(f"a line longer than {MAX_MESSAGE_BYTES} bytes")
+        if not line.isascii():
+            offset = next(i for i, b in enumerate(line) if b > 127)
+            raise FramingError(f"byte 0x{line[offset]:02x} at character {offset + 1} of {_start(line)}...: "
+                               "libtrax reads a byte over 127 as the end of the stream")
+        check_message(line, self.image_pixels)
+        if line.startswith(PREFIX):
+            self.messages += 1
 
 
 def _start(line: bytes) -> str:
