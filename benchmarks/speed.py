@@ -55,7 +55,8 @@ FRESH_PROCESS = """
 import sys, time
 import cv2, numpy
 cv2.setNumThreads(1)
-frame = cv2.imread(sys.argv[2]) if sys.argv[2] else numpy.full((720, 1280, 3), 128, numpy.uint8)
+# synthetic: noise, not one grey, which the tracker refuses as a blank frame
+frame = cv2.imread(sys.argv[2]) if sys.argv[2] else numpy.random.default_rng(0).integers(0, 256, (720, 1280, 3), numpy.uint8)
 box = [float(v) for v in sys.argv[3].split(",")]
 start = time.perf_counter()
 import dcfkit

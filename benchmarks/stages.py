@@ -44,9 +44,10 @@ def timed(stage, fn):
 
 def instrument(tracker):
     """Wrap the stages; nested stages (features inside 'scale') are counted in both."""
-    tracker_module.sample = timed("patch extraction", tracker_module.sample)
-    tracker_module.response = timed("detection (response)", tracker_module.response)
+    tracker._patch = timed("patch extraction", tracker._patch)
+    tracker.solver.response = timed("detection (response)", tracker.solver.response)
     tracker_module.subpixel_peak = timed("detection (peak)", tracker_module.subpixel_peak)
+    tracker_module.newton_peak = timed("detection (peak)", tracker_module.newton_peak)
     for f in tracker.features:
         f.extract = timed(f"feature {f.name}", f.extract)
     tracker.fft.rfft2 = timed("fft", tracker.fft.rfft2)
