@@ -112,19 +112,26 @@ class Sequence:
 # --------------------------------------------------------------------------- images
 
 
+def _regular_file_bytes(path, name: str, limit: int, over: str) -> bytes:
+    """The bytes of ``path``: a regular file (a FIFO would block, /dev/zero never end) of at
+    most ``limit`` bytes, else a :class:`DatasetError` ``cannot read <name> (...)`` (``over``
+    ends the one of a file too large); an OSError of the file system passes."""
+    info = os.stat(path)
+    if not stat.S_ISREG(info.st_mode):
+        raise DatasetError(f"cannot read {name} (not a regular file)")
+    if info.st_size > limit:
+        raise DatasetError(f"cannot read {name} ({info.st_size:.3g} bytes{over})")
+    with open(path, "rb") as file:
+        return file.read(info.st_size + 1)  # a file growing meanwhile is cut: its size was checked
+
+
 def _read_image_bytes(path, what: str) -> bytes:
-    """The bytes of an image file: a regular file (a FIFO would block, /dev/zero never end) no
-    larger than an uncompressed image of the pixel limit could be."""
-    limit = 6 * max_image_pixels() + 2**20  # 16-bit BGR, plus headers
+    """The bytes of an image file: a regular file no larger than an uncompressed image of the
+    pixel limit could be."""
     try:
-        info = os.stat(path)
-        if not stat.S_ISREG(info.st_mode):
-            raise DatasetError(f"cannot read {what}: {path} (not a regular file)")
-        if info.st_size > limit:
-            raise DatasetError(f"cannot read {what}: {path} ({info.st_size:.3g} bytes, more than an image of the "
-                               f"limit of {max_image_pixels():.3g} pixels can take: ${IMAGE_PIXELS_VARIABLE})")
-        with open(path, "rb") as file:
-            return file.read(info.st_size + 1)  # a file growing meanwhile is cut: its size was checked
+        return _regular_file_bytes(path, f"{what}: {path}", 6 * max_image_pixels() + 2**20,  # 16-bit BGR, headers
+                                   f", more than an image of the limit of {max_image_pixels():.3g} pixels can take: "
+                                   f"${IMAGE_PIXELS_VARIABLE}")
     except OSError as exc:
         reason = "file does not exist" if not os.path.exists(path) else exc.strerror
         raise DatasetError(f"cannot read {what}: {path} ({reason})") from None
@@ -331,14 +338,8 @@ def read_text(path: Path) -> str:
     /dev/zero never end) of at most :data:`MAX_TEXT_BYTES`; :class:`DatasetError` naming it
     otherwise."""
     try:
-        info = os.stat(path)
-        if not stat.S_ISREG(info.st_mode):
-            raise DatasetError(f"cannot read {path} (not a regular file)")
-        if info.st_size > MAX_TEXT_BYTES:
-            raise DatasetError(f"cannot read {path} ({info.st_size:.3g} bytes: an annotation file of more than "
-                               f"{MAX_TEXT_BYTES:.3g} bytes is not one)")
-        with open(path, "rb") as file:
-            data = file.read(MAX_TEXT_BYTES + 1)  # a file growing meanwhile is cut: its size was checked
+        data = _regular_file_bytes(path, str(path), MAX_TEXT_BYTES,
+                                   f": an annotation file of more than {MAX_TEXT_BYTES:.3g} bytes is not one")
         return data.decode("utf-8-sig")
     except FileNotFoundError:
         raise DatasetError(f"annotation file not found: {path}") from None
