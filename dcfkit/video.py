@@ -1,6 +1,7 @@
 """Reading frames (a video file, camera, stream or image folder) and writing annotated videos."""
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import itertools
 import math
@@ -127,23 +128,11 @@ def _opened_in_thread(video: str, open_capture) -> cv2.VideoCapture:
     """``open_capture()`` run in a thread, so that Ctrl-C or SIGTERM end the wait (OpenCV's
     open of a named pipe blocks until a program opens it for writing, and FFmpeg's of a URL
     until its timeout); a source not open within ``OPEN_TIMEOUT + WATCHDOG_MARGIN`` is an InputError."""
-    opened = queue.Queue(maxsize=1)
-
-    def run():
-        try:
-            opened.put((open_capture(), None))
-        except BaseException as exc:  # noqa: BLE001 - handed to the caller, raised there
-            opened.put((None, exc))
-
-    threading.Thread(target=run, name="dcfkit-open", daemon=True).start()
-    try:
-        cap, exc = opened.get(timeout=OPEN_TIMEOUT + WATCHDOG_MARGIN)
-    except queue.Empty:
-        raise InputError(f"--video: {_name(video)} did not open within {OPEN_TIMEOUT + WATCHDOG_MARGIN:g} s "
-                         f"(a named pipe opens when a program opens it for writing)") from None
-    if exc is not None:
-        raise exc
-    return cap
+    seconds = OPEN_TIMEOUT + WATCHDOG_MARGIN
+    with contextlib.closing(_in_thread((open_capture() for _ in range(1)), seconds, lambda count: (
+            f"--video: {_name(video)} did not open within {seconds:g} s (a named pipe opens when a program "
+            f"opens it for writing)"))) as opening:
+        return next(opening)
 
 
 def _open_camera(index: int) -> cv2.VideoCapture:
@@ -266,21 +255,28 @@ _END = object()
 
 
 def _read_in_thread(items: Iterator, name: str) -> Iterator:
-    """Yield ``items``, read in a thread at most one ahead, so that a run waiting for a frame
-    of a live source ends at once on Ctrl-C or SIGTERM (OpenCV's read of a stalled stream
-    returns only at its timeout, of a stalled named pipe never). An exception of ``items`` is
-    raised here, in its place, and no item for ``READ_TIMEOUT + WATCHDOG_MARGIN`` is an
-    InputError naming ``name``; when the caller stops, the thread stops after its current read
-    and closes ``items``."""
+    """The frames ``items`` of a live source, read in a thread (:func:`_in_thread`), so that a
+    run waiting for a frame ends at once on Ctrl-C or SIGTERM (OpenCV's read of a stalled
+    stream returns only at its timeout, of a stalled named pipe never); no frame for
+    ``READ_TIMEOUT + WATCHDOG_MARGIN`` is an InputError naming ``name``."""
+    seconds = READ_TIMEOUT + WATCHDOG_MARGIN
+    return _in_thread(items, seconds, lambda count: f"--video: {name} gave no frame for {seconds:g} s after frame "
+                                                    f"{count}: the stream stalled")
+
+
+def _in_thread(items: Iterator, seconds: float, stalled) -> Iterator:
+    """Yield ``items``, read in a thread at most one ahead. An exception of ``items`` is raised
+    here, in its place, and no item for ``seconds`` is an InputError saying ``stalled(count)``
+    (``count``: the items yielded); when the caller stops, the thread stops after its current
+    read and closes ``items``."""
     queue_, stop = queue.Queue(maxsize=1), threading.Event()
-    threading.Thread(target=_read_into, args=(items, queue_, stop), name="dcfkit-frames", daemon=True).start()
+    threading.Thread(target=_read_into, args=(items, queue_, stop), name="dcfkit-read", daemon=True).start()
     try:
         for count in itertools.count():
             try:
-                item, exc = queue_.get(timeout=READ_TIMEOUT + WATCHDOG_MARGIN)
+                item, exc = queue_.get(timeout=seconds)
             except queue.Empty:
-                raise InputError(f"--video: {name} gave no frame for {READ_TIMEOUT + WATCHDOG_MARGIN:g} s after "
-                                 f"frame {count}: the stream stalled") from None
+                raise InputError(stalled(count)) from None
             if exc is not None:
                 raise exc
             if item is _END:
@@ -291,7 +287,7 @@ def _read_in_thread(items: Iterator, name: str) -> Iterator:
 
 
 def _read_into(items: Iterator, queue_: queue.Queue, stop: threading.Event) -> None:
-    """The reading thread of :func:`_read_in_thread`: ``(item, None)`` for each item, then
+    """The reading thread of :func:`_in_thread`: ``(item, None)`` for each item, then
     ``(_END, None)`` or ``(None, exception)``, until ``stop`` is set; then ``items`` is closed."""
     def put(entry) -> bool:
         while not stop.is_set():
