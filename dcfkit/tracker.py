@@ -366,7 +366,7 @@ class Tracker:
         regularizer, whose w² it returns is used from this frame on."""
         self.solver.observe(detection)
         if self.spatial is not None:
-            self.w2 = _read_only(self.spatial.adapt(self.w2, detection).astype(np.float32, copy=False))
+            self.w2 = _read_only(self.spatial.adapt(self.w2, detection))
 
     def _theta(self, detection: Detection | None) -> float:
         """θ of this frame's training (0 without a temporal term; ``inf``: keep the last filter)."""

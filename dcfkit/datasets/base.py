@@ -329,8 +329,10 @@ def _missing_end_marker(data: bytes) -> bool:
 _SEPARATORS = re.compile(r"[,\s]+")
 MAX_TEXT_BYTES = 64 * 2**20  # an annotation file: LaSOT's longest is under 1 MB, a VOT mask file tens of MB
 MAX_LINE_CHARS = 4096  # a line of boxes or flags (a VOT mask line is read by its own layout)
-# a number as the toolkits write one: ASCII digits only (float() also takes '٣' and '2_0')
-_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?:nan|inf|infinity)", re.IGNORECASE | re.ASCII)
+# a number as the toolkits write one (and libtrax's atof reads): ASCII digits only (float() also
+# takes '٣' and '2_0'); compile it with re.IGNORECASE and re.ASCII
+NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?:nan|inf|infinity)"
+_NUMBER = re.compile(NUMBER, re.IGNORECASE | re.ASCII)
 
 
 def read_text(path: Path) -> str:

@@ -37,6 +37,7 @@ import threading
 import time
 from typing import Iterator
 
+from ..datasets.base import NUMBER
 from ..errors import DcfkitError, describe_error
 from ..limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
@@ -53,9 +54,8 @@ END_OF_STREAM = PREFIX + b"dcfkitend\n"  # letters alone: another character ends
 _TYPE = re.compile(rb"[A-Za-z0-9]*")
 _UNQUOTED_SPECIAL = re.compile(rb"[ \\]")
 _QUOTED_SPECIAL = re.compile(rb'["\\]')
-_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?:nan|inf|infinity)"
-_REGION = re.compile(rf"(?:(rect|rectangle|poly|polygon|mask|special):)?((?:{_NUMBER})(?:,(?:{_NUMBER}))*)",
-                     re.IGNORECASE)
+_REGION = re.compile(rf"(?:(rect|rectangle|poly|polygon|mask|special):)?((?:{NUMBER})(?:,(?:{NUMBER}))*)",
+                     re.IGNORECASE | re.ASCII)
 _KEYWORD = re.compile(rb"[A-Za-z0-9_.]{1,64}=")  # libtrax's keys: 64 characters at most (else an argument)
 TYPES = (b"hello", b"initialize", b"state", b"status", b"frame", b"quit")  # libtrax's, in any case
 _MEMORY_IMAGE = re.compile(rb"image:([0-9]{1,10});([0-9]{1,10});(rgb|gray8|gray16);")
