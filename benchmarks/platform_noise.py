@@ -60,7 +60,7 @@ def sequences(max_frames: int | None):
         if (DATA / folder).is_dir():
             out += [(s.name, s.frame, s.ground_truth) for s in load_dataset(dataset, DATA / folder, names)]
     if not out:
-        from dcfkit.synthetic import make_sequence
+        from dcfkit.datasets.synthetic import make_sequence
 
         syn = make_sequence(n_frames=40)
         out = [("synthetic", syn.frames.__getitem__, syn.ground_truth)]
@@ -87,7 +87,7 @@ def work(args) -> int:
 
     import dcfkit
     from dcfkit.config import load_config
-    from dcfkit.tracking import track
+    from dcfkit.running.tracking import track
 
     cv2.setNumThreads(1)
     boxes = {}
@@ -122,7 +122,7 @@ def run_switch(name: str, args, folder: Path) -> Path | None:
 
 
 def compare(base: dict, other: dict, gts: dict) -> list[dict]:
-    from dcfkit import metrics
+    from dcfkit.analysis import metrics
 
     rows = []
     for key in base:

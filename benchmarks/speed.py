@@ -25,8 +25,8 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 import dcfkit  # noqa: E402
-from dcfkit.synthetic import make_sequence  # noqa: E402
-from dcfkit.tracking import track as run_track  # noqa: E402
+from dcfkit.datasets.synthetic import make_sequence  # noqa: E402
+from dcfkit.running.tracking import track as run_track  # noqa: E402
 
 
 cv2.setNumThreads(1)

@@ -1,19 +1,24 @@
 """dcfkit: discriminative correlation filter trackers assembled from registered components."""
 from __future__ import annotations
 
-# part of every run key (dcfkit.results.run_key): bump it when boxes change (docs/changes.md)
+import os as _os
+
+# part of every run key (dcfkit.running.results.run_key): bump it when boxes change (docs/changes.md)
 __version__ = "0.6.0"
 
 __all__ = ["__version__", "load_tracker", "load_config", "Tracker"]
 
+# the old names of moved modules (dcfkit/_moved/__init__.py)
+__path__.append(_os.path.join(__path__[0], "_moved"))
+
 
 def __getattr__(name):  # lazy: importing dcfkit does no work
     if name in ("load_tracker", "Tracker"):
-        from . import tracker  # lazy: importing dcfkit loads no tracker code
+        from dcfkit import tracker  # lazy: importing dcfkit loads no tracker code
 
         return getattr(tracker, name)
     if name == "load_config":
-        from .config import load_config  # lazy, as above
+        from dcfkit.config import load_config  # lazy, as above
 
         return load_config
     raise AttributeError(f"module 'dcfkit' has no attribute {name!r}")

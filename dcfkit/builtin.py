@@ -1,12 +1,19 @@
-"""dcfkit's own components, registered through the same hook as any plugin."""
+"""dcfkit's own plugin, loaded through its entry point like any other: its components, and
+how the registry makes benchmark layouts."""
 from __future__ import annotations
 
-from . import features, labels, regularizers, scale, search, solvers
-from .registry import hookimpl
+import pluggy
+
+from dcfkit.components import features, labels, regularizers, scale, search, solvers
+from dcfkit.datasets.layout import new_layout
+
+# dcfkit.registry.hookimpl, made here too: this module, which the registry loads, imports nothing of it
+hookimpl = pluggy.HookimplMarker("dcfkit")
 
 
 @hookimpl
 def dcfkit_register_components(registry):
-    for module in (features, labels, regularizers, solvers, search, scale):
-        for cls in module.BUILTIN:
+    registry.accept_layouts(new_layout)
+    for family in (features, labels, regularizers, solvers, search, scale):
+        for cls in family.BUILTIN:
             registry.register(cls)

@@ -20,7 +20,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from .errors import DcfkitError, RegistryError, TrackingError, describe_error, shown
+from dcfkit.errors import DcfkitError, RegistryError, TrackingError, describe_error, shown
 
 Check = Callable[[Any, tuple, Any], "str | None"]
 

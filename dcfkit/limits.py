@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 import os
 
-from .errors import ConfigError, shown
+from dcfkit.errors import ConfigError, shown
 
 IMAGE_PIXELS_VARIABLE = "DCFKIT_MAX_IMAGE_PIXELS"
 DEFAULT_MAX_IMAGE_PIXELS = 10**8  # 300 MB as BGR; an 8K video frame has 33 million

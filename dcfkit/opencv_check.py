@@ -1,8 +1,8 @@
 """Is the installed ``cv2`` OpenCV's contrib build, which dcfkit needs?
 
 Two things dcfkit reads exist in the contrib build only: the Color Names table, compiled into
-its tracking module (:mod:`dcfkit.features.colornames`), and the CSRT, KCF and MOSSE trackers
-(:mod:`dcfkit.baselines`). The four OpenCV packages on PyPI (``opencv-python``,
+its tracking module (:mod:`dcfkit.components.features.colornames`), and the CSRT, KCF and MOSSE trackers
+(:mod:`dcfkit.integrations.opencv`). The four OpenCV packages on PyPI (``opencv-python``,
 ``opencv-python-headless``, ``opencv-contrib-python`` and dcfkit's
 ``opencv-contrib-python-headless``) all install the same ``cv2`` folder: the one installed
 last overwrites the others' files while pip keeps every one listed as installed, so ``pip

@@ -14,7 +14,7 @@ import types
 import typing
 from typing import Any, Mapping
 
-from .errors import ConfigError, clip, shown
+from dcfkit.errors import ConfigError, clip, shown
 
 
 def _number(value: float) -> str:

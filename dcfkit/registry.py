@@ -1,46 +1,33 @@
-"""Component registry over pluggy.
+"""The component registry, over pluggy: it knows kinds only as their base classes declare them.
 
-Every component, built-in or third-party, is registered through one hook,
-``dcfkit_register_components(registry)``, in which a plugin calls
-``registry.register(SomeComponent)``. Built-ins live in :mod:`dcfkit.builtin` and are
-registered exactly like plugins found through the ``dcfkit`` entry-point group. In the same
-hook a plugin registers a benchmark layout with ``registry.register_dataset(name, load,
-description, detect=..., aliases=...)`` (the arguments of
-:func:`dcfkit.datasets.register_layout`); :mod:`dcfkit.datasets` looks it up here.
-Set ``DCFKIT_DISABLE_PLUGINS=1`` to load built-ins only. Nothing happens at import time:
-the registry is built on first use of :func:`get_registry`.
+Every plugin, dcfkit's own included, is a module named by an entry point of the ``dcfkit``
+group whose hook ``dcfkit_register_components(registry)`` calls ``registry.register(cls)``
+and ``registry.register_dataset(...)``. dcfkit's entry points load first; set
+``DCFKIT_DISABLE_PLUGINS=1`` to load only them. The registry is built on first use of
+:func:`get_registry`, never at import.
 """
 from __future__ import annotations
 
 import contextlib
 import dataclasses
-import importlib
 import importlib.metadata
-import inspect
 import os
 import signal
-import types
-import typing
 import warnings
 from typing import Any, Callable, Mapping
 
 import pluggy
 
-from .contracts import checked
-from .errors import ConfigError, DcfkitError, DcfkitWarning, RegistryError, clip, describe_error, shown
-from .params import NoParams, check_schema, closest, parse_params
-from .signals import handlers_replaced
+from dcfkit.components.base import Component, Contract, base_of, check_contract_values, contract_problems, kinds
+from dcfkit.contracts import checked
+from dcfkit.errors import ConfigError, DcfkitError, DcfkitWarning, RegistryError, clip, describe_error, shown
+from dcfkit.params import check_schema, closest, parse_params
+from dcfkit.signals import handlers_replaced
 
 PROJECT = "dcfkit"
-KINDS = ("feature", "label", "regularizer", "solver", "search", "scale")
 DATASET = "dataset"  # the kind of the benchmark layouts plugins register (an Entry's cls is the Layout)
 DISABLE_ENV = "DCFKIT_DISABLE_PLUGINS"
-# The base classes of each kind (a regularizer's: one per role), whose ``contract`` a component
-# must meet. Named, not imported: their modules import this one.
-BASES = {"feature": ("dcfkit.features", "Feature"), "label": ("dcfkit.labels", "Label"),
-         "regularizer": ("dcfkit.regularizers", "SpatialRegularizer", "TemporalRegularizer"),
-         "solver": ("dcfkit.solvers", "Solver"), "search": ("dcfkit.search", "Search"),
-         "scale": ("dcfkit.scale", "ScaleEstimator")}
+__all__ = ["Component", "Contract", "PluginWarning", "Registry", "build_registry", "get_registry", "hookimpl"]
 
 hookspec = pluggy.HookspecMarker(PROJECT)
 hookimpl = pluggy.HookimplMarker(PROJECT)
@@ -53,132 +40,10 @@ class HookSpecs:
         layouts by calling ``registry.register_dataset(name, load, description, ...)``."""
 
 
-class Component:
-    """Base of all components: a ``kind``, a ``name`` and a ``Params`` schema."""
-
-    kind: str = ""
-    name: str = ""
-    Params: type = NoParams
-
-    def __init__(self, params: Any = None):
-        self.params = params if params is not None else self.Params()
-
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}({self.params})"
-
-
-@dataclasses.dataclass(frozen=True)
-class Contract:
-    """What the tracker needs of one kind of component (or regularizer role): set as ``contract``
-    on the kind's base class, checked by :meth:`Registry.register` (docs/plugins.md, section 5).
-
-    ``required``: methods the component must implement, name -> the arguments the tracker
-    passes after ``self``; ``optional``: the same for methods the base class implements.
-    ``params``: ``Params`` fields the tracker reads, name -> (type, lowest, highest): the field
-    must exist with that annotation, and a value outside the range is a ConfigError whenever
-    the component is built (the arithmetic that receives it needs the range).
-    ``returns``: method -> the check of what it returns (:mod:`dcfkit.contracts`), run on every
-    call of a built component.
-    """
-
-    required: Mapping[str, tuple[str, ...]] = dataclasses.field(default_factory=dict)
-    optional: Mapping[str, tuple[str, ...]] = dataclasses.field(default_factory=dict)
-    params: Mapping[str, tuple[type, float, float]] = dataclasses.field(default_factory=dict)
-    returns: Mapping[str, Callable] = dataclasses.field(default_factory=dict)
-
-    def hooks(self) -> dict[str, Callable | None]:
-        """Every method the tracker calls -> its return check (None: none)."""
-        return {m: self.returns.get(m) for m in (*self.required, *self.optional)}
-
-
-def base_classes(kind: str) -> tuple[type, ...]:
-    """The base classes of ``kind`` (:data:`BASES`)."""
-    module, *names = BASES[kind]
-    loaded = importlib.import_module(module)  # by name: the base modules import this one
-    return tuple(getattr(loaded, n) for n in names)
-
-
-def _as_called(cls: type, method: str) -> tuple[Any, bool]:
-    """(what ``instance.method`` is, whether it receives the instance) for an instance of
-    ``cls``: the class attribute bound as Python binds it, so that a function, a
-    ``functools.lru_cache`` or ``partialmethod`` and a ``functools.wraps`` wrapper receive the
-    instance, a static method or a callable object does not. The instance is made without
-    running ``__init__``; TypeError if it cannot be (an abstract class)."""
-    raw = inspect.getattr_static(cls, method)
-    get = getattr(type(raw), "__get__", None)
-    if get is None:  # a callable object in the class: called with the tracker's arguments alone
-        return raw, False
-    instance = object.__new__(cls)
-    called = get(raw, instance, cls)
-    return called, getattr(called, "__self__", None) is instance
-
-
-def _signature_problem(cls: type, method: str, args: tuple[str, ...]) -> str | None:
-    """Why ``cls().method(*args)`` cannot be called as the tracker calls it, or None."""
-    found = getattr(cls, method, None)
-    if not callable(found):
-        return f"{method} is {'missing' if found is None else 'not a method'}"
-    try:
-        called, takes_self = _as_called(cls, method)
-        signature = inspect.signature(called)
-    except (TypeError, ValueError):  # no signature (a builtin), or no instance without __init__: on trust
-        return None
-    try:
-        signature.bind(*([None] * len(args)))
-    except TypeError:
-        with_self = False  # a method is shown as written, self included
-        if isinstance(called, types.MethodType) and takes_self:
-            with contextlib.suppress(TypeError, ValueError):
-                signature, with_self = inspect.signature(called.__func__), True
-        return (f"{method}{signature} cannot be called as {method}({', '.join(('self',) * with_self + args)}) "
-                f"(the tracker passes {len(args)} argument{'s' * (len(args) != 1)})")
-    return None
-
-
-def contract_problems(cls: type, base: type) -> list[str]:
-    """What ``cls`` lacks of ``base.contract`` (an empty list: it meets it)."""
-    contract: Contract = base.__dict__["contract"]
-    problems = []
-    for method, args in {**contract.required, **contract.optional}.items():
-        if method in contract.required and getattr(cls, method, None) is getattr(base, method, None):
-            problems.append(f"it does not implement {method}({', '.join(args)})")
-        elif problem := _signature_problem(cls, method, args):
-            problems.append(problem)
-    hints = typing.get_type_hints(cls.Params)
-    for field, (kind, lowest, highest) in contract.params.items():
-        if hints.get(field) is not kind:
-            problems.append(f"its Params has no {kind.__name__} field '{field}' (the tracker reads "
-                            f"params.{field}, in [{lowest:g}, {highest:g}])")
-        elif not lowest <= (default := getattr(cls.Params(), field)) <= highest:
-            problems.append(f"its default {field}={shown(default)} is outside [{lowest:g}, {highest:g}]")
-    return problems
-
-
-def base_of(cls: type, kind: str, where: str) -> type:
-    """The base class of ``kind`` that ``cls`` subclasses (a RegistryError if none)."""
-    bases = [b for b in base_classes(kind) if issubclass(cls, b)]
-    if not bases:
-        names = " or ".join(f"{BASES[kind][0]}.{n}" for n in BASES[kind][1:])
-        raise RegistryError(f"{where}: a {kind} must subclass {names}")
-    base = bases[-1]  # the most specific, should a class subclass both roles' bases
-    if hasattr(base, "role") and getattr(cls, "role", None) != base.role:
-        raise RegistryError(f"{where}: role {shown(getattr(cls, 'role', None))} is not its base class "
-                            f"{base.__name__}'s ({base.role!r})")
-    return base
-
-
-def check_contract_values(contract: Contract, params: Any, where: str) -> None:
-    """A ConfigError if a parameter the tracker reads is outside its contract's range."""
-    for field, (_, lowest, highest) in contract.params.items():
-        value = getattr(params, field)
-        if not lowest <= value <= highest:
-            raise ConfigError(f"{where}.{field}: {shown(value)} is outside [{lowest:g}, {highest:g}]")
-
-
 # What a plugin may raise at import or registration and be skipped for: anything it raises
 # itself, an Exception or not (sys.exit(), raise KeyboardInterrupt, its own BaseException
 # subclass, GeneratorExit), since one broken plugin must not end every command; an interrupt
-# that a signal raised while it ran (Ctrl-C; SIGTERM, see dcfkit.tracking) goes on.
+# that a signal raised while it ran (Ctrl-C; SIGTERM, see dcfkit.running.tracking) goes on.
 PLUGIN_FAULTS = (BaseException,)
 INTERRUPTS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
 
@@ -225,9 +90,12 @@ class Registry:
     """Component classes by (kind, name), and plugins' benchmark layouts by name (kind
     :data:`DATASET`), with the plugin that provided each."""
 
-    def __init__(self):
-        self._entries: dict[str, dict[str, Entry]] = {k: {} for k in KINDS + (DATASET,)}
-        self._ambiguous: dict[str, dict[str, list[str]]] = {k: {} for k in KINDS + (DATASET,)}
+    def __init__(self, make_layout: Callable | None = None):
+        """``make_layout``: how :meth:`register_dataset` makes a layout
+        (:func:`dcfkit.datasets.layout.new_layout`); dcfkit's own plugin sets it when not given."""
+        self._entries: dict[str, dict[str, Entry]] = {DATASET: {}}  # then each kind, as first registered
+        self._ambiguous: dict[str, dict[str, list[str]]] = {DATASET: {}}
+        self._make_layout = make_layout
         self._provider, self._distribution = "?", None
         self.failures: list[str] = []
 
@@ -239,9 +107,11 @@ class Registry:
         depend on the order of installation, so using it is an error naming both.
         """
         kind, name = getattr(cls, "kind", ""), getattr(cls, "name", "")
-        if kind not in KINDS:
+        if kind not in kinds():
             raise RegistryError(f"{cls.__qualname__} (from {self._provider}): kind {shown(kind)} is not one of "
-                                f"{', '.join(KINDS)}")
+                                f"{', '.join(kinds())}")
+        self._entries.setdefault(kind, {})
+        self._ambiguous.setdefault(kind, {})
         if not name or not isinstance(name, str):
             raise RegistryError(f"{cls.__qualname__} (from {self._provider}): component has no name")
         where = f"{kind} '{name}' (from {self._provider})"
@@ -262,12 +132,21 @@ class Registry:
         """Register a benchmark layout: the arguments of :func:`dcfkit.datasets.register_layout`.
         A name or alias of a layout dcfkit has (or one registered in code) is a RegistryError; one
         that two plugins register is withdrawn, as a component's name. Returns the Layout."""
-        layouts = importlib.import_module("dcfkit.datasets.registry")  # named: that module imports this one
-        layout = layouts.new_layout(name, load, description, detect=detect, aliases=aliases,
-                                    provider=self._provider, protocol=protocol)
+        if self._make_layout is None:
+            raise RegistryError(f"{self._provider}: this registry takes no benchmark layouts: use "
+                                f"build_registry(), or Registry(make_layout=dcfkit.datasets.layout.new_layout)")
+        layout = self._make_layout(name, load, description, detect=detect, aliases=aliases,
+                                   provider=self._provider, protocol=protocol)
         for key in (layout.name,) + layout.aliases:
             self._add(DATASET, key, Entry(layout, self._provider, self._distribution))
         return layout
+
+    def accept_layouts(self, make_layout: Callable) -> None:
+        """Make benchmark layouts with ``make_layout`` (the arguments of :meth:`register_dataset`
+        and ``provider``): dcfkit's own plugin calls it, so that the registry imports no dataset code."""
+        if self._distribution is not None:
+            raise RegistryError(f"{self._provider}: only dcfkit's own plugin says how layouts are made")
+        self._make_layout = self._make_layout or make_layout
 
     def _add(self, kind: str, name: str, entry: Entry) -> None:
         """Enter ``entry`` as ``name``; a name a second plugin registers is withdrawn from both."""
@@ -286,6 +165,10 @@ class Registry:
             self._ambiguous[kind][name] = [existing.provider, self._provider]
             return
         self._entries[kind][name] = entry
+
+    def kinds(self) -> list[str]:
+        """The component kinds, in the order dcfkit's own plugin registers them."""
+        return [k for k in self._entries if k != DATASET]
 
     def names(self, kind: str) -> list[str]:
         return sorted(self._check_kind(kind))
@@ -338,9 +221,11 @@ class Registry:
         return checked(entry.cls(params), entry.provider, entry.contract.hooks())
 
     def _check_kind(self, kind: str) -> dict[str, Entry]:
-        if kind not in self._entries:
-            raise RegistryError(f"unknown component kind {shown(kind)}{closest(kind, KINDS)}; kinds: {', '.join(KINDS)}")
-        return self._entries[kind]
+        if kind not in self._entries and kind not in kinds():
+            known = kinds()
+            raise RegistryError(f"unknown component kind {shown(kind)}{closest(kind, known)}; kinds: {', '.join(known)}")
+        self._ambiguous.setdefault(kind, {})
+        return self._entries.setdefault(kind, {})
 
     def plugin_versions(self, components) -> list[str]:
         """The plugin packages (``"name version"``, sorted) behind ``(kind, name)`` components."""
@@ -400,19 +285,34 @@ def get_registry() -> Registry:
     return _REGISTRY
 
 
+def _own(ep) -> bool:
+    dist = getattr(ep, "dist", None)
+    return dist is not None and dist.name.lower().replace("_", "-") == PROJECT
+
+
+def plugin_entry_points(external: bool = True) -> tuple[list, list]:
+    """(dcfkit's own entry points, the others' if ``external``), each sorted by name. No entry
+    point of dcfkit's own is a RegistryError: its components would be missing."""
+    found = sorted(importlib.metadata.entry_points(group=PROJECT), key=lambda e: e.name)
+    own = [ep for ep in found if _own(ep)]
+    if not own:
+        raise RegistryError("dcfkit's own plugin (entry point 'builtin' of group 'dcfkit') is not installed, "
+                            "so no component is known: install dcfkit (pip install -e .), not just its folder")
+    return own, [ep for ep in found if not _own(ep)] if external else []
+
+
 def build_registry(external: bool = True) -> Registry:
-    """Build a fresh registry: built-ins, then every ``dcfkit`` entry point (if ``external``)."""
+    """Build a fresh registry: dcfkit's own plugin, then every other ``dcfkit`` entry point (if
+    ``external``), each through the same hook."""
     pm = pluggy.PluginManager(PROJECT)
     pm.add_hookspecs(HookSpecs)
     registry = Registry()
+    own, others = plugin_entry_points(external)
     with signals_noted() as signalled:
-        registry._run_plugin(pm, importlib.import_module("dcfkit.builtin"), "dcfkit", signalled=signalled)
-        for ep in sorted(importlib.metadata.entry_points(group=PROJECT), key=lambda e: e.name) if external else ():
-            if ep.value.split(":")[0] == "dcfkit.builtin":
-                continue
-            provider = f"{ep.name} ({ep.value})"
+        for ep, ours in [(ep, True) for ep in own] + [(ep, False) for ep in others]:
+            provider = PROJECT if ours else f"{ep.name} ({ep.value})"
             dist = getattr(ep, "dist", None)
-            distribution = f"{dist.name} {dist.version}" if dist is not None else provider
+            distribution = None if ours else f"{dist.name} {dist.version}" if dist is not None else provider
             try:
                 plugin = ep.load()
             except PLUGIN_FAULTS as exc:

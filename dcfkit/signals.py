@@ -1,4 +1,4 @@
-"""Signal handlers replaced for the length of a block (dcfkit.tracking's interrupts, the
+"""Signal handlers replaced for the length of a block (dcfkit.running.tracking's interrupts, the
 registry's noting of interrupts while plugins load)."""
 from __future__ import annotations
 

@@ -104,7 +104,7 @@ def clobbered_opencv(tmp_path, monkeypatch):
     cv2.legacy, cv2.TrackerMIL_create = types.ModuleType("cv2.legacy"), object
     (tmp_path / "cv2.abi3.so").write_bytes(b"\x7fELF not the contrib build")
     monkeypatch.setitem(sys.modules, "cv2", cv2)
-    monkeypatch.setattr("dcfkit.baselines.cv2", cv2)
+    monkeypatch.setattr("dcfkit.integrations.opencv.cv2", cv2)
     monkeypatch.setattr("dcfkit.opencv_check.installed_opencv",
                         lambda: {"opencv-contrib-python-headless": "4.14.0.94", "opencv-python": "5.0.0.93"})
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))

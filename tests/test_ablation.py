@@ -20,8 +20,8 @@ from dcfkit.ablation import expand, load_spec, run_ablation
 from dcfkit.config import load_config, shipped_config_dir
 from dcfkit.datasets import load_dataset, read_boxes
 from dcfkit.errors import DcfkitError, ConfigError
-from dcfkit.synthetic import make_sequence
-from dcfkit.tracker import load_tracker
+from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.tracker.tracker import load_tracker
 
 N_FRAMES = 12
 
@@ -475,7 +475,7 @@ def test_a_damaged_run_is_not_scored_and_is_recomputed(tmp_path, data):
 def test_eval_and_ablate_key_a_run_alike(tmp_path, data):
     """One run identity: the same resolved config gets the same key from `dcfkit eval` (under
     any name) as from `dcfkit ablate`."""
-    from dcfkit.evaluation import run_one_pass
+    from dcfkit.running.evaluation import run_one_pass
 
     spec = load_spec(write_spec(tmp_path / "spec.yaml", "dataset: {name: otb, root: data}\nsequences: [seqA]\n"
                                                         "variants: {mine: {config: strcf, overrides: {regularizers.temporal.theta: 20}}}\n"))
@@ -492,7 +492,7 @@ def test_a_folder_where_an_ablation_file_goes_is_refused_before_tracking(tmp_pat
                                                         "variants: {s: {config: strcf}}\n"))
     out = tmp_path / "out"
     (out / in_the_way.format(key=expand(spec)[0].key)).mkdir(parents=True)
-    monkeypatch.setattr("dcfkit.runner.track", lambda *a, **k: pytest.fail("tracked before the check"))
+    monkeypatch.setattr("dcfkit.running.runner.track", lambda *a, **k: pytest.fail("tracked before the check"))
     with pytest.raises(DcfkitError, match=r"cannot write the ablation.*: [^ ]+ is a folder; move it away"):
         run_ablation(spec, out, jobs=1, progress=False)
 
@@ -512,6 +512,6 @@ def test_an_unwritable_job_folder_is_refused_before_tracking(tmp_path, data, mon
         return real(*args, dir=dir, **kwargs)
 
     monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
-    monkeypatch.setattr("dcfkit.runner.track", lambda *a, **k: pytest.fail("tracked before the check"))
+    monkeypatch.setattr("dcfkit.running.runner.track", lambda *a, **k: pytest.fail("tracked before the check"))
     with pytest.raises(DcfkitError, match=r"cannot write the ablation's results to .*: Permission denied"):
         run_ablation(spec, tmp_path / "out", jobs=1, progress=False)

@@ -10,14 +10,14 @@ import pytest
 
 import dcfkit
 from dcfkit.errors import TrackingError
-from dcfkit.fft import make_fft
-from dcfkit.labels import Detection, gaussian_label
-from dcfkit.regularizers import GlobalVariation, LocalVariation, response_variation, target_mask
-from dcfkit.response import response as linear_response
-from dcfkit.solvers import ADMMArcf, ADMMAutoTrack, AutoTrackParams, admm
-from dcfkit.solvers.arcf import ARCFParams
-from dcfkit.solvers.autotrack import full_spectrum
-from dcfkit.synthetic import make_sequence
+from dcfkit.numerics.fft import make_fft
+from dcfkit.components.labels import Detection, gaussian_label
+from dcfkit.components.regularizers import GlobalVariation, LocalVariation, response_variation, target_mask
+from dcfkit.numerics.response import response as linear_response
+from dcfkit.components.solvers import ADMMArcf, ADMMAutoTrack, AutoTrackParams, admm
+from dcfkit.components.solvers.arcf import ARCFParams
+from dcfkit.components.solvers.autotrack import full_spectrum
+from dcfkit.datasets.synthetic import make_sequence
 
 FFT = make_fft("scipy")
 AUTOTRACK = str(pathlib.Path(__file__).parents[1] / "configs" / "autotrack.yaml")
@@ -98,7 +98,7 @@ def test_arcf_without_aberrance_is_bacf():
     w2 = np.where(target_mask(shape, (4.0, 5.0)), 0.01, np.inf).astype(np.float32)
     y, x = half(gaussian_label(shape, 1.0)), half(features(shape))
     arcf = ADMMArcf(ARCFParams(aberrance=0.0, iterations=2, learning_rate=0.013))
-    bacf = dcfkit.solvers.ADMMBacf()
+    bacf = dcfkit.components.solvers.ADMMBacf()
     np.testing.assert_allclose(arcf.train(x, y, w2, 0.0, FFT), bacf.train(x, y, w2, 0.0, FFT), rtol=1e-5, atol=1e-6)
 
 

@@ -14,15 +14,15 @@ import numpy as np
 import pytest
 
 import dcfkit
-from dcfkit.features import Gray
-from dcfkit.features.fhog import fhog
-from dcfkit.fft import make_fft
-from dcfkit.labels import Detection, DistractorRepressed, authors_distractors, regional_maxima
-from dcfkit.patches import resize_auto, round_half_away, whole_pixel_crop, whole_pixel_sample
-from dcfkit.regularizers import target_mask
-from dcfkit.response import _signed_frequencies, newton_peak, shift_spectrum, subpixel_peak
-from dcfkit.scale import DSST
-from dcfkit.solvers import ADMMParams, admm
+from dcfkit.components.features import Gray
+from dcfkit.components.features.fhog import fhog
+from dcfkit.numerics.fft import make_fft
+from dcfkit.components.labels import Detection, DistractorRepressed, authors_distractors, regional_maxima
+from dcfkit.numerics.patches import resize_auto, round_half_away, whole_pixel_crop, whole_pixel_sample
+from dcfkit.components.regularizers import target_mask
+from dcfkit.numerics.response import _signed_frequencies, newton_peak, shift_spectrum, subpixel_peak
+from dcfkit.components.scale import DSST
+from dcfkit.components.solvers import ADMMParams, admm
 
 X86_ONLY = pytest.mark.skipif(platform.machine().lower() not in ("x86_64", "amd64"),
                               reason="the processor's own SSE estimates need x86-64")
@@ -992,7 +992,7 @@ def test_translation_whole_pixel_moves_by_whole_pixels(translation):
 def test_shift_mode_gives_the_label_the_newton_peak_and_trains_at_the_clamped_position(monkeypatch):
     # tracker.m:69 centres the distractor map with round(-[disp_row, disp_col]), resp_newton's peak,
     # not the rounded pixel move over the new scale (they round apart, e.g. 2.45 cells -> 10 px -> 2.5)
-    import dcfkit.tracker as tracker_module
+    import dcfkit.tracker.tracker as tracker_module
 
     frames = sliding_frames(6, 5)  # 5 px = 1.67 cells of 3 px: sub-cell peaks
     tracker = dcfkit.load_tracker("reference/dr2track", overrides={"tracker.clamp_position": True})

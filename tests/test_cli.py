@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from dcfkit import cli
-from dcfkit.synthetic import make_sequence
+from dcfkit.datasets.synthetic import make_sequence
 
 
 @pytest.fixture(scope="module")
@@ -174,7 +174,7 @@ def test_demo_needs_two_frames_or_more(frames, capsys):
 
 
 def test_frames_are_tracked_in_natural_name_order(tmp_path):
-    from dcfkit.video import frame_files
+    from dcfkit.datasets.video import frame_files
 
     for name in ("frame10.png", "frame2.png", "frame1.png", "notes.txt"):
         (tmp_path / name).write_bytes(b"")
@@ -182,7 +182,7 @@ def test_frames_are_tracked_in_natural_name_order(tmp_path):
 
 
 def test_video_writer_draws_points_in_the_colour_of_their_tracker(tmp_path):
-    from dcfkit.video import COLOURS, VideoWriter
+    from dcfkit.datasets.video import COLOURS, VideoWriter
 
     drawn = []
     writer = VideoWriter(tmp_path / "v.avi")

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from dcfkit.errors import ConfigError
-from dcfkit.features import ColorNames, Gray, cell_average
-from dcfkit.features import colornames as cn
+from dcfkit.components.features import ColorNames, Gray, cell_average
+from dcfkit.components.features import colornames as cn
 
 
 # SHA-256 of the 32768x10 float32 normalised CN table compiled into opencv-contrib-python-headless,

@@ -13,13 +13,13 @@ from hypothesis.extra import numpy as hnp
 import dcfkit
 from dcfkit import registry as reg
 from dcfkit.contracts import ContractViolation, array, pair, scalar, within_grid
-from dcfkit.features import Gray
-from dcfkit.labels import Gaussian
-from dcfkit.regularizers import BoxWindow
-from dcfkit.scale import Pyramid
-from dcfkit.search import MotionAware
-from dcfkit.solvers import ADMMStrcf
-from dcfkit.tracking import TrackerFailure, track
+from dcfkit.components.features import Gray
+from dcfkit.components.labels import Gaussian
+from dcfkit.components.regularizers import BoxWindow
+from dcfkit.components.scale import Pyramid
+from dcfkit.components.search import MotionAware
+from dcfkit.components.solvers import ADMMStrcf
+from dcfkit.running.tracking import TrackerFailure, track
 
 from test_component_contracts import TINY, tiny_sequence
 

@@ -19,6 +19,7 @@ from hypothesis import given, settings, strategies as st
 from dcfkit import cli
 from dcfkit import registry as reg
 from dcfkit.datasets import DatasetError, Sequence, benchmark_protocol, detect_dataset, load_dataset
+from dcfkit.datasets.layout import new_layout
 from dcfkit.datasets.lasot_layout import LASOT_ATTRIBUTES
 from dcfkit.datasets.otb_layout import OTB_ATTRIBUTES
 from dcfkit.datasets.vot_layout import mask_box, polygon_box, region_box
@@ -469,7 +470,7 @@ def test_a_benchmark_is_scored_by_its_own_toolkit_unless_protocol_says_otherwise
     assert benchmark_protocol(sequences) == "lasot"
     assert benchmark_protocol([dataclasses.replace(s, dataset="") for s in sequences]) == "otb"
     with pytest.raises(RegistryError, match="unknown protocol 'nope'; protocols: otb, pysot"):
-        reg.Registry().register_dataset("mine", lambda root, sequences=None: [], "ROOT", protocol="nope")
+        reg.Registry(make_layout=new_layout).register_dataset("mine", lambda root, sequences=None: [], "ROOT", protocol="nope")
 
 
 def test_eval_on_a_test_split_runs_and_report_says_there_is_nothing_to_score(tmp_path, jpg, capsys):
@@ -532,7 +533,8 @@ def install(monkeypatch, plugins: dict[str, str]) -> None:
         exec(compile(source, f"<{module_name}>", "exec"), module.__dict__)
         monkeypatch.setitem(sys.modules, module_name, module)
         eps.append(FakeEntryPoint(module_name, module_name))
-    monkeypatch.setattr(reg.importlib.metadata, "entry_points", lambda group=None: eps if group == "dcfkit" else [])
+    own = reg.plugin_entry_points(external=False)[0]
+    monkeypatch.setattr(reg.importlib.metadata, "entry_points", lambda group=None: own + eps if group == "dcfkit" else [])
     monkeypatch.delenv(reg.DISABLE_ENV, raising=False)
     monkeypatch.setattr(reg, "_REGISTRY", None)
 
@@ -610,7 +612,7 @@ def test_a_plugin_whose_detect_raises_is_left_out_of_detection(tmp_path, jpg, mo
 
 
 def test_the_registry_checks_a_dataset_registration():
-    r = reg.Registry()
+    r = reg.Registry(make_layout=new_layout)
     layout = r.register_dataset("Mine", lambda root, sequences=None: [], "ROOT/<seq>/x.txt", aliases=("my-set",))
     assert r.dataset("my_set") is layout and r.datasets() == [layout] and r.dataset("other") is None
     with pytest.raises(RegistryError, match="load and detect must be functions"):

@@ -109,7 +109,7 @@ def test_components_lists_each_parameters_bounds_and_the_rules_between_them(caps
 def test_a_contract_range_is_listed_for_a_field_that_declares_none():
     """A plugin's temporal regularizer whose theta has no bounds of its own: the tracker's
     contract bounds it to [0, 1e10] all the same, and the listing says so."""
-    from dcfkit.regularizers import TemporalRegularizer
+    from dcfkit.components.regularizers import TemporalRegularizer
 
     @dataclasses.dataclass(frozen=True)
     class Params:

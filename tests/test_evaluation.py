@@ -14,14 +14,16 @@ import cv2
 import numpy as np
 import pytest
 
-from dcfkit import evaluation, report, results, runner
-from dcfkit.baselines import OpenCVUnavailable, available_opencv_trackers, opencv_tracker
+from dcfkit.running import evaluation, results, runner
+
+from dcfkit.analysis import report
+from dcfkit.integrations.opencv import OpenCVUnavailable, available_opencv_trackers, opencv_tracker
 from dcfkit.cli import evaluate as cli_evaluate
 from dcfkit.datasets import DatasetError, Sequence, load_dataset
 from dcfkit.errors import ConfigError, DcfkitError
 from dcfkit.registry import PluginWarning
-from dcfkit.evaluation import run_one_pass
-from dcfkit.results import import_results, load_results, run_key
+from dcfkit.running.evaluation import run_one_pass
+from dcfkit.running.results import import_results, load_results, run_key
 
 
 N_FRAMES = 6

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from dcfkit.fft import make_fft, multiply
+from dcfkit.numerics.fft import make_fft, multiply
 
 
 @pytest.mark.parametrize("backend", ["scipy", "pyfftw"])

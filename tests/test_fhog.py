@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from dcfkit.features.fhog import _cell_histograms, fhog, fhog_channels
+from dcfkit.components.features.fhog import _cell_histograms, fhog, fhog_channels
 
 # --------------------------------------------------------------- loop references
 

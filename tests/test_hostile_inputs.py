@@ -24,8 +24,8 @@ from dcfkit import cli
 from dcfkit.config import load_config
 from dcfkit.datasets import DatasetError, read_frame
 from dcfkit.errors import ConfigError, DcfkitError, InputError
-from dcfkit.synthetic import make_sequence
-from dcfkit.video import open_source
+from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.datasets.video import open_source
 
 CONFIGS = ("strcf", "bacf", "dr2track", "kcf", "dsst")
 SEQUENCE = make_sequence(n_frames=2, size=(72, 96), target=(10, 14), distractor=False)
@@ -603,7 +603,7 @@ def test_a_short_video_is_an_error_only_where_the_frame_count_is_an_index():
     """MKV and WebM counts are duration x fps estimates: a complete file may fall short of them;
     a URL that stops short lost its stream, whatever its name says."""
     from dcfkit.errors import InputError, InputWarning
-    from dcfkit.video import _stopped_short
+    from dcfkit.datasets.video import _stopped_short
 
     with pytest.raises(InputError, match=r"cut\.avi stops at frame 8 of the 10 .*not tracked"):
         _stopped_short("cut.avi", 8, 10)
@@ -672,7 +672,7 @@ def test_long_arguments_are_shown_short_in_messages(args, said, otb_root, tmp_pa
 def test_long_values_in_files_and_variables_are_shown_short(tmp_path, monkeypatch):
     from dcfkit.datasets import read_boxes
     from dcfkit.datasets.base import read_flags
-    from dcfkit.evaluation import tracker_name
+    from dcfkit.running.evaluation import tracker_name
     from dcfkit.limits import max_image_pixels
 
     (tmp_path / "gt.txt").write_text("1,1,2,2\n" + "9," * 2000 + "\n")  # a longer line is refused unsplit
@@ -721,7 +721,7 @@ def test_names_too_long_for_the_file_system_are_one_line_errors(args, said, otb_
 def test_the_raw_capture_of_a_motion_jpeg_check_is_released_when_reading_it_fails(monkeypatch):
     """_JpegPackets.of opens a second capture; an error while it reads the first packet must
     not leave that capture to the garbage collector."""
-    from dcfkit import video
+    from dcfkit.datasets import video
 
     released = []
 
@@ -767,7 +767,7 @@ def test_a_config_name_with_a_control_character_is_a_config_error(tmp_path, otb_
     err = capsys.readouterr().err
     assert err == ("dcfkit eval: error: config 'name' 'a\\x00b' must be usable as a folder name that report lists "
                    "(no / \\ :, no leading dot, no control character such as a null byte or a line break)\n")
-    from dcfkit.evaluation import tracker_name
+    from dcfkit.running.evaluation import tracker_name
 
     for name in (".mine", ".locks", "..", "a\nb"):
         with pytest.raises(ConfigError, match="must be usable as a folder name"):
@@ -775,7 +775,7 @@ def test_a_config_name_with_a_control_character_is_a_config_error(tmp_path, otb_
 
 
 def test_a_name_cannot_add_rows_to_a_markdown_or_text_table():
-    from dcfkit.report import format_rows
+    from dcfkit.analysis.report import format_rows
 
     rows = [{"sequence": "car\n| fake | 1.000 |", "auc": 0.5}, {"sequence": "a|b", "auc": 0.25}]
     markdown = format_rows(rows, "markdown").splitlines()
@@ -805,7 +805,7 @@ def test_twelve_bit_data_in_sixteen_bit_pngs_is_warned_of(tmp_path):
 
 
 def test_boxes_of_absurd_size_score_without_a_numpy_warning():
-    from dcfkit.metrics import score_sequence
+    from dcfkit.analysis.metrics import score_sequence
 
     gt = np.array([[10, 10, 20, 20], [10, 10, -20, -20], [1e300, 10, 1e300, 20]], float)
     pred = np.array([[10, 10, 20, 20]] * 3, float)  # 1e300 away from the last box: an infinite error

@@ -19,11 +19,11 @@ import dcfkit.integrations
 from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset, read_frame
 from dcfkit.errors import ConfigError, InputError, TrackingError
-from dcfkit.evaluation import run_one_pass
-from dcfkit.report import evaluate
-from dcfkit.results import load_results
-from dcfkit.synthetic import make_sequence
-from dcfkit.tracking import track
+from dcfkit.running.evaluation import run_one_pass
+from dcfkit.analysis.report import evaluate
+from dcfkit.running.results import load_results
+from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.running.tracking import track
 
 ONE_BASED = np.array([1.0, 1.0, 0.0, 0.0])
 

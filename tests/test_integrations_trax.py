@@ -19,7 +19,7 @@ import pytest
 import dcfkit
 from dcfkit.cli import main
 from dcfkit.datasets import read_frame
-from dcfkit.synthetic import make_sequence
+from dcfkit.datasets.synthetic import make_sequence
 
 NEEDS_TRAX = "vot-trax is not installed (pip install \"dcfkit[trax]\"; the test extra has it)"
 

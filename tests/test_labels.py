@@ -4,10 +4,10 @@ import pytest
 
 import dcfkit
 from dcfkit.errors import ConfigError
-from dcfkit.labels import Detection, DistractorRepressed, Gaussian, Label, gaussian_label
+from dcfkit.components.labels import Detection, DistractorRepressed, Gaussian, Label, gaussian_label
 from dcfkit.params import parse_params
-from dcfkit.response import local_maxima
-from dcfkit.synthetic import make_sequence
+from dcfkit.numerics.response import local_maxima
+from dcfkit.datasets.synthetic import make_sequence
 
 
 def test_gaussian_label_peaks_at_origin_and_is_symmetric():

@@ -17,10 +17,12 @@ import cv2
 import numpy as np
 import pytest
 
-from dcfkit import cli, video
+from dcfkit import cli
+
+from dcfkit.datasets import video
 from dcfkit.errors import InputError
-from dcfkit.synthetic import make_sequence
-from dcfkit.video import open_source
+from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.datasets.video import open_source
 
 SEQ = make_sequence(n_frames=20, size=(120, 160), target=(16, 20), distractor=False, seed=3)
 BOX = ",".join(str(v) for v in SEQ.ground_truth[0])

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from dcfkit import metrics
+from dcfkit.analysis import metrics
 
 
 def test_iou_hand_cases():

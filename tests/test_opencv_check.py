@@ -75,7 +75,7 @@ def test_the_contrib_requirement_is_the_one_pyproject_declares():
 
 def test_the_color_names_table_error_says_how_to_repair(clobbered_opencv):
     from dcfkit.errors import ConfigError
-    from dcfkit.features.colornames import _from_opencv
+    from dcfkit.components.features.colornames import _from_opencv
 
     with pytest.raises(ConfigError, match="Color Names table was not found .* OpenCV's contrib modules are missing") \
             as caught:
@@ -84,7 +84,7 @@ def test_the_color_names_table_error_says_how_to_repair(clobbered_opencv):
 
 
 def test_the_opencv_baselines_error_says_how_to_repair(clobbered_opencv):
-    from dcfkit.baselines import OpenCVUnavailable, opencv_tracker
+    from dcfkit.integrations.opencv import OpenCVUnavailable, opencv_tracker
 
     with pytest.raises(OpenCVUnavailable, match=r"OpenCV tracker CSRT is not in this OpenCV build \(available: "
                                                 r"none\); OpenCV's contrib modules are missing") as caught:

@@ -29,10 +29,10 @@ from pathlib import Path
 
 import pytest
 
-from dcfkit.compare import compare_folders
+from dcfkit.analysis.compare import compare_folders
 from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset
-from dcfkit.evaluation import run_one_pass
+from dcfkit.running.evaluation import run_one_pass
 
 OCTAVE_RUNS = Path(__file__).parent / "data" / "authors_octave"
 UAV = ("uav123_10fps", "UAV123_10fps")

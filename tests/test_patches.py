@@ -3,7 +3,7 @@ import cv2
 import numpy as np
 import pytest
 
-from dcfkit.patches import box_to_centre_size, centre_size_to_box, crop, sample
+from dcfkit.numerics.patches import box_to_centre_size, centre_size_to_box, crop, sample
 
 
 def brute_crop(image, centre, region):

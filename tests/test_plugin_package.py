@@ -15,7 +15,7 @@ import cv2
 import pytest
 
 from dcfkit.registry import DISABLE_ENV
-from dcfkit.synthetic import make_sequence
+from dcfkit.datasets.synthetic import make_sequence
 
 ROOT = Path(__file__).resolve().parents[1]
 PLUGIN = ROOT / "plugins" / "dcfkit-context-label"

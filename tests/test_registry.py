@@ -10,7 +10,7 @@ import pytest
 
 from dcfkit import registry as reg
 from dcfkit.errors import ConfigError, RegistryError
-from dcfkit.labels import Label
+from dcfkit.components.labels import Label
 from dcfkit.params import fields, param, parse_params
 
 
@@ -35,16 +35,20 @@ def install_plugin(monkeypatch, module_name, source):
     return FakeEntryPoint(module_name.split(".")[-1], module_name)
 
 
+OWN_ENTRY_POINTS = reg.plugin_entry_points(external=False)[0]  # dcfkit's own, loaded as a plugin's
+
+
 def with_entry_points(monkeypatch, eps):
+    """The installed ``dcfkit`` entry points are dcfkit's own and ``eps``."""
     monkeypatch.setattr(importlib.metadata, "entry_points",
-                        lambda group=None: [e for e in eps] if group == "dcfkit" else [])
+                        lambda group=None: OWN_ENTRY_POINTS + list(eps) if group == "dcfkit" else [])
 
 
 PLUGIN = '''
 import dataclasses
 import numpy as np
 from dcfkit.registry import hookimpl
-from dcfkit.labels import Label
+from dcfkit.components.labels import Label
 from dcfkit.params import param
 
 class Flat(Label):
@@ -304,8 +308,8 @@ def test_union_and_fixed_tuple_annotations_are_checked():
 def test_result_hashes_change_with_the_version_of_a_plugin_the_config_uses(monkeypatch):
     from dcfkit.config import load_config
     from dcfkit.errors import DcfkitError
-    from dcfkit.results import dcfkit_version, run_key
-    from dcfkit.runner import RunTask, run_in_worker
+    from dcfkit.running.results import dcfkit_version, run_key
+    from dcfkit.running.runner import RunTask, run_in_worker
 
     def registry_with(version):
         ep = install_plugin(monkeypatch, "dcfkit_test_versioned", PLUGIN)
@@ -322,7 +326,7 @@ def test_result_hashes_change_with_the_version_of_a_plugin_the_config_uses(monke
     old_key = run_key(flat)
     registry_with("0.2.0")
     assert run_key(flat) != old_key
-    monkeypatch.setattr("dcfkit.runner._worker_ready", True)  # no worker set-up in the test process
+    monkeypatch.setattr("dcfkit.running.runner._worker_ready", True)  # no worker set-up in the test process
     with pytest.raises(DcfkitError, match=r"worker's plugins \(dcfkit-test-versioned 0.2.0\) are not the client's"):
         run_in_worker(RunTask(flat, None, "unused", old_key), dcfkit_version())
     monkeypatch.setattr(reg, "_REGISTRY", None)
@@ -375,7 +379,7 @@ def test_configs_that_are_not_dcfkit_trackers_still_hash(config):
     or another name, and different when any other value in it changes."""
     import re
 
-    from dcfkit.results import run_key
+    from dcfkit.running.results import run_key
 
     digest = run_key(config)
     assert re.fullmatch(r"[0-9a-f]{16}", digest)
@@ -479,7 +483,7 @@ def test_a_real_interrupt_while_a_plugin_loads_still_interrupts(monkeypatch, sig
     imported is the user's: it ends the command, and is not blamed on the plugin."""
     import signal
 
-    from dcfkit.tracking import Interrupted, interrupt_on_termination
+    from dcfkit.running.tracking import Interrupted, interrupt_on_termination
 
     if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
         pytest.skip("Ctrl-C is not Python's default KeyboardInterrupt here")

@@ -1,4 +1,4 @@
-"""report.html (dcfkit.report_html): what the page's data holds, checked against independent
+"""report.html (dcfkit.analysis.report_html): what the page's data holds, checked against independent
 computations, and the page itself in a real headless Chromium (skipped where there is none):
 it loads without console errors or requests, its overall table sorts, its plots are drawn,
 its tooltips and legends work and its thumbnails decode.
@@ -24,11 +24,11 @@ from dcfkit.ablation import load_spec, sensitivity
 from dcfkit.ablation.page import config_changes, sensitivity_charts
 from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset
-from dcfkit.metrics import iou
-from dcfkit.report_html import render
-from dcfkit import platforms as dcfkit_platforms
-from dcfkit.report_html.provenance import folder_provenance
-from dcfkit.report_html.thumbnails import choose_frames, crop_window
+from dcfkit.analysis.metrics import iou
+from dcfkit.analysis.report_html import render
+from dcfkit.running import platforms as dcfkit_platforms
+from dcfkit.analysis.report_html.provenance import folder_provenance
+from dcfkit.analysis.report_html.thumbnails import choose_frames, crop_window
 from test_ablation import write_otb
 
 HOSTILE = "<img src=x onerror=alert(1)>&amp;</script>"  # user text that must stay text

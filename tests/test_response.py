@@ -4,9 +4,9 @@ import itertools
 import numpy as np
 import pytest
 
-from dcfkit.fft import make_fft
-from dcfkit import peak_kernels
-from dcfkit.response import local_maxima, response, subpixel_peak, wrap
+from dcfkit.numerics.fft import make_fft
+from dcfkit.numerics import peak_kernels
+from dcfkit.numerics.response import local_maxima, response, subpixel_peak, wrap
 
 
 @pytest.mark.parametrize("backend", ["scipy", "pyfftw"])
@@ -67,7 +67,7 @@ def test_wrap_gives_signed_offsets():
 
 
 def test_shift_spectrum_matches_roll_for_whole_cells():
-    from dcfkit.response import shift_spectrum
+    from dcfkit.numerics.response import shift_spectrum
 
     fft = make_fft("scipy")
     x = np.random.default_rng(2).standard_normal((3, 8, 10)).astype(np.float32)

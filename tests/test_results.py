@@ -13,10 +13,12 @@ import tempfile
 import numpy as np
 import pytest
 
-from dcfkit import report, results
+from dcfkit.analysis import report
+
+from dcfkit.running import results
 from dcfkit.errors import DcfkitError
-from dcfkit.evaluation import run_one_pass
-from dcfkit.results import ResultStore, load_results, run_key
+from dcfkit.running.evaluation import run_one_pass
+from dcfkit.running.results import ResultStore, load_results, run_key
 
 from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixture)
 
@@ -209,7 +211,7 @@ def test_a_write_failure_mid_run_stops_the_run_whatever_the_jobs(tmp_path, seqs,
 def test_a_terminated_eval_keeps_finished_sequences_and_leaves_no_partial_file(tmp_path, seqs):
     from test_evaluation import DriftTracker
 
-    from dcfkit.tracking import Interrupted, interrupt_on_termination
+    from dcfkit.running.tracking import Interrupted, interrupt_on_termination
 
     class Terminated(DriftTracker):
         def update(self, image):
@@ -264,7 +266,7 @@ def test_any_sequence_names_have_files_of_their_own(tmp_path, capsys):
     import cv2
 
     from dcfkit.cli import main
-    from dcfkit.synthetic import make_sequence
+    from dcfkit.datasets.synthetic import make_sequence
 
     names = ["car", "car_time", "car_confidence", "car.error"]
     root = tmp_path / "data"

@@ -3,7 +3,7 @@ import cv2
 import numpy as np
 import pytest
 
-from dcfkit.scale import DSST, Pyramid, scale_limits
+from dcfkit.components.scale import DSST, Pyramid, scale_limits
 
 
 def zoomed(image, centre, factor):

@@ -1,4 +1,4 @@
-"""`dcfkit track --select`: the box drawn in a window (dcfkit.selection), and its errors where no
+"""`dcfkit track --select`: the box drawn in a window (dcfkit.cli.selection), and its errors where no
 window can be shown."""
 import os
 import shutil
@@ -13,8 +13,8 @@ import pytest
 
 from dcfkit import cli
 from dcfkit.errors import InputError
-from dcfkit.selection import BoxDrawing, select_box
-from dcfkit.synthetic import make_sequence
+from dcfkit.cli.selection import BoxDrawing, select_box
+from dcfkit.datasets.synthetic import make_sequence
 
 SEQ = make_sequence(n_frames=6, seed=4)  # 360x480 frames, the target at 148,179 36x22
 ROOT = Path(__file__).resolve().parents[1]

@@ -6,10 +6,10 @@ from hypothesis import strategies as st
 
 from dcfkit.config import load_config
 from dcfkit.errors import ConfigError
-from dcfkit.fft import make_fft
+from dcfkit.numerics.fft import make_fft
 from dcfkit.params import parse_params
-from dcfkit.regularizers import Temporal
-from dcfkit.solvers import ADMMParams, admm, sherman_morrison_solve
+from dcfkit.components.regularizers import Temporal
+from dcfkit.components.solvers import ADMMParams, admm, sherman_morrison_solve
 
 
 def correlation_matrix(m: np.ndarray) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""The portable SSE estimates of fhog's 'sse' arithmetic (dcfkit.features.sse_estimates) and its
+"""The portable SSE estimates of fhog's 'sse' arithmetic (dcfkit.components.features.sse_estimates) and its
 acos table: hand-computed values, the documented error bound over every mantissa, the same
 values from the C++ header that the authors' code is built with under Octave."""
 import platform
@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dcfkit.features import sse_estimates
-from dcfkit.features.fhog_sse import acos_table
+from dcfkit.components.features import sse_estimates
+from dcfkit.components.features.fhog_sse import acos_table
 
 HEADER = Path(__file__).resolve().parents[1] / "benchmarks" / "octave" / "portable_estimates.hpp"
 X86 = platform.machine().lower() in ("x86_64", "amd64")

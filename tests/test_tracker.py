@@ -5,11 +5,11 @@ import pytest
 import dcfkit
 from dcfkit.contracts import checked
 from dcfkit.errors import InputError, TrackingError
-from dcfkit.features import Feature
-from dcfkit.labels import Label, gaussian_label
-from dcfkit.metrics import score_sequence
-from dcfkit.response import shift_spectrum
-from dcfkit.synthetic import make_sequence
+from dcfkit.components.features import Feature
+from dcfkit.components.labels import Label, gaussian_label
+from dcfkit.analysis.metrics import score_sequence
+from dcfkit.numerics.response import shift_spectrum
+from dcfkit.datasets.synthetic import make_sequence
 
 CONFIGS = ["strcf", "bacf", "dr2track", "kcf", "dsst", "configs/ablations/dr2track_no_dr.yaml",
            "configs/ablations/dr2track_no_ma.yaml"]
@@ -145,8 +145,8 @@ def test_initial_box_errors_say_what_is_wrong(sequence):
 
 
 def test_labels_stay_finite_for_a_vanishing_sigma():
-    from dcfkit.labels import gaussian_label
-    from dcfkit.scale import DSST
+    from dcfkit.components.labels import gaussian_label
+    from dcfkit.components.scale import DSST
 
     g = gaussian_label((8, 8), 1e-300)  # σ² underflows to 0: used to give NaN at the peak
     assert g[0, 0] == 1 and g.sum() == 1

@@ -1,4 +1,4 @@
-// dcfkit's portable SSE estimates (dcfkit/features/sse_estimates.py) for the authors' gradientMex
+// dcfkit's portable SSE estimates (dcfkit/components/features/sse_estimates.py) for the authors' gradientMex
 // under Octave: benchmarks/authors_octave.sh includes this from sse.hpp in place of the
 // processor's rcpps/rsqrtps, so that a run gives the same boxes on every machine. The rule:
 // the reciprocal (square root) of the middle of the input's 2^-11 (2^-10) mantissa interval,

@@ -5,12 +5,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping
 
-from ..protocols import get_protocol
-from ..report_html import evaluation_sections, sections
-from ..report_html.provenance import this_process
-from ..results import LABEL_KEYS
-from .sensitivity import METRICS, sensitivity
-from .spec import AblationSpec, format_value, job_dir
+from dcfkit.analysis.protocols import get_protocol
+from dcfkit.analysis.report_html import evaluation_sections, sections
+from dcfkit.analysis.report_html.provenance import this_process
+from dcfkit.running.results import LABEL_KEYS
+from dcfkit.ablation.sensitivity import METRICS, sensitivity
+from dcfkit.ablation.spec import AblationSpec, format_value, job_dir
 
 
 def flatten(config: Any, prefix: str = "") -> dict[str, Any]:
@@ -91,7 +91,7 @@ def sensitivity_charts(spec: AblationSpec, overall: list[dict]) -> dict:
 def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[str, ...], scores: Mapping,
                   sequences: list, results: Mapping[str, Mapping], keys: Mapping[str, str]) -> dict:
     """The page of an ablation: ``info`` is its ``summary.json`` (the summary table in
-    ``columns``), ``scores`` what :func:`dcfkit.report.evaluate` returned for ``results``
+    ``columns``), ``scores`` what :func:`dcfkit.analysis.report.evaluate` returned for ``results``
     (variant -> sequence -> result), ``keys`` variant -> run key."""
     trackers = list(keys)
     head = [variants_table(spec, info["overall"], columns, trackers)]

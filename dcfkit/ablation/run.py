@@ -1,22 +1,22 @@
 """Running an ablation spec's jobs: each distinct (run key, sequence) once, through
-:func:`dcfkit.runner.execute`, into ``OUT/jobs/<dataset>/<key>/``."""
+:func:`dcfkit.running.runner.execute`, into ``OUT/jobs/<dataset>/<key>/``."""
 from __future__ import annotations
 
 import contextlib
 import json
 from pathlib import Path
 
-from ..errors import DcfkitError, shown
-from ..results import LABEL_KEYS, ResultStore, atomic_write, dcfkit_version, ensure_writable, exclusive, read_json
-from ..runner import RunTask, execute, usable_cores
-from .spec import AblationSpec, Job, expand, job_dir, variant_names
-from .summary import output_names, summarize
+from dcfkit.errors import DcfkitError, shown
+from dcfkit.running.results import LABEL_KEYS, ResultStore, atomic_write, dcfkit_version, ensure_writable, exclusive, read_json
+from dcfkit.running.runner import RunTask, execute, usable_cores
+from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir, variant_names
+from dcfkit.ablation.summary import output_names, summarize
 
 
 def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str = "local",
                  scheduler: str | None = None, progress: bool = True, protocol: str | None = None) -> dict:
     """Run every job of ``spec`` not already done under ``out``, then write the summary
-    (scored under ``protocol``, see :mod:`dcfkit.protocols`; by default the rules of the
+    (scored under ``protocol``, see :mod:`dcfkit.analysis.protocols`; by default the rules of the
     benchmark's published tables, :func:`~dcfkit.datasets.benchmark_protocol`).
 
     ``executor`` is ``"local"`` (``jobs`` spawned worker processes, default: the usable

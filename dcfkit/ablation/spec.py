@@ -12,12 +12,12 @@ from typing import Any, Iterable, Mapping
 
 import yaml
 
-from .. import limits
-from ..config import load_config, read_yaml, shipped_config, shipped_config_dir
-from ..datasets import DatasetError, canonical_name, load_dataset
-from ..errors import ConfigError, DcfkitError, clip, shown
-from ..params import closest
-from ..results import dcfkit_version, run_key
+from dcfkit import limits
+from dcfkit.config import load_config, read_yaml, shipped_config, shipped_config_dir
+from dcfkit.datasets import DatasetError, canonical_name, load_dataset
+from dcfkit.errors import ConfigError, DcfkitError, clip, shown
+from dcfkit.params import closest
+from dcfkit.running.results import dcfkit_version, run_key
 
 SPEC_KEYS = ("name", "description", "dataset", "sequences", "variants", "grid")
 VARIANT_KEYS = ("config", "overrides", "description")
@@ -81,7 +81,7 @@ class AblationSpec:
 @dataclasses.dataclass(frozen=True)
 class Job:
     """One tracker run to do: ``variant`` on ``sequence`` with the resolved ``config``;
-    ``key`` names the run's result folder (:func:`dcfkit.results.run_key`)."""
+    ``key`` names the run's result folder (:func:`dcfkit.running.results.run_key`)."""
 
     variant: str
     config: dict

@@ -6,14 +6,14 @@ import json
 import logging
 from pathlib import Path
 
-from ..datasets import Sequence
-from ..protocols import DEFAULT, get_protocol
-from ..report import evaluate, format_table, json_ready, plot_curves
-from ..report_html import PAGE, write_page
-from ..results import ResultStore, atomic_write, read_json
-from .page import ablation_page
-from .sensitivity import plot_sensitivity, sensitivity_file
-from .spec import AblationSpec, Job, expand, job_dir
+from dcfkit.datasets import Sequence
+from dcfkit.analysis.protocols import DEFAULT, get_protocol
+from dcfkit.analysis.report import evaluate, format_table, json_ready, plot_curves
+from dcfkit.analysis.report_html import PAGE, write_page
+from dcfkit.running.results import ResultStore, atomic_write, read_json
+from dcfkit.ablation.page import ablation_page
+from dcfkit.ablation.sensitivity import plot_sensitivity, sensitivity_file
+from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir
 
 SUMMARY_COLUMNS = ("variant", "precision", "auc", "fps", "sequences", "failed")
 SEQUENCE_COLUMNS = ("variant", "sequence", "precision", "auc", "fps", "frames", "status")
@@ -37,12 +37,12 @@ def _status(folder: Path, seq: Sequence) -> tuple[str, str | None]:
 def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None = None,
               protocol: str | None = None) -> dict:
     """Score the stored results of ``jobs`` under ``protocol`` (by default the benchmark's,
-    :func:`dcfkit.report.evaluate`) and write the tables,
+    :func:`dcfkit.analysis.report.evaluate`) and write the tables,
     ``summary.json`` and plots, each naming the protocol.
 
     precision is the precision at 20 px, auc the area under the success curve (and under
     ``got10k`` also ao, sr50, sr75), fps the mean per-sequence frames per second of tracker
-    time (:mod:`dcfkit.report`). A job without result (failed or not run) is scored as a
+    time (:mod:`dcfkit.analysis.report`). A job without result (failed or not run) is scored as a
     total failure and counted in ``failed``. Returns ``{"overall", "per_sequence", "jobs",
     "files", "protocol"}`` (the protocol's name).
     """
@@ -50,7 +50,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     jobs = jobs if jobs is not None else expand(spec, sequences)
     keys = {j.variant: j.key for j in jobs}
     status, stored = _stored_runs(spec, out, sequences, jobs)
-    with _quiet(logging.getLogger("dcfkit.report")):  # missing runs are counted in 'failed'
+    with _quiet(logging.getLogger("dcfkit.analysis.report")):  # missing runs are counted in 'failed'
         scores = evaluate({variant: stored[key] for variant, key in keys.items()}, sequences, protocol=protocol)
     protocol = scores["protocol"]["name"]
     overall, per_sequence = _rows(scores, keys, sequences, status, protocol)

@@ -1,5 +1,5 @@
 """The ``dcfkit`` command line: argument parsing and printing only; the work is the
-library's (:mod:`dcfkit.evaluation`, :mod:`dcfkit.ablation`, :mod:`dcfkit.report`, ...)."""
+library's (:mod:`dcfkit.running.evaluation`, :mod:`dcfkit.ablation`, :mod:`dcfkit.analysis.report`, ...)."""
 from __future__ import annotations
 
 import contextlib
@@ -7,10 +7,10 @@ import errno
 import sys
 import warnings
 
-from ..errors import DcfkitError, DcfkitWarning, clip
-from ..results import running_command
-from ..tracking import interrupt_on_termination
-from .parser import build_parser
+from dcfkit.errors import DcfkitError, DcfkitWarning, clip
+from dcfkit.running.results import running_command
+from dcfkit.running.tracking import interrupt_on_termination
+from dcfkit.cli.parser import build_parser
 
 __all__ = ["build_parser", "main"]
 

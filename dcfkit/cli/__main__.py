@@ -1,5 +1,5 @@
 import sys
 
-from . import main
+from dcfkit.cli import main
 
 sys.exit(main())

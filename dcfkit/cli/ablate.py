@@ -4,12 +4,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..ablation import expand, job_dir, load_spec, run_ablation, summary_columns, variant_names
-from ..ablation.spec import MAX_VARIANTS
-from ..errors import DcfkitError
-from ..report import format_table
-from ..results import ResultStore
-from .common import add_protocol_argument, variant_count
+from dcfkit.ablation import expand, job_dir, load_spec, run_ablation, summary_columns, variant_names
+from dcfkit.ablation.spec import MAX_VARIANTS
+from dcfkit.errors import DcfkitError
+from dcfkit.analysis.report import format_table
+from dcfkit.running.results import ResultStore
+from dcfkit.cli.common import add_protocol_argument, variant_count
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -12,9 +12,10 @@ from typing import Any, Iterable
 
 import yaml
 
-from ..opencv_check import contrib_problem
-from ..params import Bounds, fields
-from ..registry import KINDS, PluginWarning, get_registry
+from dcfkit.opencv_check import contrib_problem
+from dcfkit.params import Bounds, fields
+from dcfkit.config import KINDS
+from dcfkit.registry import PluginWarning, get_registry
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -7,9 +7,9 @@ import json
 import sys
 import warnings
 
-from ..datasets import layouts
-from ..protocols import DEFAULT
-from ..registry import PluginWarning, get_registry
+from dcfkit.datasets import layouts
+from dcfkit.analysis.protocols import DEFAULT
+from dcfkit.registry import PluginWarning, get_registry
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

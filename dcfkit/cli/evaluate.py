@@ -8,16 +8,16 @@ import sys
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from ..baselines import opencv_tracker
-from ..compare import COLUMNS, compare_folders
-from ..config import load_config, parse_overrides
-from ..datasets import load_dataset
-from ..errors import ConfigError, shown
-from ..evaluation import check_one_pass, run_one_pass, tracker_name
-from ..report import columns, evaluate, format_table, json_ready, score_and_write, score_line
-from ..report_html import write_html_report
-from ..results import load_results
-from .common import add_dataset_arguments, add_protocol_argument, pixels
+from dcfkit.integrations.opencv import opencv_tracker
+from dcfkit.analysis.compare import COLUMNS, compare_folders
+from dcfkit.config import load_config, parse_overrides
+from dcfkit.datasets import load_dataset
+from dcfkit.errors import ConfigError, shown
+from dcfkit.running.evaluation import check_one_pass, run_one_pass, tracker_name
+from dcfkit.analysis.report import columns, evaluate, format_table, json_ready, score_and_write, score_line
+from dcfkit.analysis.report_html import write_html_report
+from dcfkit.running.results import load_results
+from dcfkit.cli.common import add_dataset_arguments, add_protocol_argument, pixels
 
 
 def add_eval_arguments(parser: argparse.ArgumentParser) -> None:

@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import argparse
 
-from .. import __version__
-from ..errors import SHOWN_CHARS
-from . import ablate, components, datasets, evaluate, track, trax
+from dcfkit import __version__
+from dcfkit.errors import SHOWN_CHARS
+from dcfkit.cli import ablate, components, datasets, evaluate, track, trax
 
 DESCRIPTION = """dcfkit: discriminative correlation filter trackers assembled from YAML.
 

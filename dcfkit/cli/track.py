@@ -10,16 +10,16 @@ from typing import Iterator
 
 import numpy as np
 
-from ..config import parse_overrides
-from ..errors import InputError, clip
-from ..metrics import score_sequence
-from ..results import CONFIDENCE_END, TIME_END, StoreError, format_boxes, format_confidence, format_times
-from ..selection import check_display, select_box
-from ..synthetic import make_sequence
-from ..tracker import load_tracker
-from ..tracking import INTERRUPTS, Step, steps, termination_deferred, track
-from ..video import DEFAULT_FPS, READ_TIMEOUT, FrameSource, VideoWriter, check_output_file, open_source
-from .common import MAX_DEMO_FRAMES, frame_count, parse_box, seed
+from dcfkit.config import parse_overrides
+from dcfkit.errors import InputError, clip
+from dcfkit.analysis.metrics import score_sequence
+from dcfkit.running.results import CONFIDENCE_END, TIME_END, StoreError, format_boxes, format_confidence, format_times
+from dcfkit.cli.selection import check_display, select_box
+from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.tracker.tracker import load_tracker
+from dcfkit.running.tracking import INTERRUPTS, Step, steps, termination_deferred, track
+from dcfkit.datasets.video import DEFAULT_FPS, READ_TIMEOUT, FrameSource, VideoWriter, check_output_file, open_source
+from dcfkit.cli.common import MAX_DEMO_FRAMES, frame_count, parse_box, seed
 
 
 TRACK_NOTES = f"""--video reads a file, a camera (0 is the first), a stream URL or a named pipe one frame at a

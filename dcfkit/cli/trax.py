@@ -4,8 +4,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..config import load_config, parse_overrides
-from ..opencv_check import contrib_problem
+from dcfkit.config import load_config, parse_overrides
+from dcfkit.opencv_check import contrib_problem
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -16,7 +16,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Check the config, then serve until the client quits (status 0); an error on a frame is
     sent to the client and printed on stderr (status 2)."""
-    from ..integrations.trax import serve  # deferred: needs the optional vot-trax package
+    from dcfkit.integrations.trax import serve  # deferred: needs the optional vot-trax package
 
     config = load_config(args.config, parse_overrides(args.set))
     problem = contrib_problem()

@@ -19,8 +19,8 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
-from ..errors import DcfkitError, InputWarning, clip, shown
-from ..limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
+from dcfkit.errors import DcfkitError, InputWarning, clip, shown
+from dcfkit.limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 log = logging.getLogger(__name__)
 

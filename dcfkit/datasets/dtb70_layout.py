@@ -3,9 +3,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .base import (Sequence, annotated_frames, first_frame_digits, image_sequence_folders, listed, read_boxes,
+from dcfkit.datasets.base import (Sequence, annotated_frames, first_frame_digits, image_sequence_folders, listed, read_boxes,
                    require_root, select_sequences)
-from .registry import Evidence, register_layout
+from dcfkit.datasets.layout import Evidence, register_layout
 
 
 def dtb70(root, sequences=None) -> list[Sequence]:

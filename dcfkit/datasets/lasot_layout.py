@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import (DatasetError, Sequence, listed, numbered_frames, read_boxes, read_flags, read_frame_values,
+from dcfkit.datasets.base import (DatasetError, Sequence, listed, numbered_frames, read_boxes, read_flags, read_frame_values,
                    read_text, require_root, select_sequences)
-from .registry import Evidence, register_layout
+from dcfkit.datasets.layout import Evidence, register_layout
 
 #: Column order of the toolkit's att files (``att_fig_name`` of run_tracker_performance_evaluation.m).
 LASOT_ATTRIBUTES = ("IV", "POC", "DEF", "MB", "CM", "ROT", "BC", "VC", "SV", "FOC", "FM", "OV", "LR", "ARC")

@@ -13,9 +13,9 @@ import io
 from pathlib import Path
 from typing import Callable
 
-from .base import (DatasetError, Sequence, check_box_count, listed, numbered_frames, read_boxes, read_flags,
+from dcfkit.datasets.base import (DatasetError, Sequence, check_box_count, listed, numbered_frames, read_boxes, read_flags,
                    read_text, require_root, select_sequences)
-from .registry import Evidence, register_layout
+from dcfkit.datasets.layout import Evidence, register_layout
 
 # Folder names under data_seq/ and anno/ that hold each subset (first found wins).
 # UAV20L uses the UAV123 images; its annotations are in anno/UAV20L in the official release.

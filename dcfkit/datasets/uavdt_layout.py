@@ -3,8 +3,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .base import DatasetError, Sequence, annotated_frames, read_boxes, require_root, select_sequences
-from .registry import Evidence, register_layout
+from dcfkit.datasets.base import DatasetError, Sequence, annotated_frames, read_boxes, require_root, select_sequences
+from dcfkit.datasets.layout import Evidence, register_layout
 
 
 def uavdt(root, sequences=None) -> list[Sequence]:

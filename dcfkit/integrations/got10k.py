@@ -52,11 +52,11 @@ from typing import Any, Mapping
 import numpy as np
 from PIL import Image
 
-from ..config import load_config
-from ..datasets import read_frame
-from ..errors import DcfkitError, InputError, TrackingError
-from ..evaluation import tracker_name
-from ..tracker import Tracker as DcfTracker
+from dcfkit.config import load_config
+from dcfkit.datasets import read_frame
+from dcfkit.errors import DcfkitError, InputError, TrackingError
+from dcfkit.running.evaluation import tracker_name
+from dcfkit.tracker.tracker import Tracker as DcfTracker
 
 try:
     from got10k.trackers import Tracker as Got10kTracker

@@ -16,7 +16,7 @@ Images: ``path`` (read by :func:`dcfkit.datasets.read_frame`, with its checks) a
 (``rgb`` or ``gray8``), on the ``color`` channel.
 
 Each reply carries the object's properties ``confidence`` (the response's peak,
-:mod:`dcfkit.confidence`: VOT's long-term analysis thresholds it) and ``apce``; a frame
+:mod:`dcfkit.tracker.confidence`: VOT's long-term analysis thresholds it) and ``apce``; a frame
 without a response (the initialising frame, a frame held as blank) has neither.
 
 An error on a frame (an unreadable image, a tracker failure) ends the session: the client is
@@ -33,13 +33,13 @@ from typing import Any, Iterator, Mapping
 
 import numpy as np
 
-from .. import __version__
-from ..confidence import confidence_of
-from ..datasets import read_frame
-from ..errors import DcfkitError, InputError, MissingDependency
-from ..tracker import Tracker
-from ..tracking import track
-from .trax_stream import ProtocolError, framed_connection
+from dcfkit import __version__
+from dcfkit.tracker.confidence import confidence_of
+from dcfkit.datasets import read_frame
+from dcfkit.errors import DcfkitError, InputError, MissingDependency
+from dcfkit.tracker.tracker import Tracker
+from dcfkit.running.tracking import track
+from dcfkit.integrations.trax_stream import ProtocolError, framed_connection
 
 try:
     import trax  # vot-trax: the optional dependency this module exists for
@@ -53,7 +53,7 @@ CHANNEL = trax.ImageChannel.COLOR
 
 def serve(config: Mapping[str, Any]) -> None:
     """Serve TraX on stdin/stdout (or ``$TRAX_SOCKET``) until the client quits, one
-    :class:`~dcfkit.tracker.Tracker` built from ``config`` (a resolved config,
+    :class:`~dcfkit.tracker.tracker.Tracker` built from ``config`` (a resolved config,
     :func:`dcfkit.load_config`) per ``initialize``. An error on a frame is sent to the client
     as the reason of a ``quit``, then raised; a failed connection raises :class:`ProtocolError`."""
     with contextlib.redirect_stdout(sys.stderr):  # the protocol's messages are the only output on stdout
@@ -119,7 +119,7 @@ def _session(server, link: _Link, config: Mapping[str, Any]) -> None:
 
 class _Run:
     """One object, from its ``initialize`` to the next ``initialize`` or ``quit``: the frames as
-    :func:`dcfkit.tracking.track` reads them (numbered from 1, the initialising frame), and the
+    :func:`dcfkit.running.tracking.track` reads them (numbered from 1, the initialising frame), and the
     replies it sends."""
 
     def __init__(self, server, link: _Link, request):
@@ -187,6 +187,6 @@ def memory_image(array: np.ndarray, what: str) -> np.ndarray:
 
 def confidence_properties(tracker) -> dict[str, float]:
     """``confidence`` (the response's peak) and ``apce`` of the last frame; none on a frame
-    without a response (:func:`dcfkit.confidence.confidence_of` gives NaN)."""
+    without a response (:func:`dcfkit.tracker.confidence.confidence_of` gives NaN)."""
     peak, apce = confidence_of(tracker)
     return {"confidence": peak, "apce": apce} if math.isfinite(peak) else {}

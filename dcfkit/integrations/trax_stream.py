@@ -37,9 +37,9 @@ import threading
 import time
 from typing import Iterator
 
-from ..datasets.base import NUMBER
-from ..errors import DcfkitError, describe_error
-from ..limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
+from dcfkit.datasets.base import NUMBER
+from dcfkit.errors import DcfkitError, describe_error
+from dcfkit.limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 PREFIX = b"@@TRAX:"
 MAX_MESSAGE_BYTES = 256 * 2**20  # an 8K RGB frame as a base64 memory image is 133 MB

@@ -24,7 +24,7 @@ import dataclasses
 
 import numpy as np
 
-from dcfkit.labels import Detection, Label
+from dcfkit.components.labels import Detection, Label
 from dcfkit.params import param
 
 

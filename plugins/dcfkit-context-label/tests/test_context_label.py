@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from dcfkit.errors import ConfigError
-from dcfkit.labels import Detection, gaussian_label
+from dcfkit.components.labels import Detection, gaussian_label
 from dcfkit.registry import Registry
 from dcfkit_context_label import dcfkit_register_components
 from dcfkit_context_label.label import ContextAware

@@ -1,0 +1,166 @@
+"""Parity check: two folders of result files side by side, sequence by sequence.
+
+:func:`compare_folders` reads ``RESULTS/<sequence>.txt`` and ``REFERENCE/<sequence>.txt``
+(1-based ``x,y,w,h`` per line, commas, tabs or spaces: the layout ``dcfkit eval`` writes and
+that of published result files) for the sequences present in both folders and in the
+given dataset, and returns one row per sequence:
+
+* ``precision``, ``auc`` of the results and ``precision_ref``, ``auc_ref`` of the reference,
+  scored against the ground truth under a scoring protocol (:mod:`dcfkit.analysis.protocols`), and
+  the differences ``d_precision``, ``d_auc`` (results minus reference);
+* ``iou``: the mean over frames of the IoU between the two box series (continuous boxes;
+  a frame where both files hold the same values counts 1, also when both are NaN; a frame
+  where only one box is NaN counts 0);
+* ``diverges_at``: the first frame (1-based) where the two centres are more than
+  ``divergence_px`` apart (a box NaN in one file only counts as apart), or None.
+
+The ``mean`` row averages precision and AUC as the protocol averages sequences, and the
+per-sequence IoUs with equal weights. Sequences found in only one folder, in both but not
+in the dataset, or whose dcfkit sidecar says the file is damaged, are listed in ``left_out``.
+``platforms`` lists each folder's platforms as their sidecars record them
+(:mod:`dcfkit.running.platforms`; "not recorded" for files without one) and ``platform_differences``
+what differs between the two: boxes from different platforms can part where a float decision
+is close (docs/architecture.md).
+"""
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+from typing import Iterable
+
+import numpy as np
+
+from dcfkit.analysis import metrics
+
+from dcfkit.running import platforms
+from dcfkit.datasets import DatasetError, Sequence, benchmark_protocol, read_boxes, scored_sequences
+from dcfkit.errors import clip, shown
+from dcfkit.running.results import ResultStore, result_files
+from dcfkit.analysis.protocols import Protocol, get_protocol
+
+__all__ = ["COLUMNS", "compare_folders", "first_divergence", "series_iou"]
+
+COLUMNS = ("sequence", "frames", "precision", "precision_ref", "d_precision", "auc", "auc_ref", "d_auc",
+           "iou", "diverges_at")
+
+log = logging.getLogger(__name__)
+
+
+def series_iou(a, b) -> np.ndarray:
+    """``(N,)`` IoU between two 0-based box series: 1 where the rows are identical (NaN
+    included), 0 where only one is non-finite or a box is empty, else the continuous IoU."""
+    a, b = metrics.as_boxes(a), metrics.as_boxes(b)
+    out = metrics.iou(a, b)
+    out[~np.isfinite(b).all(axis=1)] = 0.0
+    out[_identical(a, b)] = 1.0
+    return out
+
+
+def first_divergence(a, b, px: float) -> int | None:
+    """First frame (1-based) where the centres of ``a`` and ``b`` are more than ``px``
+    apart (identical rows never are; a NaN in one of them always is), or None."""
+    a, b = metrics.as_boxes(a), metrics.as_boxes(b)
+    d = (a[:, :2] + a[:, 2:] / 2) - (b[:, :2] + b[:, 2:] / 2)
+    with np.errstate(invalid="ignore"):
+        apart = ~(np.hypot(d[:, 0], d[:, 1]) <= px) & ~_identical(a, b)
+    return int(np.argmax(apart)) + 1 if apart.any() else None
+
+
+def _identical(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return ((a == b) | (np.isnan(a) & np.isnan(b))).all(axis=1)
+
+
+def compare_folders(results, reference, sequences: Iterable[Sequence], protocol: str | Protocol | None = None,
+                    divergence_px: float = 2.0) -> dict:
+    """Compare the result files of two folders on ``sequences`` (their ground truth).
+
+    Returns a plain dict: ``protocol`` (name), ``divergence_px``, ``results`` and
+    ``reference`` (the folders), ``rows`` (one per compared sequence, keys
+    :data:`COLUMNS`), ``mean`` (the same keys, ``sequence`` "mean", ``frames`` the total,
+    ``diverges_at`` None), ``diverged`` (how many sequences diverge) and ``left_out``
+    (``only_in_results``, ``only_in_reference``, ``not_in_dataset``, ``damaged``: sequence names).
+    Raises :class:`DatasetError` for a missing folder, a malformed line (naming file and
+    line), two files of one sequence with different line counts, or a line count that is
+    not the sequence's frame count (naming the sequence). Sequences whose ground truth is
+    withheld after frame 1 (test splits) are left out, as in :func:`dcfkit.analysis.report.evaluate`,
+    whose default ``protocol`` (the benchmark's) is this one's too.
+    """
+    sequences = list(sequences)
+    proto = get_protocol(protocol or benchmark_protocol(sequences))
+    if not divergence_px >= 0:
+        raise DatasetError(f"divergence_px must be a number >= 0, got {shown(divergence_px)}")
+    (ours, damaged, our_platforms), (theirs, damaged_ref, their_platforms) = (_intact_files(results),
+                                                                              _intact_files(reference))
+    sequences = scored_sequences(sequences)
+    known = {s.name for s in sequences}
+    both = [s for s in sequences if s.name in ours and s.name in theirs]
+    left_out = {"only_in_results": sorted(set(ours) - set(theirs)),
+                "only_in_reference": sorted(set(theirs) - set(ours)),
+                "not_in_dataset": sorted((set(ours) & set(theirs)) - known),
+                "damaged": sorted(set(damaged) | set(damaged_ref))}
+    if not both:
+        raise DatasetError(f"no sequence has results in both {clip(str(results))} ({len(ours)} files) and {clip(str(reference))} "
+                           f"({len(theirs)} files) and ground truth in the dataset ({len(known)} sequences)")
+    rows, scores, scores_ref = [], [], []
+    for seq in both:
+        a, b = _boxes(seq, ours[seq.name], theirs[seq.name])
+        s, s_ref = (metrics.score_sequence(x, seq.ground_truth, protocol=proto) for x in (a, b))
+        scores.append(s)
+        scores_ref.append(s_ref)
+        rows.append(_row(seq.name, len(seq), s, s_ref, float(series_iou(a, b).mean()),
+                         first_divergence(a, b, divergence_px)))
+    mean = _row("mean", sum(r["frames"] for r in rows), metrics.average(scores, protocol=proto),
+                metrics.average(scores_ref, protocol=proto), float(np.mean([r["iou"] for r in rows])), None)
+    ours_platforms = _distinct(our_platforms[s.name] for s in both)
+    theirs_platforms = _distinct(their_platforms[s.name] for s in both)
+    return {"protocol": proto.name, "divergence_px": float(divergence_px), "results": str(results),
+            "reference": str(reference), "rows": rows, "mean": mean,
+            "diverged": sum(r["diverges_at"] is not None for r in rows), "left_out": left_out,
+            "platforms": {"results": sorted({platforms.describe(p) for p in ours_platforms}),
+                          "reference": sorted({platforms.describe(p) for p in theirs_platforms})},
+            "platform_differences": sorted({d for a in ours_platforms for b in theirs_platforms
+                                            for d in platforms.differences(a, b)})}
+
+
+def _distinct(records: Iterable) -> list:
+    """The different records, each once (dicts: not hashable)."""
+    out = []
+    for record in records:
+        if record not in out:
+            out.append(record)
+    return out
+
+
+def _intact_files(folder) -> tuple[dict[str, Path], list[str], dict[str, dict | None]]:
+    """The result files of ``folder``, apart the sequences whose dcfkit sidecar says the file is
+    damaged (never compared; each logged), and each file's platform record (None without one).
+    Files without a sidecar are taken as they are."""
+    files, store = result_files(folder), ResultStore(folder)
+    damaged, platform_records = [], {}
+    for name in list(files):
+        meta = store.sidecar(name)
+        record = meta.get("platform") if isinstance(meta, dict) else None
+        platform_records[name] = record if isinstance(record, dict) else None
+        problem = store.problem(name, meta) if meta is not None else None
+        if problem is not None:
+            log.warning("%s: left out of the comparison", problem)
+            damaged.append(files.pop(name))
+    return files, [p.stem for p in damaged], platform_records
+
+
+def _boxes(seq: Sequence, path: Path, path_ref: Path) -> tuple[np.ndarray, np.ndarray]:
+    a, b = read_boxes(path), read_boxes(path_ref)
+    if len(a) != len(b):
+        raise DatasetError(f"sequence {seq.name!r}: {path} has {len(a)} lines but {path_ref} has {len(b)}")
+    if len(a) != len(seq):
+        raise DatasetError(f"sequence {seq.name!r}: {path} and {path_ref} have {len(a)} lines but the "
+                           f"sequence has {len(seq)} frames")
+    return a, b
+
+
+def _row(name: str, frames: int, s: dict, s_ref: dict, iou: float, diverges_at: int | None) -> dict:
+    return {"sequence": name, "frames": frames,
+            "precision": s["precision"], "precision_ref": s_ref["precision"],
+            "d_precision": s["precision"] - s_ref["precision"],
+            "auc": s["auc"], "auc_ref": s_ref["auc"], "d_auc": s["auc"] - s_ref["auc"],
+            "iou": iou, "diverges_at": diverges_at}

@@ -1,0 +1,73 @@
+"""What produced a report's results, read from the result sidecars (:mod:`dcfkit.running.results`):
+commands, dcfkit and plugin versions, run keys (config hashes), machines, platforms
+(:mod:`dcfkit.running.platforms`), times, config.
+
+Sidecars written before dcfkit recorded the command and the machine lack them; they are
+then "not recorded", and imported result files (no sidecars) have nothing recorded.
+"""
+from __future__ import annotations
+
+from collections import Counter
+from pathlib import Path
+from typing import Iterable, Mapping
+
+from dcfkit.running import platforms
+from dcfkit.running.results import ResultStore, command_line, dcfkit_version, invocation, machine, now
+
+NOT_RECORDED = "not recorded"
+
+
+def describe_machine(record) -> str:
+    """``host: CPU, N cores, OS, Python x.y`` of a :func:`dcfkit.running.results.machine` record."""
+    if not isinstance(record, Mapping):
+        return NOT_RECORDED
+    parts = [str(record[k]) for k in ("cpu",) if record.get(k)]
+    if record.get("cores"):
+        parts.append(f"{record['cores']} cores")
+    parts += [str(record[k]) for k in ("system",) if record.get(k)]
+    if record.get("python"):
+        parts.append(f"Python {record['python']}")
+    return f"{record.get('host') or '?'}: {', '.join(parts)}"
+
+
+def _counted(values: Iterable) -> list[list]:
+    """``[[value, count], ...]``, most frequent first (a folder usually holds one of each)."""
+    return [[value, count] for value, count in Counter(values).most_common()]
+
+
+def _command(meta: Mapping) -> str:
+    line = command_line(meta)
+    if line is None:
+        return NOT_RECORDED
+    return f"cd {meta['cwd']} && {line}" if isinstance(meta.get("cwd"), str) else line
+
+
+def folder_provenance(folder: Path, names: Iterable[str]) -> dict:
+    """What the sidecars of sequences ``names`` in ``folder`` record: ``folder``,
+    ``sequences`` (sidecars read), ``run_keys``, ``versions``, ``plugins``, ``commands``,
+    ``machines``, ``platforms`` (each ``[[value, sequences], ...]``), ``times`` (first, last) and
+    ``config`` (the first sidecar's)."""
+    store = ResultStore(folder)
+    metas = [m for m in (store.sidecar(n) for n in names) if m is not None]
+    if not metas:
+        return {"folder": str(folder), "sequences": 0}
+    times = sorted(str(m["time"]) for m in metas if m.get("time"))
+    return {
+        "folder": str(folder),
+        "sequences": len(metas),
+        "run_keys": _counted(str(m.get("run_key", m.get("config_hash", NOT_RECORDED))) for m in metas),
+        "versions": _counted(str(m.get("dcfkit_version", NOT_RECORDED)) for m in metas),
+        "plugins": _counted(", ".join(map(str, m.get("plugins") or [])) or "none" for m in metas),
+        "commands": _counted(_command(m) for m in metas),
+        "machines": _counted(describe_machine(m.get("machine")) for m in metas),
+        "platforms": _counted(platforms.describe(m.get("platform")) for m in metas),
+        "times": [times[0], times[-1]] if times else [],
+        "config": metas[0].get("config"),
+    }
+
+
+def this_process() -> dict:
+    """The command, dcfkit version, machine and time of the process writing the report."""
+    here = invocation()
+    return {"command": _command(here), "dcfkit": dcfkit_version(), "machine": describe_machine(machine()),
+            "platform": platforms.describe(platforms.record()), "time": now()}

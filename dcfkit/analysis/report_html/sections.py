@@ -1,0 +1,104 @@
+"""The sections of a report page as plain data (``report.js`` draws them): tables, line
+charts, the sequence gallery and the provenance.
+
+Trackers are numbered by their place in the page's ``trackers`` list; a series or a box of
+tracker ``i`` gets its colour and its legend toggle (key ``t<i>``) from that number, so a
+tracker looks the same in every plot and thumbnail.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Iterable, Mapping, Sequence as Seq
+
+from dcfkit.datasets import ATTRIBUTE_NAMES, Sequence
+from dcfkit.analysis.report import PLOT_STYLE, SCORE_LABELS
+from dcfkit.analysis.report_html.provenance import folder_provenance
+from dcfkit.analysis.report_html.thumbnails import sequence_thumbnails
+
+COLUMN_LABELS = {**SCORE_LABELS, "norm_precision": "norm. precision", "fps": "fps", "sequences": "sequences",
+                 "missing": "missing", "frames": "frames", "failed": "failed", "key": "run key",
+                 "name": "attribute name"}
+TEXT_COLUMNS = ("sequence", "attribute", "name", "status", "key", "variant")
+
+
+def _column(key: str, tracker_column: str) -> dict:
+    kind = "tracker" if key == tracker_column else "text" if key in TEXT_COLUMNS else "num"
+    digits = 1 if key == "fps" else 0 if key in ("sequences", "missing", "frames", "failed") else 3
+    return {"key": key, "label": COLUMN_LABELS.get(key, key), "type": kind, "digits": digits}
+
+
+def count(n: int, noun: str) -> str:
+    """``1 tracker``, ``3 trackers``."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
+def table(section_id: str, title: str, rows: Seq[Mapping], columns: Seq[str], trackers: Seq[str],
+          tracker_column: str = "tracker", filterable: bool = False, note: str = "") -> dict:
+    """A sortable table (``filterable``: with a filter box) of ``rows`` (dicts) in ``columns``;
+    the ``tracker_column`` holds tracker numbers, drawn with their colour."""
+    index = {t: i for i, t in enumerate(trackers)}
+    cols = [_column(c, tracker_column) for c in columns]
+    cells = [[index[r[c]] if c == tracker_column else r.get(c) for c in columns] for r in rows]
+    return {"kind": "table", "id": section_id, "title": title, "columns": cols, "rows": cells,
+            "filter": filterable, "note": note}
+
+
+def _score(value) -> str:
+    return f"{value:.3f}" if value is not None and math.isfinite(value) else "-"
+
+
+def curve_chart(kind: str, curves: Mapping[str, Mapping], thresholds, trackers: Seq[str], title: str | None = None,
+                small: bool = False) -> dict:
+    """One OTB plot (``kind`` precision, success or norm_precision): a series per tracker,
+    best score first, labelled ``name [score]`` as :func:`dcfkit.analysis.report.plot_curves` does."""
+    style = PLOT_STYLE[kind]
+    score = {t: curves[t][style["score"]] for t in curves}
+    scored = sorted(curves, key=lambda t: -score[t] if _finite(score[t]) else math.inf)
+    series = [{"key": f"t{trackers.index(t)}", "t": trackers.index(t),
+               "label": f"{t} [{_score(curves[t][style['score']])}]", "y": curves[t][kind]} for t in scored]
+    return {"title": title or style["title"], "xlabel": style["xlabel"], "ylabel": style["ylabel"],
+            "x": thresholds, "ylim": [0, 1], "series": series, "small": small}
+
+
+def _finite(value) -> bool:
+    return value is not None and math.isfinite(value)
+
+
+def curve_charts(evaluation: Mapping, trackers: Seq[str]) -> dict:
+    """The success, precision and normalized precision plots of all sequences."""
+    charts = [curve_chart(kind, evaluation["curves"], evaluation["thresholds"][kind], trackers)
+              for kind in ("success", "precision", "norm_precision")]
+    return {"kind": "charts", "id": "plots", "title": "Success and precision plots", "charts": charts}
+
+
+def attribute_charts(evaluation: Mapping, trackers: Seq[str]) -> dict | None:
+    """One small success plot per attribute, or None when the sequences have none."""
+    if not evaluation["attribute_curves"]:
+        return None
+    charts = [curve_chart("success", curves, evaluation["thresholds"]["success"], trackers, small=True,
+                          title=f"{ATTRIBUTE_NAMES.get(attr, attr)} ({evaluation['attributes'][attr]})")
+              for attr, curves in evaluation["attribute_curves"].items()]
+    return {"kind": "charts", "id": "attribute-plots", "title": "Success plots per attribute", "charts": charts}
+
+
+def gallery(sequences: Seq[Sequence], results: Mapping[str, Mapping], trackers: Seq[str],
+            per_sequence: Seq[Mapping], tracker_column: str = "tracker") -> dict:
+    """Per sequence: its attributes, each tracker's AUC and the thumbnails of
+    :mod:`~dcfkit.analysis.report_html.thumbnails` (frame 1 and the worst frame of each third)."""
+    auc = {(r[tracker_column], r["sequence"]): r["auc"] for r in per_sequence}
+    cards = [{"name": s.name, "frames": len(s), "attributes": [a for a, on in s.attributes.items() if on],
+              "auc": [auc.get((t, s.name)) for t in trackers],
+              "thumbs": sequence_thumbnails(s, results, trackers)} for s in sequences]
+    return {"kind": "gallery", "id": "frames", "title": "Frames",
+            "note": "Frame 1 whole, then in each third of the sequence the frame where the trackers overlap the "
+                    "ground truth least on average, zoomed to the boxes. White: ground truth.", "cards": cards}
+
+
+def provenance(folders: Mapping[str, Path], names: Iterable[str], trackers: Seq[str], this_run: Mapping,
+               extra: Seq[tuple[str, str]] = ()) -> dict:
+    """What produced the results of each tracker (its folder's sidecars) and this page."""
+    names = list(names)
+    entries = [{"t": trackers.index(t), **folder_provenance(folder, names)} for t, folder in folders.items()]
+    return {"kind": "provenance", "id": "provenance", "title": "Provenance", "report": dict(this_run),
+            "extra": [list(e) for e in extra], "trackers": entries}

@@ -1,0 +1,147 @@
+"""What every component is: a ``kind``, a ``name``, a ``Params`` schema, and the
+:class:`Contract` of its kind, which the kind's base class declares
+(``class Label(Component, declares="label")``). The registry checks classes against it."""
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import inspect
+import types
+import typing
+from typing import Any, Callable, Mapping
+
+from dcfkit.errors import ConfigError, RegistryError, shown
+from dcfkit.params import NoParams
+
+_BASES: dict[str, list[type]] = {}  # kind -> its base classes (a regularizer's: one per role), as declared
+
+
+def kinds() -> tuple[str, ...]:
+    """The kinds declared so far, in the order their base classes were defined."""
+    return tuple(_BASES)
+
+
+class Component:
+    """Base of all components: a ``kind``, a ``name`` and a ``Params`` schema."""
+
+    kind: str = ""
+    name: str = ""
+    Params: type = NoParams
+
+    def __init_subclass__(cls, declares: str | None = None, **kwargs):
+        """``class Label(Component, declares="label")`` makes ``Label`` the base class of a kind:
+        it sets ``kind`` and must hold the kind's :class:`Contract` as ``contract``."""
+        super().__init_subclass__(**kwargs)
+        if declares is None:
+            return
+        if not isinstance(cls.__dict__.get("contract"), Contract):
+            raise TypeError(f"{cls.__qualname__} declares kind {declares!r} without a Contract as 'contract'")
+        cls.kind = declares
+        _BASES.setdefault(declares, []).append(cls)
+
+    def __init__(self, params: Any = None):
+        self.params = params if params is not None else self.Params()
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.params})"
+
+
+@dataclasses.dataclass(frozen=True)
+class Contract:
+    """What the tracker needs of one kind of component (or regularizer role): set as ``contract``
+    on the kind's base class, checked by :meth:`Registry.register` (docs/plugins.md, section 5).
+
+    ``required``: methods the component must implement, name -> the arguments the tracker
+    passes after ``self``; ``optional``: the same for methods the base class implements.
+    ``params``: ``Params`` fields the tracker reads, name -> (type, lowest, highest): the field
+    must exist with that annotation, and a value outside the range is a ConfigError whenever
+    the component is built (the arithmetic that receives it needs the range).
+    ``returns``: method -> the check of what it returns (:mod:`dcfkit.contracts`), run on every
+    call of a built component.
+    """
+
+    required: Mapping[str, tuple[str, ...]] = dataclasses.field(default_factory=dict)
+    optional: Mapping[str, tuple[str, ...]] = dataclasses.field(default_factory=dict)
+    params: Mapping[str, tuple[type, float, float]] = dataclasses.field(default_factory=dict)
+    returns: Mapping[str, Callable] = dataclasses.field(default_factory=dict)
+
+    def hooks(self) -> dict[str, Callable | None]:
+        """Every method the tracker calls -> its return check (None: none)."""
+        return {m: self.returns.get(m) for m in (*self.required, *self.optional)}
+
+
+def _as_called(cls: type, method: str) -> tuple[Any, bool]:
+    """(what ``instance.method`` is, whether it receives the instance) for an instance of
+    ``cls``: the class attribute bound as Python binds it, so that a function, a
+    ``functools.lru_cache`` or ``partialmethod`` and a ``functools.wraps`` wrapper receive the
+    instance, a static method or a callable object does not. The instance is made without
+    running ``__init__``; TypeError if it cannot be (an abstract class)."""
+    raw = inspect.getattr_static(cls, method)
+    get = getattr(type(raw), "__get__", None)
+    if get is None:  # a callable object in the class: called with the tracker's arguments alone
+        return raw, False
+    instance = object.__new__(cls)
+    called = get(raw, instance, cls)
+    return called, getattr(called, "__self__", None) is instance
+
+
+def _signature_problem(cls: type, method: str, args: tuple[str, ...]) -> str | None:
+    """Why ``cls().method(*args)`` cannot be called as the tracker calls it, or None."""
+    found = getattr(cls, method, None)
+    if not callable(found):
+        return f"{method} is {'missing' if found is None else 'not a method'}"
+    try:
+        called, takes_self = _as_called(cls, method)
+        signature = inspect.signature(called)
+    except (TypeError, ValueError):  # no signature (a builtin), or no instance without __init__: on trust
+        return None
+    try:
+        signature.bind(*([None] * len(args)))
+    except TypeError:
+        with_self = False  # a method is shown as written, self included
+        if isinstance(called, types.MethodType) and takes_self:
+            with contextlib.suppress(TypeError, ValueError):
+                signature, with_self = inspect.signature(called.__func__), True
+        return (f"{method}{signature} cannot be called as {method}({', '.join(('self',) * with_self + args)}) "
+                f"(the tracker passes {len(args)} argument{'s' * (len(args) != 1)})")
+    return None
+
+
+def contract_problems(cls: type, base: type) -> list[str]:
+    """What ``cls`` lacks of ``base.contract`` (an empty list: it meets it)."""
+    contract: Contract = base.__dict__["contract"]
+    problems = []
+    for method, args in {**contract.required, **contract.optional}.items():
+        if method in contract.required and getattr(cls, method, None) is getattr(base, method, None):
+            problems.append(f"it does not implement {method}({', '.join(args)})")
+        elif problem := _signature_problem(cls, method, args):
+            problems.append(problem)
+    hints = typing.get_type_hints(cls.Params)
+    for field, (kind, lowest, highest) in contract.params.items():
+        if hints.get(field) is not kind:
+            problems.append(f"its Params has no {kind.__name__} field '{field}' (the tracker reads "
+                            f"params.{field}, in [{lowest:g}, {highest:g}])")
+        elif not lowest <= (default := getattr(cls.Params(), field)) <= highest:
+            problems.append(f"its default {field}={shown(default)} is outside [{lowest:g}, {highest:g}]")
+    return problems
+
+
+def base_of(cls: type, kind: str, where: str) -> type:
+    """The base class of ``kind`` that ``cls`` subclasses (a RegistryError if none)."""
+    bases = [b for b in _BASES.get(kind, ()) if issubclass(cls, b)]
+    if not bases:
+        names = " or ".join(f"{b.__module__.removesuffix('.base')}.{b.__qualname__}" for b in _BASES.get(kind, ()))
+        raise RegistryError(f"{where}: a {kind} must subclass {names}")
+    base = bases[-1]  # the most specific, should a class subclass both roles' bases
+    if hasattr(base, "role") and getattr(cls, "role", None) != base.role:
+        raise RegistryError(f"{where}: role {shown(getattr(cls, 'role', None))} is not its base class "
+                            f"{base.__name__}'s ({base.role!r})")
+    return base
+
+
+def check_contract_values(contract: Contract, params: Any, where: str) -> None:
+    """A ConfigError if a parameter the tracker reads is outside its contract's range."""
+    for field, (_, lowest, highest) in contract.params.items():
+        value = getattr(params, field)
+        if not lowest <= value <= highest:
+            raise ConfigError(f"{where}.{field}: {shown(value)} is outside [{lowest:g}, {highest:g}]")

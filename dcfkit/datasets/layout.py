@@ -1,0 +1,143 @@
+"""A benchmark layout: its names, loader, detector and protocol, checked when it is registered.
+
+Built-in layouts register here when :mod:`dcfkit.datasets` is imported, as a script does with
+:func:`register_layout`; a plugin's go through ``registry.register_dataset`` (:mod:`dcfkit.registry`),
+which makes them with :func:`new_layout`. Lookups are in :mod:`dcfkit.datasets.registry`.
+"""
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import enum
+from pathlib import Path
+from typing import Callable, Iterable, Iterator
+
+from dcfkit.analysis.protocols import PROTOCOLS
+from dcfkit.datasets.base import DatasetError, Sequence
+from dcfkit.errors import RegistryError, shown
+
+Loader = Callable[..., list[Sequence]]  # (root, sequences=None) -> list[Sequence]
+Detector = Callable[[Path], int]  # root -> Evidence (or bool)
+
+
+class Evidence(enum.IntEnum):
+    """How specifically a folder looks like one layout; detection picks the most specific.
+
+    ``detect`` may also return a bool: True counts as :attr:`FOLDERS`.
+    """
+
+    NONE = 0
+    FOLDERS = 1  # the folder structure fits, and other benchmarks share it
+    FILES = 2  # file names or counts fit this benchmark
+    NAME = 3  # a folder is named after this benchmark
+
+
+# How the candidates fit, in the error when several fit equally well (not read from docstrings,
+# which python -OO strips).
+_EVIDENCE_TEXT = {
+    Evidence.FOLDERS: "by the folder structure only",
+    Evidence.FILES: "by file names or counts",
+    Evidence.NAME: "by folder names",
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class Layout:
+    """One registered benchmark layout (see :func:`register_layout`)."""
+
+    name: str
+    load: Loader
+    description: str
+    detect: Detector | None = None
+    aliases: tuple[str, ...] = ()
+    provider: str = ""  # the plugin that registered it; "" for dcfkit's and those registered in code
+    protocol: str = ""  # the scoring protocol of the benchmark's own toolkit; "" for the OTB toolkit's
+
+    def __str__(self) -> str:
+        also = f" (also {', '.join(self.aliases)})" if self.aliases else ""
+        source = f" [plugin {self.provider}]" if self.provider else ""
+        return f"{self.name}{also}: {self.description}{source}"
+
+
+_LAYOUTS: dict[str, Layout] = {}  # canonical name -> layout, in registration order
+_NAMES: dict[str, str] = {}  # every name and alias -> canonical name
+
+
+def _key(name: str) -> str:
+    """The one spelling of a name: case-insensitive, and ``-`` read as ``_`` (``uav123-20l``)."""
+    return str(name).strip().lower().replace("-", "_")
+
+
+def register_layout(name: str, load: Loader, description: str, *,
+                    detect: Detector | None = None, aliases: Iterable[str] = (), protocol: str = "") -> Layout:
+    """Make ``name`` and its ``aliases`` loadable by :func:`load_dataset` (case-insensitive, ``-``
+    read as ``_``).
+
+    ``load(root, sequences=None)`` returns the :class:`Sequence` list; ``description`` is
+    one line saying what is on disk (``ROOT/<seq>/img/%05d.jpg, ...``); ``detect(root)``
+    returns an :class:`Evidence` (or a bool) for :func:`detect_dataset`, which skips layouts
+    without one. ``protocol`` names the scoring protocol of the toolkit that published the
+    benchmark's tables (:mod:`dcfkit.analysis.protocols`), which scores its sequences unless
+    ``--protocol`` says otherwise; by default the OTB toolkit's. A name or alias that is
+    already registered is a :class:`RegistryError`.
+    """
+    layout = new_layout(name, load, description, detect=detect, aliases=aliases, protocol=protocol)
+    _LAYOUTS[layout.name] = layout
+    _NAMES.update(dict.fromkeys((layout.name,) + layout.aliases, layout.name))
+    return layout
+
+
+def new_layout(name: str, load: Loader, description: str, *, detect: Detector | None = None,
+               aliases: Iterable[str] = (), provider: str = "", protocol: str = "") -> Layout:
+    """A checked :class:`Layout`, not yet registered (:func:`register_layout` registers it here, a
+    plugin's ``registry.register_dataset`` in :mod:`dcfkit.registry`); a :class:`RegistryError`
+    if it is malformed or a name is taken here."""
+    layout = Layout(_key(name), load, str(description).strip(), detect,
+                    tuple(dict.fromkeys(_key(a) for a in aliases if _key(a) != _key(name))), provider,
+                    str(protocol or ""))
+    _check_new_layout(layout)
+    return layout
+
+
+def _check_new_layout(layout: Layout) -> None:
+    where = f"dataset layout {layout.name!r}" + (f" (from {layout.provider})" if layout.provider else "")
+    if not layout.name:
+        raise RegistryError(f"dataset layout {shown(layout.description)}: the name is empty")
+    if "auto" in (layout.name,) + layout.aliases:
+        raise RegistryError(f"{where}: 'auto' cannot be a name: load_dataset('auto', root) detects the dataset")
+    for taken in (n for n in (layout.name,) + layout.aliases if n in _NAMES):
+        owner = _NAMES[taken]
+        also = "" if owner == taken else f" (as a name of {owner!r})"
+        fix = "give the plugin's layout another name" if layout.provider else \
+            f"unregister_layout({owner!r}) first to replace it"
+        raise RegistryError(f"{where}: the name {taken!r} is already registered{also}; {fix}")
+    if not callable(layout.load) or not (layout.detect is None or callable(layout.detect)):
+        raise RegistryError(f"{where}: load and detect must be functions")
+    if layout.protocol and layout.protocol not in PROTOCOLS:
+        raise RegistryError(f"{where}: unknown protocol {shown(layout.protocol)}; protocols: {', '.join(PROTOCOLS)}")
+    if not layout.description or "\n" in layout.description:
+        raise RegistryError(f"{where}: the description must be one non-empty line, "
+                            f"got {shown(layout.description)}")
+
+
+def unregister_layout(name: str) -> Layout:
+    """Remove the layout called ``name`` (or one of its aliases) with all its names; a plugin's
+    cannot be (uninstall the plugin, or set DCFKIT_DISABLE_PLUGINS)."""
+    if _key(name) not in _NAMES:
+        raise DatasetError(f"no dataset layout {shown(name)} registered in code; layouts: {', '.join(_LAYOUTS)}")
+    layout = _LAYOUTS.pop(_NAMES[_key(name)])
+    for n in (layout.name,) + layout.aliases:
+        del _NAMES[n]
+    return layout
+
+
+@contextlib.contextmanager
+def registered_layout(name: str, load: Loader, description: str, *,
+                      detect: Detector | None = None, aliases: Iterable[str] = (),
+                      protocol: str = "") -> Iterator[Layout]:
+    """:func:`register_layout` for the duration of a ``with`` block (tests, experiments)."""
+    layout = register_layout(name, load, description, detect=detect, aliases=aliases, protocol=protocol)
+    try:
+        yield layout
+    finally:
+        unregister_layout(layout.name)

@@ -1,0 +1,86 @@
+"""Real 2-D FFTs over the last two axes, with a selectable backend.
+
+``scipy`` (default) uses :mod:`scipy.fft` with one worker; ``pyfftw`` builds FFTW plans
+once per (shape, dtype) and reuses them, one thread. Both keep float32/complex64 data in
+single precision. Forward transforms are unnormalised, inverse ones scaled by 1/K (numpy
+convention), which is the convention the solver's equations assume (Eq. 10's K).
+:func:`multiply` is the elementwise product of spectra, rounded the same way on every machine.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from dcfkit.errors import shown
+
+BACKENDS = ("scipy", "pyfftw")
+
+
+class ScipyFFT:
+    name = "scipy"
+
+    def __init__(self):
+        import scipy.fft  # lazy: only the chosen backend is imported
+
+        self._fft = scipy.fft
+
+    def rfft2(self, x: np.ndarray) -> np.ndarray:
+        return self._fft.rfft2(x, axes=(-2, -1), workers=1)
+
+    def irfft2(self, xf: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+        return self._fft.irfft2(xf, s=shape, axes=(-2, -1), workers=1)
+
+
+class PyFFTW:
+    """pyfftw with plans cached per (shape, dtype). Inputs are copied into the plan's own
+    buffer (FFTW's multi-dimensional c2r transform overwrites its input) and outputs copied
+    out of it, so callers' arrays are never touched or aliased."""
+
+    name = "pyfftw"
+
+    def __init__(self):
+        import pyfftw  # lazy: only the chosen backend is imported
+
+        self._pyfftw = pyfftw
+        self._plans: dict = {}
+
+    def _plan(self, key, build):
+        plan = self._plans.get(key)
+        if plan is None:
+            plan = self._plans[key] = build()
+        return plan
+
+    def rfft2(self, x: np.ndarray) -> np.ndarray:
+        builders = self._pyfftw.builders
+        plan = self._plan(("r", x.shape, x.dtype.str),
+                          lambda: builders.rfft2(self._pyfftw.empty_aligned(x.shape, x.dtype), axes=(-2, -1),
+                                                 threads=1, planner_effort="FFTW_ESTIMATE"))
+        plan.input_array[...] = x
+        return plan().copy()
+
+    def irfft2(self, xf: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+        builders = self._pyfftw.builders
+        plan = self._plan(("i", xf.shape, xf.dtype.str, tuple(shape)),
+                          lambda: builders.irfft2(self._pyfftw.empty_aligned(xf.shape, xf.dtype), s=shape,
+                                                  axes=(-2, -1), threads=1, planner_effort="FFTW_ESTIMATE"))
+        plan.input_array[...] = xf
+        return plan().copy()
+
+
+def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Elementwise product of complex arrays (broadcast), ``(ar br - ai bi) + i (ar bi + ai br)``
+    with each product rounded: numpy's complex64 product fuses them (FMA) on processors with
+    AVX2 and not on others, so its last bits depend on the machine."""
+    a, b = np.asarray(a), np.asarray(b)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape), np.result_type(a, b))
+    out.real = a.real * b.real - a.imag * b.imag
+    out.imag = a.real * b.imag + a.imag * b.real
+    return out
+
+
+def make_fft(backend: str = "scipy"):
+    """An FFT backend by name ('scipy' or 'pyfftw')."""
+    if backend == "scipy":
+        return ScipyFFT()
+    if backend == "pyfftw":
+        return PyFFTW()
+    raise ValueError(f"unknown FFT backend {shown(backend)}; choose one of {', '.join(BACKENDS)}")

@@ -1,0 +1,158 @@
+"""One-pass evaluation (OPE): a tracker config on every sequence of a benchmark.
+
+Trackers come from a factory ``make_tracker(config) -> tracker``, called once per sequence
+(default: :func:`dcfkit.load_tracker`); a tracker is any object with ``init(image, box)``
+and ``update(image) -> box`` (:mod:`dcfkit.running.tracking`). Results go to
+``OUT/<config name>/``, a :class:`dcfkit.running.results.ResultStore`: one file of 1-based boxes and
+one sidecar per sequence (per-frame tracker seconds, image decoding excluded; before its
+first sequence of a dcfkit config a process runs a throw-away copy of the tracker on the
+first frame, untimed, so that one-time loading of compiled code is not counted).
+
+On rerun a sequence is skipped when its results are intact and from the same run key
+(:func:`dcfkit.running.results.run_key`); damaged and failed sequences are run again.
+"""
+from __future__ import annotations
+
+import contextlib
+import json
+import logging
+from pathlib import Path
+from typing import Iterable, Mapping
+
+import numpy as np
+
+from dcfkit.datasets import DatasetError, Sequence
+from dcfkit.errors import ConfigError, shown
+from dcfkit.running.results import (ResultStore, dcfkit_version, ensure_writable, exclusive, json_default, make_dir,
+                      remove_temporary_files, run_key)
+from dcfkit.running.runner import RunTask, execute
+
+__all__ = ["check_one_pass", "run_one_pass", "tracker_name"]
+
+log = logging.getLogger(__name__)
+
+
+def tracker_name(config: Mapping) -> str:
+    """``config['name']``, checked to be usable as the results folder's name."""
+    name = config.get("name") if isinstance(config, Mapping) else None
+    if not isinstance(name, str) or not name.strip():
+        raise ConfigError("config has no top-level 'name' (the tracker name used for the output folder)")
+    if name.startswith(".") or any(c in name for c in "/\\:") or not name.isprintable():
+        raise ConfigError(f"config 'name' {shown(name)} must be usable as a folder name that report lists (no / \\ :, "
+                          f"no leading dot, no control character such as a null byte or a line break)")
+    return name
+
+
+def _check_first_boxes(sequences: list[Sequence]) -> None:
+    bad = [s.name + (f" (first box in {s.annotation})" if s.annotation else "") for s in sequences
+           if not (np.isfinite(s.ground_truth[0]).all() and (s.ground_truth[0, 2:] > 0).all())]
+    if bad:
+        raise DatasetError(f"one-pass evaluation initialises on frame 1's ground truth, which is NaN or "
+                           f"empty in sequence(s): {', '.join(bad)}")
+
+
+def _check_same_dataset(store: ResultStore, metas: dict, todo: list[Sequence]) -> None:
+    """OUT/<tracker>/<sequence> has no benchmark level: never mix two benchmarks there."""
+    for seq in todo:
+        old = (metas[seq.name] or {}).get("dataset")
+        if old and seq.dataset and old != seq.dataset:
+            raise DatasetError(f"{store.sidecar_path(seq.name)} holds results on dataset {shown(old)}, and this run "
+                               f"is on {shown(seq.dataset)}: use a separate --out for each benchmark")
+
+
+def _say_what_is_recomputed(store: ResultStore, metas: dict, todo: list[Sequence], config: dict, key: str) -> None:
+    """Say so when results are recomputed because they are damaged, or replaced because they
+    are another config's (not merely another dcfkit version's)."""
+    same = json.dumps(config, sort_keys=True, default=json_default)
+    damaged = [s.name for s in todo if store.status(s, key, metas[s.name]) == "damaged"]
+    replaced = [s.name for s in todo
+                if (metas[s.name] or {}).get("run_key") not in (None, key)
+                and json.dumps(metas[s.name].get("config"), sort_keys=True, default=json_default) != same]
+    if damaged:
+        log.warning("%s: recomputing %d damaged result(s): %s", store.folder, len(damaged), ", ".join(damaged[:10]))
+    if replaced:
+        log.warning("%s: replacing the results of another config named %r for %d sequence(s): %s (give this "
+                    "config another name to keep both)", store.folder, config["name"], len(replaced),
+                    ", ".join(replaced[:10]))
+
+
+def _plan(config: dict, sequences: list[Sequence], out_dir) -> tuple[ResultStore, str, list[Sequence], dict]:
+    """(store, run key, sequences to run, their sidecars), after every check that needs no
+    tracking: the first boxes, the benchmark of the results there, and (when anything is to
+    run) that the folder takes the result files."""
+    name = tracker_name(config)
+    _check_first_boxes(sequences)
+    key = run_key(config)
+    store = ResultStore(Path(out_dir) / name)
+    metas = {s.name: store.sidecar(s.name) for s in sequences}  # each read once
+    todo = [s for s in sequences if store.status(s, key, metas[s.name]) != "done"]
+    _check_same_dataset(store, metas, todo)
+    if todo:
+        ensure_writable(store.folder, [f for s in todo for f in store.file_names(s.name)], f"{name}'s results")
+    return store, key, todo, metas
+
+
+def check_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir) -> None:
+    """Raise now what :func:`run_one_pass` would raise before tracking (``dcfkit eval`` checks
+    every config this way before it runs the first)."""
+    _plan(dict(config), list(sequences), out_dir)
+
+
+def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_tracker=None,
+                 jobs: int = 1, progress: bool = True) -> dict:
+    """One-pass evaluation of the tracker described by ``config`` on ``sequences``.
+
+    Each sequence starts from a fresh tracker initialised on frame 1's ground truth; results
+    go to ``out_dir/<config['name']>/``. Sequences with intact results of the same run key
+    are skipped; before anything is tracked, the folder is checked to take the others. A
+    tracker exception fails only its sequence; a write failure (:class:`StoreError`) stops
+    the run. ``jobs > 1`` runs sequences in spawned worker processes; ``make_tracker`` must
+    then be picklable.
+
+    Returns a plain dict: ``tracker``, ``dir``, ``run_key``, ``done`` (computed now),
+    ``skipped`` (already done), ``failed`` (sequence -> message).
+    """
+    config, sequences = dict(config), list(sequences)
+    folder = Path(out_dir) / tracker_name(config)
+    if not folder.is_dir():
+        make_dir(folder)  # a first run: the locks need the folder
+    with contextlib.ExitStack() as locks:  # a run on other sequences of this folder may go on alongside
+        with contextlib.suppress(OSError):  # e.g. read-only results to score: exclusive() warns and goes on
+            (folder / ".locks").mkdir(exist_ok=True)
+        for seq in sequences:
+            locks.enter_context(exclusive(folder / ".locks" / f"{seq.name}.lock", "dcfkit eval",
+                                          f"{folder.name}'s results of sequence {seq.name!r} to {folder}"))
+        store, key, todo, metas = _plan(config, sequences, out_dir)
+        _say_what_is_recomputed(store, metas, todo, config, key)
+        remove_temporary_files(store.folder, [f for s in todo for f in store.file_names(s.name)])
+        summary = {"tracker": folder.name, "dir": store.folder, "run_key": key,
+                   "done": [], "skipped": [s.name for s in sequences if s not in todo], "failed": {}}
+        _run(summary, [RunTask(config, s, store.folder, key, make_tracker) for s in todo], jobs, progress,
+             dcfkit_version())
+    order = {s.name: i for i, s in enumerate(sequences)}
+    summary["done"].sort(key=order.get)
+    return summary
+
+
+def _run(summary: dict, tasks: list[RunTask], jobs: int, progress: bool, version: str) -> None:
+    """Execute ``tasks`` with a progress bar in frames, recording each outcome in ``summary``."""
+    from tqdm.auto import tqdm  # lazy: tqdm.auto probes for Jupyter on import
+
+    bar = tqdm(total=sum(len(t.seq) for t in tasks), unit="frame", desc=summary["tracker"],
+               disable=not progress or not tasks, dynamic_ncols=True)
+    done_frames = [0]
+
+    def on_result(task: RunTask, result: dict) -> None:
+        if result["status"] == "done":
+            summary["done"].append(result["sequence"])
+        else:
+            summary["failed"][result["sequence"]] = result["error"]
+            log.warning("%s: %s", summary["tracker"], result["error"])
+        done_frames[0] += len(task.seq)
+        bar.set_postfix_str(task.seq.name, refresh=False)
+        bar.update(done_frames[0] - bar.n)  # a failed sequence skips its rest
+
+    try:
+        execute(tasks, on_result, jobs=jobs, version=version, on_frame=lambda: bar.update(1))
+    finally:
+        bar.close()

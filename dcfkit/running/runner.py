@@ -1,0 +1,294 @@
+"""Running many (config, sequence) runs into result stores: in this process, in a local
+process pool or on dask.distributed. ``dcfkit eval`` (:mod:`dcfkit.running.evaluation`) and
+``dcfkit ablate`` (:mod:`dcfkit.ablation`) differ only in which runs they ask for.
+
+Each run is :func:`dcfkit.running.tracking.track` on a fresh tracker, written to a
+:class:`dcfkit.running.results.ResultStore`; a tracker exception fails only its run (an
+``.error`` naming the 1-based frame and its file). Workers have one BLAS/OpenMP/OpenCV
+thread each and die with the parent.
+"""
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import multiprocessing
+import os
+import signal
+import sys
+import warnings
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
+from pathlib import Path
+from typing import Any, Callable, Iterable, Mapping
+
+import cv2
+
+from dcfkit.running import platforms
+from dcfkit.datasets import Sequence
+from dcfkit.errors import DcfkitError, shown
+from dcfkit.registry import PluginWarning
+from dcfkit.running.results import ResultStore, StoreError, dcfkit_version, invocation, machine, now, plugin_versions, run_key
+from dcfkit.running.tracking import TrackerFailure, track
+
+_THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+                "NUMEXPR_NUM_THREADS", "VECLIB_MAXIMUM_THREADS")
+
+
+@dataclasses.dataclass(frozen=True)
+class RunTask:
+    """One run to do: ``config`` on ``seq`` into the store at ``folder`` under ``key``.
+    ``make_tracker(config)`` builds the tracker (None: :func:`dcfkit.load_tracker`)."""
+
+    config: dict
+    seq: Sequence
+    folder: Path
+    key: str
+    make_tracker: Callable | None = None
+
+
+# --------------------------------------------------------------------------- one run
+
+
+def load_dcfkit_tracker(config):
+    from dcfkit.tracker.tracker import load_tracker  # lazy: scoring results needs no tracker core
+
+    return load_tracker(config)
+
+
+_warmed_up: set[str] = set()  # run keys this process has run once, untimed
+
+
+def _warm_up(task: RunTask) -> None:
+    """Run a throw-away dcfkit tracker for one init and update, once per process and config, so
+    that one-time loading (numba's compiled loops, the CN table) is not charged to the fps of
+    whichever sequence comes first. A failure here is left to the timed run to report."""
+    if task.make_tracker is not None or task.key in _warmed_up:
+        return
+    _warmed_up.add(task.key)
+    with contextlib.suppress(Exception):
+        image = task.seq.frame(0)
+        tracker = load_dcfkit_tracker(dict(task.config))
+        tracker.init(image, task.seq.init_box)
+        tracker.update(image)
+
+
+def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | None = None,
+                 origin: Mapping | None = None) -> dict:
+    """Run ``task`` and store its boxes or its failure; returns ``{"sequence", "status",
+    "frames", "error" (failed) or "fps" (done)}``. ``origin``: the client's
+    :func:`~dcfkit.running.results.invocation` (default: this process's), recorded in the sidecar
+    with the machine that ran it."""
+    seq, store = task.seq, ResultStore(task.folder)
+    _warm_up(task)
+    reading = [0]  # the 1-based number of the frame being read, for errors in decoding
+
+    def frames():
+        for i in range(len(seq)):
+            reading[0] = i + 1
+            yield seq.frame(i)
+
+    tracker = None
+    try:
+        tracker = (task.make_tracker or load_dcfkit_tracker)(dict(task.config))
+        run = track(tracker, frames(), seq.init_box, (lambda *_: on_frame()) if on_frame else None)
+    except Exception as exc:
+        frame = exc.frame if isinstance(exc, TrackerFailure) else reading[0] or None
+        return record_failure(task, version, _failure_message(seq, exc, tracker is None, frame), exc, frame)
+    meta = {"sequence": seq.name, "dataset": seq.dataset, "tracker": task.config.get("name"),
+            "init_box": [float(v) for v in seq.init_box], "fps": run.fps, "total_time": float(run.times.sum()),
+            "run_key": task.key, "dcfkit_version": version, "plugins": plugin_versions(task.config),
+            "time": now(), **(origin or invocation()), "machine": machine(), "platform": platforms.record(),
+            "config": task.config,
+            "times": run.times.tolist()}
+    store.write(seq, run.boxes, meta, run.times, run.confidence)
+    return {"sequence": seq.name, "status": "done", "fps": run.fps, "frames": len(seq)}
+
+
+def _failure_message(seq: Sequence, exc: Exception, creating: bool, frame: int | None) -> str:
+    """What to say of a failed run, naming the sequence and the 1-based frame and its file."""
+    if isinstance(exc, DcfkitError) and not isinstance(exc, TrackerFailure) and f"sequence {seq.name!r}" in str(exc):
+        return str(exc)  # e.g. an unreadable frame: its message names the sequence and the frame
+    if creating:
+        return f"sequence {seq.name!r}: creating the tracker raised {type(exc).__name__}: {exc}"
+    where = f"frame {frame} of {len(seq)} ({seq.frames[frame - 1].name})" if frame else "before its first frame"
+    detail = exc.detail if isinstance(exc, TrackerFailure) else f"{type(exc).__name__}: {exc}"
+    return f"sequence {seq.name!r}, {where}: {detail}"
+
+
+def record_failure(task: RunTask, version: str, message: str, exc: BaseException, frame: int | None = None) -> dict:
+    """Store ``task``'s failure (on ``frame``, 1-based, if known) and return the failed-run summary."""
+    cause = exc.__cause__ if isinstance(exc, TrackerFailure) and exc.__cause__ else exc
+    ResultStore(task.folder).write_failure(task.seq, {
+        "tracker": task.config.get("name"), "frame": frame,
+        "frame_file": str(task.seq.frames[frame - 1]) if frame else None,
+        "error": message, "run_key": task.key, "dcfkit_version": version}, cause)
+    return {"sequence": task.seq.name, "status": "failed", "error": message, "frames": len(task.seq)}
+
+
+# --------------------------------------------------------------------------- worker processes
+
+
+@contextlib.contextmanager
+def single_threaded_env():
+    """Set the BLAS/OpenMP thread variables to 1 (inherited by spawned workers), then restore."""
+    saved = {k: os.environ.get(k) for k in _THREAD_VARS}
+    os.environ.update({k: "1" for k in _THREAD_VARS})
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def worker_init(parent_pid: int | None = None):
+    """A worker process: one BLAS/OpenMP/OpenCV thread. With ``parent_pid`` (a pool worker) it
+    dies with the parent and ignores SIGINT: Ctrl-C reaches the whole process group, and a
+    worker interrupted mid-protocol would leave the parent waiting for it forever; the parent
+    stops its workers itself."""
+    os.environ.update({k: "1" for k in _THREAD_VARS})
+    warnings.simplefilter("ignore", PluginWarning)  # the parent said it
+    cv2.setNumThreads(1)
+    if parent_pid is not None:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        _die_with_parent(parent_pid)
+
+
+def _die_with_parent(parent_pid: int) -> None:
+    """Linux: have the kernel kill this worker when the parent dies, even by SIGKILL
+    (a pool worker would otherwise wait forever on its task queue)."""
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(Exception):
+            import ctypes  # Linux only
+
+            ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
+    if os.getppid() != parent_pid:  # the parent died before prctl
+        os._exit(1)
+
+
+_worker_ready = False
+
+
+def run_in_worker(task: RunTask, version: str, origin: Mapping | None = None) -> dict:
+    """:func:`run_sequence` in a pool or dask worker, which must run the client's dcfkit and plugins."""
+    global _worker_ready
+    if not _worker_ready:  # dask workers have no initializer: one OpenCV thread each
+        worker_init()
+        _worker_ready = True
+    if dcfkit_version() != version:
+        raise DcfkitError(f"this worker runs dcfkit {dcfkit_version()}, the client {version}; "
+                          f"install the same version on every worker")
+    if task.make_tracker is None and run_key(task.config, version) != task.key:
+        raise DcfkitError(f"this worker's plugins ({', '.join(plugin_versions(task.config)) or 'none'}) are not "
+                          f"the client's: install the same plugin versions on every worker")
+    return run_sequence(task, version, origin=origin)
+
+
+def crash_message(seq: Sequence, exc: BaseException) -> str:
+    """What to say of a run whose worker failed outside the tracker."""
+    if isinstance(exc, BrokenProcessPool):
+        return (f"sequence {seq.name!r}: a worker process died (killed, out of memory, or it could not start: "
+                "a script that runs this with jobs > 1 needs an `if __name__ == '__main__':` guard); "
+                "rerun to retry")
+    return f"sequence {seq.name!r}: the worker failed: {type(exc).__name__}: {exc}"
+
+
+def run_pool(calls: Mapping[Any, tuple], jobs: int, on_result: Callable[[Any, Any], None],
+             on_crash: Callable[[Any, BaseException], Any]) -> None:
+    """Run ``fn(*args)`` for every ``key: (fn, *args)`` of ``calls`` in ``jobs`` spawned,
+    single-threaded worker processes; ``on_result(key, result)`` as each finishes.
+
+    A call whose worker raised outside ``fn``'s own handling, or died (killed, out of memory:
+    the pool then fails every call not yet finished), gets ``on_crash(key, exc)`` as its
+    result. Ctrl-C or any error in the caller terminates the workers at once."""
+    with single_threaded_env():  # workers are spawned on submit and inherit it
+        pool = ProcessPoolExecutor(max_workers=min(jobs, len(calls)), mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=worker_init, initargs=(os.getpid(),))
+        try:
+            futures = {pool.submit(*call): key for key, call in calls.items()}
+            _deliver(as_completed(futures), futures.__getitem__, on_result, on_crash)
+        except BaseException:
+            for process in list((getattr(pool, "_processes", None) or {}).values()):
+                process.terminate()  # results are written atomically: nothing half-written stays
+            raise
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _deliver(finished: Iterable, key_of: Callable, on_result: Callable, on_crash: Callable) -> None:
+    """``on_result(key, result)`` for each future as it finishes; a future that raised gets
+    ``on_crash(key, exc)`` as its result."""
+    for future in finished:
+        key = key_of(future)
+        try:
+            result = future.result()
+        except Exception as exc:
+            result = on_crash(key, exc)
+        on_result(key, result)
+
+
+def _run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: str, origin: Mapping, on_result,
+              on_crash) -> None:
+    try:
+        from distributed import Client, LocalCluster, as_completed as dask_completed  # optional: dcfkit[dask]
+    except ImportError:
+        raise DcfkitError("--executor dask needs dask.distributed: pip install 'dcfkit[dask]'") from None
+    with contextlib.ExitStack() as stack:
+        if scheduler:
+            client = stack.enter_context(Client(scheduler))
+        else:
+            with single_threaded_env():  # inherited by the worker processes
+                cluster = stack.enter_context(LocalCluster(
+                    n_workers=max(1, min(jobs, len(tasks))), threads_per_worker=1, processes=True,
+                    dashboard_address=None))
+            client = stack.enter_context(Client(cluster))
+        futures = [client.submit(run_in_worker, t, version, origin, pure=False,
+                                 key=f"dcfkit-{t.key}-{t.seq.dataset}-{t.seq.name}") for t in tasks]
+        by_key = {f.key: t for f, t in zip(futures, tasks)}
+        try:
+            _deliver(dask_completed(futures), lambda future: by_key[future.key], on_result, on_crash)
+        except BaseException:
+            client.cancel(futures)
+            raise
+
+
+def usable_cores() -> int:
+    with contextlib.suppress(AttributeError):
+        return max(1, len(os.sched_getaffinity(0)))
+    return max(1, os.cpu_count() or 1)
+
+
+def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None], jobs: int = 1,
+            executor: str = "local", scheduler: str | None = None, version: str | None = None,
+            on_frame: Callable[[], None] | None = None) -> None:
+    """Run every task, calling ``on_result(task, summary)`` as each finishes (in this process).
+
+    ``executor="local"``: in this process when ``jobs == 1`` or there is one task (then
+    ``on_frame()`` is called after every frame), else in ``jobs`` spawned worker processes
+    (tasks and their ``make_tracker`` must be picklable). ``"dask"``: ``Client(scheduler)``,
+    or a ``LocalCluster`` of ``jobs`` single-threaded workers when ``scheduler`` is None."""
+    tasks = list(tasks)
+    version = version if version is not None else dcfkit_version()
+    origin = invocation()  # the client's command, whichever process or machine runs a task
+    if executor not in ("local", "dask"):
+        raise DcfkitError(f"executor must be 'local' or 'dask', got {shown(executor)}")
+    if jobs < 1:
+        raise DcfkitError(f"jobs must be >= 1, got {jobs}")
+
+    def crashed(task: RunTask, exc: BaseException) -> dict:
+        if isinstance(exc, StoreError):  # as in this process: writing the next run would fail too
+            raise exc
+        return record_failure(task, version, crash_message(task.seq, exc), exc)
+
+    if not tasks:
+        return
+    if executor == "dask":
+        _run_dask(tasks, jobs, scheduler, version, origin, on_result, crashed)
+    elif jobs == 1 or len(tasks) == 1:
+        for task in tasks:
+            on_result(task, run_sequence(task, version, on_frame, origin))
+    else:
+        run_pool({i: (run_in_worker, t, version, origin) for i, t in enumerate(tasks)}, jobs,
+                 lambda i, result: on_result(tasks[i], result), lambda i, exc: crashed(tasks[i], exc))
