@@ -14,7 +14,6 @@ Images are (H, W, 3) uint8 BGR or (H, W) uint8 gray; boxes are (x, y, w, h) floa
 """
 from __future__ import annotations
 
-import dataclasses
 from typing import Any, Mapping
 
 import cv2
@@ -22,89 +21,18 @@ import numpy as np
 
 from dcfkit.tracker.confidence import Confidence
 from dcfkit.config import TrackerParams, load_config
-from dcfkit.contracts import ContractViolation, naming_the_frame
-from dcfkit.errors import ConfigError, InputError, TrackingError, shown
+from dcfkit.contracts import naming_the_frame
+from dcfkit.errors import InputError, TrackingError
 from dcfkit.components.features import extract_stack
 from dcfkit.numerics.fft import make_fft
 from dcfkit.components.labels import Detection, gaussian_label
-from dcfkit.limits import SAMPLE_PIXELS_VARIABLE, sample_budget
-from dcfkit.numerics.patches import box_to_centre_size, centre_size_to_box, cropper, round_half_away, sampler, whole_pixel_sampler
+from dcfkit.numerics.patches import (box_to_centre_size, centre_size_to_box, round_half_away, sampler,
+                                     whole_pixel_sampler)
 from dcfkit.registry import get_registry
 from dcfkit.numerics.response import newton_peak, shift_spectrum, subpixel_peak
-from dcfkit.components.scale import DSST, scale_limits
-
-MAX_CHANNELS = 256  # feature channels in all: 6 times the shipped configs' 42 (gray, fhog, colornames)
-MAX_BOX_TO_IMAGE = 10  # an initial box is at most this many times the image's width and height
-
-
-def check_image(image: Any, frame: int) -> np.ndarray:
-    """Reject anything but a non-empty (H, W) or (H, W, 3) uint8 array, naming the frame."""
-    if not isinstance(image, np.ndarray):
-        raise InputError(f"frame {frame}: expected a numpy image, got {type(image).__name__}")
-    if image.dtype != np.uint8:
-        raise InputError(f"frame {frame}: expected a uint8 image, got dtype {image.dtype}")
-    if image.ndim == 3 and image.shape[2] == 1:
-        image = image[:, :, 0]
-    if not (image.ndim == 2 or (image.ndim == 3 and image.shape[2] == 3)):
-        raise InputError(f"frame {frame}: expected an HxW or HxWx3 image, got shape {image.shape}")
-    if image.shape[0] < 1 or image.shape[1] < 1:
-        raise InputError(f"frame {frame}: the image is empty (shape {image.shape})")
-    return image
-
-
-def check_box(box: Any, image_shape: tuple[int, ...]) -> np.ndarray:
-    """A finite (x, y, w, h) that overlaps the image, each side at least a pixel and at most
-    ``MAX_BOX_TO_IMAGE`` times the image's."""
-    try:
-        raw = np.asarray(box)
-        if raw.dtype.kind not in "iuf":  # not booleans, complex numbers, strings or objects
-            raise TypeError
-        b = raw.astype(float).reshape(-1)
-    except (TypeError, ValueError):
-        raise InputError(f"initial box must be 4 numbers (x, y, w, h), got {shown(box)}") from None
-    if b.size != 4 or not np.all(np.isfinite(b)):
-        raise InputError(f"initial box must be 4 finite numbers (x, y, w, h), got {shown(box)}")
-    x, y, w, h = (float(v) for v in b)
-    if w <= 0 or h <= 0:
-        raise InputError(f"initial box {(x, y, w, h)} has non-positive size (w={w:g}, h={h:g})")
-    if w < 1 or h < 1:  # nothing to track, and a size that underflows the geometry's areas
-        raise InputError(f"initial box {(x, y, w, h)} is under a pixel wide or tall (w={w:g}, h={h:g}); "
-                         f"boxes are in pixels, not fractions of the image")
-    height, width = image_shape[:2]
-    if w > MAX_BOX_TO_IMAGE * width or h > MAX_BOX_TO_IMAGE * height:
-        raise InputError(f"initial box {(x, y, w, h)} is more than {MAX_BOX_TO_IMAGE} times as wide or as tall "
-                         f"as the {width}x{height} image")
-    if x + w <= 0 or y + h <= 0 or x >= width or y >= height:
-        raise InputError(f"initial box {(x, y, w, h)} lies outside the {width}x{height} image")
-    return b
-
-
-def _read_only(w2: np.ndarray) -> np.ndarray:
-    """``w2``, which every component reads and none may change (a solver that wrote into it
-    would be caught by the regularizer's check, and the regularizer blamed), made read-only."""
-    w2 = np.array(w2, dtype=np.float32)  # a copy: the regularizer's own array stays writable for it
-    w2.setflags(write=False)
-    return w2
-
-
-def hann2d(shape: tuple[int, int], interior: bool = True) -> np.ndarray:
-    """Cosine window, (H, W) float32: without zero borders (hann(n + 2) trimmed: BACF, DR²Track)
-    or, with ``interior=False``, hann(n) itself, zero on the border (STRCF)."""
-    pad = 2 if interior else 0
-    ends = slice(1, -1) if interior else slice(None)
-    return np.outer(np.hanning(shape[0] + pad)[ends], np.hanning(shape[1] + pad)[ends]).astype(np.float32)
-
-
-@dataclasses.dataclass
-class Geometry:
-    """Sizes fixed at init, in pixels at scale 1 unless stated (see STRCF's init_size)."""
-
-    base_target: np.ndarray      # (h, w) target
-    sample_size: np.ndarray      # (h, w) resampled search patch, a multiple of the cell size
-    filter_size: tuple[int, int]  # (H, W) in cells
-    target_cells: tuple[float, float]
-    cell_size: int               # pixels per cell (tracker.cell_size, or smaller for a small target)
-
+from dcfkit.components.scale import scale_limits
+from dcfkit.tracker.checks import check_box, check_config_budget, check_first_frame, check_image, check_terms, read_only
+from dcfkit.tracker.geometry import Geometry, geometry, hann2d
 
 class Tracker:
     """A DCF tracker assembled from components (see :func:`dcfkit.load_tracker`)."""
@@ -121,7 +49,7 @@ class Tracker:
         self.spatial = build("regularizer", regs["spatial"], "regularizers.spatial") if regs.get("spatial") else None
         self.temporal = build("regularizer", regs["temporal"], "regularizers.temporal") if regs.get("temporal") else None
         self.solver = build("solver", config["solver"], "solver")
-        self._check_terms()
+        check_terms(self)
         self.search = build("search", config["search"], "search")
         self.scale_estimator = build("scale", config["scale"], "scale")
         self.fft = make_fft(self.params.fft_backend)
@@ -133,76 +61,7 @@ class Tracker:
         self.last_search_box: tuple[float, float, float, float] | None = None
         self.last_distractors = np.zeros((0, 2))
         self.held_frames: list[int] = []  # 1-based numbers of frames held as blank
-        self._check_config_budget()
-
-    def _check_terms(self) -> None:
-        """ConfigError if a regularizer is configured that the solver has no term for (``Solver.terms``):
-        it would be ignored."""
-        for role, regularizer in (("spatial", self.spatial), ("temporal", self.temporal)):
-            if regularizer is not None and role not in self.solver.terms:
-                raise ConfigError(f"{self.name}: solver '{self.solver.name}' has no {role} term, so "
-                                  f"regularizers.{role} '{regularizer.name}' would be ignored: "
-                                  f"set regularizers.{role}: null")
-
-    # -- budgets: memory and time per frame stay bounded (docs/architecture.md) -------------
-    def _search_scales(self) -> np.ndarray:
-        """The relative scales of the search samples (one sample each per frame)."""
-        try:
-            return np.asarray(self.scale_estimator.search_factors(), dtype=float).reshape(-1)
-        except ContractViolation as exc:
-            if exc.__cause__ is None:  # what it returned, not an exception it raised: said
-                raise
-            return np.ones(1)  # an estimator that needs init first: budgeted as one scale, copies checked anyway
-        except Exception:  # likewise, from an estimator no registry built
-            return np.ones(1)
-
-    def _check_config_budget(self) -> None:
-        """ConfigError naming the keys whose samples would be over :func:`sample_budget` for any box
-        (features hold channels x cells floats, so the channels count too)."""
-        p, n = self.params, len(self._search_scales())
-        pixels, cells = sample_budget()
-        channels = sum(f.channels() for f in self.features)
-        if channels > MAX_CHANNELS:
-            raise ConfigError(f"{self.name}: the features have {channels} channels together, over the limit of "
-                              f"{MAX_CHANNELS} (dcfkit.tracker.tracker.MAX_CHANNELS; the shipped configs have 42)")
-        area = p.max_image_sample_size
-        if n * area > pixels or n * area / p.cell_size**2 > cells:
-            raise ConfigError(f"{self.name}: {n} search scales (scale.n_scales) of tracker.max_image_sample_size "
-                              f"{area:g} px (tracker.cell_size {p.cell_size}) are {n * area:.3g} px and "
-                              f"{n * area / p.cell_size**2:.3g} cells a frame, over the limit of {pixels:.3g} px and "
-                              f"{cells:.3g} cells (${SAMPLE_PIXELS_VARIABLE})")
-        if isinstance(self.scale_estimator, DSST):
-            d = self.scale_estimator.params
-            model = max(d.model_max_area, (2 * d.cell_size) ** 2)  # a sample has at least 2x2 cells
-            work = model * (d.n_scales + d.step ** (2 * (d.n_scales - 1)))  # the samples and their working patch
-            if work > pixels:
-                raise ConfigError(f"{self.name}: scale.n_scales {d.n_scales} samples of scale.model_max_area "
-                                  f"{d.model_max_area} px, and their working patch (scale.step {d.step:g}), are "
-                                  f"{work:.3g} px a frame, over the limit of {pixels:.3g} (${SAMPLE_PIXELS_VARIABLE})")
-
-    # -- geometry ---------------------------------------------------------------------------
-    def _geometry(self, target: np.ndarray) -> tuple[Geometry, float]:
-        """STRCF's init_size, in its arithmetic (a floor of a size decides a sample's pixels), with
-        BACF's smaller cells for a target whose search area has too few of them."""
-        p = self.params
-        cell, low, high = p.cell_size, p.min_image_sample_size, p.max_image_sample_size
-        area = float(np.prod(target * p.search_area_scale))
-        if p.cell_selection_thresh > 0 and area / cell**2 < p.cell_selection_thresh * high / cell**2:
-            smaller = min(cell, max(1, int(np.ceil(np.sqrt(area / (p.cell_selection_thresh * high / cell**2))))))
-            low, high = low * (smaller / cell) ** 2, high * (smaller / cell) ** 2  # the same areas in cells
-            cell = smaller
-        scale = 1.0
-        if area > high:
-            scale = np.sqrt(area / high)
-        elif area < low:
-            scale = np.sqrt(area / low)
-        base_target = target / scale
-        region = (np.full(2, np.sqrt(np.prod(base_target * p.search_area_scale))) if p.search_area_shape == "square"
-                  else np.floor(base_target * p.search_area_scale))
-        cells = np.maximum(round_half_away(region / cell), 4).astype(int)
-        target_cells = tuple(float(v) for v in base_target / cell)
-        geom = Geometry(base_target, cells * cell, (int(cells[0]), int(cells[1])), target_cells, cell)
-        return geom, float(scale)
+        check_config_budget(self)
 
     def _patch(self, image: np.ndarray, centre: np.ndarray, scale: float, g: Geometry | None = None) -> np.ndarray:
         """The search patch at ``centre``, resampled to the sample size (``tracker.sampling``)."""
@@ -244,10 +103,10 @@ class Tracker:
         if self.params.init_position == "whole_pixel":  # 1-based floor([y x] + floor([h w] / 2))
             target = np.floor(target)
             centre = np.floor(box[[1, 0]] + np.floor(target / 2))
-        g, scale = self._geometry(target)
+        g, scale = geometry(self.params, target)
         limits = scale_limits(g.base_target, g.sample_size, image.shape, initial=scale)
         scale = float(np.clip(scale, *limits))
-        self._check_first_frame(image.shape, centre, g, scale, box)
+        check_first_frame(self, image.shape, centre, g, scale, box)
         patch = self._patch(image, centre, scale, g)
         std = self._blank(patch)
         if std is not None:  # checked before any state changes: a failed init leaves the tracker as it was
@@ -266,7 +125,7 @@ class Tracker:
         regularizers = [r for r in (self.spatial, self.temporal) if r is not None]
         for component in (*self.features, self.label, self.solver, *regularizers):  # a new target: nothing kept
             component.reset()
-        self.w2 = _read_only(self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
+        self.w2 = read_only(self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
                              else np.zeros(g.filter_size, np.float32))
         self.search.reset(centre)
         self.scale_estimator.init(image, centre, g.base_target, self.scale, self.limits)
@@ -275,42 +134,6 @@ class Tracker:
         self.last_distractors = np.zeros((0, 2))
         self.held_frames = []
         self._train(image, None, self._spectrum(patch))  # m^1: the patch checked above
-
-    def _check_first_frame(self, shape, centre: np.ndarray, g: Geometry, scale: float, box: np.ndarray) -> None:
-        """InputError naming the initial box if its samples would be over a budget: the search
-        samples' pixels and cells (:func:`sample_budget`; an extreme aspect ratio can inflate
-        them), or a region copied from the image at the largest search scale or by the DSST
-        (``$DCFKIT_MAX_IMAGE_PIXELS``). Checked before any state changes."""
-        what = f"frame 1: initial box {tuple(float(v) for v in box)}"
-        factors = self._search_scales()
-        pixels, cells = sample_budget()
-        n, area, n_cells = len(factors), int(np.prod(g.sample_size)), int(np.prod(g.filter_size))
-        if n * area > pixels or n * n_cells > cells:
-            raise InputError(f"{what}: {n} search samples of {g.sample_size[1]}x{g.sample_size[0]} px "
-                             f"({g.filter_size[1]}x{g.filter_size[0]} cells) a frame, over the limit of {pixels:.3g} px "
-                             f"and {cells:.3g} cells (${SAMPLE_PIXELS_VARIABLE})")
-        largest = float(factors.max(initial=1.0))
-        try:
-            self._sampler(shape, centre, scale * largest, g)  # the geometry only: nothing is copied
-            if isinstance(self.scale_estimator, DSST):
-                self._check_dsst_copies(shape, centre, g.base_target * scale)
-        except InputError as exc:
-            raise InputError(f"{what}: {exc}") from None
-
-    def _check_dsst_copies(self, shape, centre: np.ndarray, target: np.ndarray) -> None:
-        """The geometry of the DSST's largest copy at its first frame (an InputError if it would
-        be over the image budget): its largest scale sample, cut whole ('whole_pixel'), or cut
-        for the working patch, which is at least 2 cells times the span a side: the most a
-        sampler can copy for it (the more it shrinks, the wider its blocks of edge pixels; one
-        that shrinks less than 2 times copies the region itself, which is then under 4 working
-        patches: within the DSST's sample budget)."""
-        d = self.scale_estimator.params
-        span = d.step ** (d.n_scales - 1)
-        region = np.maximum(np.floor(target * span ** 0.5), 2)
-        if d.sampling == "whole_pixel":
-            cropper(shape, centre, region)
-        else:
-            sampler(shape, centre, region, np.full(2, np.ceil(2 * d.cell_size * span)))
 
     @naming_the_frame(lambda tracker: tracker.frame)
     def update(self, image: np.ndarray) -> tuple[float, float, float, float]:
@@ -366,7 +189,7 @@ class Tracker:
         regularizer, whose w² it returns is used from this frame on."""
         self.solver.observe(detection)
         if self.spatial is not None:
-            self.w2 = _read_only(self.spatial.adapt(self.w2, detection))
+            self.w2 = read_only(self.spatial.adapt(self.w2, detection))
 
     def _theta(self, detection: Detection | None) -> float:
         """θ of this frame's training (0 without a temporal term; ``inf``: keep the last filter)."""

@@ -1,0 +1,51 @@
+"""The sizes a tracker fixes at its first frame, and its cosine window."""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from dcfkit.config import TrackerParams
+from dcfkit.numerics.patches import round_half_away
+
+
+def hann2d(shape: tuple[int, int], interior: bool = True) -> np.ndarray:
+    """Cosine window, (H, W) float32: without zero borders (hann(n + 2) trimmed: BACF, DR²Track)
+    or, with ``interior=False``, hann(n) itself, zero on the border (STRCF)."""
+    pad = 2 if interior else 0
+    ends = slice(1, -1) if interior else slice(None)
+    return np.outer(np.hanning(shape[0] + pad)[ends], np.hanning(shape[1] + pad)[ends]).astype(np.float32)
+
+
+@dataclasses.dataclass
+class Geometry:
+    """Sizes fixed at init, in pixels at scale 1 unless stated (see STRCF's init_size)."""
+
+    base_target: np.ndarray      # (h, w) target
+    sample_size: np.ndarray      # (h, w) resampled search patch, a multiple of the cell size
+    filter_size: tuple[int, int]  # (H, W) in cells
+    target_cells: tuple[float, float]
+    cell_size: int               # pixels per cell (tracker.cell_size, or smaller for a small target)
+
+
+def geometry(p: TrackerParams, target: np.ndarray) -> tuple[Geometry, float]:
+    """STRCF's init_size, in its arithmetic (a floor of a size decides a sample's pixels), with
+    BACF's smaller cells for a target whose search area has too few of them."""
+    cell, low, high = p.cell_size, p.min_image_sample_size, p.max_image_sample_size
+    area = float(np.prod(target * p.search_area_scale))
+    if p.cell_selection_thresh > 0 and area / cell**2 < p.cell_selection_thresh * high / cell**2:
+        smaller = min(cell, max(1, int(np.ceil(np.sqrt(area / (p.cell_selection_thresh * high / cell**2))))))
+        low, high = low * (smaller / cell) ** 2, high * (smaller / cell) ** 2  # the same areas in cells
+        cell = smaller
+    scale = 1.0
+    if area > high:
+        scale = np.sqrt(area / high)
+    elif area < low:
+        scale = np.sqrt(area / low)
+    base_target = target / scale
+    region = (np.full(2, np.sqrt(np.prod(base_target * p.search_area_scale))) if p.search_area_shape == "square"
+              else np.floor(base_target * p.search_area_scale))
+    cells = np.maximum(round_half_away(region / cell), 4).astype(int)
+    target_cells = tuple(float(v) for v in base_target / cell)
+    geom = Geometry(base_target, cells * cell, (int(cells[0]), int(cells[1])), target_cells, cell)
+    return geom, float(scale)
