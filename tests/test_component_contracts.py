@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 import dcfkit
 from dcfkit import registry as reg
 from dcfkit.components.base import base_of, contract_problems
-from dcfkit.config import KINDS
+from dcfkit.config.slots import KINDS
 from dcfkit.errors import ConfigError, DcfkitError, RegistryError
 from dcfkit.components.features import Feature
 from dcfkit.components.labels import Label

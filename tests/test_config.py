@@ -4,7 +4,8 @@ from pathlib import Path
 
 import pytest
 
-from dcfkit.config import load_config, parse_overrides, shipped_config_dir
+from dcfkit.config import load_config, shipped_config_dir
+from dcfkit.config.overrides import parse_overrides
 from dcfkit.errors import ConfigError, DcfkitError, RegistryError
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"

@@ -20,7 +20,8 @@ from hypothesis import given, strategies as st
 
 from dcfkit import config
 from dcfkit.ablation import load_spec
-from dcfkit.config import load_config, parse_overrides
+from dcfkit.config import load_config
+from dcfkit.config.overrides import parse_overrides
 from dcfkit.errors import ConfigError, DcfkitError, RegistryError
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"

@@ -13,7 +13,8 @@ from typing import Any, Iterable, Mapping
 import yaml
 
 from dcfkit import limits
-from dcfkit.config import load_config, read_yaml, shipped_config, shipped_config_dir
+from dcfkit.config import load_config, shipped_config, shipped_config_dir
+from dcfkit.config.bounded_yaml import read_yaml
 from dcfkit.datasets import DatasetError, canonical_name, load_dataset
 from dcfkit.errors import ConfigError, DcfkitError, clip, shown
 from dcfkit.params import closest

@@ -14,7 +14,7 @@ import yaml
 
 from dcfkit.opencv_check import contrib_problem
 from dcfkit.params import Bounds, fields
-from dcfkit.config import KINDS
+from dcfkit.config.slots import KINDS
 from dcfkit.registry import PluginWarning, get_registry
 
 

@@ -1,7 +1,7 @@
 """Reference documentation generated from the code, so that it cannot go stale.
 
 * :func:`config_reference` — ``docs/configs.md``: the top-level keys of a config, the
-  ``tracker`` section (:class:`dcfkit.config.TrackerParams`) and, for every component kind,
+  ``tracker`` section (:class:`dcfkit.config.tracker_params.TrackerParams`) and, for every component kind,
   every built-in component with its parameters (name, type, default, description), read from
   the registry and the components' ``Params`` schemas.
 * :func:`cli_reference` — ``docs/cli.md``: usage and options of each subcommand, read from
@@ -21,10 +21,11 @@ import sys
 from pathlib import Path
 
 from dcfkit.ablation.spec import MAX_VARIANTS
-from dcfkit.config import TOP_LEVEL, TrackerParams, resolve
+from dcfkit.config.slots import TOP_LEVEL, resolve
+from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.limits import IMAGE_PIXELS_VARIABLE, SAMPLE_PIXELS_VARIABLE, VARIANTS_VARIABLE
 from dcfkit.params import fields
-from dcfkit.config import KINDS
+from dcfkit.config.slots import KINDS
 from dcfkit.registry import DISABLE_ENV, build_registry
 from dcfkit.cli.components import cell, checks, component_rows, components_markdown, params_table, summary
 from dcfkit.cli.parser import build_parser

@@ -10,7 +10,8 @@ from typing import Any, Callable, Mapping
 
 from dcfkit.integrations.opencv import opencv_tracker
 from dcfkit.analysis.compare import COLUMNS, compare_folders
-from dcfkit.config import load_config, parse_overrides
+from dcfkit.config import load_config
+from dcfkit.config.overrides import parse_overrides
 from dcfkit.datasets import load_dataset
 from dcfkit.errors import ConfigError, shown
 from dcfkit.running.evaluation import check_one_pass, run_one_pass, tracker_name

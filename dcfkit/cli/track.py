@@ -10,7 +10,7 @@ from typing import Iterator
 
 import numpy as np
 
-from dcfkit.config import parse_overrides
+from dcfkit.config.overrides import parse_overrides
 from dcfkit.errors import InputError, clip
 from dcfkit.analysis.metrics import score_sequence
 from dcfkit.running.results import CONFIDENCE_END, TIME_END, StoreError, format_boxes, format_confidence, format_times

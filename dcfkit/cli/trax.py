@@ -4,7 +4,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from dcfkit.config import load_config, parse_overrides
+from dcfkit.config import load_config
+from dcfkit.config.overrides import parse_overrides
 from dcfkit.opencv_check import contrib_problem
 
 

@@ -52,7 +52,7 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from dcfkit import __version__
-from dcfkit.config import components
+from dcfkit.config.slots import components
 from dcfkit.datasets import DatasetError, Sequence, read_boxes
 from dcfkit.errors import DcfkitError, clip, shown
 from dcfkit.running.platforms import cpu_model

@@ -5,7 +5,7 @@ import dataclasses
 
 import numpy as np
 
-from dcfkit.config import TrackerParams
+from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.numerics.patches import round_half_away
 
 

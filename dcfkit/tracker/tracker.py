@@ -20,7 +20,8 @@ import cv2
 import numpy as np
 
 from dcfkit.tracker.confidence import Confidence
-from dcfkit.config import TrackerParams, load_config
+from dcfkit.config import load_config
+from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.contracts import naming_the_frame
 from dcfkit.errors import InputError, TrackingError
 from dcfkit.components.features import extract_stack
