@@ -20,12 +20,13 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from dcfkit.config import load_config
-from dcfkit.datasets import ATTRIBUTE_NAMES, Sequence
 from dcfkit.analysis.report import score_folders, write_files
 from dcfkit.analysis.report_html import report_page, write_page
-from dcfkit.running.results import ResultStore, dcfkit_version, invocation, machine, now, run_key
+from dcfkit.config import load_config
+from dcfkit.datasets import ATTRIBUTE_NAMES, Sequence
 from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.running.provenance import dcfkit_version, invocation, machine, now, run_key
+from dcfkit.running.results import ResultStore
 
 CONFIGS = ("kcf", "dsst", "strcf", "bacf", "dr2track", "arcf", "autotrack")
 

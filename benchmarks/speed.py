@@ -28,7 +28,6 @@ import dcfkit  # noqa: E402
 from dcfkit.datasets.synthetic import make_sequence  # noqa: E402
 from dcfkit.running.tracking import track as run_track  # noqa: E402
 
-
 cv2.setNumThreads(1)
 SYNTHETIC = "synthetic_720p"
 

@@ -19,8 +19,8 @@ from dcfkit import ablation, cli
 from dcfkit.ablation import expand, load_spec, run_ablation
 from dcfkit.config import load_config, shipped_config_dir
 from dcfkit.datasets import load_dataset, read_boxes
-from dcfkit.errors import DcfkitError, ConfigError
 from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.errors import ConfigError, DcfkitError
 from dcfkit.tracker.tracker import load_tracker
 
 N_FRAMES = 12

@@ -9,15 +9,15 @@ import numpy as np
 import pytest
 
 import dcfkit
-from dcfkit.errors import TrackingError
-from dcfkit.numerics.fft import make_fft
 from dcfkit.components.labels import Detection, gaussian_label
 from dcfkit.components.regularizers import GlobalVariation, LocalVariation, response_variation, target_mask
-from dcfkit.numerics.response import response as linear_response
 from dcfkit.components.solvers import ADMMArcf, ADMMAutoTrack, AutoTrackParams, admm
 from dcfkit.components.solvers.arcf import ARCFParams
 from dcfkit.components.solvers.autotrack import full_spectrum
 from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.errors import TrackingError
+from dcfkit.numerics.fft import make_fft
+from dcfkit.numerics.response import response as linear_response
 
 FFT = make_fft("scipy")
 AUTOTRACK = str(pathlib.Path(__file__).parents[1] / "configs" / "autotrack.yaml")

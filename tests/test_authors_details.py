@@ -16,13 +16,13 @@ import pytest
 import dcfkit
 from dcfkit.components.features import Gray
 from dcfkit.components.features.fhog import fhog
-from dcfkit.numerics.fft import make_fft
 from dcfkit.components.labels import Detection, DistractorRepressed, authors_distractors, regional_maxima
-from dcfkit.numerics.patches import resize_auto, round_half_away, whole_pixel_crop, whole_pixel_sample
 from dcfkit.components.regularizers import target_mask
-from dcfkit.numerics.response import _signed_frequencies, newton_peak, shift_spectrum, subpixel_peak
 from dcfkit.components.scale import DSST
 from dcfkit.components.solvers import ADMMParams, admm
+from dcfkit.numerics.fft import make_fft
+from dcfkit.numerics.patches import resize_auto, round_half_away, whole_pixel_crop, whole_pixel_sample
+from dcfkit.numerics.response import _signed_frequencies, newton_peak, shift_spectrum, subpixel_peak
 
 X86_ONLY = pytest.mark.skipif(platform.machine().lower() not in ("x86_64", "amd64"),
                               reason="the processor's own SSE estimates need x86-64")

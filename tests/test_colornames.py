@@ -4,10 +4,9 @@ import hashlib
 import numpy as np
 import pytest
 
-from dcfkit.errors import ConfigError
 from dcfkit.components.features import ColorNames, Gray, cell_average
 from dcfkit.components.features import colornames as cn
-
+from dcfkit.errors import ConfigError
 
 # SHA-256 of the 32768x10 float32 normalised CN table compiled into opencv-contrib-python-headless,
 # written here independently of the loader's own constant

@@ -15,16 +15,16 @@ from hypothesis import strategies as st
 import dcfkit
 from dcfkit import registry as reg
 from dcfkit.components.base import base_of, contract_problems
-from dcfkit.config.slots import KINDS
-from dcfkit.errors import ConfigError, DcfkitError, RegistryError
 from dcfkit.components.features import Feature
 from dcfkit.components.labels import Label
-from dcfkit.params import param
-from dcfkit.registry import Component
 from dcfkit.components.regularizers import SpatialRegularizer, TemporalRegularizer
 from dcfkit.components.search import Search
 from dcfkit.components.solvers import Solver
+from dcfkit.config.slots import KINDS
 from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.errors import ConfigError, DcfkitError, RegistryError
+from dcfkit.params import param
+from dcfkit.registry import Component
 
 
 @functools.lru_cache(maxsize=1)

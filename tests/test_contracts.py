@@ -7,21 +7,21 @@ import re
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
+from test_component_contracts import TINY, tiny_sequence
 
 import dcfkit
 from dcfkit import registry as reg
-from dcfkit.contracts import ContractViolation, array, pair, scalar, within_grid
 from dcfkit.components.features import Gray
 from dcfkit.components.labels import Gaussian
 from dcfkit.components.regularizers import BoxWindow
 from dcfkit.components.scale import Pyramid
 from dcfkit.components.search import MotionAware
 from dcfkit.components.solvers import ADMMStrcf
+from dcfkit.contracts import ContractViolation, array, pair, scalar, within_grid
 from dcfkit.running.tracking import TrackerFailure, track
-
-from test_component_contracts import TINY, tiny_sequence
 
 PROVIDER = "evil-plugin"
 

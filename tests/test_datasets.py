@@ -12,12 +12,22 @@ import numpy as np
 import pytest
 
 from dcfkit import datasets
-from dcfkit.datasets import (DatasetError, Evidence, Sequence, canonical_name, detect_dataset, layouts, load_dataset,
-                             read_boxes, read_frame, register_layout, registered_layout)
+from dcfkit.datasets import (
+    DatasetError,
+    Evidence,
+    Sequence,
+    canonical_name,
+    detect_dataset,
+    layouts,
+    load_dataset,
+    read_boxes,
+    read_frame,
+    register_layout,
+    registered_layout,
+)
 from dcfkit.datasets.base import numbered_frames, require_root, select_sequences
 from dcfkit.datasets.uav123_layout import uav123_sequence_table
 from dcfkit.errors import RegistryError
-
 
 # --------------------------------------------------------------------------- fixture builders
 

@@ -14,13 +14,14 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from dcfkit import cli
 from dcfkit import registry as reg
 from dcfkit.datasets import DatasetError, Sequence, benchmark_protocol, detect_dataset, load_dataset
-from dcfkit.datasets.layout import new_layout
 from dcfkit.datasets.lasot_layout import LASOT_ATTRIBUTES
+from dcfkit.datasets.layout import new_layout
 from dcfkit.datasets.otb_layout import OTB_ATTRIBUTES
 from dcfkit.datasets.vot_layout import mask_box, polygon_box, region_box
 from dcfkit.errors import RegistryError
@@ -410,7 +411,7 @@ def test_otb_attributes_from_the_toolkit_att_files_and_pysot_json(tmp_path, jpg)
 
 
 def test_each_layout_is_detected_as_itself_and_the_older_ones_still_are(tmp_path, jpg):
-    from test_datasets import dtb_root, uav_root, write_anno, touch_frames  # the older layouts' builders
+    from test_datasets import dtb_root, touch_frames, uav_root, write_anno  # the older layouts' builders
 
     def place(name: str) -> Path:  # each in a folder of its own, named neutrally
         return tmp_path / name / "data"

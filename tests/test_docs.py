@@ -6,7 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from dcfkit.cli import components, docs as docs_gen, main
+from dcfkit.cli import components, main
+from dcfkit.cli import docs as docs_gen
 from dcfkit.params import fields, param
 from dcfkit.registry import build_registry, get_registry
 

@@ -14,17 +14,17 @@ import cv2
 import numpy as np
 import pytest
 
-from dcfkit.running import evaluation, results, runner
-
 from dcfkit.analysis import report
-from dcfkit.integrations.opencv import OpenCVUnavailable, available_opencv_trackers, opencv_tracker
 from dcfkit.cli import evaluate as cli_evaluate
 from dcfkit.datasets import DatasetError, Sequence, load_dataset
 from dcfkit.errors import ConfigError, DcfkitError
+from dcfkit.integrations.opencv import OpenCVUnavailable, available_opencv_trackers, opencv_tracker
 from dcfkit.registry import PluginWarning
+from dcfkit.running import evaluation, provenance, results, runner
+from dcfkit.running import files as store_files
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.running.results import import_results, load_results, run_key
-
+from dcfkit.running.provenance import run_key
+from dcfkit.running.results import import_results, load_results
 
 N_FRAMES = 6
 
@@ -109,7 +109,7 @@ def test_result_files_are_one_based_with_sidecar(tmp_path, seqs):
     assert lines[5] == "8.000,4.000,5.000,6.000"
     meta = json.loads((d / "a.json").read_text())
     assert meta["run_key"] == run_key(CONFIG) == summary["run_key"]
-    assert meta["dcfkit_version"] == results.dcfkit_version()
+    assert meta["dcfkit_version"] == provenance.dcfkit_version()
     assert len(meta["times"]) == N_FRAMES and meta["fps"] > 0 and meta["config"] == CONFIG
     times = np.loadtxt(d / "a.time")  # the toolkits' time file: one float a line
     np.testing.assert_allclose(times, meta["times"], atol=1e-8)
@@ -165,7 +165,7 @@ def test_resume_recomputes_nothing(tmp_path, seqs, caplog, monkeypatch):
     assert "replacing the results of another config named 'drift' for 3 sequence(s): a, b, c" in caplog.text
     # the same config under another dcfkit version is recomputed without that warning
     caplog.clear()
-    monkeypatch.setattr(results, "dcfkit_version", lambda: "99.0")
+    monkeypatch.setattr(provenance, "dcfkit_version", lambda: "99.0")
     with caplog.at_level("WARNING"):
         summary = run_one_pass({**CONFIG, "drift": 2.0}, seqs, tmp_path, make_tracker=Counter(), progress=False)
     assert summary["done"] == ["a", "b", "c"] and "replacing" not in caplog.text
@@ -317,7 +317,7 @@ def test_atomic_write_interrupted_keeps_old_file(tmp_path, monkeypatch):
     def boom(*a):
         raise Crash
 
-    monkeypatch.setattr(results.os, "replace", boom)
+    monkeypatch.setattr(store_files.os, "replace", boom)
     with pytest.raises(Crash):
         results.atomic_write(target, "new\n")
     assert target.read_text() == "old\n" and files(tmp_path) == {"x.txt"}
@@ -616,10 +616,10 @@ def test_run_pool_reports_a_dead_worker_as_a_crash_of_the_unfinished_calls():
 def test_result_files_get_the_usual_permissions(tmp_path, monkeypatch):
     saved = os.umask(0o022)
     try:
-        results._file_mode.cache_clear()
+        store_files._file_mode.cache_clear()
         path = tmp_path / "r.txt"
         results.atomic_write(path, "1\n")
         assert path.stat().st_mode & 0o777 == 0o644 and path.read_text() == "1\n"  # mkstemp alone: 0o600
     finally:
         os.umask(saved)
-        results._file_mode.cache_clear()
+        store_files._file_mode.cache_clear()

@@ -16,7 +16,8 @@ from pathlib import Path
 
 import pytest
 import yaml
-from hypothesis import given, strategies as st
+from hypothesis import given
+from hypothesis import strategies as st
 
 from dcfkit import config
 from dcfkit.ablation import load_spec

@@ -15,17 +15,17 @@ import zlib
 import cv2
 import numpy as np
 import pytest
-from PIL import Image
 from hypothesis import event, example, given
 from hypothesis import strategies as st
+from PIL import Image
 
 import dcfkit
 from dcfkit import cli
 from dcfkit.config import load_config
 from dcfkit.datasets import DatasetError, read_frame
-from dcfkit.errors import ConfigError, DcfkitError, InputError
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.datasets.video import open_source
+from dcfkit.errors import ConfigError, DcfkitError, InputError
 
 CONFIGS = ("strcf", "bacf", "dr2track", "kcf", "dsst")
 SEQUENCE = make_sequence(n_frames=2, size=(72, 96), target=(10, 14), distractor=False)
@@ -602,8 +602,8 @@ def test_many_feature_channels_are_refused_at_load():
 def test_a_short_video_is_an_error_only_where_the_frame_count_is_an_index():
     """MKV and WebM counts are duration x fps estimates: a complete file may fall short of them;
     a URL that stops short lost its stream, whatever its name says."""
-    from dcfkit.errors import InputError, InputWarning
     from dcfkit.datasets.video import _stopped_short
+    from dcfkit.errors import InputError, InputWarning
 
     with pytest.raises(InputError, match=r"cut\.avi stops at frame 8 of the 10 .*not tracked"):
         _stopped_short("cut.avi", 8, 10)
@@ -672,8 +672,8 @@ def test_long_arguments_are_shown_short_in_messages(args, said, otb_root, tmp_pa
 def test_long_values_in_files_and_variables_are_shown_short(tmp_path, monkeypatch):
     from dcfkit.datasets import read_boxes
     from dcfkit.datasets.base import read_flags
-    from dcfkit.running.evaluation import tracker_name
     from dcfkit.limits import max_image_pixels
+    from dcfkit.running.evaluation import tracker_name
 
     (tmp_path / "gt.txt").write_text("1,1,2,2\n" + "9," * 2000 + "\n")  # a longer line is refused unsplit
     (tmp_path / "att.txt").write_text("1 " * 2000)

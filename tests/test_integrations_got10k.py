@@ -16,13 +16,13 @@ from PIL import Image
 
 import dcfkit
 import dcfkit.integrations
+from dcfkit.analysis.report import evaluate
 from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset, read_frame
+from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.errors import ConfigError, InputError, TrackingError
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.analysis.report import evaluate
 from dcfkit.running.results import load_results
-from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.running.tracking import track
 
 ONE_BASED = np.array([1.0, 1.0, 0.0, 0.0])

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 import dcfkit
+from dcfkit.components.labels import gaussian_label
+from dcfkit.components.solvers import KernelParams, KernelRidge, Ridge, RidgeParams, kernel_correlation
+from dcfkit.components.solvers.kcf import squared_norm
 from dcfkit.config import load_config
 from dcfkit.errors import ConfigError
 from dcfkit.numerics.fft import make_fft
-from dcfkit.components.labels import gaussian_label
 from dcfkit.params import parse_params
-from dcfkit.components.solvers import KernelParams, KernelRidge, Ridge, RidgeParams, kernel_correlation
-from dcfkit.components.solvers.kcf import squared_norm
 
 SHAPES = [(5, 6), (6, 7), (4, 4)]  # even and odd widths: the half spectrum's Parseval weights differ
 

@@ -3,11 +3,11 @@ import numpy as np
 import pytest
 
 import dcfkit
-from dcfkit.errors import ConfigError
 from dcfkit.components.labels import Detection, DistractorRepressed, Gaussian, Label, gaussian_label
-from dcfkit.params import parse_params
-from dcfkit.numerics.response import local_maxima
 from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.errors import ConfigError
+from dcfkit.numerics.response import local_maxima
+from dcfkit.params import parse_params
 
 
 def test_gaussian_label_peaks_at_origin_and_is_symmetric():

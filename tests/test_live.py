@@ -18,11 +18,10 @@ import numpy as np
 import pytest
 
 from dcfkit import cli
-
 from dcfkit.datasets import video
-from dcfkit.errors import InputError
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.datasets.video import open_source
+from dcfkit.errors import InputError
 
 SEQ = make_sequence(n_frames=20, size=(120, 160), target=(16, 20), distractor=False, seed=3)
 BOX = ",".join(str(v) for v in SEQ.ground_truth[0])

@@ -74,8 +74,8 @@ def test_the_contrib_requirement_is_the_one_pyproject_declares():
 
 
 def test_the_color_names_table_error_says_how_to_repair(clobbered_opencv):
-    from dcfkit.errors import ConfigError
     from dcfkit.components.features.colornames import _from_opencv
+    from dcfkit.errors import ConfigError
 
     with pytest.raises(ConfigError, match="Color Names table was not found .* OpenCV's contrib modules are missing") \
             as caught:

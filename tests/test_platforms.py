@@ -7,17 +7,15 @@ import sys
 
 import numpy as np
 import pytest
+from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixture)
 
 from dcfkit import cli
-
-from dcfkit.running import platforms
 from dcfkit.analysis.compare import compare_folders
-from dcfkit.datasets import load_dataset
-from dcfkit.running.evaluation import run_one_pass
 from dcfkit.analysis.report import evaluate
+from dcfkit.datasets import load_dataset
+from dcfkit.running import platforms
+from dcfkit.running.evaluation import run_one_pass
 from dcfkit.running.results import load_results
-
-from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixture)
 
 RECORD = {"arch": "x86_64", "cpu": "Some CPU (cpu family 6, model 85)", "simd": "X86_V2 X86_V3",
           "blas": "openblas 0.3 Haswell", "libc": "glibc 2.36", "libraries": {"numpy": "2.4.6", "scipy": "1.17.1"},

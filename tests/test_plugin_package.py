@@ -14,14 +14,16 @@ from pathlib import Path
 import cv2
 import pytest
 
-from dcfkit.registry import DISABLE_ENV
 from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.registry import DISABLE_ENV
 
 ROOT = Path(__file__).resolve().parents[1]
 PLUGIN = ROOT / "plugins" / "dcfkit-context-label"
 CONFIG = PLUGIN / "configs" / "strcf_context.yaml"
 TUTORIAL = ROOT / "docs" / "plugins.md"
 PROVIDER = "context (dcfkit_context_label)"  # entry-point name (module)
+
+
 @pytest.fixture(scope="module")
 def site(pip_install_copy) -> Path:
     """The plugin pip-installed into a fresh folder; its dist-info carries the entry point."""

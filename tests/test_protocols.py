@@ -16,10 +16,9 @@ import numpy as np
 import pytest
 
 from dcfkit import cli
-
 from dcfkit.analysis import metrics
-from dcfkit.datasets import read_boxes
 from dcfkit.analysis.protocols import PROTOCOLS, get_protocol
+from dcfkit.datasets import read_boxes
 
 NAN = [math.nan] * 4
 SQ13 = math.sqrt(13)

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import dcfkit
-from dcfkit.datasets import load_dataset
 from dcfkit.analysis.metrics import average, score_sequence
+from dcfkit.datasets import load_dataset
 
 FLOORS = {"dr2track": 0.88, "strcf": 0.81, "bacf": 0.90, "kcf": 0.48, "dsst": 0.27}  # measured minus ~0.08
 

@@ -18,18 +18,18 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
+from test_ablation import write_otb
 
 from dcfkit import cli
 from dcfkit.ablation import load_spec, sensitivity
 from dcfkit.ablation.page import config_changes, sensitivity_charts
-from dcfkit.config import load_config
-from dcfkit.datasets import load_dataset
 from dcfkit.analysis.metrics import iou
 from dcfkit.analysis.report_html import render
-from dcfkit.running import platforms as dcfkit_platforms
 from dcfkit.analysis.report_html.provenance import folder_provenance
 from dcfkit.analysis.report_html.thumbnails import choose_frames, crop_window
-from test_ablation import write_otb
+from dcfkit.config import load_config
+from dcfkit.datasets import load_dataset
+from dcfkit.running import platforms as dcfkit_platforms
 
 HOSTILE = "<img src=x onerror=alert(1)>&amp;</script>"  # user text that must stay text
 HOSTILE_NAME = "<img src=x onerror=alert(1)><script>alert(2)"  # as a tracker (a folder name: no slash)

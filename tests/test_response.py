@@ -4,8 +4,8 @@ import itertools
 import numpy as np
 import pytest
 
-from dcfkit.numerics.fft import make_fft
 from dcfkit.numerics import peak_kernels
+from dcfkit.numerics.fft import make_fft
 from dcfkit.numerics.response import local_maxima, response, subpixel_peak, wrap
 
 

@@ -12,15 +12,14 @@ import tempfile
 
 import numpy as np
 import pytest
+from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixture)
 
 from dcfkit.analysis import report
-
-from dcfkit.running import results
 from dcfkit.errors import DcfkitError
+from dcfkit.running import files, results
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.running.results import ResultStore, load_results, run_key
-
-from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixture)
+from dcfkit.running.provenance import run_key
+from dcfkit.running.results import ResultStore, load_results
 
 
 @contextlib.contextmanager
@@ -202,7 +201,7 @@ class Blocker:
 
 @pytest.mark.parametrize("jobs", [1, 2])
 def test_a_write_failure_mid_run_stops_the_run_whatever_the_jobs(tmp_path, seqs, jobs):
-    with pytest.raises(results.StoreError, match=r"cannot write .*b\.txt"):
+    with pytest.raises(files.StoreError, match=r"cannot write .*b\.txt"):
         run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Blocker(str(tmp_path / "drift")), jobs=jobs,
                      progress=False)
     assert "b" not in load_results(tmp_path, "drift", seqs)

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from dcfkit import cli
-from dcfkit.errors import InputError
 from dcfkit.cli.selection import BoxDrawing, select_box
 from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.errors import InputError
 
 SEQ = make_sequence(n_frames=6, seed=4)  # 360x480 frames, the target at 148,179 36x22
 ROOT = Path(__file__).resolve().parents[1]

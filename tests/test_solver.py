@@ -4,12 +4,12 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from dcfkit.components.regularizers import Temporal
+from dcfkit.components.solvers import ADMMParams, admm, sherman_morrison_solve
 from dcfkit.config import load_config
 from dcfkit.errors import ConfigError
 from dcfkit.numerics.fft import make_fft
 from dcfkit.params import parse_params
-from dcfkit.components.regularizers import Temporal
-from dcfkit.components.solvers import ADMMParams, admm, sherman_morrison_solve
 
 
 def correlation_matrix(m: np.ndarray) -> np.ndarray:

@@ -1,10 +1,10 @@
 """The portable SSE estimates of fhog's 'sse' arithmetic (dcfkit.components.features.sse_estimates) and its
 acos table: hand-computed values, the documented error bound over every mantissa, the same
 values from the C++ header that the authors' code is built with under Octave."""
+import math
 import platform
 import shutil
 import subprocess
-import math
 from pathlib import Path
 
 import numpy as np

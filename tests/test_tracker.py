@@ -3,13 +3,13 @@ import numpy as np
 import pytest
 
 import dcfkit
-from dcfkit.contracts import checked
-from dcfkit.errors import InputError, TrackingError
+from dcfkit.analysis.metrics import score_sequence
 from dcfkit.components.features import Feature
 from dcfkit.components.labels import Label, gaussian_label
-from dcfkit.analysis.metrics import score_sequence
-from dcfkit.numerics.response import shift_spectrum
+from dcfkit.contracts import checked
 from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.errors import InputError, TrackingError
+from dcfkit.numerics.response import shift_spectrum
 
 CONFIGS = ["strcf", "bacf", "dr2track", "kcf", "dsst", "configs/ablations/dr2track_no_dr.yaml",
            "configs/ablations/dr2track_no_ma.yaml"]

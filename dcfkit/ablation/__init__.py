@@ -14,7 +14,7 @@ Results are stored per *run*, keyed by what determines the boxes::
     OUT/jobs/<dataset>/<key>/<sequence>.error        instead, when the tracker raised
     OUT/configs/<key>.json                           the config behind <key>
 
-``key`` is :func:`dcfkit.running.results.run_key` of the resolved config (``dcfkit eval`` uses the
+``key`` is :func:`dcfkit.running.provenance.run_key` of the resolved config (``dcfkit eval`` uses the
 same key), so two variants with the same parameters (the base point of every one-at-a-time
 sweep) share one run. Each ``OUT/jobs/<dataset>/<key>/`` is a
 :class:`dcfkit.running.results.ResultStore`, written by :mod:`dcfkit.running.runner`: a rerun skips intact
@@ -31,8 +31,8 @@ written.
 from __future__ import annotations
 
 from dcfkit.ablation.run import run_ablation
-from dcfkit.ablation.spec import AblationSpec, Grid, Job, Variant, expand, job_dir, load_spec, variant_names
 from dcfkit.ablation.sensitivity import plot_sensitivity, sensitivity
+from dcfkit.ablation.spec import AblationSpec, Grid, Job, Variant, expand, job_dir, load_spec, variant_names
 from dcfkit.ablation.summary import SEQUENCE_COLUMNS, SUMMARY_COLUMNS, summarize, summary_columns
 
 __all__ = ["AblationSpec", "Grid", "Job", "SEQUENCE_COLUMNS", "SUMMARY_COLUMNS", "Variant", "expand", "job_dir",

@@ -5,12 +5,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping
 
+from dcfkit.ablation.sensitivity import METRICS, sensitivity
+from dcfkit.ablation.spec import AblationSpec, format_value, job_dir
 from dcfkit.analysis.protocols import get_protocol
 from dcfkit.analysis.report_html import evaluation_sections, sections
 from dcfkit.analysis.report_html.provenance import this_process
-from dcfkit.running.results import LABEL_KEYS
-from dcfkit.ablation.sensitivity import METRICS, sensitivity
-from dcfkit.ablation.spec import AblationSpec, format_value, job_dir
+from dcfkit.running.provenance import LABEL_KEYS
 
 
 def flatten(config: Any, prefix: str = "") -> dict[str, Any]:

@@ -6,11 +6,13 @@ import contextlib
 import json
 from pathlib import Path
 
-from dcfkit.errors import DcfkitError, shown
-from dcfkit.running.results import LABEL_KEYS, ResultStore, atomic_write, dcfkit_version, ensure_writable, exclusive, read_json
-from dcfkit.running.runner import RunTask, execute, usable_cores
 from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir, variant_names
 from dcfkit.ablation.summary import output_names, summarize
+from dcfkit.errors import DcfkitError, shown
+from dcfkit.running.files import atomic_write, ensure_writable, exclusive, read_json
+from dcfkit.running.provenance import LABEL_KEYS, dcfkit_version
+from dcfkit.running.results import ResultStore
+from dcfkit.running.runner import RunTask, execute, usable_cores
 
 
 def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str = "local",

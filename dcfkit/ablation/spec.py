@@ -18,7 +18,7 @@ from dcfkit.config.bounded_yaml import read_yaml
 from dcfkit.datasets import DatasetError, canonical_name, load_dataset
 from dcfkit.errors import ConfigError, DcfkitError, clip, shown
 from dcfkit.params import closest
-from dcfkit.running.results import dcfkit_version, run_key
+from dcfkit.running.provenance import dcfkit_version, run_key
 
 SPEC_KEYS = ("name", "description", "dataset", "sequences", "variants", "grid")
 VARIANT_KEYS = ("config", "overrides", "description")
@@ -82,7 +82,7 @@ class AblationSpec:
 @dataclasses.dataclass(frozen=True)
 class Job:
     """One tracker run to do: ``variant`` on ``sequence`` with the resolved ``config``;
-    ``key`` names the run's result folder (:func:`dcfkit.running.results.run_key`)."""
+    ``key`` names the run's result folder (:func:`dcfkit.running.provenance.run_key`)."""
 
     variant: str
     config: dict
@@ -369,8 +369,6 @@ def expand(spec: AblationSpec, sequences: Iterable | None = None, version: str |
     version = version if version is not None else dcfkit_version()
     keys = {v.name: run_key(v.config, version) for v in spec.variants}
     return [Job(v.name, v.config, seq, keys[v.name]) for v in spec.variants for seq in names]
-
-
 
 
 def job_dir(out: Path, dataset: str, key: str) -> Path:

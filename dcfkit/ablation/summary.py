@@ -6,14 +6,15 @@ import json
 import logging
 from pathlib import Path
 
-from dcfkit.datasets import Sequence
-from dcfkit.analysis.protocols import DEFAULT, get_protocol
-from dcfkit.analysis.report import evaluate, format_table, json_ready, plot_curves
-from dcfkit.analysis.report_html import PAGE, write_page
-from dcfkit.running.results import ResultStore, atomic_write, read_json
 from dcfkit.ablation.page import ablation_page
 from dcfkit.ablation.sensitivity import plot_sensitivity, sensitivity_file
 from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir
+from dcfkit.analysis.protocols import DEFAULT, get_protocol
+from dcfkit.analysis.report import evaluate, format_table, json_ready, plot_curves
+from dcfkit.analysis.report_html import PAGE, write_page
+from dcfkit.datasets import Sequence
+from dcfkit.running.files import atomic_write, read_json
+from dcfkit.running.results import ResultStore
 
 SUMMARY_COLUMNS = ("variant", "precision", "auc", "fps", "sequences", "failed")
 SEQUENCE_COLUMNS = ("variant", "sequence", "precision", "auc", "fps", "frames", "status")

@@ -31,12 +31,11 @@ from typing import Iterable
 import numpy as np
 
 from dcfkit.analysis import metrics
-
-from dcfkit.running import platforms
+from dcfkit.analysis.protocols import Protocol, get_protocol
 from dcfkit.datasets import DatasetError, Sequence, benchmark_protocol, read_boxes, scored_sequences
 from dcfkit.errors import clip, shown
+from dcfkit.running import platforms
 from dcfkit.running.results import ResultStore, result_files
-from dcfkit.analysis.protocols import Protocol, get_protocol
 
 __all__ = ["COLUMNS", "compare_folders", "first_divergence", "series_iou"]
 

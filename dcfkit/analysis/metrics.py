@@ -30,8 +30,8 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
-from dcfkit.errors import shown
 from dcfkit.analysis.protocols import DEFAULT, Protocol, get_protocol
+from dcfkit.errors import shown
 
 __all__ = [
     "as_boxes",

@@ -22,17 +22,18 @@ import math
 import os
 from collections import Counter
 from pathlib import Path
-from typing import Iterable, Mapping, Sequence as Seq
+from typing import Iterable, Mapping
+from typing import Sequence as Seq
 
 import numpy as np
 
 from dcfkit.analysis import metrics
-
-from dcfkit.running import platforms
+from dcfkit.analysis.protocols import DEFAULT, Protocol, get_protocol
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, benchmark_protocol, scored_sequences
 from dcfkit.errors import clip, shown
-from dcfkit.analysis.protocols import DEFAULT, Protocol, get_protocol
-from dcfkit.running.results import atomic_write, ensure_writable, import_results, load_results
+from dcfkit.running import platforms
+from dcfkit.running.files import atomic_write, ensure_writable
+from dcfkit.running.results import import_results, load_results
 
 __all__ = [
     "columns",

@@ -7,10 +7,10 @@ import errno
 import sys
 import warnings
 
-from dcfkit.errors import DcfkitError, DcfkitWarning, clip
-from dcfkit.running.results import running_command
-from dcfkit.running.tracking import interrupt_on_termination
 from dcfkit.cli.parser import build_parser
+from dcfkit.errors import DcfkitError, DcfkitWarning, clip
+from dcfkit.running.provenance import running_command
+from dcfkit.running.tracking import interrupt_on_termination
 
 __all__ = ["build_parser", "main"]
 

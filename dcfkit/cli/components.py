@@ -12,9 +12,9 @@ from typing import Any, Iterable
 
 import yaml
 
+from dcfkit.config.slots import KINDS
 from dcfkit.opencv_check import contrib_problem
 from dcfkit.params import Bounds, fields
-from dcfkit.config.slots import KINDS
 from dcfkit.registry import PluginWarning, get_registry
 
 

@@ -8,17 +8,17 @@ import sys
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from dcfkit.integrations.opencv import opencv_tracker
 from dcfkit.analysis.compare import COLUMNS, compare_folders
+from dcfkit.analysis.report import columns, evaluate, format_table, json_ready, score_and_write, score_line
+from dcfkit.analysis.report_html import write_html_report
+from dcfkit.cli.common import add_dataset_arguments, add_protocol_argument, pixels
 from dcfkit.config import load_config
 from dcfkit.config.overrides import parse_overrides
 from dcfkit.datasets import load_dataset
 from dcfkit.errors import ConfigError, shown
+from dcfkit.integrations.opencv import opencv_tracker
 from dcfkit.running.evaluation import check_one_pass, run_one_pass, tracker_name
-from dcfkit.analysis.report import columns, evaluate, format_table, json_ready, score_and_write, score_line
-from dcfkit.analysis.report_html import write_html_report
 from dcfkit.running.results import load_results
-from dcfkit.cli.common import add_dataset_arguments, add_protocol_argument, pixels
 
 
 def add_eval_arguments(parser: argparse.ArgumentParser) -> None:

@@ -4,8 +4,8 @@ from __future__ import annotations
 import argparse
 
 from dcfkit import __version__
-from dcfkit.errors import SHOWN_CHARS
 from dcfkit.cli import ablate, components, datasets, evaluate, track, trax
+from dcfkit.errors import SHOWN_CHARS
 
 DESCRIPTION = """dcfkit: discriminative correlation filter trackers assembled from YAML.
 

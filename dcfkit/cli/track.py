@@ -10,17 +10,17 @@ from typing import Iterator
 
 import numpy as np
 
-from dcfkit.config.overrides import parse_overrides
-from dcfkit.errors import InputError, clip
 from dcfkit.analysis.metrics import score_sequence
-from dcfkit.running.results import CONFIDENCE_END, TIME_END, StoreError, format_boxes, format_confidence, format_times
-from dcfkit.cli.selection import check_display, select_box
-from dcfkit.datasets.synthetic import make_sequence
-from dcfkit.tracker.tracker import load_tracker
-from dcfkit.running.tracking import INTERRUPTS, Step, steps, termination_deferred, track
-from dcfkit.datasets.video import DEFAULT_FPS, READ_TIMEOUT, FrameSource, VideoWriter, check_output_file, open_source
 from dcfkit.cli.common import MAX_DEMO_FRAMES, frame_count, parse_box, seed
-
+from dcfkit.cli.selection import check_display, select_box
+from dcfkit.config.overrides import parse_overrides
+from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.datasets.video import DEFAULT_FPS, READ_TIMEOUT, FrameSource, VideoWriter, check_output_file, open_source
+from dcfkit.errors import InputError, clip
+from dcfkit.running.files import StoreError, format_boxes, format_confidence, format_times
+from dcfkit.running.results import CONFIDENCE_END, TIME_END
+from dcfkit.running.tracking import INTERRUPTS, Step, steps, termination_deferred, track
+from dcfkit.tracker.tracker import load_tracker
 
 TRACK_NOTES = f"""--video reads a file, a camera (0 is the first), a stream URL or a named pipe one frame at a
 time, and each box is printed (or written to --out) as soon as its frame is tracked: Ctrl-C or

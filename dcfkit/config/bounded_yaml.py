@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 from typing import Any, Mapping
-import yaml
-from dcfkit.errors import ConfigError, clip, shown
 
+import yaml
+
+from dcfkit.errors import ConfigError, clip, shown
 
 # Bounds on what a config, an ablation spec or a --set value may be, far beyond any real one
 # (the shipped configs and specs: at most 6.4 KB, 409 values, 5 levels). Read when used: a

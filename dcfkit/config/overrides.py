@@ -3,9 +3,11 @@ from __future__ import annotations
 
 import copy
 from typing import Any, Mapping
+
 import yaml
+
+from dcfkit.config.bounded_yaml import _load_yaml, _OverLimit
 from dcfkit.errors import ConfigError, clip, shown
-from dcfkit.config.bounded_yaml import _OverLimit, _load_yaml
 
 
 def merge(base: Mapping, override: Mapping) -> dict:

@@ -4,11 +4,11 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 from typing import Any, Mapping
+
+from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.errors import ConfigError, clip, shown
 from dcfkit.params import closest, parse_params
 from dcfkit.registry import get_registry
-from dcfkit.config.tracker_params import TrackerParams
-
 
 SLOTS = ("features", "label", "regularizers", "solver", "search", "scale")
 

@@ -19,10 +19,25 @@ itself in :mod:`~dcfkit.datasets.layout` (name, aliases, loader, detection, desc
 another benchmark is added with :func:`register_layout`. See ``docs/evaluation.md`` for the
 layouts.
 """
-from dcfkit.datasets.base import ATTRIBUTE_NAMES, DatasetError, DatasetWarning, Sequence, read_boxes, read_frame, scored_sequences
+from dcfkit.datasets.base import (
+                                     ATTRIBUTE_NAMES,
+                                     DatasetError,
+                                     DatasetWarning,
+                                     Sequence,
+                                     read_boxes,
+                                     read_frame,
+                                     scored_sequences,
+)
 from dcfkit.datasets.layout import Evidence, Layout, register_layout, registered_layout, unregister_layout
-from dcfkit.datasets.registry import (DATASETS, benchmark_protocol, canonical_name, detect_dataset, get_layout, layouts,
-                                     load_dataset)
+from dcfkit.datasets.registry import (
+                                     DATASETS,
+                                     benchmark_protocol,
+                                     canonical_name,
+                                     detect_dataset,
+                                     get_layout,
+                                     layouts,
+                                     load_dataset,
+)
 
 # Importing a layout module registers it; the import order is the order of the names in
 # messages ("valid names: uav123, uav123_10fps, ..."), so it is not alphabetical.

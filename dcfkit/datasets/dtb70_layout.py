@@ -3,8 +3,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from dcfkit.datasets.base import (Sequence, annotated_frames, first_frame_digits, image_sequence_folders, listed, read_boxes,
-                   require_root, select_sequences)
+from dcfkit.datasets.base import (
+    Sequence,
+    annotated_frames,
+    first_frame_digits,
+    image_sequence_folders,
+    listed,
+    read_boxes,
+    require_root,
+    select_sequences,
+)
 from dcfkit.datasets.layout import Evidence, register_layout
 
 

@@ -16,8 +16,17 @@ from typing import Callable
 
 import numpy as np
 
-from dcfkit.datasets.base import (DatasetError, Sequence, annotated_frames, held_out_sequence, listed, read_boxes,
-                   read_frame_values, require_root, select_sequences)
+from dcfkit.datasets.base import (
+    DatasetError,
+    Sequence,
+    annotated_frames,
+    held_out_sequence,
+    listed,
+    read_boxes,
+    read_frame_values,
+    require_root,
+    select_sequences,
+)
 from dcfkit.datasets.layout import Evidence, register_layout
 
 SPLITS = ("train", "val", "test")

@@ -15,10 +15,21 @@ from pathlib import Path
 
 import numpy as np
 
-from dcfkit.errors import shown
-from dcfkit.datasets.base import (DatasetError, Sequence, check_box_count, first_frame_digits, image_sequence_folders, listed,
-                   read_boxes, read_flags, read_text, require_root, select_sequences)
+from dcfkit.datasets.base import (
+    DatasetError,
+    Sequence,
+    check_box_count,
+    first_frame_digits,
+    image_sequence_folders,
+    listed,
+    read_boxes,
+    read_flags,
+    read_text,
+    require_root,
+    select_sequences,
+)
 from dcfkit.datasets.layout import Evidence, register_layout
+from dcfkit.errors import shown
 
 #: Column order of the OTB toolkit's att files (``attName`` of its perfPlot.m).
 OTB_ATTRIBUTES = ("IV", "OPR", "SV", "OCC", "DEF", "MB", "FM", "IPR", "OV", "BC", "LR")

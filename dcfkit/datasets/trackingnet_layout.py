@@ -13,8 +13,15 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from dcfkit.datasets.base import (DatasetError, Sequence, annotated_frames, held_out_sequence, read_boxes, require_root,
-                   select_sequences)
+from dcfkit.datasets.base import (
+    DatasetError,
+    Sequence,
+    annotated_frames,
+    held_out_sequence,
+    read_boxes,
+    require_root,
+    select_sequences,
+)
 from dcfkit.datasets.layout import Evidence, register_layout
 
 _TRAIN_CHUNK = re.compile(r"^train_\d+$", re.IGNORECASE)

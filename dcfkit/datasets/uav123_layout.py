@@ -13,8 +13,18 @@ import io
 from pathlib import Path
 from typing import Callable
 
-from dcfkit.datasets.base import (DatasetError, Sequence, check_box_count, listed, numbered_frames, read_boxes, read_flags,
-                   read_text, require_root, select_sequences)
+from dcfkit.datasets.base import (
+    DatasetError,
+    Sequence,
+    check_box_count,
+    listed,
+    numbered_frames,
+    read_boxes,
+    read_flags,
+    read_text,
+    require_root,
+    select_sequences,
+)
 from dcfkit.datasets.layout import Evidence, register_layout
 
 # Folder names under data_seq/ and anno/ that hold each subset (first found wins).

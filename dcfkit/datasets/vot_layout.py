@@ -21,10 +21,19 @@ from pathlib import Path
 
 import numpy as np
 
-from dcfkit.errors import shown
-from dcfkit.datasets.base import (DatasetError, Sequence, annotated_frames, annotation_lines, listed, parse_number, read_text,
-                   require_root, select_sequences)
+from dcfkit.datasets.base import (
+    DatasetError,
+    Sequence,
+    annotated_frames,
+    annotation_lines,
+    listed,
+    parse_number,
+    read_text,
+    require_root,
+    select_sequences,
+)
 from dcfkit.datasets.layout import Evidence, register_layout
+from dcfkit.errors import shown
 
 #: How a polygon becomes a box: ``bounds`` the smallest box holding it (the VOT toolkit's
 #: ``Polygon.convert(RegionType.RECTANGLE)``, pytracking's VOT loader); ``area`` pysot's

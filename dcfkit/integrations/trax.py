@@ -34,12 +34,12 @@ from typing import Any, Iterator, Mapping
 import numpy as np
 
 from dcfkit import __version__
-from dcfkit.tracker.confidence import confidence_of
 from dcfkit.datasets import read_frame
 from dcfkit.errors import DcfkitError, InputError, MissingDependency
-from dcfkit.tracker.tracker import Tracker
-from dcfkit.running.tracking import track
 from dcfkit.integrations.trax_stream import ProtocolError, framed_connection
+from dcfkit.running.tracking import track
+from dcfkit.tracker.confidence import confidence_of
+from dcfkit.tracker.tracker import Tracker
 
 try:
     import trax  # vot-trax: the optional dependency this module exists for

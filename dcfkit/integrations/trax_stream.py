@@ -125,6 +125,7 @@ def _check_image(text: bytes, limit: int) -> None:
         raise FramingError(f"a {width}x{height} {fmt.decode()} memory image of {size} bytes whose data holds "
                            f"{max(decoded, 0)}")
 
+
 def _check_region(text: bytes) -> None:
     """Raise :class:`FramingError` if ``text``, an ``initialize``'s region, is one libtrax
     would misread."""

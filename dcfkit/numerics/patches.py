@@ -13,6 +13,7 @@ import numpy as np
 from dcfkit.errors import InputError
 from dcfkit.limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
+
 def box_to_centre_size(box) -> tuple[np.ndarray, np.ndarray]:
     """(x, y, w, h) -> centre (y, x) and size (h, w), float64."""
     x, y, w, h = (float(v) for v in box)

@@ -9,7 +9,7 @@ first sequence of a dcfkit config a process runs a throw-away copy of the tracke
 first frame, untimed, so that one-time loading of compiled code is not counted).
 
 On rerun a sequence is skipped when its results are intact and from the same run key
-(:func:`dcfkit.running.results.run_key`); damaged and failed sequences are run again.
+(:func:`dcfkit.running.provenance.run_key`); damaged and failed sequences are run again.
 """
 from __future__ import annotations
 
@@ -23,8 +23,9 @@ import numpy as np
 
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.errors import ConfigError, shown
-from dcfkit.running.results import (ResultStore, dcfkit_version, ensure_writable, exclusive, json_default, make_dir,
-                      remove_temporary_files, run_key)
+from dcfkit.running.files import ensure_writable, exclusive, make_dir, remove_temporary_files
+from dcfkit.running.provenance import dcfkit_version, json_default, run_key
+from dcfkit.running.results import ResultStore
 from dcfkit.running.runner import RunTask, execute
 
 __all__ = ["check_one_pass", "run_one_pass", "tracker_name"]

@@ -13,7 +13,6 @@ import os
 import platform
 from importlib import metadata
 
-import numpy  # noqa: F401 - loads the BLAS that threadpoolctl inspects
 from threadpoolctl import threadpool_info
 
 try:

@@ -31,255 +31,34 @@ is a :class:`StoreError` naming the file.
 from __future__ import annotations
 
 import contextlib
-import contextvars
 import dataclasses
-import functools
-import glob
-import hashlib
 import json
 import logging
-import os
-import platform
 import re
-import shlex
-import sys
-import tempfile
 import traceback
-from datetime import datetime, timezone
 from pathlib import Path
-from typing import Iterable, Mapping
+from typing import Iterable
 
 import numpy as np
 
-from dcfkit import __version__
-from dcfkit.config.slots import components
 from dcfkit.datasets import DatasetError, Sequence, read_boxes
-from dcfkit.errors import DcfkitError, clip, shown
-from dcfkit.running.platforms import cpu_model
-from dcfkit.registry import get_registry
+from dcfkit.errors import clip, shown
+from dcfkit.running.files import (
+    atomic_write,
+    checksum,
+    format_boxes,
+    format_confidence,
+    format_times,
+    make_dir,
+    read_json,
+)
+from dcfkit.running.provenance import json_default, now
 
 log = logging.getLogger(__name__)
 
-LABEL_KEYS = ("name", "description")  # config keys that never change a box
 # the endings of a sequence's files in a store; none is an ending of another
 BOXES_END, SIDECAR_END, ERROR_END, TIME_END, CONFIDENCE_END = ".txt", ".json", ".error", ".time", ".confidence"
 TOOLKIT_TIME_SUFFIX, TOOLKIT_CONFIDENCE_SUFFIX = "_time", "_confidence"  # <sequence>_time.txt, as toolkits write
-
-
-# --------------------------------------------------------------------------- identity
-
-
-def dcfkit_version() -> str:
-    """``dcfkit.__version__`` (part of every run key)."""
-    return __version__
-
-
-def json_default(obj):
-    """``json.dumps`` fallback for numpy values, dataclasses and sets."""
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        return dataclasses.asdict(obj)
-    if isinstance(obj, (set, frozenset)):
-        return sorted(obj)
-    return str(obj)
-
-
-def plugin_versions(config: Mapping) -> list[str]:
-    """``"package version"`` of each installed plugin whose components ``config`` uses."""
-    used = components(config)
-    return get_registry().plugin_versions(used) if used else []  # e.g. an OpenCV baseline: no registry
-
-
-def run_key(config: Mapping, version: str | None = None) -> str:
-    """The identity of a run: 16 hex digits of SHA-256 over the canonical JSON (sorted keys)
-    of ``config`` without its ``name`` and ``description`` (they change no box), the dcfkit
-    version and the versions of the plugins whose components the config uses (a plugin's
-    new release gives new results; configs of built-ins only keep their keys)."""
-    payload = {"config": {k: v for k, v in config.items() if k not in LABEL_KEYS},
-               "dcfkit": version if version is not None else dcfkit_version()}
-    plugins = plugin_versions(config)
-    if plugins:
-        payload["plugins"] = plugins
-    text = json.dumps(payload, sort_keys=True, separators=(",", ":"), default=json_default)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-
-def now() -> str:
-    return datetime.now(timezone.utc).isoformat(timespec="seconds")
-
-
-_COMMAND: contextvars.ContextVar[list | None] = contextvars.ContextVar("dcfkit_command", default=None)
-
-
-@contextlib.contextmanager
-def running_command(argv: list[str]):
-    """Within: :func:`invocation` says ``argv`` (the CLI's ``dcfkit ...`` when its ``main`` is
-    called with arguments, as tests and scripts do, rather than their own process's)."""
-    token = _COMMAND.set(list(argv))
-    try:
-        yield
-    finally:
-        _COMMAND.reset(token)
-
-
-def invocation() -> dict:
-    """How this command was given: ``{"command": argv, "cwd": working directory}``. The
-    process's ``sys.argv`` (with ``python -m PACKAGE`` as the first words when it was run so:
-    ``sys.argv[0]`` is then the path of ``__main__.py``, which does not run alone) unless
-    :func:`running_command` says otherwise. Result sidecars record the client's."""
-    argv = _COMMAND.get()
-    if argv is None:
-        argv = list(sys.argv)
-        spec = getattr(sys.modules.get("__main__"), "__spec__", None)
-        if spec is not None and spec.name.endswith(".__main__"):
-            argv[:1] = ["python", "-m", spec.name.removesuffix(".__main__")]
-        elif argv:
-            argv[0] = os.path.basename(argv[0]) or argv[0]
-    return {"command": argv, "cwd": os.getcwd()}
-
-
-def command_line(record: Mapping) -> str | None:
-    """A sidecar's or :func:`invocation`'s command as one shell line, or None if not recorded."""
-    argv = record.get("command")
-    if not isinstance(argv, list) or not all(isinstance(a, str) for a in argv):
-        return None
-    return shlex.join(argv)
-
-
-@functools.lru_cache(maxsize=1)
-def machine() -> dict:
-    """The machine this process runs on: host name, OS, CPU model, cores, Python version."""
-    return {"host": platform.node(), "system": platform.platform(terse=True), "cpu": cpu_model(),
-            "cores": os.cpu_count(), "python": platform.python_version()}
-
-
-# --------------------------------------------------------------------------- files
-
-
-@functools.lru_cache(maxsize=1)
-def _file_mode() -> int:
-    """The mode open() would give a new file (mkstemp's are owner-only)."""
-    mask = os.umask(0)
-    os.umask(mask)
-    return 0o666 & ~mask
-
-
-class StoreError(DcfkitError):
-    """Results could not be written: the run stops (writing the next run would fail too)."""
-
-
-def atomic_write(path: Path, data: str | bytes) -> None:
-    """Write ``data`` to ``path`` via a temporary file in the same folder + ``os.replace``;
-    a :class:`StoreError` naming the file if it cannot be written."""
-    try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    except OSError as exc:
-        raise StoreError(f"cannot write {clip(str(path))}: {exc.strerror}") from None
-    try:
-        os.fchmod(fd, _file_mode())
-        with os.fdopen(fd, "wb") as f:
-            f.write(data.encode("utf-8") if isinstance(data, str) else data)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException as exc:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        if isinstance(exc, OSError):
-            raise StoreError(f"cannot write {clip(str(path))}: {exc.strerror or exc}") from None
-        raise
-
-
-def make_dir(folder: Path) -> Path:
-    """``mkdir -p``, with a :class:`StoreError` naming the folder (e.g. a file is in the way)."""
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise StoreError(f"cannot create the folder {clip(str(folder))}: {exc.strerror}") from None
-    return folder
-
-
-def ensure_writable(folder: Path, names: Iterable[str] = (), what: str = "results") -> None:
-    """Create ``folder`` if needed and raise a :class:`StoreError` now, before any work, if it
-    cannot take ``what`` (a probe file is written and removed) or if a file to be written
-    there, ``folder/<name>``, is a folder."""
-    make_dir(folder)
-    try:
-        fd, probe = tempfile.mkstemp(dir=folder, prefix=".write-probe.")
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise StoreError(f"cannot write {what} to {clip(str(folder))}: {exc.strerror}") from None
-    blocked = [name for name in names if (folder / name).is_dir()]
-    if blocked:
-        raise StoreError(f"cannot write {what} to {folder}: {', '.join(blocked)} "
-                         f"{'is a folder; move it' if len(blocked) == 1 else 'are folders; move them'} away")
-
-
-def remove_temporary_files(folder: Path, names: Iterable[str]) -> None:
-    """Remove what a killed run left of writing ``folder/<name>`` (never read)."""
-    for name in names:
-        for stale in folder.glob(f".{glob.escape(name)}.*.tmp"):
-            with contextlib.suppress(OSError):
-                stale.unlink()
-
-
-@contextlib.contextmanager
-def exclusive(lock: Path, command: str, what: str):
-    """Hold the file lock ``lock`` so two runs never write the same results (released on any
-    exit). Where no lock can be taken (not POSIX, a file system without flock) the run goes
-    on unlocked, with a warning."""
-    try:
-        import fcntl  # POSIX only: elsewhere the run goes on unlocked
-
-        handle = open(lock, "a+")
-    except (ImportError, OSError) as exc:
-        if not isinstance(exc, ImportError):
-            log.warning("cannot create the lock %s (%s): running without it", lock, exc.strerror)
-        yield
-        return
-    with handle:
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise DcfkitError(f"another `{command}` is writing {what} (it holds {lock}); "
-                              f"wait for it or write elsewhere") from None
-        except OSError as exc:
-            log.warning("cannot lock %s (%s): running without the lock", lock, exc.strerror)
-        yield
-
-
-def read_json(path: Path) -> dict | None:
-    """The JSON object in ``path``, or None if it is missing, unreadable or not an object."""
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    return data if isinstance(data, dict) else None
-
-
-def format_boxes(boxes: np.ndarray, offset: float = 1.0) -> str:
-    """0-based ``(N, 4)`` boxes as ``%.3f`` ``x,y,w,h`` lines, ``offset`` added to x and y: 1 for
-    the 1-based lines of a result file, 0 for ``dcfkit track --out`` without ``--one-based``."""
-    shifted = np.asarray(boxes, dtype=np.float64) + np.array([offset, offset, 0.0, 0.0])
-    return "".join("%.3f,%.3f,%.3f,%.3f\n" % tuple(b) for b in shifted)
-
-
-def format_confidence(confidence: np.ndarray) -> str:
-    """``(N, 2)`` ``(peak, apce)`` rows as ``peak,apce`` lines, ``%.6g``; NaN as ``nan``."""
-    return "".join("%.6g,%.6g\n" % (p, a) for p, a in np.asarray(confidence, dtype=np.float64).reshape(-1, 2))
-
-
-def format_times(times: np.ndarray) -> str:
-    """Seconds per frame, one ``%.8f`` a line (the OTB and GOT-10k toolkits' ``_time.txt``)."""
-    return "".join("%.8f\n" % t for t in np.asarray(times, dtype=np.float64).reshape(-1))
-
-
-def checksum(data: bytes) -> str:
-    return hashlib.sha256(data).hexdigest()
 
 
 # --------------------------------------------------------------------------- the store

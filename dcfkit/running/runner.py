@@ -23,11 +23,13 @@ from typing import Any, Callable, Iterable, Mapping
 
 import cv2
 
-from dcfkit.running import platforms
 from dcfkit.datasets import Sequence
 from dcfkit.errors import DcfkitError, shown
 from dcfkit.registry import PluginWarning
-from dcfkit.running.results import ResultStore, StoreError, dcfkit_version, invocation, machine, now, plugin_versions, run_key
+from dcfkit.running import platforms
+from dcfkit.running.files import StoreError
+from dcfkit.running.provenance import dcfkit_version, invocation, machine, now, plugin_versions, run_key
+from dcfkit.running.results import ResultStore
 from dcfkit.running.tracking import TrackerFailure, track
 
 _THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS",
@@ -76,7 +78,7 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
                  origin: Mapping | None = None) -> dict:
     """Run ``task`` and store its boxes or its failure; returns ``{"sequence", "status",
     "frames", "error" (failed) or "fps" (done)}``. ``origin``: the client's
-    :func:`~dcfkit.running.results.invocation` (default: this process's), recorded in the sidecar
+    :func:`~dcfkit.running.provenance.invocation` (default: this process's), recorded in the sidecar
     with the machine that ran it."""
     seq, store = task.seq, ResultStore(task.folder)
     _warm_up(task)
@@ -232,7 +234,8 @@ def _deliver(finished: Iterable, key_of: Callable, on_result: Callable, on_crash
 def _run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: str, origin: Mapping, on_result,
               on_crash) -> None:
     try:
-        from distributed import Client, LocalCluster, as_completed as dask_completed  # optional: dcfkit[dask]
+        from distributed import Client, LocalCluster  # optional: dcfkit[dask]
+        from distributed import as_completed as dask_completed  # optional, as above
     except ImportError:
         raise DcfkitError("--executor dask needs dask.distributed: pip install 'dcfkit[dask]'") from None
     with contextlib.ExitStack() as stack:

@@ -18,9 +18,9 @@ from typing import Callable, Iterable, Iterator
 
 import numpy as np
 
-from dcfkit.tracker.confidence import confidence_of
 from dcfkit.errors import DcfkitError, shown
 from dcfkit.signals import handlers_replaced
+from dcfkit.tracker.confidence import confidence_of
 
 OnFrame = Callable[[int, np.ndarray, np.ndarray, object], None]
 

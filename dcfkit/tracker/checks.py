@@ -14,7 +14,6 @@ from dcfkit.limits import SAMPLE_PIXELS_VARIABLE, sample_budget
 from dcfkit.numerics.patches import cropper, sampler
 from dcfkit.tracker.geometry import Geometry
 
-
 MAX_CHANNELS = 256  # feature channels in all: 6 times the shipped configs' 42 (gray, fhog, colornames)
 MAX_BOX_TO_IMAGE = 10  # an initial box is at most this many times the image's width and height
 

@@ -19,21 +19,27 @@ from typing import Any, Mapping
 import cv2
 import numpy as np
 
-from dcfkit.tracker.confidence import Confidence
+from dcfkit.components.features import extract_stack
+from dcfkit.components.labels import Detection, gaussian_label
+from dcfkit.components.scale import scale_limits
 from dcfkit.config import load_config
 from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.contracts import naming_the_frame
 from dcfkit.errors import InputError, TrackingError
-from dcfkit.components.features import extract_stack
 from dcfkit.numerics.fft import make_fft
-from dcfkit.components.labels import Detection, gaussian_label
-from dcfkit.numerics.patches import (box_to_centre_size, centre_size_to_box, round_half_away, sampler,
-                                     whole_pixel_sampler)
-from dcfkit.registry import get_registry
+from dcfkit.numerics.patches import (
+    box_to_centre_size,
+    centre_size_to_box,
+    round_half_away,
+    sampler,
+    whole_pixel_sampler,
+)
 from dcfkit.numerics.response import newton_peak, shift_spectrum, subpixel_peak
-from dcfkit.components.scale import scale_limits
+from dcfkit.registry import get_registry
 from dcfkit.tracker.checks import check_box, check_config_budget, check_first_frame, check_image, check_terms, read_only
+from dcfkit.tracker.confidence import Confidence
 from dcfkit.tracker.geometry import Geometry, geometry, hann2d
+
 
 class Tracker:
     """A DCF tracker assembled from components (see :func:`dcfkit.load_tracker`)."""

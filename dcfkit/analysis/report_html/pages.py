@@ -2,14 +2,15 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Iterable, Mapping, Sequence as Seq
+from typing import Iterable, Mapping
+from typing import Sequence as Seq
 
-from dcfkit.datasets import Sequence, scored_sequences
 from dcfkit.analysis.protocols import Protocol, get_protocol
 from dcfkit.analysis.report import columns, default_report_dir, score_folders, write_files
 from dcfkit.analysis.report_html import sections
 from dcfkit.analysis.report_html.document import write_page
 from dcfkit.analysis.report_html.provenance import this_process
+from dcfkit.datasets import Sequence, scored_sequences
 
 PAGE = "report.html"
 

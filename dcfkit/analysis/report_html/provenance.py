@@ -12,13 +12,14 @@ from pathlib import Path
 from typing import Iterable, Mapping
 
 from dcfkit.running import platforms
-from dcfkit.running.results import ResultStore, command_line, dcfkit_version, invocation, machine, now
+from dcfkit.running.provenance import command_line, dcfkit_version, invocation, machine, now
+from dcfkit.running.results import ResultStore
 
 NOT_RECORDED = "not recorded"
 
 
 def describe_machine(record) -> str:
-    """``host: CPU, N cores, OS, Python x.y`` of a :func:`dcfkit.running.results.machine` record."""
+    """``host: CPU, N cores, OS, Python x.y`` of a :func:`dcfkit.running.provenance.machine` record."""
     if not isinstance(record, Mapping):
         return NOT_RECORDED
     parts = [str(record[k]) for k in ("cpu",) if record.get(k)]

@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Iterable, Mapping, Sequence as Seq
+from typing import Iterable, Mapping
+from typing import Sequence as Seq
 
-from dcfkit.datasets import ATTRIBUTE_NAMES, Sequence
 from dcfkit.analysis.report import PLOT_STYLE, SCORE_LABELS
 from dcfkit.analysis.report_html.provenance import folder_provenance
 from dcfkit.analysis.report_html.thumbnails import sequence_thumbnails
+from dcfkit.datasets import ATTRIBUTE_NAMES, Sequence
 
 COLUMN_LABELS = {**SCORE_LABELS, "norm_precision": "norm. precision", "fps": "fps", "sequences": "sequences",
                  "missing": "missing", "frames": "frames", "failed": "failed", "key": "run key",

@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import base64
 import logging
-from typing import Mapping, Sequence as Seq
+from typing import Mapping
+from typing import Sequence as Seq
 
 import cv2
 import numpy as np
 
-from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.analysis.metrics import as_boxes, iou
+from dcfkit.datasets import DatasetError, Sequence
 
 log = logging.getLogger(__name__)
 

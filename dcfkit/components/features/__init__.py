@@ -13,11 +13,11 @@ import math
 import cv2
 import numpy as np
 
-from dcfkit.contracts import array, scalar
-from dcfkit.params import param
 from dcfkit.components.base import Component, Contract
 from dcfkit.components.features.colornames import load_table, table_path_problem
 from dcfkit.components.features.fhog import ARITHMETICS, fhog
+from dcfkit.contracts import array, scalar
+from dcfkit.params import param
 
 
 def cell_average(x: np.ndarray, cell_size: int) -> np.ndarray:

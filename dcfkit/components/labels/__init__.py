@@ -26,13 +26,12 @@ import dataclasses
 
 import numpy as np
 
-from dcfkit.contracts import array, pair, within_grid
-from dcfkit.params import param
-from dcfkit.numerics.patches import round_half_away
 from dcfkit.components.base import Component, Contract
 from dcfkit.components.regularizers import target_mask
+from dcfkit.contracts import array, pair, within_grid
+from dcfkit.numerics.patches import round_half_away
 from dcfkit.numerics.response import local_maxima, wrap
-
+from dcfkit.params import param
 
 MAX_MU = 1e6
 MAX_NEIGHBOURHOOD = 101

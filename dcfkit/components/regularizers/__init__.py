@@ -15,7 +15,15 @@ cropping matrix P (h = P^T P h). The temporal regularizer contributes θ‖h - h
 from __future__ import annotations
 
 from dcfkit.components.regularizers.adaptive import GlobalVariation, LocalVariation, response_variation
-from dcfkit.components.regularizers.base import MAX_POWER, MAX_THETA, MAX_WEIGHT, PLACEMENTS, SpatialRegularizer, TemporalRegularizer, target_mask
+from dcfkit.components.regularizers.base import (
+           MAX_POWER,
+           MAX_THETA,
+           MAX_WEIGHT,
+           PLACEMENTS,
+           SpatialRegularizer,
+           TemporalRegularizer,
+           target_mask,
+)
 from dcfkit.components.regularizers.windows import BoxWindow, Crop, SmoothWindow, Temporal
 
 BUILTIN = (BoxWindow, SmoothWindow, Crop, Temporal, LocalVariation, GlobalVariation)

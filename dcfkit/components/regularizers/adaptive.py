@@ -20,9 +20,9 @@ import dataclasses
 
 import numpy as np
 
-from dcfkit.params import param
 from dcfkit.components.regularizers.base import MAX_THETA, MAX_WEIGHT, PLACEMENTS, TemporalRegularizer, target_mask
 from dcfkit.components.regularizers.windows import BoxWindow
+from dcfkit.params import param
 
 
 def response_variation(previous: tuple[np.ndarray, tuple[float, float]], detection) -> np.ndarray:

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from dcfkit.contracts import array, scalar
 from dcfkit.components.base import Component, Contract
-
+from dcfkit.contracts import array, scalar
 
 PLACEMENTS = ("centred", "authors")
 

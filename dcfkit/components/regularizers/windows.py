@@ -5,8 +5,16 @@ import dataclasses
 
 import numpy as np
 
+from dcfkit.components.regularizers.base import (
+    MAX_POWER,
+    MAX_THETA,
+    MAX_WEIGHT,
+    PLACEMENTS,
+    SpatialRegularizer,
+    TemporalRegularizer,
+    target_mask,
+)
 from dcfkit.params import param
-from dcfkit.components.regularizers.base import MAX_POWER, MAX_THETA, MAX_WEIGHT, PLACEMENTS, SpatialRegularizer, TemporalRegularizer, target_mask
 
 
 class BoxWindow(SpatialRegularizer):

@@ -14,11 +14,11 @@ import math
 
 import numpy as np
 
-from dcfkit.contracts import scalar, search_factors
-from dcfkit.components.features.fhog import ARITHMETICS, fhog
-from dcfkit.params import param
-from dcfkit.numerics.patches import resize_auto, sample, sampler, whole_pixel_crop
 from dcfkit.components.base import Component, Contract
+from dcfkit.components.features.fhog import ARITHMETICS, fhog
+from dcfkit.contracts import scalar, search_factors
+from dcfkit.numerics.patches import resize_auto, sample, sampler, whole_pixel_crop
+from dcfkit.params import param
 
 
 def _note_limits(value, args, estimator) -> None:

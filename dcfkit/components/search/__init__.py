@@ -5,10 +5,9 @@ import dataclasses
 
 import numpy as np
 
+from dcfkit.components.base import Component, Contract
 from dcfkit.contracts import array
 from dcfkit.params import param
-from dcfkit.components.base import Component, Contract
-
 
 MAX_COORDINATE = 2.0**31  # a centre (y, x) in pixels: no image is that large, and int32 holds it
 

@@ -25,10 +25,10 @@ import dataclasses
 
 import numpy as np
 
-from dcfkit.params import param
-from dcfkit.numerics.response import response as linear_response
 from dcfkit.components.solvers.base import running_average
 from dcfkit.components.solvers.strcf_bacf import ADMMBacf, BACFParams, admm
+from dcfkit.numerics.response import response as linear_response
+from dcfkit.params import param
 
 MAX_ABERRANCE = 1e4  # γ: the sample is scaled by √(1 + γ), kept well inside float32
 

@@ -15,9 +15,9 @@ import dataclasses
 
 import numpy as np
 
-from dcfkit.params import param
 from dcfkit.components.regularizers.base import MAX_THETA
 from dcfkit.components.solvers.strcf_bacf import ADMMParams, ADMMStrcf, admm
+from dcfkit.params import param
 
 
 @dataclasses.dataclass(frozen=True)

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from dcfkit.contracts import array, finite_arrays
 from dcfkit.components.base import Component, Contract
+from dcfkit.contracts import array, finite_arrays
 from dcfkit.numerics.response import response as linear_response
 
 

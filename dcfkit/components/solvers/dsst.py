@@ -24,9 +24,9 @@ import dataclasses
 
 import numpy as np
 
+from dcfkit.components.solvers.base import Solver, running_average
 from dcfkit.numerics.fft import multiply
 from dcfkit.params import param
-from dcfkit.components.solvers.base import Solver, running_average
 
 
 @dataclasses.dataclass(frozen=True)

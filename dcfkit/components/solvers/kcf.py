@@ -29,8 +29,8 @@ import dataclasses
 
 import numpy as np
 
-from dcfkit.params import param
 from dcfkit.components.solvers.base import Solver, running_average
+from dcfkit.params import param
 
 KERNELS = ("gaussian", "linear", "polynomial")
 

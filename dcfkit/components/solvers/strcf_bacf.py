@@ -30,8 +30,8 @@ from typing import Callable
 
 import numpy as np
 
-from dcfkit.params import param
 from dcfkit.components.solvers.base import Solver, running_average
+from dcfkit.params import param
 
 
 def _floats(z: np.ndarray) -> np.ndarray:

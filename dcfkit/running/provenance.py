@@ -1,0 +1,112 @@
+"""Where a result came from: the run key naming what decides its boxes, and the command,
+machine and versions that made it."""
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import dataclasses
+import functools
+import hashlib
+import json
+import os
+import platform
+import shlex
+import sys
+from datetime import datetime, timezone
+from typing import Mapping
+
+import numpy as np
+
+from dcfkit import __version__
+from dcfkit.config.slots import components
+from dcfkit.registry import get_registry
+from dcfkit.running.platforms import cpu_model
+
+_COMMAND: contextvars.ContextVar[list | None] = contextvars.ContextVar("dcfkit_command", default=None)
+
+
+LABEL_KEYS = ("name", "description")  # config keys that never change a box
+
+
+def dcfkit_version() -> str:
+    """``dcfkit.__version__`` (part of every run key)."""
+    return __version__
+
+
+def json_default(obj):
+    """``json.dumps`` fallback for numpy values, dataclasses and sets."""
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return dataclasses.asdict(obj)
+    if isinstance(obj, (set, frozenset)):
+        return sorted(obj)
+    return str(obj)
+
+
+def plugin_versions(config: Mapping) -> list[str]:
+    """``"package version"`` of each installed plugin whose components ``config`` uses."""
+    used = components(config)
+    return get_registry().plugin_versions(used) if used else []  # e.g. an OpenCV baseline: no registry
+
+
+def run_key(config: Mapping, version: str | None = None) -> str:
+    """The identity of a run: 16 hex digits of SHA-256 over the canonical JSON (sorted keys)
+    of ``config`` without its ``name`` and ``description`` (they change no box), the dcfkit
+    version and the versions of the plugins whose components the config uses (a plugin's
+    new release gives new results; configs of built-ins only keep their keys)."""
+    payload = {"config": {k: v for k, v in config.items() if k not in LABEL_KEYS},
+               "dcfkit": version if version is not None else dcfkit_version()}
+    plugins = plugin_versions(config)
+    if plugins:
+        payload["plugins"] = plugins
+    text = json.dumps(payload, sort_keys=True, separators=(",", ":"), default=json_default)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def now() -> str:
+    return datetime.now(timezone.utc).isoformat(timespec="seconds")
+
+
+@contextlib.contextmanager
+def running_command(argv: list[str]):
+    """Within: :func:`invocation` says ``argv`` (the CLI's ``dcfkit ...`` when its ``main`` is
+    called with arguments, as tests and scripts do, rather than their own process's)."""
+    token = _COMMAND.set(list(argv))
+    try:
+        yield
+    finally:
+        _COMMAND.reset(token)
+
+
+def invocation() -> dict:
+    """How this command was given: ``{"command": argv, "cwd": working directory}``. The
+    process's ``sys.argv`` (with ``python -m PACKAGE`` as the first words when it was run so:
+    ``sys.argv[0]`` is then the path of ``__main__.py``, which does not run alone) unless
+    :func:`running_command` says otherwise. Result sidecars record the client's."""
+    argv = _COMMAND.get()
+    if argv is None:
+        argv = list(sys.argv)
+        spec = getattr(sys.modules.get("__main__"), "__spec__", None)
+        if spec is not None and spec.name.endswith(".__main__"):
+            argv[:1] = ["python", "-m", spec.name.removesuffix(".__main__")]
+        elif argv:
+            argv[0] = os.path.basename(argv[0]) or argv[0]
+    return {"command": argv, "cwd": os.getcwd()}
+
+
+def command_line(record: Mapping) -> str | None:
+    """A sidecar's or :func:`invocation`'s command as one shell line, or None if not recorded."""
+    argv = record.get("command")
+    if not isinstance(argv, list) or not all(isinstance(a, str) for a in argv):
+        return None
+    return shlex.join(argv)
+
+
+@functools.lru_cache(maxsize=1)
+def machine() -> dict:
+    """The machine this process runs on: host name, OS, CPU model, cores, Python version."""
+    return {"host": platform.node(), "system": platform.platform(terse=True), "cpu": cpu_model(),
+            "cores": os.cpu_count(), "python": platform.python_version()}
