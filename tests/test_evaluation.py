@@ -14,7 +14,7 @@ import cv2
 import numpy as np
 import pytest
 
-from dcfkit.analysis import report
+from dcfkit.analysis import report, tables
 from dcfkit.cli import evaluate as cli_evaluate
 from dcfkit.datasets import DatasetError, Sequence, load_dataset
 from dcfkit.errors import ConfigError, DcfkitError
@@ -447,12 +447,12 @@ def test_evaluate_scores_and_sorting(seqs):
     sv = [r for r in ev["per_attribute"] if r["attribute"] == "SV"]
     assert [r["sequences"] for r in sv] == [2, 2] and ev["attributes"] == {"SV": 2, "FM": 1}
     np.testing.assert_allclose(ev["curves"]["perfect"]["precision"], 1.0)
-    md = report.format_rows(ev["overall"], "markdown", report.OVERALL_COLUMNS)
+    md = tables.format_rows(ev["overall"], "markdown", tables.OVERALL_COLUMNS)
     assert md.splitlines()[0] == "| tracker | auc | precision | norm_precision | fps | sequences | missing |"
     assert "| perfect | 0.952 | 1.000 | 1.000 | - | 3 | 0 |" in md
-    csv_text = report.format_rows(ev["overall"], "csv", report.OVERALL_COLUMNS)
+    csv_text = tables.format_rows(ev["overall"], "csv", tables.OVERALL_COLUMNS)
     assert csv_text.splitlines()[1].startswith("perfect,0.952380952")
-    assert "perfect" in report.format_rows(ev["overall"], "table")
+    assert "perfect" in tables.format_rows(ev["overall"], "table")
 
 
 def test_short_results_are_scored_as_failures_with_a_warning(seqs, caplog):

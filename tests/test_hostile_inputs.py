@@ -775,7 +775,7 @@ def test_a_config_name_with_a_control_character_is_a_config_error(tmp_path, otb_
 
 
 def test_a_name_cannot_add_rows_to_a_markdown_or_text_table():
-    from dcfkit.analysis.report import format_rows
+    from dcfkit.analysis.tables import format_rows
 
     rows = [{"sequence": "car\n| fake | 1.000 |", "auc": 0.5}, {"sequence": "a|b", "auc": 0.25}]
     markdown = format_rows(rows, "markdown").splitlines()

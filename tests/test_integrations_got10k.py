@@ -16,7 +16,7 @@ from PIL import Image
 
 import dcfkit
 import dcfkit.integrations
-from dcfkit.analysis.report import evaluate
+from dcfkit.analysis.scoring import evaluate
 from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset, read_frame
 from dcfkit.datasets.synthetic import make_sequence

@@ -11,7 +11,7 @@ from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixtur
 
 from dcfkit import cli
 from dcfkit.analysis.compare import compare_folders
-from dcfkit.analysis.report import evaluate
+from dcfkit.analysis.scoring import evaluate
 from dcfkit.datasets import load_dataset
 from dcfkit.running import platforms
 from dcfkit.running.evaluation import run_one_pass

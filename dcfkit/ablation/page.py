@@ -91,7 +91,7 @@ def sensitivity_charts(spec: AblationSpec, overall: list[dict]) -> dict:
 def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[str, ...], scores: Mapping,
                   sequences: list, results: Mapping[str, Mapping], keys: Mapping[str, str]) -> dict:
     """The page of an ablation: ``info`` is its ``summary.json`` (the summary table in
-    ``columns``), ``scores`` what :func:`dcfkit.analysis.report.evaluate` returned for ``results``
+    ``columns``), ``scores`` what :func:`dcfkit.analysis.scoring.evaluate` returned for ``results``
     (variant -> sequence -> result), ``keys`` variant -> run key."""
     trackers = list(keys)
     head = [variants_table(spec, info["overall"], columns, trackers)]

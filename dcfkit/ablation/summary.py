@@ -9,9 +9,12 @@ from pathlib import Path
 from dcfkit.ablation.page import ablation_page
 from dcfkit.ablation.sensitivity import plot_sensitivity, sensitivity_file
 from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir
+from dcfkit.analysis.plots import plot_curves
 from dcfkit.analysis.protocols import DEFAULT, get_protocol
-from dcfkit.analysis.report import evaluate, format_table, json_ready, plot_curves
+from dcfkit.analysis.report import json_ready
 from dcfkit.analysis.report_html import PAGE, write_page
+from dcfkit.analysis.scoring import evaluate
+from dcfkit.analysis.tables import format_table
 from dcfkit.datasets import Sequence
 from dcfkit.running.files import atomic_write, read_json
 from dcfkit.running.results import ResultStore
@@ -38,7 +41,7 @@ def _status(folder: Path, seq: Sequence) -> tuple[str, str | None]:
 def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None = None,
               protocol: str | None = None) -> dict:
     """Score the stored results of ``jobs`` under ``protocol`` (by default the benchmark's,
-    :func:`dcfkit.analysis.report.evaluate`) and write the tables,
+    :func:`dcfkit.analysis.scoring.evaluate`) and write the tables,
     ``summary.json`` and plots, each naming the protocol.
 
     precision is the precision at 20 px, auc the area under the success curve (and under

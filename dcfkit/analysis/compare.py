@@ -81,7 +81,7 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     Raises :class:`DatasetError` for a missing folder, a malformed line (naming file and
     line), two files of one sequence with different line counts, or a line count that is
     not the sequence's frame count (naming the sequence). Sequences whose ground truth is
-    withheld after frame 1 (test splits) are left out, as in :func:`dcfkit.analysis.report.evaluate`,
+    withheld after frame 1 (test splits) are left out, as in :func:`dcfkit.analysis.scoring.evaluate`,
     whose default ``protocol`` (the benchmark's) is this one's too.
     """
     sequences = list(sequences)

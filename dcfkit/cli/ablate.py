@@ -6,7 +6,7 @@ from pathlib import Path
 
 from dcfkit.ablation import expand, job_dir, load_spec, run_ablation, summary_columns, variant_names
 from dcfkit.ablation.spec import MAX_VARIANTS
-from dcfkit.analysis.report import format_table
+from dcfkit.analysis.tables import format_table
 from dcfkit.cli.common import add_protocol_argument, variant_count
 from dcfkit.errors import DcfkitError
 from dcfkit.running.results import ResultStore

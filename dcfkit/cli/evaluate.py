@@ -9,8 +9,10 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from dcfkit.analysis.compare import COLUMNS, compare_folders
-from dcfkit.analysis.report import columns, evaluate, format_table, json_ready, score_and_write, score_line
+from dcfkit.analysis.report import columns, json_ready, score_and_write
 from dcfkit.analysis.report_html import write_html_report
+from dcfkit.analysis.scoring import evaluate
+from dcfkit.analysis.tables import format_table, score_line
 from dcfkit.cli.common import add_dataset_arguments, add_protocol_argument, pixels
 from dcfkit.config import load_config
 from dcfkit.config.overrides import parse_overrides

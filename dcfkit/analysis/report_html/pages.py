@@ -18,7 +18,7 @@ PAGE = "report.html"
 def evaluation_sections(evaluation: Mapping, sequences: Seq[Sequence], results: Mapping[str, Mapping],
                         trackers: Seq[str]) -> list[dict]:
     """The plots, the per-attribute and per-sequence tables and the frames of an evaluation
-    (:func:`dcfkit.analysis.report.evaluate`), in page order, for ``trackers``."""
+    (:func:`dcfkit.analysis.scoring.evaluate`), in page order, for ``trackers``."""
     protocol = evaluation["protocol"]["name"]
     out = [sections.curve_charts(evaluation, trackers), sections.attribute_charts(evaluation, trackers)]
     if evaluation["per_attribute"]:

@@ -12,9 +12,10 @@ from pathlib import Path
 from typing import Iterable, Mapping
 from typing import Sequence as Seq
 
-from dcfkit.analysis.report import PLOT_STYLE, SCORE_LABELS
+from dcfkit.analysis.plots import PLOT_STYLE
 from dcfkit.analysis.report_html.provenance import folder_provenance
 from dcfkit.analysis.report_html.thumbnails import sequence_thumbnails
+from dcfkit.analysis.tables import SCORE_LABELS
 from dcfkit.datasets import ATTRIBUTE_NAMES, Sequence
 
 COLUMN_LABELS = {**SCORE_LABELS, "norm_precision": "norm. precision", "fps": "fps", "sequences": "sequences",
@@ -52,7 +53,7 @@ def _score(value) -> str:
 def curve_chart(kind: str, curves: Mapping[str, Mapping], thresholds, trackers: Seq[str], title: str | None = None,
                 small: bool = False) -> dict:
     """One OTB plot (``kind`` precision, success or norm_precision): a series per tracker,
-    best score first, labelled ``name [score]`` as :func:`dcfkit.analysis.report.plot_curves` does."""
+    best score first, labelled ``name [score]`` as :func:`dcfkit.analysis.plots.plot_curves` does."""
     style = PLOT_STYLE[kind]
     score = {t: curves[t][style["score"]] for t in curves}
     scored = sorted(curves, key=lambda t: -score[t] if _finite(score[t]) else math.inf)

@@ -1,0 +1,164 @@
+"""Scoring trackers' results on sequences under one protocol: per sequence, per attribute, overall, with the curves."""
+from __future__ import annotations
+
+import logging
+import math
+from collections import Counter
+from typing import Iterable, Mapping
+
+import numpy as np
+
+from dcfkit.analysis import metrics
+from dcfkit.analysis.protocols import Protocol, get_protocol
+from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, benchmark_protocol, scored_sequences
+from dcfkit.errors import shown
+from dcfkit.running import platforms
+
+log = logging.getLogger(__name__)
+
+
+def _boxes_and_fps(result) -> tuple[np.ndarray, float | None]:
+    if hasattr(result, "boxes"):
+        return np.asarray(result.boxes, dtype=np.float64), getattr(result, "fps", None)
+    if isinstance(result, Mapping):
+        return np.asarray(result["boxes"], dtype=np.float64), result.get("fps")
+    return np.asarray(result, dtype=np.float64), None
+
+
+def _mean_or_none(values) -> float | None:
+    values = [v for v in values if v is not None and math.isfinite(v)]
+    return float(np.mean(values)) if values else None
+
+
+def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
+             include_first: bool = True, weighting: str | None = None,
+             protocol: str | Protocol | None = None) -> dict:
+    """Score ``results`` (tracker -> sequence name -> boxes) on ``sequences`` under ``protocol``
+    (by default the rules of the benchmark's published tables,
+    :func:`~dcfkit.datasets.benchmark_protocol`: LaSOT's for LaSOT, the OTB toolkit's for UAV123).
+
+    A result is a :class:`dcfkit.running.results.SequenceResult`, a dict with ``boxes`` (and
+    optional ``fps``) or an ``(N, 4)`` array of 0-based boxes. ``weighting`` ``None`` averages
+    as the protocol does. Returns a plain dict with ``overall``, ``per_sequence`` and
+    ``per_attribute`` row lists (trackers best first by the protocol's ranking score: AO for
+    ``got10k``, else AUC), ``curves`` (tracker -> averaged ``precision``/``success``/
+    ``norm_precision`` curves), ``attribute_curves`` (attribute -> tracker -> curves),
+    ``attributes`` (attribute -> number of sequences), ``thresholds``, ``protocol`` (name,
+    title, source), ``settings`` and ``platforms`` (tracker -> ``[[platform, sequences], ...]``
+    of :func:`dcfkit.running.platforms.describe`). Sequences whose ground truth is withheld after
+    frame 1 (test splits) are left out (:func:`~dcfkit.datasets.scored_sequences`: a
+    :class:`DatasetError` if that leaves none).
+    """
+    sequences = list(sequences)
+    proto = get_protocol(protocol or benchmark_protocol(sequences))
+    weighting = weighting or proto.weighting
+    keys = proto.score_keys
+    sequences = scored_sequences(sequences)
+    per_seq, fps, missing = {}, {}, {}
+    for tracker, res in results.items():
+        per_seq[tracker], fps[tracker], missing[tracker] = _score_tracker(tracker, res, sequences, include_first,
+                                                                          proto)
+
+    overall, curves = [], {}
+    for tracker in results:
+        avg = metrics.average(per_seq[tracker].values(), weighting, proto)
+        curves[tracker] = _curves(avg)
+        overall.append({"tracker": tracker, **{k: avg[k] for k in keys},
+                        "fps": _mean_or_none(fps[tracker].values()),
+                        "sequences": len(sequences), "missing": len(missing[tracker]), "frames": avg["frames"]})
+    overall = _rank(overall, proto)
+    ranked = [r["tracker"] for r in overall]
+    per_sequence = [
+        {"tracker": t, "sequence": s.name, **{k: per_seq[t][s.name][k] for k in keys},
+         "fps": fps[t][s.name], "frames": per_seq[t][s.name]["frames"]}
+        for t in ranked for s in sequences]
+    attributes = _attribute_members(sequences)
+    per_attribute, attribute_curves = _per_attribute(attributes, per_seq, ranked, weighting, proto)
+    return {
+        "protocol": {"name": proto.name, "title": proto.title, "source": proto.source},
+        "overall": overall,
+        "per_sequence": per_sequence,
+        "per_attribute": per_attribute,
+        "curves": curves,
+        "attribute_curves": attribute_curves,
+        "attributes": {a: len(n) for a, n in attributes.items()},
+        "thresholds": _thresholds(proto),
+        "settings": {"protocol": proto.name, "include_first": include_first, "weighting": weighting},
+        "platforms": {t: _platforms(res.values()) for t, res in results.items()},
+    }
+
+
+def _platforms(results: Iterable) -> list[list]:
+    """``[[platform line, sequences], ...]`` of one tracker's results (imports: none recorded)."""
+    return [[line, n] for line, n in Counter(
+        platforms.describe(getattr(r, "platform", None)) for r in results).most_common()]
+
+
+def _score_tracker(tracker: str, res: Mapping, sequences: list[Sequence], include_first: bool,
+                   proto: Protocol) -> tuple[dict, dict, list]:
+    """(sequence -> scores, sequence -> fps, missing sequence names) of one tracker's results."""
+    scores, fps, missing = {}, {}, []
+    for seq in sequences:
+        if seq.name in res:
+            boxes, fps[seq.name] = _boxes_and_fps(res[seq.name])
+            if len(boxes) > len(seq):
+                raise DatasetError(f"tracker {shown(tracker)}, sequence {seq.name!r}: {len(boxes)} boxes for "
+                                   f"{len(seq)} frames")
+            if len(boxes) < len(seq):
+                log.warning("tracker %r, sequence %r: %d boxes for %d frames; the last %d frames are "
+                            "scored as failures", tracker, seq.name, len(boxes), len(seq), len(seq) - len(boxes))
+        else:
+            boxes, fps[seq.name] = np.empty((0, 4)), None
+            missing.append(seq.name)
+        scores[seq.name] = metrics.score_sequence(boxes, seq.ground_truth, include_first, proto)
+    if missing:
+        log.warning("tracker %r has no results for %d of %d sequences (scored as failures; "
+                    "report on the sequences that were run, e.g. with --sequences, to leave them out): %s",
+                    tracker, len(missing), len(sequences), ", ".join(missing[:10]))
+    return scores, fps, missing
+
+
+def _rank(rows: list[dict], proto: Protocol) -> list[dict]:
+    return sorted(rows, key=lambda r: _sort_key(r[proto.rank_key]))
+
+
+def _attribute_members(sequences: list[Sequence]) -> dict[str, list[str]]:
+    """attribute -> the sequences that have it (attributes no sequence has are left out)."""
+    members: dict[str, list[str]] = {}
+    for seq in sequences:
+        for attr, present in seq.attributes.items():
+            members.setdefault(attr, [])
+            if present:
+                members[attr].append(seq.name)
+    return {a: names for a, names in members.items() if names}
+
+
+def _per_attribute(attributes: dict, per_seq: dict, ranked: list[str], weighting: str,
+                   proto: Protocol) -> tuple[list[dict], dict]:
+    """Rows (per attribute, trackers ranked) and curves of the scores averaged per attribute."""
+    per_attribute, attribute_curves = [], {}
+    for attr, names in attributes.items():
+        attribute_curves[attr] = {}
+        rows = []
+        for tracker in ranked:
+            avg = metrics.average([per_seq[tracker][n] for n in names], weighting, proto)
+            attribute_curves[attr][tracker] = _curves(avg)
+            rows.append({"attribute": attr, "name": ATTRIBUTE_NAMES.get(attr, attr),
+                         "sequences": len(names), "tracker": tracker, **{k: avg[k] for k in proto.score_keys}})
+        per_attribute += _rank(rows, proto)
+    return per_attribute, attribute_curves
+
+
+def _thresholds(proto: Protocol) -> dict[str, np.ndarray]:
+    return {"precision": proto.precision_thresholds, "success": proto.success_thresholds,
+            "norm_precision": proto.norm_precision_thresholds}
+
+
+def _curves(avg: dict) -> dict:
+    return {"precision": avg["precision_curve"], "success": avg["success_curve"],
+            "norm_precision": avg["norm_precision_curve"], "precision_score": avg["precision"],
+            "auc": avg["auc"], "norm_precision_score": avg["norm_precision"]}
+
+
+def _sort_key(score) -> float:
+    return -score if score is not None and math.isfinite(score) else math.inf

@@ -1,0 +1,100 @@
+"""Score tables as text, Markdown or CSV."""
+from __future__ import annotations
+
+import csv
+import io
+import math
+from typing import Mapping
+from typing import Sequence as Seq
+
+from dcfkit.analysis.protocols import DEFAULT, Protocol, get_protocol
+from dcfkit.errors import shown
+
+_TABLES = {  # the columns before and after a protocol's scores (Protocol.score_keys)
+    "overall": (("tracker",), ("fps", "sequences", "missing")),
+    "per_sequence": (("tracker", "sequence"), ("fps", "frames")),
+    "per_attribute": (("attribute", "name", "sequences", "tracker"), ()),
+}
+
+
+def columns(table: str, protocol: str | Protocol = DEFAULT) -> tuple[str, ...]:
+    """Columns of the ``overall``, ``per_sequence`` or ``per_attribute`` table under ``protocol``."""
+    lead, tail = _TABLES[table]
+    return lead + get_protocol(protocol).score_keys + tail
+
+
+OVERALL_COLUMNS = columns("overall")
+SEQUENCE_COLUMNS = columns("per_sequence")
+ATTRIBUTE_COLUMNS = columns("per_attribute")
+
+
+def _cell(key: str, value, full: bool = False) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "" if full else "-"
+    if isinstance(value, float):
+        if full:
+            return repr(value)
+        return f"{value:.1f}" if key == "fps" else f"{value:.3f}"
+    if full:
+        return str(value)
+    # a sequence or tracker is named by a folder, whose name may hold a line break or a '|'
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode() for c in str(value))
+
+
+def format_rows(rows: Seq[Mapping], fmt: str = "table", columns: Seq[str] | None = None) -> str:
+    """Rows as an aligned text table (``"table"``), ``"markdown"`` or ``"csv"``.
+
+    Floats are shown with 3 decimals (fps with 1) in table/markdown; CSV keeps full
+    precision and leaves missing values empty.
+    """
+    if fmt not in ("table", "markdown", "csv"):
+        raise ValueError(f"format must be table, markdown or csv, got {shown(fmt)}")
+    if columns is None:
+        columns = list(rows[0]) if rows else []
+    if fmt == "csv":
+        buf = io.StringIO()
+        writer = csv.writer(buf, lineterminator="\n")
+        writer.writerow(columns)
+        for row in rows:
+            writer.writerow([_cell(c, row.get(c), full=True) for c in columns])
+        return buf.getvalue()
+    cells = [[_cell(c, row.get(c)) for c in columns] for row in rows]
+    numeric = [all(_is_number(row.get(c)) for row in rows) and bool(rows) for c in columns]
+    if fmt == "markdown":
+        lines = ["| " + " | ".join(columns) + " |",
+                 "|" + "|".join("---:" if n else ":---" for n in numeric) + "|"]
+        lines += ["| " + " | ".join(c.replace("|", "\\|") for c in r) + " |" for r in cells]
+        return "\n".join(lines) + "\n"
+    widths = [max([len(c)] + [len(r[i]) for r in cells]) for i, c in enumerate(columns)]
+
+    def line(values):
+        return "  ".join(v.rjust(w) if n else v.ljust(w)
+                         for v, w, n in zip(values, widths, numeric)).rstrip()
+
+    out = [line(columns), "  ".join("-" * w for w in widths)] + [line(r) for r in cells]
+    return "\n".join(out) + "\n"
+
+
+def _is_number(value) -> bool:
+    return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool))
+
+
+#: how scores are named in text (a score key of :class:`~dcfkit.analysis.protocols.Protocol` -> its name)
+SCORE_LABELS = {"ao": "AO", "sr50": "SR@0.5", "sr75": "SR@0.75", "auc": "AUC", "precision": "precision",
+                "norm_precision": "normalized precision"}
+
+
+def score_line(row: Mapping, protocol: str | Protocol = DEFAULT) -> str:
+    """One overall row as ``precision 0.891, AUC 0.520 on 6 sequences (protocol otb)``."""
+    proto = get_protocol(protocol)
+    scores = ", ".join(f"{SCORE_LABELS[k]} {_cell(k, row[k])}" for k in proto.score_keys)
+    return f"{scores} on {row['sequences']} sequences (protocol {proto.name})"
+
+
+def format_table(rows: Seq[Mapping], fmt: str, columns: Seq[str], protocol: str | Protocol = DEFAULT) -> str:
+    """:func:`format_rows` naming the scoring protocol: a first line (``table``,
+    ``markdown``) or a last ``protocol`` column (``csv``, so the file stays one table)."""
+    proto = get_protocol(protocol)
+    if fmt == "csv":
+        return format_rows([{**r, "protocol": proto.name} for r in rows], fmt, (*columns, "protocol"))
+    return f"{proto.describe()}\n\n" + format_rows(rows, fmt, columns)
