@@ -26,6 +26,10 @@ class TrackingError(DcfkitError, RuntimeError):
     """Tracking could not continue on a frame (the message names the frame)."""
 
 
+class DatasetError(DcfkitError, ValueError):
+    """A benchmark folder, annotation file or sequence name is wrong (the message says where)."""
+
+
 class MissingDependency(DcfkitError, ImportError):
     """An optional package is not installed (the message names the extra that installs it)."""
 

@@ -706,7 +706,7 @@ ANNOTATION_PIECES = [b"0", b"1", b"7", b"12.5", b"-3", b"1e30", b"1e19", b"9" * 
 def test_fuzzed_annotation_files_read_or_say_why(tmp_path_factory, data, n_frames):
     """Whatever bytes an annotation file holds, each reader returns what it promises (shape,
     dtype) or raises a DatasetError naming the file; never another exception."""
-    from dcfkit.datasets.base import read_boxes, read_flags, read_frame_values
+    from dcfkit.datasets.annotations import read_boxes, read_flags, read_frame_values
     from dcfkit.datasets.vot_layout import read_regions
 
     path = tmp_path_factory.mktemp("fuzz") / "annotation.txt"

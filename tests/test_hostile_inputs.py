@@ -671,7 +671,7 @@ def test_long_arguments_are_shown_short_in_messages(args, said, otb_root, tmp_pa
 
 def test_long_values_in_files_and_variables_are_shown_short(tmp_path, monkeypatch):
     from dcfkit.datasets import read_boxes
-    from dcfkit.datasets.base import read_flags
+    from dcfkit.datasets.annotations import read_flags
     from dcfkit.limits import max_image_pixels
     from dcfkit.running.evaluation import tracker_name
 

@@ -19,15 +19,9 @@ itself in :mod:`~dcfkit.datasets.layout` (name, aliases, loader, detection, desc
 another benchmark is added with :func:`register_layout`. See ``docs/evaluation.md`` for the
 layouts.
 """
-from dcfkit.datasets.base import (
-                                     ATTRIBUTE_NAMES,
-                                     DatasetError,
-                                     DatasetWarning,
-                                     Sequence,
-                                     read_boxes,
-                                     read_frame,
-                                     scored_sequences,
-)
+from dcfkit.datasets.annotations import read_boxes
+from dcfkit.datasets.base import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
+from dcfkit.datasets.images import DatasetWarning, read_frame
 from dcfkit.datasets.layout import Evidence, Layout, register_layout, registered_layout, unregister_layout
 from dcfkit.datasets.registry import (
                                      DATASETS,

@@ -3,13 +3,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from dcfkit.datasets.annotations import listed, read_boxes
 from dcfkit.datasets.base import (
     Sequence,
     annotated_frames,
     first_frame_digits,
     image_sequence_folders,
-    listed,
-    read_boxes,
     require_root,
     select_sequences,
 )

@@ -16,14 +16,12 @@ from typing import Callable
 
 import numpy as np
 
+from dcfkit.datasets.annotations import listed, read_boxes, read_frame_values
 from dcfkit.datasets.base import (
     DatasetError,
     Sequence,
     annotated_frames,
     held_out_sequence,
-    listed,
-    read_boxes,
-    read_frame_values,
     require_root,
     select_sequences,
 )

@@ -20,18 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from dcfkit.datasets.base import (
-    DatasetError,
-    Sequence,
-    listed,
-    numbered_frames,
-    read_boxes,
-    read_flags,
-    read_frame_values,
-    read_text,
-    require_root,
-    select_sequences,
-)
+from dcfkit.datasets.annotations import listed, read_boxes, read_flags, read_frame_values, read_text
+from dcfkit.datasets.base import DatasetError, Sequence, numbered_frames, require_root, select_sequences
 from dcfkit.datasets.layout import Evidence, register_layout
 
 #: Column order of the toolkit's att files (``att_fig_name`` of run_tracker_performance_evaluation.m).

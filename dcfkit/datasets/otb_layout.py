@@ -15,16 +15,13 @@ from pathlib import Path
 
 import numpy as np
 
+from dcfkit.datasets.annotations import listed, read_boxes, read_flags, read_text
 from dcfkit.datasets.base import (
     DatasetError,
     Sequence,
     check_box_count,
     first_frame_digits,
     image_sequence_folders,
-    listed,
-    read_boxes,
-    read_flags,
-    read_text,
     require_root,
     select_sequences,
 )

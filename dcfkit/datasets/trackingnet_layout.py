@@ -13,12 +13,12 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from dcfkit.datasets.annotations import read_boxes
 from dcfkit.datasets.base import (
     DatasetError,
     Sequence,
     annotated_frames,
     held_out_sequence,
-    read_boxes,
     require_root,
     select_sequences,
 )

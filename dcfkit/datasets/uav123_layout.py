@@ -13,15 +13,12 @@ import io
 from pathlib import Path
 from typing import Callable
 
+from dcfkit.datasets.annotations import listed, read_boxes, read_flags, read_text
 from dcfkit.datasets.base import (
     DatasetError,
     Sequence,
     check_box_count,
-    listed,
     numbered_frames,
-    read_boxes,
-    read_flags,
-    read_text,
     require_root,
     select_sequences,
 )

@@ -3,7 +3,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from dcfkit.datasets.base import DatasetError, Sequence, annotated_frames, read_boxes, require_root, select_sequences
+from dcfkit.datasets.annotations import read_boxes
+from dcfkit.datasets.base import DatasetError, Sequence, annotated_frames, require_root, select_sequences
 from dcfkit.datasets.layout import Evidence, register_layout
 
 

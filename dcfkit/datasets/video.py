@@ -19,7 +19,7 @@ import cv2
 import numpy as np
 
 from dcfkit.datasets import read_frame
-from dcfkit.datasets.base import jpeg_damage, jpeg_decodable
+from dcfkit.datasets.images import jpeg_damage, jpeg_decodable
 from dcfkit.errors import InputError, InputWarning, clip, shown
 from dcfkit.limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
@@ -316,7 +316,7 @@ JPEG_FOURCCS = ("MJPG", "JPEG", "AVRN", "AVDJ", "DMB1")
 class _JpegPackets:
     """The coded frames of a Motion JPEG video, read beside the decoded ones by a second
     capture in OpenCV's raw mode (``CAP_PROP_FORMAT`` -1: the packet, not decoded), and checked
-    as read_frame checks a JPEG file (:func:`~dcfkit.datasets.base.jpeg_damage`). FFmpeg's
+    as read_frame checks a JPEG file (:func:`~dcfkit.datasets.images.jpeg_damage`). FFmpeg's
     decoder conceals damage (it patches over the blocks it cannot decode) and OpenCV reports
     none. Each frame is one packet, so the two captures stay in step. The check is libjpeg's
     decode at 1/8 scale, about 40% more time than FFmpeg's full decode alone."""

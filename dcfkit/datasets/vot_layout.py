@@ -21,17 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from dcfkit.datasets.base import (
-    DatasetError,
-    Sequence,
-    annotated_frames,
-    annotation_lines,
-    listed,
-    parse_number,
-    read_text,
-    require_root,
-    select_sequences,
-)
+from dcfkit.datasets.annotations import annotation_lines, listed, parse_number, read_text
+from dcfkit.datasets.base import DatasetError, Sequence, annotated_frames, require_root, select_sequences
 from dcfkit.datasets.layout import Evidence, register_layout
 from dcfkit.errors import shown
 

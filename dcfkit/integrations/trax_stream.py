@@ -37,7 +37,7 @@ import threading
 import time
 from typing import Iterator
 
-from dcfkit.datasets.base import NUMBER
+from dcfkit.datasets.annotations import NUMBER
 from dcfkit.errors import DcfkitError, describe_error
 from dcfkit.limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
