@@ -182,7 +182,7 @@ def test_frames_are_tracked_in_natural_name_order(tmp_path):
 
 
 def test_video_writer_draws_points_in_the_colour_of_their_tracker(tmp_path):
-    from dcfkit.datasets.video import COLOURS, VideoWriter
+    from dcfkit.datasets.video_writer import COLOURS, VideoWriter
 
     drawn = []
     writer = VideoWriter(tmp_path / "v.avi")

@@ -15,7 +15,8 @@ from dcfkit.cli.common import MAX_DEMO_FRAMES, frame_count, parse_box, seed
 from dcfkit.cli.selection import check_display, select_box
 from dcfkit.config.overrides import parse_overrides
 from dcfkit.datasets.synthetic import make_sequence
-from dcfkit.datasets.video import DEFAULT_FPS, READ_TIMEOUT, FrameSource, VideoWriter, check_output_file, open_source
+from dcfkit.datasets.video import READ_TIMEOUT, FrameSource, open_source
+from dcfkit.datasets.video_writer import DEFAULT_FPS, VideoWriter, check_output_file
 from dcfkit.errors import InputError, clip
 from dcfkit.running.files import StoreError, format_boxes, format_confidence, format_times
 from dcfkit.running.results import CONFIDENCE_END, TIME_END
