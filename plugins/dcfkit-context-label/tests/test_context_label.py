@@ -1,12 +1,12 @@
 """The context_aware label against hand-computed labels on small grids."""
 import numpy as np
 import pytest
-from dcfkit_context_label import dcfkit_register_components
-from dcfkit_context_label.label import ContextAware
 
 from dcfkit.components.labels import Detection, gaussian_label
 from dcfkit.errors import ConfigError
 from dcfkit.registry import Registry
+from dcfkit_context_label import dcfkit_register_components
+from dcfkit_context_label.label import ContextAware
 
 
 def test_fixed_context_patches_are_repressed():
