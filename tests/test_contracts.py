@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
-from test_component_contracts import TINY, tiny_sequence
+from test_base import TINY, tiny_sequence
 
 import dcfkit
 from dcfkit import registry as reg

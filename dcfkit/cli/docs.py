@@ -73,7 +73,7 @@ def config_reference(registry=None) -> str:
     registry = registry or build_registry(external=False)
     defaults = _slot_defaults(registry)
     out = ["# Config reference\n",
-           GENERATED_NOTE.format(source="`dcfkit/config.py` and the components' `Params` schemas") + "\n",
+           GENERATED_NOTE.format(source="`dcfkit/config/` and the components' `Params` schemas") + "\n",
            "A tracker config is a YAML mapping that names one component per slot and sets their "
            "parameters; unknown keys and wrong types are errors that name the file and key. "
            "Omitted parameters take the defaults below. The shipped configs are in `configs/`; "

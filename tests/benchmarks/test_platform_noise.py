@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "platform_noise.py"
+SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "platform_noise.py"
 
 
 @pytest.mark.slow

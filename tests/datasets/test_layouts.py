@@ -442,7 +442,7 @@ def test_eval_and_report_on_lasot_give_per_attribute_tables(tmp_path, jpg, capsy
     for name, flags in {"airplane-1": iv, "airplane-2": iv, "airplane-10": arc, "bird-3": iv}.items():
         write(root / "annos" / "att" / f"{name}.txt", flags)
     out = tmp_path / "out"
-    kcf = str(Path(__file__).resolve().parents[1] / "configs" / "kcf.yaml")
+    kcf = str(Path(__file__).resolve().parents[2] / "configs" / "kcf.yaml")
     assert cli.main(["eval", kcf, "--dataset", "lasot", "--root", str(root), "--out", str(out), "--no-progress",
                      "--protocol", "lasot"]) == 0
     assert "kcf: 4 run, 0 already done, 0 failed" in capsys.readouterr().out
@@ -457,7 +457,7 @@ def test_eval_and_report_on_lasot_give_per_attribute_tables(tmp_path, jpg, capsy
 
 def test_a_benchmark_is_scored_by_its_own_toolkit_unless_protocol_says_otherwise(tmp_path, jpg, capsys):
     root, out = lasot_root(tmp_path, jpg), tmp_path / "out"
-    kcf = str(Path(__file__).resolve().parents[1] / "configs" / "kcf.yaml")
+    kcf = str(Path(__file__).resolve().parents[2] / "configs" / "kcf.yaml")
     assert cli.main(["eval", kcf, "--dataset", "lasot", "--root", str(root), "--out", str(out), "--no-progress"]) == 0
     assert "(protocol lasot)" in capsys.readouterr().out
     assert cli.main(["report", str(out), "--dataset", "lasot", "--root", str(root)]) == 0
@@ -477,7 +477,7 @@ def test_a_benchmark_is_scored_by_its_own_toolkit_unless_protocol_says_otherwise
 def test_eval_on_a_test_split_runs_and_report_says_there_is_nothing_to_score(tmp_path, jpg, capsys):
     root = got_root(tmp_path, jpg, ("test",))
     out = tmp_path / "out"
-    kcf = str(Path(__file__).resolve().parents[1] / "configs" / "kcf.yaml")
+    kcf = str(Path(__file__).resolve().parents[2] / "configs" / "kcf.yaml")
     assert cli.main(["eval", kcf, "--dataset", "got10k_test", "--root", str(root), "--out", str(out),
                      "--no-progress"]) == 0
     printed = capsys.readouterr().out
@@ -637,7 +637,7 @@ def test_sequences_made_by_hand_are_scored_unless_withheld():
 
 
 def test_the_dataset_plugin_of_the_tutorial_runs(tmp_path, jpg, monkeypatch, capsys):
-    tutorial = (Path(__file__).resolve().parents[1] / "docs" / "plugins.md").read_text(encoding="utf-8")
+    tutorial = (Path(__file__).resolve().parents[2] / "docs" / "plugins.md").read_text(encoding="utf-8")
     (source,) = re.findall(r"<!-- example: dataset plugin -->\n```python\n(.*?)```", tutorial, re.S)
     install(monkeypatch, {"dcfkit_tc128": source})
     root = tmp_path / "Temple-color-128"

@@ -17,7 +17,7 @@ from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.errors import InputError
 
 SEQ = make_sequence(n_frames=6, seed=4)  # 360x480 frames, the target at 148,179 36x22
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture

@@ -34,7 +34,7 @@ from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset
 from dcfkit.running.evaluation import run_one_pass
 
-OCTAVE_RUNS = Path(__file__).parent / "data" / "authors_octave"
+OCTAVE_RUNS = Path(__file__).parents[1] / "data" / "authors_octave"
 UAV = ("uav123_10fps", "UAV123_10fps")
 FAITHFUL = ("arcf", "autotrack")  # shipped configs that are their authors' code
 # AutoTrack's occlusion test divides by its last response map, whose values near zero are
@@ -164,6 +164,6 @@ def test_parity_on_a_simulated_platform(shared_data, tmp_path):
            "DCFKIT_TEST_DATA": str(shared_data)}
     command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(Path(__file__)),
                "-k", "box_for_box or is_the_authors_code"]
-    run = subprocess.run(command, env=env, capture_output=True, text=True, cwd=Path(__file__).parents[1])
+    run = subprocess.run(command, env=env, capture_output=True, text=True, cwd=Path(__file__).parents[2])
     assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-2000:]
     assert "7 passed" in run.stdout, run.stdout[-2000:]

@@ -13,7 +13,7 @@ import pytest
 from dcfkit.components.features import sse_estimates
 from dcfkit.components.features.fhog_sse import acos_table
 
-HEADER = Path(__file__).resolve().parents[1] / "benchmarks" / "octave" / "portable_estimates.hpp"
+HEADER = Path(__file__).resolve().parents[3] / "benchmarks" / "octave" / "portable_estimates.hpp"
 X86 = platform.machine().lower() in ("x86_64", "amd64")
 
 

@@ -18,14 +18,14 @@ import numpy as np
 import pytest
 
 from dcfkit import cli
-from dcfkit.datasets import video
+from dcfkit.datasets import video, video_writer
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.datasets.video import open_source
 from dcfkit.errors import InputError
 
 SEQ = make_sequence(n_frames=20, size=(120, 160), target=(16, 20), distractor=False, seed=3)
 BOX = ",".join(str(v) for v in SEQ.ground_truth[0])
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def write_video(path: Path, fps: float = 10.0, frames=SEQ.frames) -> Path:
@@ -307,7 +307,7 @@ def test_the_saved_video_of_a_folder_has_the_default_rate(tmp_path):
         cv2.imwrite(str(folder / f"{i}.png"), frame)
     assert cli.main(["track", "kcf", "--frames", str(folder), f"--box={BOX}", "--out", str(tmp_path / "b.txt"),
                      "--save-video", str(tmp_path / "out.avi")]) == 0
-    assert cv2.VideoCapture(str(tmp_path / "out.avi")).get(cv2.CAP_PROP_FPS) == video.DEFAULT_FPS
+    assert cv2.VideoCapture(str(tmp_path / "out.avi")).get(cv2.CAP_PROP_FPS) == video_writer.DEFAULT_FPS
 
 
 @pytest.mark.parametrize("signame", ["SIGINT", "SIGTERM"])

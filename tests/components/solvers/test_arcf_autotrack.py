@@ -20,7 +20,7 @@ from dcfkit.numerics.fft import make_fft
 from dcfkit.numerics.response import response as linear_response
 
 FFT = make_fft("scipy")
-AUTOTRACK = str(pathlib.Path(__file__).parents[1] / "configs" / "autotrack.yaml")
+AUTOTRACK = str(pathlib.Path(__file__).parents[3] / "configs" / "autotrack.yaml")
 rng = np.random.default_rng(7)
 
 

@@ -8,7 +8,7 @@ from dcfkit.config import load_config, shipped_config_dir
 from dcfkit.config.overrides import parse_overrides
 from dcfkit.errors import ConfigError, DcfkitError, RegistryError
 
-CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 
 @pytest.mark.parametrize("name", ["strcf", "bacf", "dr2track", "kcf", "dsst"])

@@ -25,7 +25,7 @@ from dcfkit.config import load_config
 from dcfkit.config.overrides import parse_overrides
 from dcfkit.errors import ConfigError, DcfkitError, RegistryError
 
-CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 SHIPPED = sorted(CONFIGS.glob("*.yaml")) + sorted((CONFIGS / "reference").glob("*.yaml"))
 SECONDS = 3.0  # what "fast" means here: every refusal below takes milliseconds
 PEAK_BYTES = 30 * 2**20  # Python allocations of one refusal (tracemalloc's peak); a bomb wanted GBs
