@@ -14,11 +14,11 @@ from test_base import TINY, tiny_sequence
 
 import dcfkit
 from dcfkit import registry as reg
-from dcfkit.components.features import Gray
-from dcfkit.components.labels import Gaussian
+from dcfkit.components.features.gray import Gray
+from dcfkit.components.labels.gaussian import Gaussian
 from dcfkit.components.regularizers import BoxWindow
-from dcfkit.components.scale import Pyramid
-from dcfkit.components.search import MotionAware
+from dcfkit.components.scale.pyramid import Pyramid
+from dcfkit.components.search.strategies import MotionAware
 from dcfkit.components.solvers import ADMMStrcf
 from dcfkit.contracts import ContractViolation, array, pair, scalar, within_grid
 from dcfkit.running.tracking import TrackerFailure, track

@@ -34,7 +34,7 @@ def test_the_names_old_code_imported_are_the_same_objects(monkeypatch):
         from dcfkit.labels import Detection, Label
         from dcfkit.results import ResultStore
         from dcfkit.tracking import track
-    from dcfkit.components.labels import Detection as new_detection, Label as new_label
+    from dcfkit.components.labels.base import Detection as new_detection, Label as new_label
     from dcfkit.running.results import ResultStore as new_store
     from dcfkit.running.tracking import track as new_track
     assert (Detection, Label, ResultStore, track) == (new_detection, new_label, new_store, new_track)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from dcfkit import registry as reg
-from dcfkit.components.labels import Label
+from dcfkit.components.labels.base import Label
 from dcfkit.errors import ConfigError, RegistryError
 from dcfkit.params import fields, param, parse_params
 

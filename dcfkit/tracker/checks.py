@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from dcfkit.components.scale import DSST
+from dcfkit.components.scale.dsst import DSST
 from dcfkit.contracts import ContractViolation
 from dcfkit.errors import ConfigError, InputError, shown
 from dcfkit.limits import SAMPLE_PIXELS_VARIABLE, sample_budget

@@ -19,9 +19,9 @@ from typing import Any, Mapping
 import cv2
 import numpy as np
 
-from dcfkit.components.features import extract_stack
-from dcfkit.components.labels import Detection, gaussian_label
-from dcfkit.components.scale import scale_limits
+from dcfkit.components.features.base import extract_stack
+from dcfkit.components.labels.base import Detection, gaussian_label
+from dcfkit.components.scale.base import scale_limits
 from dcfkit.config import load_config
 from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.contracts import naming_the_frame

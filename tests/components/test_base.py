@@ -15,10 +15,10 @@ from hypothesis import strategies as st
 import dcfkit
 from dcfkit import registry as reg
 from dcfkit.components.base import base_of, contract_problems
-from dcfkit.components.features import Feature
-from dcfkit.components.labels import Label
+from dcfkit.components.features.base import Feature
+from dcfkit.components.labels.base import Label
 from dcfkit.components.regularizers import SpatialRegularizer, TemporalRegularizer
-from dcfkit.components.search import Search
+from dcfkit.components.search.base import Search
 from dcfkit.components.solvers import Solver
 from dcfkit.config.slots import KINDS
 from dcfkit.datasets.synthetic import make_sequence

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from dcfkit.components.regularizers import BoxWindow, Crop, SmoothWindow
-from dcfkit.components.search import Fixed, MotionAware
+from dcfkit.components.search.strategies import Fixed, MotionAware
 
 
 def test_motion_aware_search_centres_on_the_last_position_plus_the_last_displacement():

@@ -14,11 +14,12 @@ import numpy as np
 import pytest
 
 import dcfkit
-from dcfkit.components.features import Gray
+from dcfkit.components.features.gray import Gray
 from dcfkit.components.features.fhog import fhog
-from dcfkit.components.labels import Detection, DistractorRepressed, authors_distractors, regional_maxima
+from dcfkit.components.labels.distractors import DistractorRepressed, authors_distractors, regional_maxima
+from dcfkit.components.labels.base import Detection
 from dcfkit.components.regularizers import target_mask
-from dcfkit.components.scale import DSST
+from dcfkit.components.scale.dsst import DSST
 from dcfkit.components.solvers import ADMMParams, admm
 from dcfkit.numerics.fft import make_fft
 from dcfkit.numerics.patches import resize_auto, round_half_away, whole_pixel_crop, whole_pixel_sample

@@ -4,8 +4,8 @@ import pytest
 
 import dcfkit
 from dcfkit.analysis.metrics import score_sequence
-from dcfkit.components.features import Feature
-from dcfkit.components.labels import Label, gaussian_label
+from dcfkit.components.features.base import Feature
+from dcfkit.components.labels.base import Label, gaussian_label
 from dcfkit.contracts import checked
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.errors import InputError, TrackingError
@@ -145,8 +145,8 @@ def test_initial_box_errors_say_what_is_wrong(sequence):
 
 
 def test_labels_stay_finite_for_a_vanishing_sigma():
-    from dcfkit.components.labels import gaussian_label
-    from dcfkit.components.scale import DSST
+    from dcfkit.components.labels.base import gaussian_label
+    from dcfkit.components.scale.dsst import DSST
 
     g = gaussian_label((8, 8), 1e-300)  # σ² underflows to 0: used to give NaN at the peak
     assert g[0, 0] == 1 and g.sum() == 1

@@ -8,6 +8,7 @@ directory. A ``.npy``/``.mat`` file can be named instead (``colornames.table_pat
 """
 from __future__ import annotations
 
+import dataclasses
 import functools
 import glob
 import hashlib
@@ -16,8 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
+from dcfkit.components.features.base import Feature
 from dcfkit.errors import ConfigError, clip, shown
 from dcfkit.opencv_check import contrib_advice
+from dcfkit.params import param
 
 SHAPE = (32768, 10)
 SHA256 = "e6a0a45f68cf5880d018f9e2f82dff180e992296d335b0fa8eb253b9db403ec0"
@@ -140,3 +143,27 @@ def load_table(path: str = "") -> np.ndarray:
     except OSError:
         pass  # a read-only home only costs the next process a re-read
     return table
+
+
+class ColorNames(Feature):
+    """The 10-D normalised Color Names (van de Weijer et al. 2009), averaged over each cell."""
+
+    name = "colornames"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        table_path: str = param("", "a .npy/.mat CN table; empty: read it from the installed OpenCV")
+
+        def validate(self):
+            return table_path_problem(self.table_path) if self.table_path else None
+
+    def channels(self) -> int:
+        return 10
+
+    def extract(self, patch, cell_size):
+        from dcfkit.components.features.kernels import colornames_cells  # numba, compiled on first use
+
+        table = load_table(self.params.table_path)
+        out = np.empty((table.shape[1], patch.shape[0] // cell_size, patch.shape[1] // cell_size), np.float32)
+        colornames_cells(np.ascontiguousarray(patch), table, cell_size, out)
+        return out

@@ -38,11 +38,15 @@ more than the arithmetic on them.
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 from collections import OrderedDict
 from functools import lru_cache
 
 import numpy as np
+
+from dcfkit.components.features.base import Feature
+from dcfkit.params import param
 
 __all__ = ["ARITHMETICS", "fhog", "fhog_channels"]
 
@@ -287,3 +291,44 @@ def _normalise(hist: np.ndarray, n_orients: int, clip: float, cell_size: int, ws
     kernels.texture(clipped, np.float32(_TEXTURE_SCALE), out[no:])
     out = out.reshape(no + 4, n, hb, wb)
     return out[:, 0][None] if n == 1 else np.ascontiguousarray(out.transpose(1, 0, 2, 3))
+
+
+MAX_ORIENTS = 36  # fhog's bins of 5 degrees
+
+
+MIN_CLIP = 1e-6
+
+
+class FHOG(Feature):
+    """Felzenszwalb HOG: 18 signed + 9 unsigned orientation bins + 4 texture channels."""
+
+    name = "fhog"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        # at most MAX_ORIENTS: 3 channels each, the size of the maps and the solver's time; clip at least
+        # MIN_CLIP: a smaller one keeps only which bins are empty, or rounds to float32's 0
+        n_orients: int = param(9, "unsigned orientation bins (signed ones: twice as many)", ge=2, le=MAX_ORIENTS)
+        clip: float = param(0.2, "truncation of the normalised histograms", ge=MIN_CLIP, le=1)
+        soft_orientation: bool = param(False, "split each gradient between the two nearest orientation bins "
+                                              "(false: nearest bin only, as Piotr's fhog used by STRCF/BACF)")
+        channel_order: str = param("bgr", "which colour channel's gradient a pixel takes when two are equally "
+                                   "strong: the first of 'bgr' (OpenCV's order) or of 'rgb' (MATLAB's: the "
+                                   "authors' code)", choices=("bgr", "rgb"))
+        arithmetic: str = param("exact", "'exact' square roots and arctan, or the estimates and acos table of "
+                                "Piotr's compiled gradientMex that the authors' MATLAB runs: 'sse' the same on every "
+                                "machine, 'sse_cpu' this processor's (x86 only)", choices=ARITHMETICS)
+
+        def validate(self):
+            """gradientMex's arithmetic only with soft_orientation false."""
+            if self.arithmetic != "exact" and self.soft_orientation:
+                return (f"arithmetic {self.arithmetic!r} (Piotr's gradientMex) bins orientations hard: "
+                        "set soft_orientation false")
+
+    def channels(self) -> int:
+        return 3 * self.params.n_orients + 4
+
+    def extract(self, patch, cell_size):
+        p = self.params
+        return fhog(patch, cell_size=cell_size, n_orients=p.n_orients, clip=p.clip, soft_orientation=p.soft_orientation,
+                    channel_order=p.channel_order, arithmetic=p.arithmetic)

@@ -59,7 +59,7 @@ class SpatialRegularizer(Component, declares="regularizer"):
 
     def adapt(self, w2: np.ndarray, detection) -> np.ndarray:
         """The w² for this frame's training, given the one in force and the frame's
-        :class:`dcfkit.components.labels.Detection`: (H, W) float32 as ``weights_squared``'s. Fixed: ``w2``."""
+        :class:`dcfkit.components.labels.base.Detection`: (H, W) float32 as ``weights_squared``'s. Fixed: ``w2``."""
         return w2
 
 

@@ -60,5 +60,5 @@ class Solver(Component, declares="solver"):
         return linear_response(hf, samples, shape, fft)
 
     def observe(self, detection) -> None:
-        """What the detection of this frame saw (a :class:`dcfkit.components.labels.Detection`), before the
+        """What the detection of this frame saw (a :class:`dcfkit.components.labels.base.Detection`), before the
         frame's ``train``; the built-in ADMM solvers keep nothing of it (ARCF's keeps the map)."""

@@ -4,7 +4,9 @@ import hashlib
 import numpy as np
 import pytest
 
-from dcfkit.components.features import ColorNames, Gray, cell_average
+from dcfkit.components.features.colornames import ColorNames
+from dcfkit.components.features.gray import Gray
+from dcfkit.components.features.base import cell_average
 from dcfkit.components.features import colornames as cn
 from dcfkit.errors import ConfigError
 

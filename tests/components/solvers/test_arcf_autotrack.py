@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import dcfkit
-from dcfkit.components.labels import Detection, gaussian_label
+from dcfkit.components.labels.base import Detection, gaussian_label
 from dcfkit.components.regularizers import GlobalVariation, LocalVariation, response_variation, target_mask
 from dcfkit.components.solvers import ADMMArcf, ADMMAutoTrack, AutoTrackParams, admm
 from dcfkit.components.solvers.arcf import ARCFParams

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import dcfkit
-from dcfkit.components.labels import gaussian_label
+from dcfkit.components.labels.base import gaussian_label
 from dcfkit.components.solvers import KernelParams, KernelRidge, Ridge, RidgeParams, kernel_correlation
 from dcfkit.components.solvers.kcf import squared_norm
 from dcfkit.config import load_config

@@ -1,0 +1,40 @@
+"""Gray level, averaged per cell."""
+from __future__ import annotations
+
+import dataclasses
+
+import cv2
+import numpy as np
+
+from dcfkit.components.features.base import Feature, cell_average
+from dcfkit.params import param
+
+# rgb2gray's weights of R, G, B in MATLAB and Octave, applied to the unrounded colour values
+MATLAB_GRAY_WEIGHTS = (0.298936, 0.587043, 0.114021)
+
+
+class Gray(Feature):
+    """Gray level in [-0.5, 0.5], averaged over each cell."""
+
+    name = "gray"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        conversion: str = param("opencv", "'opencv': cv2's BGR2GRAY, rounded to whole gray levels; 'matlab': "
+                                "rgb2gray of the unrounded values, as the authors' get_colorspace",
+                                choices=("opencv", "matlab"))
+
+    def channels(self) -> int:
+        return 1
+
+    def extract(self, patch, cell_size):
+        if self.params.conversion == "matlab":
+            # products summed in one fixed order (a BLAS matmul's order depends on the processor)
+            r, g, b = (np.float32(w) for w in MATLAB_GRAY_WEIGHTS)
+            pixels = patch.astype(np.float32)
+            gray = (pixels[..., 0] * b + pixels[..., 1] * g) + pixels[..., 2] * r
+        else:
+            gray = cv2.cvtColor(patch, cv2.COLOR_BGR2GRAY).astype(np.float32)
+        gray *= 1.0 / 255.0
+        gray -= 0.5
+        return cell_average(gray, cell_size)[None]

@@ -1,0 +1,139 @@
+"""The DSST's scale filter (Danelljan et al., BMVC 2014), as DR²Track and STRCF use it."""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from dcfkit.components.features.fhog import ARITHMETICS, fhog
+from dcfkit.components.scale.base import MAX_SCALES, MIN_LAM, ScaleEstimator, _check_span, _factors
+from dcfkit.numerics.patches import resize_auto, sample, sampler, whole_pixel_crop
+from dcfkit.params import param
+
+
+class DSST(ScaleEstimator):
+    """Discriminative scale filter: fHOG of S target-sized samples, a 1-D filter over scale."""
+
+    name = "dsst"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        n_scales: int = param(33, "number of scales in the scale filter", ge=3, le=MAX_SCALES)
+        step: float = param(1.03, "ratio between neighbouring scales", gt=1)
+        # beyond 10, σ is over 1.7 n_scales: a flat label, every scale alike
+        sigma_factor: float = param(0.25, "label width: σ = n_scales / √33 · sigma_factor", gt=0, le=10)
+        # the scale filter divides by Σ|x̂|² + λ, which may be λ alone: λ bounds its gain, 1/λ. The floor
+        # is the ADMM penalty's (solvers.PENALTY_RANGE), far below Σ|x̂|² of a textured sample (7 to 3000
+        # on the synthetic sequence, where the default 0.01 is a thousandth of the least); subnormals
+        # (1e-320) were accepted
+        lam: float = param(0.01, "λ: regularization of the scale filter", ge=MIN_LAM, le=1e10)
+        learning_rate: float = param(0.025, "interpolation rate of the scale model", gt=0, le=1)
+        model_max_area: int = param(512, "largest area (pixels) of a scale sample", ge=1, le=10000)
+        cell_size: int = param(4, "fHOG cell size of the scale samples", ge=1, le=16)
+        model_size: str = param("base_target", "size of a scale sample: 'base_target' the target at the search "
+                                "patch's resolution (at least 2x2 cells), 'image_target' its size in image pixels "
+                                "(the authors' init_scale: floored; at least 2 cells, where theirs allows 2 px)",
+                                choices=("base_target", "image_target"))
+        sampling: str = param("working_patch", "'working_patch': the largest region cut once and each scale "
+                              "resampled from it; 'whole_pixel': each scale cropped in whole pixels and resized "
+                              "(the authors' get_scale_sample)", choices=("working_patch", "whole_pixel"))
+        window: str = param("hann_interior", "window over the scales: 'hann_interior' hann(S+2) without its zero "
+                            "ends, or 'hann' hann(S) (the authors')", choices=("hann_interior", "hann"))
+        channel_order: str = param("bgr", "colour channel order deciding fHOG's ties (see fhog.channel_order)",
+                                   choices=("bgr", "rgb"))
+        fhog_arithmetic: str = param("exact", "fHOG's arithmetic (see fhog.arithmetic)", choices=ARITHMETICS)
+        model_update: str = param("reextract", "samples the model learns from after a scale change: 'reextract' at "
+                                  "the new scale, or 'shift' the search samples moved by the scale change, missing "
+                                  "ones extracted (DR²Track's shift_sample_scale, which leaves those at the large "
+                                  "end unwindowed)", choices=("reextract", "shift"))
+
+        def validate(self):
+            """step ** ((n_scales - 1) / 2) <= 10: the scales span at most x10 each way."""
+            return _check_span(self.n_scales, self.step)
+
+    def init(self, image, centre, base_target, scale, limits):
+        super().init(image, centre, base_target, scale, limits)
+        p = self.params
+        n = p.n_scales
+        self.factors = _factors(n, p.step)
+        offsets = np.arange(n) - (n - 1) // 2
+        sigma = n / np.sqrt(33) * p.sigma_factor
+        with np.errstate(over="ignore"):  # a σ so small that σ² underflows: a delta label, not NaN
+            self.label_f = np.fft.fft(np.exp(-0.5 * offsets**2 / max(sigma**2, np.finfo(float).tiny)))
+        self.window = np.hanning(n + 2)[1:-1] if p.window == "hann_interior" else np.hanning(n)
+        authors = p.model_size == "image_target"  # init_scale: the target in image pixels, floored
+        # the authors' target_sz is whole pixels; base_target * scale rebuilds it up to rounding
+        # (10.999999999999998 for 11), which the floor below must not see
+        target = np.round(self.base_target * scale, 9) if authors else self.base_target
+        area = float(np.prod(target))
+        shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
+        # at least 2 cells, which fhog needs (init_scale allows 2 px: a side under 8 px differs)
+        self.model_size = np.maximum((np.floor if authors else np.round)(target * shrink),
+                                     2 * p.cell_size).astype(int)
+        # the working patch and its resampling to each scale keep their geometry every frame
+        span = self.factors[-1] / self.factors[0]
+        self.work_size = np.ceil(self.model_size * span).astype(int)
+        middle = (self.work_size - 1) / 2
+        self.resamplers = [sampler(self.work_size, middle, self.work_size * (f / self.factors[-1]), self.model_size)
+                           for f in self.factors]
+        self.num = self.den = None
+        self._learn(np.fft.fft(self._samples(image, centre, scale), axis=1))
+
+    def _samples(self, image, centre, scale, which=None, windowed=True) -> np.ndarray:
+        """(D, S) windowed fHOG of the S scale samples around ``centre`` (``which``: only these
+        scales, (D, len(which))).
+
+        'working_patch': the largest region is cut from the image and resampled once to a
+        small working patch (fine enough for the smallest scale); every scale sample is resized
+        from it. 'whole_pixel': floor(target x scale) whole pixels per scale, resized."""
+        which = range(len(self.factors)) if which is None else which
+        if self.params.sampling == "whole_pixel":
+            patches = np.stack([
+                resize_auto(whole_pixel_crop(image, centre, np.maximum(np.floor(self.base_target * (scale * f)), 2)),
+                            self.model_size) for f in self.factors[list(which)]])
+        else:
+            work = sample(image, centre, self.base_target * scale * self.factors[-1], self.work_size)
+            patches = np.stack([self.resamplers[i](work) for i in which])
+        feats = fhog(patches, cell_size=self.params.cell_size, batch=True, channel_order=self.params.channel_order,
+                     arithmetic=self.params.fhog_arithmetic)
+        feats = feats.reshape(len(patches), -1).T
+        return feats * self.window[None, list(which)] if windowed else feats
+
+    def _learn(self, xsf: np.ndarray) -> None:
+        """Update the scale model with the (D, S) spectrum of the scale samples."""
+        num = self.label_f[None, :] * xsf.conj()
+        den = np.einsum("ds,ds->s", xsf, xsf.conj()).real
+        if self.num is None:
+            self.num, self.den = num, den
+        else:
+            lr = self.params.learning_rate
+            self.num = (1 - lr) * self.num + lr * num
+            self.den = (1 - lr) * self.den + lr * den
+
+    def update(self, image, centre, scale):
+        xs = self._samples(image, centre, scale)
+        xsf = np.fft.fft(xs, axis=1)
+        resp = np.fft.ifft(np.einsum("ds,ds->s", self.num, xsf) / (self.den + self.params.lam)).real
+        best = int(np.argmax(resp))
+        new_scale = float(np.clip(scale * self.factors[best], *self.limits))
+        if self.params.model_update == "shift":
+            xsf = np.fft.fft(self._shifted(xs, best - (len(self.factors) - 1) // 2, image, centre, new_scale), axis=1)
+        elif new_scale != scale:  # learn from samples at the new scale; unchanged: the same samples
+            xsf = np.fft.fft(self._samples(image, centre, new_scale), axis=1)
+        self._learn(xsf)
+        return new_scale
+
+    def _shifted(self, xs, step, image, centre, new_scale) -> np.ndarray:
+        """DR²Track's shift_sample_scale: scale k of the new samples is scale k + ``step`` of the
+        search samples ``xs`` (re-windowed), the ones beyond the ends are extracted at
+        ``new_scale``; those at the large end (``step`` > 0) are left unwindowed, as theirs."""
+        if step == 0:
+            return xs
+        n, win = len(self.factors), self.window
+        out = np.zeros_like(xs)
+        source = np.arange(n) + step
+        kept = (source >= 0) & (source < n)
+        out[:, kept] = xs[:, source[kept]] / (win[source[kept]] + 1e-5) * win[kept]
+        fresh = np.flatnonzero(~kept)
+        out[:, fresh] = self._samples(image, centre, new_scale, fresh, windowed=step < 0)
+        return out
