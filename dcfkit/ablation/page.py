@@ -7,7 +7,6 @@ from typing import Any, Mapping
 
 from dcfkit.ablation.sensitivity import METRICS, sensitivity
 from dcfkit.ablation.spec import AblationSpec, format_value, job_dir
-from dcfkit.analysis.protocols import get_protocol
 from dcfkit.analysis.report_html import evaluation_sections, sections
 from dcfkit.analysis.report_html.provenance import this_process
 from dcfkit.running.provenance import LABEL_KEYS
@@ -100,7 +99,7 @@ def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[s
     folders = {v: job_dir(out, spec.dataset, k) for v, k in keys.items()}
     extra = [("spec", str(spec.path)), ("dataset", f"{spec.dataset} at {spec.root}")]
     return {"title": f"dcfkit ablation {spec.name}: {sections.count(len(trackers), 'variant')} on {spec.dataset}",
-            "protocol": get_protocol(scores["protocol"]["name"]).describe(),
+            "protocol": scores.protocol.describe(),
             "subtitle": f"{spec.description + ' · ' if spec.description else ''}"
                         f"{sections.count(len(sequences), 'sequence')}, {sum(len(s) for s in sequences)} frames",
             "trackers": trackers,

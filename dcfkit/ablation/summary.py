@@ -13,7 +13,7 @@ from dcfkit.analysis.plots import plot_curves
 from dcfkit.analysis.protocols import DEFAULT, get_protocol
 from dcfkit.analysis.report import json_ready
 from dcfkit.analysis.report_html import PAGE, write_page
-from dcfkit.analysis.scoring import evaluate
+from dcfkit.analysis.scoring import evaluate, protocol_record
 from dcfkit.analysis.tables import format_table
 from dcfkit.datasets import Sequence
 from dcfkit.running.files import atomic_write, read_json
@@ -48,7 +48,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     ``got10k`` also ao, sr50, sr75), fps the mean per-sequence frames per second of tracker
     time (:mod:`dcfkit.analysis.report`). A job without result (failed or not run) is scored as a
     total failure and counted in ``failed``. Returns ``{"overall", "per_sequence", "jobs",
-    "files", "protocol"}`` (the protocol's name).
+    "files", "protocol"}`` (the :class:`~dcfkit.analysis.protocols.Protocol`).
     """
     out = Path(out)
     jobs = jobs if jobs is not None else expand(spec, sequences)
@@ -56,19 +56,19 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     status, stored = _stored_runs(spec, out, sequences, jobs)
     with _quiet(logging.getLogger("dcfkit.analysis.report")):  # missing runs are counted in 'failed'
         scores = evaluate({variant: stored[key] for variant, key in keys.items()}, sequences, protocol=protocol)
-    protocol = scores["protocol"]["name"]
+    protocol = scores.protocol
     overall, per_sequence = _rows(scores, keys, sequences, status, protocol)
     job_rows = [{"variant": j.variant, "sequence": j.sequence, "key": j.key,
                  "status": status[j.key, j.sequence][0], "error": status[j.key, j.sequence][1]} for j in jobs]
     info = {"spec": str(spec.path), "name": spec.name, "description": spec.description,
-            "protocol": scores["protocol"],
+            "protocol": protocol_record(scores.protocol),
             "dataset": spec.dataset, "root": str(spec.root), "sequences": [s.name for s in sequences],
             "overall": overall, "per_sequence": per_sequence, "jobs": job_rows,
             "grid": ({"base": spec.grid.base, "mode": spec.grid.mode,
                       "parameters": {k: {"label": lab, "values": vals}
                                      for k, (lab, vals) in spec.grid.parameters.items()}}
                      if spec.grid else None)}
-    files = _write_files(spec, out, info, scores["curves"], protocol)
+    files = _write_files(spec, out, info, scores.curves, protocol)
     page = ablation_page(spec, out, info, summary_columns("summary", protocol), scores, sequences,
                          {variant: stored[key] for variant, key in keys.items()}, keys)
     files.append(write_page(page, out / PAGE))
@@ -100,12 +100,12 @@ def _rows(scores: dict, keys: dict, sequences: list[Sequence], status: dict, pro
     overall = sorted(({"variant": r["tracker"], "precision": r["precision"], "auc": r["auc"],
                        **{k: r[k] for k in extra}, "fps": r["fps"],
                        "sequences": r["sequences"], "failed": r["missing"], "key": keys[r["tracker"]]}
-                      for r in scores["overall"]), key=lambda r: order[r["variant"]])
+                      for r in scores.overall), key=lambda r: order[r["variant"]])
     per_sequence = sorted(({"variant": r["tracker"], "sequence": r["sequence"], "precision": r["precision"],
                             "auc": r["auc"], **{k: r[k] for k in extra}, "fps": r["fps"],
                             "frames": frames[r["sequence"]],
                             "status": status[keys[r["tracker"]], r["sequence"]][0]}
-                           for r in scores["per_sequence"]),
+                           for r in scores.per_sequence),
                           key=lambda r: (order[r["variant"]], seq_order[r["sequence"]]))
     return overall, per_sequence
 

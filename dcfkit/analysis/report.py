@@ -26,7 +26,7 @@ import numpy as np
 
 from dcfkit.analysis.plots import plot_curves
 from dcfkit.analysis.protocols import Protocol
-from dcfkit.analysis.scoring import evaluate
+from dcfkit.analysis.scoring import Evaluation, evaluate
 from dcfkit.analysis.tables import columns, format_rows, format_table, score_line
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
 from dcfkit.errors import clip, shown
@@ -134,25 +134,25 @@ def report_file_names(sequences: Seq[Sequence]) -> list[str]:
             + [f"{p}.{ext}" for p in plots for ext in ("png", "svg")])
 
 
-def write_files(evaluation: dict, report_dir: Path) -> list[Path]:
+def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
     """The tables, ``report.json`` and plots of :func:`write_report` from ``evaluation``."""
     paths = []
-    protocol = evaluation["protocol"]["name"]
+    protocol = evaluation.protocol.name
 
     def text(name, content):
         path = report_dir / name
         atomic_write(path, content)
         paths.append(path)
 
-    tables = REPORT_TABLES if evaluation["per_attribute"] else REPORT_TABLES[:2]
+    tables = REPORT_TABLES if evaluation.per_attribute else REPORT_TABLES[:2]
     for stem in tables:
         for fmt, ext in TABLE_FORMATS:
-            text(f"{stem}.{ext}", format_table(evaluation[stem], fmt, columns(stem, protocol), protocol))
-    text("report.json", json.dumps(json_ready(evaluation), indent=1) + "\n")
+            text(f"{stem}.{ext}", format_table(getattr(evaluation, stem), fmt, columns(stem, protocol), protocol))
+    text("report.json", json.dumps(json_ready(evaluation.as_record()), indent=1) + "\n")
     for kind in ("precision", "success"):
-        paths += plot_curves(evaluation["curves"], kind, report_dir / kind, protocol=protocol)
-    for attr, curves in evaluation["attribute_curves"].items():
-        n = evaluation["attributes"][attr]
+        paths += plot_curves(evaluation.curves, kind, report_dir / kind, protocol=protocol)
+    for attr, curves in evaluation.attribute_curves.items():
+        n = evaluation.attributes[attr]
         title = f"Success plots of OPE - {ATTRIBUTE_NAMES.get(attr, attr)} ({n})"
         paths += plot_curves(curves, "success", report_dir / f"success_{attr}", title=title, protocol=protocol)
     return paths

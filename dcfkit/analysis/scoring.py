@@ -1,6 +1,8 @@
 """Scoring trackers' results on sequences under one protocol: per sequence, per attribute, overall, with the curves."""
 from __future__ import annotations
 
+import dataclasses
+
 import logging
 import math
 from collections import Counter
@@ -30,9 +32,41 @@ def _mean_or_none(values) -> float | None:
     return float(np.mean(values)) if values else None
 
 
+@dataclasses.dataclass(frozen=True)
+class Evaluation:
+    """The scores of :func:`evaluate`, with the :class:`Protocol` they were scored under.
+
+    ``overall``, ``per_sequence`` and ``per_attribute`` are row lists (trackers best first by
+    the protocol's ranking score); ``curves`` maps tracker -> averaged curves,
+    ``attribute_curves`` attribute -> tracker -> curves, ``attributes`` attribute -> number of
+    sequences; ``platforms`` tracker -> ``[[platform, sequences], ...]``.
+    """
+
+    protocol: Protocol
+    overall: list[dict]
+    per_sequence: list[dict]
+    per_attribute: list[dict]
+    curves: dict
+    attribute_curves: dict
+    attributes: dict[str, int]
+    thresholds: dict
+    settings: dict
+    platforms: dict
+
+    def as_record(self) -> dict:
+        """The scores as plain data (``report.json``): the protocol as its name, title and source."""
+        record = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        record["protocol"] = protocol_record(self.protocol)
+        return record
+
+
+def protocol_record(protocol: Protocol) -> dict:
+    return {"name": protocol.name, "title": protocol.title, "source": protocol.source}
+
+
 def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
              include_first: bool = True, weighting: str | None = None,
-             protocol: str | Protocol | None = None) -> dict:
+             protocol: str | Protocol | None = None) -> Evaluation:
     """Score ``results`` (tracker -> sequence name -> boxes) on ``sequences`` under ``protocol``
     (by default the rules of the benchmark's published tables,
     :func:`~dcfkit.datasets.benchmark_protocol`: LaSOT's for LaSOT, the OTB toolkit's for UAV123).
@@ -74,18 +108,12 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
         for t in ranked for s in sequences]
     attributes = _attribute_members(sequences)
     per_attribute, attribute_curves = _per_attribute(attributes, per_seq, ranked, weighting, proto)
-    return {
-        "protocol": {"name": proto.name, "title": proto.title, "source": proto.source},
-        "overall": overall,
-        "per_sequence": per_sequence,
-        "per_attribute": per_attribute,
-        "curves": curves,
-        "attribute_curves": attribute_curves,
-        "attributes": {a: len(n) for a, n in attributes.items()},
-        "thresholds": _thresholds(proto),
-        "settings": {"protocol": proto.name, "include_first": include_first, "weighting": weighting},
-        "platforms": {t: _platforms(res.values()) for t, res in results.items()},
-    }
+    return Evaluation(
+        protocol=proto, overall=overall, per_sequence=per_sequence, per_attribute=per_attribute,
+        curves=curves, attribute_curves=attribute_curves,
+        attributes={a: len(n) for a, n in attributes.items()}, thresholds=_thresholds(proto),
+        settings={"protocol": proto.name, "include_first": include_first, "weighting": weighting},
+        platforms={t: _platforms(res.values()) for t, res in results.items()})
 
 
 def _platforms(results: Iterable) -> list[list]:

@@ -89,7 +89,7 @@ def _scores(args: argparse.Namespace, tracker: str, sequences: list) -> str:
                 f"(a test split); submit {Path(args.out) / tracker}/<sequence>.txt to the benchmark's server "
                 f"(docs/evaluation.md, 'Test splits')")
     scores = evaluate({tracker: load_results(args.out, tracker, sequences)}, sequences, protocol=args.protocol)
-    return score_line(scores["overall"][0], scores["protocol"]["name"])
+    return score_line(scores.overall[0], scores.protocol.name)
 
 
 def add_report_arguments(parser: argparse.ArgumentParser) -> None:
@@ -119,13 +119,13 @@ def run_report(args: argparse.Namespace) -> int:
     write = write_html_report if args.html else score_and_write
     evaluation, paths = write(args.out, sequences, trackers, args.report_dir, include_first=not args.skip_first,
                               weighting="frame" if args.frame_weighted else None, protocol=args.protocol)
-    protocol = evaluation["protocol"]["name"]  # --protocol, else the benchmark's
-    print(format_table(evaluation["overall"], args.format, columns("overall", protocol), protocol), end="")
+    protocol = evaluation.protocol.name  # --protocol, else the benchmark's
+    print(format_table(evaluation.overall, args.format, columns("overall", protocol), protocol), end="")
     if args.format == "table":
-        for tracker, rows in evaluation["platforms"].items():
+        for tracker, rows in evaluation.platforms.items():
             lines = [f"{line} ({n} sequences)" if len(rows) > 1 else line for line, n in rows]
             print(f"{tracker} platform: {'; '.join(lines)}")
-        recorded = {line for rows in evaluation["platforms"].values() for line, _ in rows} - {"not recorded"}
+        recorded = {line for rows in evaluation.platforms.values() for line, _ in rows} - {"not recorded"}
         if len(recorded) > 1:
             print(f"warning: these results come from {len(recorded)} platforms; their boxes may part where a float "
                   f"decision is close (docs/architecture.md)", file=sys.stderr)

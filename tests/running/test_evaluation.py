@@ -437,22 +437,22 @@ def test_evaluate_scores_and_sorting(seqs):
     perfect = {s.name: gt_boxes() for s in seqs}
     shifted = {s.name: gt_boxes(x0=32.0) for s in seqs[:2]}  # far off; "c" missing
     ev = report.evaluate({"shifted": shifted, "perfect": perfect}, seqs)
-    top, low = ev["overall"]
+    top, low = ev.overall
     assert top["tracker"] == "perfect" and top["auc"] == pytest.approx(20 / 21) and top["precision"] == 1
     # otb scores frame 1 with the ground truth: 1/6 on a and b; c has no results: 0
     assert low["tracker"] == "shifted" and low["missing"] == 1 and low["precision"] == pytest.approx(1 / 9)
-    assert ev["protocol"]["name"] == "otb" and ev["settings"]["weighting"] == "sequence"
+    assert ev.protocol.name == "otb" and ev.settings["weighting"] == "sequence"
     assert top["fps"] is None  # plain arrays carry no timing
-    assert len(ev["per_sequence"]) == 6
-    sv = [r for r in ev["per_attribute"] if r["attribute"] == "SV"]
-    assert [r["sequences"] for r in sv] == [2, 2] and ev["attributes"] == {"SV": 2, "FM": 1}
-    np.testing.assert_allclose(ev["curves"]["perfect"]["precision"], 1.0)
-    md = tables.format_rows(ev["overall"], "markdown", tables.OVERALL_COLUMNS)
+    assert len(ev.per_sequence) == 6
+    sv = [r for r in ev.per_attribute if r["attribute"] == "SV"]
+    assert [r["sequences"] for r in sv] == [2, 2] and ev.attributes == {"SV": 2, "FM": 1}
+    np.testing.assert_allclose(ev.curves["perfect"]["precision"], 1.0)
+    md = tables.format_rows(ev.overall, "markdown", tables.OVERALL_COLUMNS)
     assert md.splitlines()[0] == "| tracker | auc | precision | norm_precision | fps | sequences | missing |"
     assert "| perfect | 0.952 | 1.000 | 1.000 | - | 3 | 0 |" in md
-    csv_text = tables.format_rows(ev["overall"], "csv", tables.OVERALL_COLUMNS)
+    csv_text = tables.format_rows(ev.overall, "csv", tables.OVERALL_COLUMNS)
     assert csv_text.splitlines()[1].startswith("perfect,0.952380952")
-    assert "perfect" in tables.format_rows(ev["overall"], "table")
+    assert "perfect" in tables.format_rows(ev.overall, "table")
 
 
 def test_short_results_are_scored_as_failures_with_a_warning(seqs, caplog):
@@ -460,7 +460,7 @@ def test_short_results_are_scored_as_failures_with_a_warning(seqs, caplog):
     with caplog.at_level("WARNING"):
         ev = report.evaluate({"short": short}, seqs[:1])
     assert f"'short', sequence 'a': 2 boxes for {N_FRAMES} frames" in caplog.text
-    assert ev["overall"][0]["precision"] == pytest.approx(2 / N_FRAMES)  # not copied forward by otb's rule
+    assert ev.overall[0]["precision"] == pytest.approx(2 / N_FRAMES)  # not copied forward by otb's rule
 
 
 def test_write_report_files(tmp_path, seqs):
@@ -572,7 +572,7 @@ def test_real_sequence_with_opencv_kcf(tmp_path, shared_data):
     first = (tmp_path / "kcf" / "boat1.txt").read_text().splitlines()[0]
     assert first == "393.000,328.000,155.000,319.000"  # the annotation file's first line
     ev = report.evaluate({"kcf": load_results(tmp_path, "kcf", [short])}, [short])
-    assert ev["overall"][0]["auc"] > 0.5 and ev["overall"][0]["fps"] > 0
+    assert ev.overall[0]["auc"] > 0.5 and ev.overall[0]["fps"] > 0
 
 
 class DyingTracker(DriftTracker):

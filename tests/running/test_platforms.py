@@ -80,7 +80,7 @@ def test_sidecars_reports_and_compare_name_the_platform(tmp_path, seqs, capsys):
     assert any(d.startswith("cpu: ") for d in res["platform_differences"])
     scores = evaluate({"here": load_results(tmp_path / "here", "drift", seqs),
                        "there": load_results(tmp_path / "there", "drift", seqs)}, seqs)
-    assert scores["platforms"]["there"] == [[platforms.describe(RECORD), 3]]
+    assert scores.platforms["there"] == [[platforms.describe(RECORD), 3]]
 
     _with_platform(there, None)  # e.g. files made before platforms were recorded
     assert compare_folders(here, there, seqs)["platform_differences"] == []

@@ -61,7 +61,7 @@ def test_a_result_file_cut_short_is_never_scored_and_is_recomputed(tmp_path, seq
     assert sorted(loaded) == ["b", "c"]
     assert "a.txt is not the file its run wrote" in caplog.text
     scores = report.evaluate({"drift": loaded}, seqs)
-    assert scores["overall"][0]["missing"] == 1
+    assert scores.overall[0]["missing"] == 1
     # recomputed: the next run redoes exactly that sequence
     counter = Counter()
     summary = run_one_pass(CONFIG, seqs, tmp_path, make_tracker=counter, progress=False)

@@ -5,7 +5,7 @@ from pathlib import Path
 from typing import Iterable, Mapping
 from typing import Sequence as Seq
 
-from dcfkit.analysis.protocols import Protocol, get_protocol
+from dcfkit.analysis.protocols import Protocol
 from dcfkit.analysis.report import columns, default_report_dir, score_folders, write_files
 from dcfkit.analysis.report_html import sections
 from dcfkit.analysis.report_html.document import write_page
@@ -19,14 +19,14 @@ def evaluation_sections(evaluation: Mapping, sequences: Seq[Sequence], results: 
                         trackers: Seq[str]) -> list[dict]:
     """The plots, the per-attribute and per-sequence tables and the frames of an evaluation
     (:func:`dcfkit.analysis.scoring.evaluate`), in page order, for ``trackers``."""
-    protocol = evaluation["protocol"]["name"]
+    protocol = evaluation.protocol.name
     out = [sections.curve_charts(evaluation, trackers), sections.attribute_charts(evaluation, trackers)]
-    if evaluation["per_attribute"]:
-        out.append(sections.table("per-attribute", "Per attribute", evaluation["per_attribute"],
+    if evaluation.per_attribute:
+        out.append(sections.table("per-attribute", "Per attribute", evaluation.per_attribute,
                                   columns("per_attribute", protocol), trackers, filterable=True))
-    out.append(sections.table("per-sequence", "Per sequence", evaluation["per_sequence"],
+    out.append(sections.table("per-sequence", "Per sequence", evaluation.per_sequence,
                               columns("per_sequence", protocol), trackers, filterable=True))
-    out.append(sections.gallery(sequences, results, trackers, evaluation["per_sequence"]))
+    out.append(sections.gallery(sequences, results, trackers, evaluation.per_sequence))
     return [s for s in out if s is not None]
 
 
@@ -34,10 +34,10 @@ def report_page(evaluation: Mapping, sequences: Seq[Sequence], results: Mapping[
                 folders: Mapping[str, Path]) -> dict:
     """The page of a report on ``sequences``: ``results`` (tracker -> sequence -> result) read
     from ``folders`` (tracker -> folder) and scored as ``evaluation``."""
-    protocol = get_protocol(evaluation["protocol"]["name"])
-    trackers = [r["tracker"] for r in evaluation["overall"]]
+    protocol = evaluation.protocol
+    trackers = [r["tracker"] for r in evaluation.overall]
     datasets = sorted({s.dataset for s in sequences if s.dataset})
-    overall = sections.table("overall", "Overall", evaluation["overall"], columns("overall", protocol.name),
+    overall = sections.table("overall", "Overall", evaluation.overall, columns("overall", protocol.name),
                              trackers, note="Click a column's name to sort by it.")
     on = ", ".join(datasets) or "sequences"
     return {"title": f"dcfkit report: {sections.count(len(trackers), 'tracker')} on {on}",

@@ -69,18 +69,18 @@ def _finite(value) -> bool:
 
 def curve_charts(evaluation: Mapping, trackers: Seq[str]) -> dict:
     """The success, precision and normalized precision plots of all sequences."""
-    charts = [curve_chart(kind, evaluation["curves"], evaluation["thresholds"][kind], trackers)
+    charts = [curve_chart(kind, evaluation.curves, evaluation.thresholds[kind], trackers)
               for kind in ("success", "precision", "norm_precision")]
     return {"kind": "charts", "id": "plots", "title": "Success and precision plots", "charts": charts}
 
 
 def attribute_charts(evaluation: Mapping, trackers: Seq[str]) -> dict | None:
     """One small success plot per attribute, or None when the sequences have none."""
-    if not evaluation["attribute_curves"]:
+    if not evaluation.attribute_curves:
         return None
-    charts = [curve_chart("success", curves, evaluation["thresholds"]["success"], trackers, small=True,
+    charts = [curve_chart("success", curves, evaluation.thresholds["success"], trackers, small=True,
                           title=f"{ATTRIBUTE_NAMES.get(attr, attr)} ({evaluation['attributes'][attr]})")
-              for attr, curves in evaluation["attribute_curves"].items()]
+              for attr, curves in evaluation.attribute_curves.items()]
     return {"kind": "charts", "id": "attribute-plots", "title": "Success plots per attribute", "charts": charts}
 
 
