@@ -15,7 +15,7 @@ OLD_NAMES = sorted(p.stem for p in (Path(dcfkit.__file__).parent / "_moved").glo
 
 def test_every_module_the_old_docs_showed_has_its_old_name():
     shown = {"tracking", "results", "solvers", "regularizers", "labels", "features", "search", "scale", "report",
-             "evaluation", "baselines", "synthetic", "platforms", "compare", "protocols", "runner", "report_html"}
+             "evaluation", "baselines", "synthetic", "platforms", "compare", "runner", "report_html"}
     assert shown <= set(OLD_NAMES)
 
 
@@ -34,7 +34,8 @@ def test_the_names_old_code_imported_are_the_same_objects(monkeypatch):
         from dcfkit.labels import Detection, Label
         from dcfkit.results import ResultStore
         from dcfkit.tracking import track
-    from dcfkit.components.labels.base import Detection as new_detection, Label as new_label
+    from dcfkit.components.labels.base import Detection as new_detection
+    from dcfkit.components.labels.base import Label as new_label
     from dcfkit.running.results import ResultStore as new_store
     from dcfkit.running.tracking import track as new_track
     assert (Detection, Label, ResultStore, track) == (new_detection, new_label, new_store, new_track)

@@ -18,7 +18,7 @@ from dcfkit.running.runner import RunTask, execute, usable_cores
 def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str = "local",
                  scheduler: str | None = None, progress: bool = True, protocol: str | None = None) -> dict:
     """Run every job of ``spec`` not already done under ``out``, then write the summary
-    (scored under ``protocol``, see :mod:`dcfkit.analysis.protocols`; by default the rules of the
+    (scored under ``protocol``, see :mod:`dcfkit.protocols`; by default the rules of the
     benchmark's published tables, :func:`~dcfkit.datasets.benchmark_protocol`).
 
     ``executor`` is ``"local"`` (``jobs`` spawned worker processes, default: the usable

@@ -8,7 +8,7 @@ from typing import Any, Mapping
 
 from dcfkit.ablation.spec import AblationSpec, format_value
 from dcfkit.analysis.plots import save_figure
-from dcfkit.analysis.protocols import DEFAULT
+from dcfkit.protocols import DEFAULT
 
 METRICS = (("precision", "precision@20", "C3", "o", "#d62728"), ("auc", "AUC", "C0", "s", "#1f77b4"))
 

@@ -10,12 +10,12 @@ from dcfkit.ablation.page import ablation_page
 from dcfkit.ablation.sensitivity import plot_sensitivity, sensitivity_file
 from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir
 from dcfkit.analysis.plots import plot_curves
-from dcfkit.analysis.protocols import DEFAULT, get_protocol
 from dcfkit.analysis.report import json_ready
 from dcfkit.analysis.report_html import PAGE, write_page
 from dcfkit.analysis.scoring import evaluate, protocol_record
 from dcfkit.analysis.tables import format_table
 from dcfkit.datasets import Sequence
+from dcfkit.protocols import DEFAULT, get_protocol
 from dcfkit.running.files import atomic_write, read_json
 from dcfkit.running.results import ResultStore
 
@@ -48,7 +48,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     ``got10k`` also ao, sr50, sr75), fps the mean per-sequence frames per second of tracker
     time (:mod:`dcfkit.analysis.report`). A job without result (failed or not run) is scored as a
     total failure and counted in ``failed``. Returns ``{"overall", "per_sequence", "jobs",
-    "files", "protocol"}`` (the :class:`~dcfkit.analysis.protocols.Protocol`).
+    "files", "protocol"}`` (the :class:`~dcfkit.protocols.Protocol`).
     """
     out = Path(out)
     jobs = jobs if jobs is not None else expand(spec, sequences)

@@ -6,7 +6,7 @@ that of published result files) for the sequences present in both folders and in
 given dataset, and returns one row per sequence:
 
 * ``precision``, ``auc`` of the results and ``precision_ref``, ``auc_ref`` of the reference,
-  scored against the ground truth under a scoring protocol (:mod:`dcfkit.analysis.protocols`), and
+  scored against the ground truth under a scoring protocol (:mod:`dcfkit.protocols`), and
   the differences ``d_precision``, ``d_auc`` (results minus reference);
 * ``iou``: the mean over frames of the IoU between the two box series (continuous boxes;
   a frame where both files hold the same values counts 1, also when both are NaN; a frame
@@ -31,9 +31,9 @@ from typing import Iterable
 import numpy as np
 
 from dcfkit.analysis import metrics
-from dcfkit.analysis.protocols import Protocol, get_protocol
 from dcfkit.datasets import DatasetError, Sequence, benchmark_protocol, read_boxes, scored_sequences
 from dcfkit.errors import clip, shown
+from dcfkit.protocols import Protocol, get_protocol
 from dcfkit.running import platforms
 from dcfkit.running.results import ResultStore, result_files
 

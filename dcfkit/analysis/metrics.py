@@ -3,7 +3,7 @@
 The rules that decide which frames count and what a frame scores (out-of-view ground
 truth, failed predictions, the first frame, centre and IoU conventions, thresholds,
 averaging) differ between the toolkits that published tracking results; they live in
-:mod:`dcfkit.analysis.protocols`, one :class:`~dcfkit.analysis.protocols.Protocol` per toolkit: ``otb``
+:mod:`dcfkit.protocols`, one :class:`~dcfkit.protocols.Protocol` per toolkit: ``otb``
 (the OTB / UAV123 MATLAB toolkit, the default), ``pysot`` and ``got10k``. This module turns
 a protocol's per-frame values into curves and scores, and averages sequences.
 
@@ -30,8 +30,8 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
-from dcfkit.analysis.protocols import DEFAULT, Protocol, get_protocol
 from dcfkit.errors import shown
+from dcfkit.protocols import DEFAULT, Protocol, get_protocol
 
 __all__ = [
     "as_boxes",

@@ -7,8 +7,8 @@ from pathlib import Path
 from typing import Mapping
 from typing import Sequence as Seq
 
-from dcfkit.analysis.protocols import DEFAULT, Protocol, get_protocol
 from dcfkit.analysis.scoring import _sort_key, _thresholds
+from dcfkit.protocols import DEFAULT, Protocol, get_protocol
 from dcfkit.running.files import atomic_write
 
 #: title, axis labels, score and legend place of the plots of each curve kind

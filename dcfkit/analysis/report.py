@@ -3,7 +3,7 @@
 :func:`evaluate` turns results into plain dicts: one row per tracker (``overall``), per
 tracker and sequence (``per_sequence``) and per tracker and attribute
 (``per_attribute``), plus the averaged curves for plotting. Scores follow a named scoring
-protocol of :mod:`dcfkit.analysis.protocols` (default ``otb``, the OTB / UAV123 MATLAB toolkit),
+protocol of :mod:`dcfkit.protocols` (default ``otb``, the OTB / UAV123 MATLAB toolkit),
 and every output names it: a first line of the text and Markdown tables, a ``protocol``
 column of the CSV tables, ``protocol`` in ``report.json`` and the plot titles. Averages
 weigh sequences as the protocol does unless ``weighting`` says otherwise. A tracker's
@@ -25,11 +25,11 @@ from typing import Sequence as Seq
 import numpy as np
 
 from dcfkit.analysis.plots import plot_curves
-from dcfkit.analysis.protocols import Protocol
 from dcfkit.analysis.scoring import Evaluation, evaluate
 from dcfkit.analysis.tables import columns, format_rows, format_table, score_line
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
 from dcfkit.errors import clip, shown
+from dcfkit.protocols import Protocol
 from dcfkit.running.files import atomic_write, ensure_writable
 from dcfkit.running.results import import_results, load_results
 

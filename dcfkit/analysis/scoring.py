@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import dataclasses
-
 import logging
 import math
 from collections import Counter
@@ -11,9 +10,9 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from dcfkit.analysis import metrics
-from dcfkit.analysis.protocols import Protocol, get_protocol
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, benchmark_protocol, scored_sequences
 from dcfkit.errors import shown
+from dcfkit.protocols import Protocol, get_protocol
 from dcfkit.running import platforms
 
 log = logging.getLogger(__name__)

@@ -7,8 +7,8 @@ import math
 from typing import Mapping
 from typing import Sequence as Seq
 
-from dcfkit.analysis.protocols import DEFAULT, Protocol, get_protocol
 from dcfkit.errors import shown
+from dcfkit.protocols import DEFAULT, Protocol, get_protocol
 
 _TABLES = {  # the columns before and after a protocol's scores (Protocol.score_keys)
     "overall": (("tracker",), ("fps", "sequences", "missing")),
@@ -79,7 +79,7 @@ def _is_number(value) -> bool:
     return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool))
 
 
-#: how scores are named in text (a score key of :class:`~dcfkit.analysis.protocols.Protocol` -> its name)
+#: how scores are named in text (a score key of :class:`~dcfkit.protocols.Protocol` -> its name)
 SCORE_LABELS = {"ao": "AO", "sr50": "SR@0.5", "sr75": "SR@0.75", "auc": "AUC", "precision": "precision",
                 "norm_precision": "normalized precision"}
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from dcfkit.analysis.protocols import DEFAULT, PROTOCOLS
 from dcfkit.errors import DcfkitError, shown
+from dcfkit.protocols import DEFAULT, PROTOCOLS
 
 
 def parse_box(text: str) -> tuple[float, ...]:

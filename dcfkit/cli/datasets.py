@@ -7,8 +7,8 @@ import json
 import sys
 import warnings
 
-from dcfkit.analysis.protocols import DEFAULT
 from dcfkit.datasets import layouts
+from dcfkit.protocols import DEFAULT
 from dcfkit.registry import PluginWarning, get_registry
 
 

@@ -10,7 +10,7 @@ Conventions
   back, so they score unchanged in the MATLAB / pysot toolkits.
 * A row of NaN marks a frame where the target is out of view (absent). Such rows are kept
   (the frame still exists and the tracker still sees it); each scoring protocol of
-  :mod:`dcfkit.analysis.protocols` says how they count. A test split that publishes frame 1's box
+  :mod:`dcfkit.protocols` says how they count. A test split that publishes frame 1's box
   only has NaN rows after it and ``ground_truth_withheld`` set (:func:`scored_sequences`).
 * Images are decoded by OpenCV (:func:`read_frame`): ``(H, W, 3) uint8``, **BGR** channel order.
 

@@ -12,9 +12,9 @@ import enum
 from pathlib import Path
 from typing import Callable, Iterable, Iterator
 
-from dcfkit.analysis.protocols import PROTOCOLS
 from dcfkit.datasets.base import DatasetError, Sequence
 from dcfkit.errors import RegistryError, shown
+from dcfkit.protocols import PROTOCOLS
 
 Loader = Callable[..., list[Sequence]]  # (root, sequences=None) -> list[Sequence]
 Detector = Callable[[Path], int]  # root -> Evidence (or bool)
@@ -77,7 +77,7 @@ def register_layout(name: str, load: Loader, description: str, *,
     one line saying what is on disk (``ROOT/<seq>/img/%05d.jpg, ...``); ``detect(root)``
     returns an :class:`Evidence` (or a bool) for :func:`detect_dataset`, which skips layouts
     without one. ``protocol`` names the scoring protocol of the toolkit that published the
-    benchmark's tables (:mod:`dcfkit.analysis.protocols`), which scores its sequences unless
+    benchmark's tables (:mod:`dcfkit.protocols`), which scores its sequences unless
     ``--protocol`` says otherwise; by default the OTB toolkit's. A name or alias that is
     already registered is a :class:`RegistryError`.
     """

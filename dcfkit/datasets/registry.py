@@ -8,10 +8,10 @@ import warnings
 from pathlib import Path
 from typing import Iterable, Iterator, Mapping
 
-from dcfkit.analysis.protocols import DEFAULT
 from dcfkit.datasets.base import DatasetError, Sequence, require_root
 from dcfkit.datasets.layout import _EVIDENCE_TEXT, _LAYOUTS, _NAMES, Evidence, Layout, Loader, _key
 from dcfkit.errors import RegistryError, describe_error, shown
+from dcfkit.protocols import DEFAULT
 from dcfkit.registry import PluginWarning, get_registry
 
 
@@ -126,7 +126,7 @@ def _evidence(layout: Layout, root: Path) -> Evidence:
 def benchmark_protocol(sequences: Iterable[Sequence]) -> str:
     """The protocol that scored the published tables of the benchmark ``sequences`` come from:
     their layout's ``protocol`` (LaSOT's toolkit for LaSOT, GOT-10k's for GOT-10k), else the
-    OTB toolkit's (:data:`dcfkit.analysis.protocols.DEFAULT`), also for sequences of several benchmarks
+    OTB toolkit's (:data:`dcfkit.protocols.DEFAULT`), also for sequences of several benchmarks
     that disagree."""
     found = set()
     for name in {s.dataset for s in sequences}:

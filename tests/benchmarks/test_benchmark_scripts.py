@@ -1,17 +1,39 @@
-"""The benchmark scripts run end to end on a few synthetic frames, so that a change cannot
-break them unseen (stages.py and speed.py had: a renamed tracker function, a grey frame the
-tracker now refuses as blank). platform_noise.py has its own test; compare_speed.py (two git
-checkouts) and restarts.py (a dataset and a spec) are too large to run here. Nothing about
-their speed is asserted: that is what they print."""
+"""Every benchmark script runs end to end on a few synthetic frames, so that a change cannot
+break one unseen (stages.py and speed.py had: a renamed tracker function, a grey frame the
+tracker now refuses as blank). platform_noise.py has its own test. Nothing about their speed
+is asserted: that is what they print."""
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
 
+import cv2
 import pytest
 
+from dcfkit.datasets.synthetic import make_sequence
+from dcfkit.datasets.uav123_layout import uav123_sequence_table
+
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
+ROOT = BENCHMARKS.parent
+
+
+@pytest.fixture
+def synthetic_uav123(tmp_path) -> Path:
+    """A UAV123@10fps root whose one sequence (wakeboard7's frame range) is synthetic."""
+    root = tmp_path / "UAV123_10fps"
+    folder, first, last = uav123_sequence_table()["UAV123_10fps"]["wakeboard7"]
+    seq = make_sequence(n_frames=last - first + 1, size=(120, 160), target=(16, 20))
+    frames = root / "data_seq" / "UAV123_10fps" / folder
+    frames.mkdir(parents=True)
+    for i, image in enumerate(seq.frames):
+        cv2.imwrite(str(frames / f"{first + i:06d}.jpg"), image)
+    anno = root / "anno" / "UAV123_10fps"
+    anno.mkdir(parents=True)
+    (anno / "wakeboard7.txt").write_text("".join(f"{x + 1:.2f},{y + 1:.2f},{w:.2f},{h:.2f}\n"
+                                                 for x, y, w, h in seq.ground_truth))
+    return root
 
 
 def run(script: str, *args: str, tmp_path: Path) -> str:
@@ -50,3 +72,33 @@ def test_same_boxes_saves_then_finds_no_change(tmp_path):
     out = run("same_boxes.py", "--root", str(tmp_path / "none"), "--configs", "kcf", "--compare", "boxes.npz",
               tmp_path=tmp_path)
     assert out.rstrip().endswith("1 of 1 runs identical"), out
+
+
+@pytest.mark.slow
+def test_compare_speed_of_a_checkout_with_itself(tmp_path, synthetic_uav123):
+    out = run("compare_speed.py", str(ROOT), "--root", str(synthetic_uav123), "--configs", "kcf",
+              "--json", "speed.json", tmp_path=tmp_path)
+    assert "wakeboard7" in out and "median over sequences" in out
+    assert json.loads((tmp_path / "speed.json").read_text())["median"]["kcf"]["ratio"] > 0
+
+
+@pytest.mark.slow
+def test_restarts(tmp_path, synthetic_uav123):
+    spec = tmp_path / "spec.yaml"
+    spec.write_text("name: smoke\ndataset: uav123_10fps\nvariants:\n  plain: kcf\n")
+    out = run("restarts.py", str(spec), "--root", str(synthetic_uav123), "--starts", "2", "--json", "restarts.json",
+              tmp_path=tmp_path)
+    segments = json.loads((tmp_path / "restarts.json").read_text())
+    assert [(s["variant"], s["first"], "error" in s) for s in segments] == [("plain", 0, False), ("plain", 33, False)]
+    assert "segments  lost  precision  AUC" in out
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("octave") is None, reason="GNU Octave is not installed (apt-get install octave)")
+@pytest.mark.skipif(not (ROOT.parent / "shared" / "reference").is_dir(), reason="no ../shared/reference (the authors' code)")
+def test_authors_octave(tmp_path, synthetic_uav123):
+    done = subprocess.run(["bash", str(BENCHMARKS / "authors_octave.sh"), "strcf", str(synthetic_uav123),
+                           str(tmp_path / "out"), "wakeboard7"], capture_output=True, text=True, timeout=1200)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    boxes = (tmp_path / "out" / "UAV123_10fps" / "wakeboard7.txt").read_text().splitlines()
+    assert len(boxes) == 67 and all(len(line.split(",")) == 4 for line in boxes)

@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 import dcfkit
-from dcfkit.components.features.gray import Gray
 from dcfkit.components.features.fhog import fhog
-from dcfkit.components.labels.distractors import DistractorRepressed, authors_distractors, regional_maxima
+from dcfkit.components.features.gray import Gray
 from dcfkit.components.labels.base import Detection
+from dcfkit.components.labels.distractors import DistractorRepressed, authors_distractors, regional_maxima
 from dcfkit.components.regularizers import target_mask
 from dcfkit.components.scale.dsst import DSST
 from dcfkit.components.solvers import ADMMParams, admm

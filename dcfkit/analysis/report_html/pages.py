@@ -5,12 +5,12 @@ from pathlib import Path
 from typing import Iterable, Mapping
 from typing import Sequence as Seq
 
-from dcfkit.analysis.protocols import Protocol
 from dcfkit.analysis.report import columns, default_report_dir, score_folders, write_files
 from dcfkit.analysis.report_html import sections
 from dcfkit.analysis.report_html.document import write_page
 from dcfkit.analysis.report_html.provenance import this_process
 from dcfkit.datasets import Sequence, scored_sequences
+from dcfkit.protocols import Protocol
 
 PAGE = "report.html"
 

@@ -4,10 +4,10 @@ import hashlib
 import numpy as np
 import pytest
 
+from dcfkit.components.features import colornames as cn
+from dcfkit.components.features.base import cell_average
 from dcfkit.components.features.colornames import ColorNames
 from dcfkit.components.features.gray import Gray
-from dcfkit.components.features.base import cell_average
-from dcfkit.components.features import colornames as cn
 from dcfkit.errors import ConfigError
 
 # SHA-256 of the 32768x10 float32 normalised CN table compiled into opencv-contrib-python-headless,

@@ -3,9 +3,9 @@ import numpy as np
 import pytest
 
 import dcfkit
-from dcfkit.components.labels.gaussian import Gaussian
-from dcfkit.components.labels.distractors import DistractorRepressed
 from dcfkit.components.labels.base import Detection, Label, gaussian_label
+from dcfkit.components.labels.distractors import DistractorRepressed
+from dcfkit.components.labels.gaussian import Gaussian
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.errors import ConfigError
 from dcfkit.numerics.response import local_maxima

@@ -3,9 +3,9 @@ import cv2
 import numpy as np
 import pytest
 
+from dcfkit.components.scale.base import scale_limits
 from dcfkit.components.scale.dsst import DSST
 from dcfkit.components.scale.pyramid import Pyramid
-from dcfkit.components.scale.base import scale_limits
 
 
 def zoomed(image, centre, factor):

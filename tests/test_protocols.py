@@ -17,8 +17,8 @@ import pytest
 
 from dcfkit import cli
 from dcfkit.analysis import metrics
-from dcfkit.analysis.protocols import PROTOCOLS, get_protocol
 from dcfkit.datasets import read_boxes
+from dcfkit.protocols import PROTOCOLS, get_protocol
 
 NAN = [math.nan] * 4
 SQ13 = math.sqrt(13)
