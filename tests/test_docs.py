@@ -120,3 +120,14 @@ def test_a_contract_range_is_listed_for_a_field_that_declares_none():
     registry.register(type("Plain", (TemporalRegularizer,), {"name": "plain_theta", "Params": Params}))
     (row,) = [r for r in components.component_rows(registry, ["regularizer"]) if r["name"] == "plain_theta"]
     assert row["params"][0]["bounds"] == "[0, 1e+10]" and row["checks"] == ""
+
+
+def test_the_architecture_page_opens_with_every_layer_and_stays_short():
+    text = (DOCS / "architecture.md").read_text(encoding="utf-8")
+    picture = text.split("```")[1]
+    package = DOCS.parent / "dcfkit"
+    layers = {p.parent.name for p in package.glob("*/__init__.py")} - {"_moved"}
+    modules = {p.name for p in package.glob("*.py")} - {"__init__.py"}
+    assert all(f"{name}/" in picture for name in layers), sorted(n for n in layers if f"{n}/" not in picture)
+    assert all(name in text[:text.index("## ")] for name in modules), modules
+    assert len(text.encode()) <= 20_000

@@ -147,7 +147,7 @@ def cli_reference() -> str:
             f"- `{VARIANTS_VARIABLE}=N`: the most variants of an ablation spec (default {MAX_VARIANTS}; `ablate "
             "--max-variants` wins).",
             f"- `{IMAGE_PIXELS_VARIABLE}`, `{SAMPLE_PIXELS_VARIABLE}`: the memory budgets of one image and of one "
-            "frame's samples ([architecture.md](architecture.md)).\n"]
+            "frame's samples ([hardening.md](hardening.md)).\n"]
     return "\n".join(out).rstrip() + "\n"
 
 

@@ -27,7 +27,7 @@ TRACK_NOTES = f"""--video reads a file, a camera (0 is the first), a stream URL 
 time, and each box is printed (or written to --out) as soon as its frame is tracked: Ctrl-C or
 SIGTERM ends a run on an endless source and keeps every box. A camera that stops giving frames
 ends the run with an error, and so does a stream that gives none for {READ_TIMEOUT:g} s; a stream that ends
-is said on stderr. The Motion JPEG damage check (docs/architecture.md) reads a file's frames
+is said on stderr. The Motion JPEG damage check (docs/hardening.md) reads a file's frames
 twice, so it applies to files only. --select opens a matplotlib window: it needs a display and
 tkinter (on Debian or Ubuntu: apt install python3-tk) or another window backend."""
 

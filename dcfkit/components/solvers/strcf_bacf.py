@@ -18,7 +18,7 @@ all but vanishes). ADMM splits h = v and alternates (per frame, from h = u = 0, 
 
 The multiplier is kept unscaled (u = γ z of the paper), the standard form when γ changes
 between iterations; the paper's update z ← z + γ(v − h) agrees with it while γ = 1
-(docs/architecture.md). Spectra are half spectra (rfft2) of real maps, shape
+(docs/reference.md). Spectra are half spectra (rfft2) of real maps, shape
 (C, H, W//2+1) complex64; every equation above is per frequency, so solving on the half
 spectrum is exact.
 """
