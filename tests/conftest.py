@@ -41,7 +41,9 @@ def pytest_collection_modifyitems(config, items):
 
 
 @pytest.fixture(autouse=True)
-def _no_external_plugins_unless_asked(monkeypatch):
+def _single_threaded_openmp(monkeypatch):
+    """OpenMP (numba, BLAS) in one thread unless the environment says otherwise: tests run
+    side by side on two cores, and their subprocesses inherit it."""
     monkeypatch.setenv("OMP_NUM_THREADS", os.environ.get("OMP_NUM_THREADS", "1"))
 
 

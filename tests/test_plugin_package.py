@@ -114,3 +114,66 @@ def test_every_marked_block_names_a_plugin_file():
     text = TUTORIAL.read_text(encoding="utf-8")
     marked = re.findall(r"<!-- file: plugins/dcfkit-context-label/(\S+) -->", text)
     assert sorted(set(marked)) == sorted(QUOTED)
+
+
+# A plugin as the 0.5 tutorial taught it: the module paths of 0.5 and 0.6, one hook, register(cls).
+LEGACY_PLUGIN = '''
+import dataclasses
+
+import numpy as np
+
+from dcfkit.labels import Detection, Label
+from dcfkit.params import param
+from dcfkit.registry import hookimpl
+
+
+class Raised(Label):
+    """The label raised by a constant (a 0.5-style plugin)."""
+
+    name = "legacy_raised"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        level: float = param(0.0, "added to the Gaussian", ge=0, le=1)
+
+    def make(self, g: np.ndarray, detection: Detection | None):
+        return (g + np.float32(self.params.level)).astype(np.float32), np.zeros((0, 2), int)
+
+
+@hookimpl
+def dcfkit_register_components(registry):
+    registry.register(Raised)
+'''
+
+
+@pytest.fixture(scope="module")
+def legacy_site(pip_install_copy, tmp_path_factory) -> Path:
+    project = tmp_path_factory.mktemp("legacy") / "dcfkit-legacy-raised"
+    (project / "legacy_raised").mkdir(parents=True)
+    (project / "legacy_raised" / "__init__.py").write_text(LEGACY_PLUGIN)
+    (project / "pyproject.toml").write_text(
+        '[build-system]\nrequires = ["setuptools>=61"]\nbuild-backend = "setuptools.build_meta"\n\n'
+        '[project]\nname = "dcfkit-legacy-raised"\nversion = "0.5.0"\n\n'
+        '[project.entry-points.dcfkit]\nraised = "legacy_raised"\n\n'
+        '[tool.setuptools]\npackages = ["legacy_raised"]\n')
+    return pip_install_copy(project)
+
+
+@pytest.mark.install
+def test_a_plugin_written_for_0_5_loads_unchanged(legacy_site, tmp_path):
+    rows = labels(run(legacy_site, "components", "--kind", "label", "--format", "json"))
+    assert rows["legacy_raised"]["provider"] == "raised (legacy_raised)"
+    seq = make_sequence(n_frames=8)
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    for i, image in enumerate(seq.frames):
+        assert cv2.imwrite(str(frames / f"{i + 1:06d}.png"), image)
+    config = tmp_path / "legacy.yaml"
+    config.write_text("base: strcf\nname: legacy\nlabel: {name: legacy_raised, level: 0.1}\n")
+    box = ",".join(f"{v:.2f}" for v in seq.ground_truth[0])
+    done = run(legacy_site, "track", str(config), "--frames", str(frames), "--box", box, "--out", str(tmp_path / "b.txt"))
+    assert done.returncode == 0 and "legacy: 8 frames" in done.stderr, done.stderr
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(legacy_site), str(ROOT)])}
+    warned = subprocess.run([sys.executable, "-W", "always::DeprecationWarning", "-c", "import legacy_raised"],
+                            env=env, capture_output=True, text=True, timeout=60)
+    assert warned.returncode == 0 and "dcfkit.labels moved to dcfkit.components.labels in dcfkit 0.7" in warned.stderr
