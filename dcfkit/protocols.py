@@ -1,90 +1,11 @@
-"""Scoring protocols: the per-frame rules of the toolkits that published tracking results.
+"""Scoring protocols: the per-frame rules of the toolkits that published tracking results:
+``otb`` (the OTB / UAV123 MATLAB toolkit), ``lasot``, ``pysot`` and ``got10k``.
+docs/evaluation.md ("Scoring protocols") sets each rule beside the toolkit file it follows.
 
 A :class:`Protocol` says, for one sequence, which frames are in the denominator and what
-overlap and centre error each frame gets; :mod:`dcfkit.analysis.metrics` turns those into curves
-and averages them. Every protocol sees the boxes as the result and annotation files hold
-them: ``(N, 4) float64`` ``(x, y, w, h)``, **1-based** (some rules test ``x > 0``).
-
-A frame's *overlap* passes success threshold ``t`` when ``overlap > t`` and its *error*
-passes precision threshold ``t`` when ``error <= t``; so overlap ``-1`` never succeeds,
-error ``-1`` always does, and NaN fails both.
-
-``otb`` (the default): the OTB / UAV123 MATLAB toolkit (``calcSeqErrRobust.m``,
-``calcRectInt.m``, ``genPerfMat.m``, ``plotDrawSave.m``), which computed the published
-UAV123 tables.
-
-* Every frame is in the denominator.
-* A ground truth is *out of view* unless all four values are ``> 0`` (so NaN rows, empty
-  boxes, and boxes with ``x <= 0`` or ``y <= 0`` in 1-based pixels): overlap -1 and error
-  -1, whatever the prediction.
-* Frame 1's prediction is replaced by the ground truth.
-* From frame 2 on, a prediction is replaced by the previous frame's (already replaced)
-  prediction -- for frame 2 the file's frame-1 box, NaN or not, since the ground-truth copy
-  comes after the loop -- when MATLAB's ``if (isnan(r) | r(3)<=0 | r(4)<=0) & ~isnan(gt)`` holds: the
-  condition is a 1x4 vector and ``if`` needs all four true, so it holds when the
-  prediction is all NaN or has ``w <= 0`` or ``h <= 0``, *and* no ground-truth value is
-  NaN. A prediction with only some values NaN, or one in a frame whose ground truth is
-  NaN, is kept (and its NaN fails every threshold, or is copied forward).
-* Centre ``x + (w-1)/2``; IoU by ``calcRectInt``: right edge ``x + w - 1``, intersection
-  width ``max(0, min(right) - max(left) + 1)``, with MATLAB's ``min``/``max`` ignoring NaN.
-* Thresholds ``0:0.05:1`` (overlap) and ``0:50`` px; precision at 20 px, AUC the mean of
-  the success curve. Sequences weigh equally, and a sequence whose curve is all zero is
-  left out of that curve's mean (``aa(sum(aa,2)>eps,:)``).
-
-``lasot``: the LaSOT evaluation toolkit (``calc_seq_err_robust.m``, ``eval_tracker.m``,
-``calc_rect_int.m``, ``plot_draw_save.m``), the OTB toolkit with absent frames.
-
-* ``otb``'s rules, except for a NaN ground-truth row: the target is absent (LaSOT's
-  full-occlusion or out-of-view flags; the toolkit reads them from ``annos/absent``). The
-  toolkit removes absent frames before scoring but divides by all frames, so an absent frame
-  counts in the denominator and fails every threshold: overlap -1 and error +inf. (pytracking's
-  LaSOT analysis and pysot's LaSOT benchmark do the same.)
-* A failed prediction is repaired when it has one NaN value or more (``sum(isnan(r))``; the
-  OTB toolkit wants four), or ``w <= 0`` or ``h <= 0``; in an absent frame too, where the
-  toolkit's ground truth holds numbers, never NaN.
-
-``pysot``: pysot's ``toolkit/evaluation/ope_benchmark.py`` and ``toolkit/utils/statistics.py``.
-
-* Every frame is in the denominator; the first frame is scored as the file has it; failed
-  predictions are kept (NaN fails every threshold).
-* Overlap -1 when the ground truth's ``w > 0 and h > 0`` does not hold (NaN included);
-  otherwise the IoU of continuous boxes (``[x, x+w)``), clipped to [0, 1].
-* Error -1 when the ground truth's centre ``x + (w-1)/2`` is not ``> 0`` on both axes (NaN,
-  and ``(0, 0, 0, 0)`` whose centre is -0.5); otherwise the Euclidean centre distance. So
-  an empty but finite ground truth away from the origin is scored in precision.
-* Normalized error: both centres divided by the ground truth's ``(w, h) + 1e-16``, same
-  ``> 0`` test; thresholds ``arange(0, 51) / 100``, score at index 20 (0.2).
-* Thresholds ``arange(0, 1.05, 0.05)`` and ``arange(0, 51)``; precision at index 20, AUC the
-  mean of the success curve; sequences weigh equally.
-* pysot's ``UAVDataset`` passes the rows of its ``UAV123.json`` on unchanged (NaN rows
-  included) and has no ``absent`` flags (only LaSOT has them: its absent frames are dropped
-  from the frames but not from ``n_frame``), so every UAV123 frame counts as above.
-
-``got10k``: got10k-toolkit's ``got10k/experiments/got10k.py`` (GOT-10k ``val`` report) and
-``got10k/utils/metrics.py``.
-
-* The first frame is not scored (``anno[1:]``). Absent frames are not scored either:
-  GOT-10k marks them with its ``cover`` flags (0: not visible), which dcfkit's GOT-10k
-  loaders turn into NaN rows, and UAV benchmarks have none, so a row with a NaN is absent
-  (also the rule of the toolkit's LaSOT and UAV123 experiments).
-* IoU of continuous boxes, ``inter / (union + eps)`` clipped to [0, 1]; an empty ground
-  truth that is not NaN is scored (IoU 0).
-* AO = mean IoU, SR@0.5 and SR@0.75 = fraction of IoU ``> 0.5`` / ``> 0.75``, success
-  curve over ``linspace(0, 1, 101)``, AUC its mean. Frames of all sequences are pooled
-  (``np.concatenate``), so long sequences weigh more.
-* Precision as the toolkit's OTB experiment: centre ``x + (w-1)/2``, thresholds 0..50 px.
-  Normalized error divides by ``max(1, w)`` and ``max(1, h)`` of the ground truth (LaSOT
-  experiment), thresholds ``linspace(0, 0.5, 51)``, score at 0.2.
-* Where dcfkit differs: a NaN prediction has IoU 0 (the toolkit's NaN would make AO NaN;
-  SR and the curve are the same either way), and boxes are not clipped to the image
-  (``bound=resolution`` of the GOT-10k report: dcfkit's metrics do not know image sizes).
-* The same toolkit's OTB, UAV123 and LaSOT experiments score differently (frame 1 replaced
-  by the ground truth, 21 overlap thresholds, per-sequence means): ``got10k`` here is the
-  GOT-10k report.
-
-Rules every protocol shares in dcfkit: rows a result file does not have (a truncated or
-missing result) fail every threshold, substituted by nothing; ``include_first=False``
-takes frame 1 out of the denominator.
+overlap and centre error each frame gets; :mod:`dcfkit.analysis.metrics` turns those into
+curves and averages them. Boxes are ``(N, 4)`` ``(x, y, w, h)``, 1-based as the files hold
+them (some rules test ``x > 0``).
 """
 from __future__ import annotations
 

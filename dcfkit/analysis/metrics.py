@@ -1,11 +1,8 @@
 """One-pass evaluation (OPE) scores under a named scoring protocol.
 
-The rules that decide which frames count and what a frame scores (out-of-view ground
-truth, failed predictions, the first frame, centre and IoU conventions, thresholds,
-averaging) differ between the toolkits that published tracking results; they live in
-:mod:`dcfkit.protocols`, one :class:`~dcfkit.protocols.Protocol` per toolkit: ``otb``
-(the OTB / UAV123 MATLAB toolkit, the default), ``pysot`` and ``got10k``. This module turns
-a protocol's per-frame values into curves and scores, and averages sequences.
+Which frames count and what a frame scores are a toolkit's rules, one
+:class:`~dcfkit.protocols.Protocol` each (:mod:`dcfkit.protocols`); this module turns a
+protocol's per-frame values into curves and scores, and averages sequences.
 
 Boxes are ``(N, 4) float64`` ``(x, y, w, h)``, **0-based** as dcfkit keeps them in memory;
 :func:`score_sequence` adds 1 to x and y before applying a protocol, because some rules

@@ -5,44 +5,12 @@
 
     ExperimentDTB70("data/DTB70").run(Tracker("strcf"))   # results/DTB70/strcf/<seq>.txt
 
-The boxes got10k writes are the boxes ``dcfkit eval strcf --dataset dtb70`` writes for the
-same sequences (to their three decimals), as long as Pillow, which got10k decodes frames
-with, and OpenCV, which dcfkit does, return the same pixels (they do for the JPEGs of the
-development data: both bundle libjpeg-turbo). What got10k 0.1.3 does, and what this adapter
-does about it:
-
-**Images.** ``Tracker.track``, the frame loop of got10k's experiments but VOT's supervised
-and real-time runs (``got10k/trackers/__init__.py``), opens each frame with
-``PIL.Image.open`` and converts any mode but ``'RGB'`` (grayscale ``'L'``, palette, RGBA)
-with ``convert('RGB')``. Those two VOT runs hand over ``Image.open``'s image unconverted,
-or with ``read_image=False`` the file's path. dcfkit takes BGR, the order of
-``cv2.imread``: the adapter converts a PIL image as ``track`` does and reverses its
-channels, reads a path with dcfkit's own :func:`~dcfkit.datasets.read_frame`, and takes a
-numpy array in got10k's order: RGB (``(H, W, 3)``) or gray (``(H, W)``). RGB given as BGR
-is no error a tracker can see: its gray and Color Names features (STRCF's, among others)
-would read other colours.
-
-**Boxes.** The datasets read their annotation files unchanged with ``np.loadtxt``
-(``got10k/datasets/otb.py``, ``uav123.py``, ``dtb70.py``, ``tcolor128.py``, ``lasot.py``,
-``got10k.py``), so for these benchmarks the box ``init`` receives is **1-based**, the OTB
-convention (GOT-10k's annotations are 1-based too, as its authors say in got-10k/toolkit
-issue 6). ``ExperimentOTB.run`` (which the DTB70, UAV123, NfS and TColor128 experiments
-inherit) writes the boxes ``update`` returns unchanged, ``%.3f``, frame 1 holding the
-initial box: the published result files of these benchmarks, and dcfkit's, are 1-based.
-Its ``report`` scores them with ``rect_iou`` and ``center_error``
-(``got10k/utils/metrics.py``), which only compare the two boxes, so a 1-based box taken
-as 0-based is scored without complaint: the tracker learns the target 1 px off in x and y.
-The adapter subtracts 1 from x and y of the box ``init`` receives and adds 1 to those
-``update`` returns; ``one_based=False`` passes boxes unchanged, for a 0-based dataset.
-
-**Sequences.** got10k calls ``init`` on the same object for each sequence: ``init`` builds
-a new dcfkit tracker from the config (read and checked once, when the adapter is made), as
-``dcfkit eval`` does per sequence, so nothing learnt on one sequence reaches the next.
-dcfkit trackers are deterministic (``is_deterministic=True``: GOT-10k's experiment then runs
-one repetition, not three).
-
-Importing this module imports got10k: without it, a :class:`ModuleNotFoundError` names the
-extra that installs it (``pip install "dcfkit[got10k]"``).
+got10k 0.1.3 hands over RGB PIL images (``got10k/trackers/__init__.py``; VOT's runs: an
+unconverted image or a path) and the annotation files' 1-based boxes (``np.loadtxt`` in
+``got10k/datasets/*.py``), writes returned boxes unchanged and calls ``init`` on one object
+for every sequence. The adapter gives dcfkit BGR and 0-based boxes, returns 1-based ones, and
+builds a new tracker at each ``init`` (docs/integrations.md has the table, and what goes wrong
+without it). Importing this module imports got10k (``pip install "dcfkit[got10k]"``).
 """
 from __future__ import annotations
 

@@ -1,32 +1,11 @@
 """The results store: one folder of per-sequence result files that cannot be silently damaged.
 
-``FOLDER/<sequence>.txt``
-    one ``x,y,w,h`` line per frame, ``%.3f``, **1-based** (1 is added to x and y), so the
-    MATLAB OTB/UAV123 toolkit and pysot read it unchanged. Frame 1 holds the initial
-    ground-truth box; a lost target is ``nan,nan,nan,nan``.
-``FOLDER/<sequence>.time``
-    tracker seconds per frame, one ``%.8f`` a line (decoding excluded; frame 1 is ``init``),
-    as the OTB and GOT-10k toolkits' ``_time.txt`` files hold them.
-``FOLDER/<sequence>.confidence``
-    one ``peak,apce`` line per frame (:mod:`dcfkit.tracker.confidence`), ``%.6g``; ``nan,nan`` for
-    frame 1 (``init``: no response), frames held as blank, and trackers without a confidence.
-``FOLDER/<sequence>.json``
-    sidecar: the run key (:func:`run_key`), the SHA-256 of the ``.txt`` as written (and of
-    the time and confidence files), per-frame tracker seconds, fps, the config, the dcfkit
-    and plugin versions. Written last: it marks the sequence as done.
-``FOLDER/<sequence>.error``
-    instead, when the tracker raised: frame (1-based), error, traceback, as JSON.
-
-Each kind of file has its own ending, and only boxes end in ``.txt``: any sequence name has
-files of its own (were ``car``'s time file ``car_time.txt``, it would be the boxes file of a
-sequence ``car_time``).
-
-Every file is written to a temporary file in the same folder and moved into place with
-``os.replace``. A result is used only when its sidecar is well formed and its ``.txt``
-still has the recorded checksum (:meth:`ResultStore.problem`): a file cut short or edited
-is never scored by ``report``, ``compare`` or the ablation summary, and ``eval``/``ablate``
-recompute it (they also require the run key of the config they run). Every write failure
-is a :class:`StoreError` naming the file.
+Per sequence: ``<seq>.txt`` (1-based ``x,y,w,h`` per frame, ``%.3f``: the toolkits' format),
+``<seq>.time``, ``<seq>.confidence``, and the sidecar ``<seq>.json`` (run key, checksums,
+config, versions), written last to mark it done; ``<seq>.error`` instead when the tracker
+raised (docs/evaluation.md, "Running", has every field). Every file is written whole or not
+at all (:mod:`dcfkit.running.files`), and a result is used only while its ``.txt`` has the
+checksum its sidecar recorded (:meth:`ResultStore.problem`).
 """
 from __future__ import annotations
 

@@ -1,27 +1,11 @@
-"""Per-frame confidence of a detection, read from its response map (read-only: no box changes).
+"""Per-frame confidence of a detection, read from its response map R (no box changes).
 
-:class:`Confidence` holds two numbers of the response map R of the chosen search scale:
-
-``peak``
-    max R, the grid maximum (not the sub-pixel value the tracker moves to). Its scale is
-    the filter's: comparable along one run, not between configs.
-``apce``
-    the average peak-to-correlation energy of Wang et al. (CVPR 2017, "Large Margin Object
-    Tracking with Circulant Feature Maps")::
-
-        APCE = |R_max - R_min|² / mean((R - R_min)²)
-
-    over the whole map. A single sharp peak on a flat floor gives a high value; a map with
-    several peaks or spread energy (occlusion, a wrong frame, drift) a low one.
-
-Why APCE rather than the peak-to-sidelobe ratio (PSR, MOSSE): the PSR needs a window around
-the peak left out of the sidelobe (11 x 11 *pixels* in MOSSE), which has no natural size in
-cells across configs whose cell sizes and map sizes differ; APCE has no parameter. Both are
-invariant to ``a * R + b`` (a > 0), so APCE compares across configs where the peak does not.
-
-Frames without a response have :data:`NO_CONFIDENCE` (both NaN): frame 1 (``init``: there is
-nothing to detect yet) and frames held as blank (``tracker.held_frames``). A flat map (every
-value equal) has APCE 0: it has no peak.
+``peak`` is max R on the grid (its scale is the filter's: comparable along one run only);
+``apce`` is the average peak-to-correlation energy of Wang et al. (CVPR 2017),
+``|R_max - R_min|² / mean((R - R_min)²)`` over the map: high for one sharp peak, low for
+several peaks or spread energy (docs/evaluation.md says why APCE, not the PSR). Frames
+without a response (frame 1, frames held as blank) have :data:`NO_CONFIDENCE`; a flat map
+has APCE 0.
 """
 from __future__ import annotations
 

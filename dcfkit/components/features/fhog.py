@@ -25,15 +25,8 @@ bin only) by default; ``soft_orientation=True`` splits each magnitude between
 the two nearest bins instead.  The all-zero 32nd "truncation" channel is not
 produced.
 
-Speed (2-core VM, one thread, best of 5): 1.05 ms for a 200x200x3 patch, 0.50 ms
-for a batch of 33 34x17x3 patches (the numpy/OpenCV formulation it replaced:
-1.66 and 0.96 ms, with bit-identical output for the cell size 4).  Gradients,
-the scatter of pixels into cells and the block normalisation are compiled loops;
-arctan2 and the texture sums stay numpy's, whose last bits decide orientation
-bins at their boundaries and match the previous output.  Intermediates live in per-thread scratch
-buffers reused by calls of the same geometry (the last 4 geometries, a few MB
-each): on this machine a page fault costs about 2 us, so fresh large arrays cost
-more than the arithmetic on them.
+The loops are compiled (:mod:`.kernels`); arctan2 and the texture sums stay numpy's, whose
+last bits decide orientation bins at their boundaries.
 """
 
 from __future__ import annotations
