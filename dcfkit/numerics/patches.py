@@ -149,7 +149,7 @@ def resize_auto(patch: np.ndarray, out) -> np.ndarray:
     width exceeds the old *height*, area averaging otherwise. Their mexResize.cpp means "when
     the width grows", but compares with ``oldSize.height`` of a Mat that mexopencv hands over
     untransposed, i.e. the number of rows; on the square search patches the two agree, on the
-    DSST's non-square scale samples they do not (tests/tracker/test_authors_details.py)."""
+    DSST's non-square scale samples they do not (tests/numerics/test_patches.py)."""
     oh, ow = int(out[0]), int(out[1])
     grows = ow > patch.shape[0]
     return cv2.resize(patch, (ow, oh), interpolation=cv2.INTER_LINEAR if grows else cv2.INTER_AREA)

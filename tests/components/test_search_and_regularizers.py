@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from dcfkit.components.regularizers import BoxWindow, Crop, SmoothWindow
+from dcfkit.components.regularizers import BoxWindow, Crop, SmoothWindow, target_mask
 from dcfkit.components.search.strategies import Fixed, MotionAware
 
 
@@ -48,3 +48,44 @@ def test_smooth_window_is_minimum_at_the_centre_and_edge_at_the_box_border():
     assert w2[4, 6] == pytest.approx(3.0 ** 2) and w2[2, 4] == pytest.approx(3.0 ** 2)
     assert w2[6, 6] == pytest.approx((0.1 + 2.9 * 2) ** 2)
     assert w2.dtype == np.float32
+
+
+# The authors' MATLAB detail this option reproduces, against an independent reference (the
+# line worked out by hand or re-run in numpy, a brute-force loop, a dense solve). file.m:line
+# cites ../shared/reference/DR2Track/DR2Track1 unless STRCF's (../shared/reference/STRCF) is named.
+# --------------------------------------------------------------------------------------------
+# the authors' MATLAB: the regularization window's box: init_regwindow.m
+# --------------------------------------------------------------------------------------------
+
+def init_regwindow_rows(n, target):
+    """init_regwindow.m:9-13 for one axis, 0-based: center = floor((n+1)/2) + mod(n+1, 2),
+    range = [0, r-1] - floor(r/2), r = floor(target) (tracker.m's reg_sz, init_size.m:14)."""
+    r = int(np.floor(target))
+    center = (n + 1) // 2 + (n + 1) % 2
+    first, last = center + 0 - r // 2, center + (r - 1) - r // 2
+    return list(range(first - 1, last))
+
+
+@pytest.mark.parametrize("shape, target", [
+    ((12, 12), (3.0, 3.7)), ((12, 12), (4.2, 4.9)), ((11, 11), (3.5, 3.0)), ((11, 11), (4.0, 4.5)),
+    ((12, 11), (5.9, 5.1)), ((50, 49), (9.3, 10.0)), ((8, 7), (1.0, 1.0)),
+])
+def test_target_mask_authors_is_init_regwindow(shape, target):
+    rows = init_regwindow_rows(shape[0], target[0])
+    cols = init_regwindow_rows(shape[1], target[1])
+    expected = np.zeros(shape, bool)
+    expected[np.ix_(rows, cols)] = True
+    assert np.array_equal(target_mask(shape, target, "authors"), expected)
+
+
+@pytest.mark.parametrize("n, target, centred, authors", [
+    (12, 3.0, [4, 5, 6], [5, 6, 7]),     # even patch, odd box: the two differ (middle 5.5: lower / upper)
+    (12, 4.0, [4, 5, 6, 7], [4, 5, 6, 7]),
+    (11, 3.0, [4, 5, 6], [4, 5, 6]),
+    (11, 4.0, [3, 4, 5, 6], [3, 4, 5, 6]),
+    (9, 0.4, [4], [4]),                   # at least one cell
+])
+def test_target_mask_hand_cases(n, target, centred, authors):
+    for placement, rows in (("centred", centred), ("authors", authors)):
+        mask = target_mask((n, 1), (target, 1.0), placement)
+        assert np.flatnonzero(mask[:, 0]).tolist() == rows, placement

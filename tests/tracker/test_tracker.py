@@ -1,14 +1,17 @@
 """Whole trackers: every shipped config on a generated sequence, bad input, determinism."""
+import cv2
 import numpy as np
 import pytest
 
 import dcfkit
 from dcfkit.analysis.metrics import score_sequence
 from dcfkit.components.features.base import Feature
-from dcfkit.components.labels.base import Label, gaussian_label
+from dcfkit.components.labels.base import Detection, Label, gaussian_label
+from dcfkit.components.labels.distractors import authors_distractors
 from dcfkit.contracts import checked
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.errors import InputError, TrackingError
+from dcfkit.numerics.patches import round_half_away
 from dcfkit.numerics.response import shift_spectrum
 
 CONFIGS = ["strcf", "bacf", "dr2track", "kcf", "dsst", "configs/ablations/dr2track_no_dr.yaml",
@@ -50,7 +53,7 @@ def test_tracking_is_deterministic_and_exposes_diagnostics(sequence, config):
     # last_search_box maps the response onto the image: its peak is the tracked centre, and
     # every repressed distractor (x, y) falls on (within a cell of) a local maximum of the map
     # (label.selection local_maxima; the authors' lookup, in the shipped config, also takes the
-    # rows x columns of equal values: tests/test_authors_details.py checks it by hand)
+    # rows x columns of equal values: tests/components/labels/test_labels.py checks it by hand)
     R = tracker.last_response
     H, W = R.shape
     sx, sy, sw, sh = tracker.last_search_box
@@ -393,3 +396,134 @@ def test_the_strongest_repressed_peak_is_the_look_alike_when_it_is_in_view(seque
             in_view += 1
             on_it += np.linalg.norm(tracker.last_distractors[0] - centre) < twin[3] / 2
     assert in_view >= 10 and on_it >= 0.7 * in_view
+
+
+# The authors' MATLAB detail this option reproduces, against an independent reference (the
+# line worked out by hand or re-run in numpy, a brute-force loop, a dense solve). file.m:line
+# cites ../shared/reference/DR2Track/DR2Track1 unless STRCF's (../shared/reference/STRCF) is named.
+# --------------------------------------------------------------------------------------------
+# the authors' MATLAB: tracker: init_position, box_output, clamp_position, translation
+# --------------------------------------------------------------------------------------------
+
+def texture(shape, seed=0, blur=1.5):
+    rng = np.random.default_rng(seed)
+    return cv2.GaussianBlur((rng.random(shape) * 255).astype(np.uint8), (0, 0), blur)
+
+
+@pytest.mark.parametrize("box, position, size", [
+    # tracker.m:10-11 with run_DR2Track.m:90-91: 1-based pos = floor([y x] + floor([h w]/2)),
+    # target_sz = floor([h w]). Box (10.6, 20.3, 31.7, 21.4) is 1-based (11.6, 21.3, ...):
+    # pos = floor([21.3 + 10, 11.6 + 15]) = [31, 26] -> 0-based (30, 25); size (21, 31)
+    ((10.6, 20.3, 31.7, 21.4), (30, 25), (21, 31)),
+    # (0, 0, 20, 15) -> 1-based (1, 1): pos = floor([1 + 7, 1 + 10]) = [8, 11] -> (7, 10) (exact: (7, 9.5))
+    ((0.0, 0.0, 20.0, 15.0), (7, 10), (15, 20)),
+    ((40.2, 35.9, 27.0, 33.0), (51, 53), (33, 27)),  # floor([36.9 + 16, 41.2 + 13]) - 1 = (51, 53)
+])
+def test_init_position_whole_pixel(box, position, size):
+    image = texture((120, 160, 3))
+    tracker = dcfkit.load_tracker("strcf", overrides={"tracker.init_position": "whole_pixel"})
+    tracker.init(image, box)
+    assert tuple(tracker.position) == position
+    np.testing.assert_allclose(tracker.geometry.base_target * tracker.scale, size, rtol=1e-12)
+
+
+@pytest.mark.parametrize("output, box, expected", [
+    # tracker.m:43-45 (DR²Track): target_sz = round(base_target_sz * scale), rect = [pos - sz/2, sz]
+    # (1-based pos = 0-based + 1, and the 1-based x becomes 0-based by -1: the same x = cx - w/2).
+    # box (11.5, 20.3, 30, 36.5): centre (20.3 + 17.75, 11.5 + 14.5) = (38.05, 26); round(36.5) = 37
+    ("half_size", (11.5, 20.3, 30.0, 36.5), (26 - 15, 38.05 - 18.5, 30, 37)),
+    # STRCF's report_tracking_result.m:4: round([pos - (sz - 1)/2, sz]), 1-based: x = round(27 - 14.5)
+    # = round(12.5) = 13 -> 0-based 12; y = round(39.05 - 17.75) = round(21.3) = 21 -> 20; h = 37
+    ("rounded", (11.5, 20.3, 30.0, 36.5), (12, 20, 30, 37)),
+    # centre (20.3 + 14.7, 10.6 + 15.35) = (35, 25.95): x = round(26.95 - 15.35) = round(11.6) = 12 -> 11,
+    # y = round(36 - 14.7) = round(21.3) = 21 -> 20, w = round(31.7) = 32, h = round(30.4) = 30
+    ("rounded", (10.6, 20.3, 31.7, 30.4), (11, 20, 32, 30)),
+    # x = -0.5: 1-based 0.5 rounds to 1 -> 0-based 0 (rounding the 0-based -0.5 would give -1)
+    ("rounded", (-0.5, 20.3, 30.0, 36.5), (0, 20, 30, 37)),
+    ("exact", (11.5, 20.3, 30.0, 36.5), (11.5, 20.3, 30.0, 36.5)),
+])
+def test_box_output(output, box, expected):
+    # a target area between 22500/25 and 40000/25 px²: currentScaleFactor = 1, the size is the box's
+    image = texture((120, 160, 3))
+    tracker = dcfkit.load_tracker("strcf", overrides={"tracker.box_output": output})
+    tracker.init(image, box)
+    assert tracker.scale == 1.0
+    np.testing.assert_allclose(tracker.box, expected, atol=1e-9)
+
+
+def sliding_frames(n, step, width=160):
+    """A textured scene sliding left by ``step`` pixels a frame (the target moves with it)."""
+    world = texture((120, width + step * n, 3), seed=3)
+    return [np.ascontiguousarray(world[:, step * t: step * t + width]) for t in range(n)]
+
+
+@pytest.mark.parametrize("clamp", [False, True])
+def test_clamp_position_false_lets_the_target_leave_the_image(clamp):
+    frames = sliding_frames(7, 4)
+    tracker = dcfkit.load_tracker("strcf", overrides={"tracker.clamp_position": clamp})
+    tracker.init(frames[0], (5.0, 50.0, 30.0, 30.0))  # centre x = 19.5, then 15.5, 11.5, ... -4.5
+    for frame in frames[1:]:
+        tracker.update(frame)
+    truth = 19.5 - 4 * 6
+    if clamp:
+        assert tracker.position[1] == 0.0  # held on the image
+    else:
+        assert tracker.position[1] < 0 and abs(tracker.position[1] - truth) < 1.0
+
+
+@pytest.mark.parametrize("translation", ["whole_pixel", "exact"])
+def test_translation_whole_pixel_moves_by_whole_pixels(translation):
+    frames = sliding_frames(5, 3)
+    tracker = dcfkit.load_tracker("strcf", overrides={"tracker.translation": translation})
+    tracker.init(frames[0], (60.3, 40.6, 30.0, 30.0))  # centre (55.1, 74.8): not a whole pixel
+    moves = []
+    for frame in frames[1:]:
+        before = tracker.position.copy()  # STRCF's fixed search: the search centre is the last position
+        tracker.update(frame)
+        moves.append(tracker.position - before)
+    moves = np.array(moves)
+    fractional = np.abs(moves - np.round(moves))
+    assert np.abs(moves[:, 1]).min() > 2  # it tracks the slide
+    if translation == "whole_pixel":  # run_detection.m:27: translation_vec = round(disp * cell * scale)
+        assert fractional.max() < 1e-9
+    else:
+        assert fractional.max() > 1e-3
+
+
+def test_shift_mode_gives_the_label_the_newton_peak_and_trains_at_the_clamped_position(monkeypatch):
+    # tracker.m:69 centres the distractor map with round(-[disp_row, disp_col]), resp_newton's peak,
+    # not the rounded pixel move over the new scale (they round apart, e.g. 2.45 cells -> 10 px -> 2.5)
+    import dcfkit.tracker.tracker as tracker_module
+
+    frames = sliding_frames(6, 5)  # 5 px = 1.67 cells of 3 px: sub-cell peaks
+    tracker = dcfkit.load_tracker("reference/dr2track", overrides={"tracker.clamp_position": True})
+    peaks, offsets, shifts = [], [], []
+    find_peak, make_label, shift = tracker._peak, tracker.label.make, tracker_module.shift_spectrum
+    monkeypatch.setattr(tracker, "_peak", lambda maps: peaks.append(find_peak(maps)) or peaks[-1])
+    monkeypatch.setattr(tracker.label, "make", lambda g, d: (d and offsets.append(d.offset)) or make_label(g, d))
+    monkeypatch.setattr(tracker_module, "shift_spectrum",
+                        lambda xf, dy, dx, shape: shifts.append((dy, dx)) or shift(xf, dy, dx, shape))
+    tracker.init(frames[0], (5.0, 40.6, 30.0, 30.0))  # centre x 19.5 -> -5.5: clamped at 0 at the end
+    for frame in frames[1:]:
+        centre = round_half_away(tracker._clamp(tracker.search.centre(), frame.shape))
+        tracker.update(frame)
+        expected = (tracker.position - centre) / (tracker.geometry.cell_size * tracker.scale)
+        np.testing.assert_allclose(shifts[-1], expected, rtol=0, atol=1e-12)
+    assert [tuple(o) for o in offsets] == [(dy, dx) for _, dy, dx in peaks]
+    assert any(abs(dy - round(dy)) > 0.05 or abs(dx - round(dx)) > 0.05 for _, dy, dx in peaks)
+    assert tracker.position[1] == 0.0  # the last move was clamped
+
+
+def test_authors_exclusion_box_as_tall_as_the_map_does_not_wrap():
+    # a target of 10 rows in a 10-row map: tracker.m's Bys = floor(5 - 5):... starts at 0 (MATLAB
+    # would fail on index 0); the box must cover every row, not wrap to the last one alone
+    h, w = 10, 16
+    centred = np.zeros((h, w), np.float32)
+    centred[5, 8] = 1.0     # the peak, in the middle
+    centred[2, 5] = 0.5     # inside the exclusion box's columns (floor(8 - 1.5) - 1 = 5 ... 9): excluded
+    centred[7, 1] = 0.4     # outside it: distractors
+    centred[2, 14] = 0.3
+    detection = Detection(np.roll(centred, (-(h // 2), -(w // 2)), axis=(0, 1)), (0, 0), (10.0, 3.0), (0.0, 0.0))
+    offsets, values = authors_distractors(detection, top_n=30)
+    assert sorted(map(tuple, offsets.tolist())) == [(-3, 6), (2, -7)]
+    np.testing.assert_allclose(sorted(values), [0.3, 0.4])

@@ -1,6 +1,8 @@
 """fhog: Felzenszwalb HOG as in Piotr's toolbox, checked against per-pixel loop references."""
 import math
+import platform
 
+import cv2
 import numpy as np
 import pytest
 
@@ -368,3 +370,137 @@ def test_result_does_not_depend_on_where_the_image_sits_in_memory():
         moved = storage[offset:].reshape(patch.shape)
         moved[:] = patch
         np.testing.assert_array_equal(fhog(moved), expected)
+
+
+# The authors' MATLAB detail this option reproduces, against an independent reference (the
+# line worked out by hand or re-run in numpy, a brute-force loop, a dense solve). file.m:line
+# cites ../shared/reference/DR2Track/DR2Track1 unless STRCF's (../shared/reference/STRCF) is named.
+# --------------------------------------------------------------------------------------------
+# the authors' MATLAB: fhog: which channel wins a tie; Piotr's SSE arithmetic
+# --------------------------------------------------------------------------------------------
+
+X86_ONLY = pytest.mark.skipif(platform.machine().lower() not in ("x86_64", "amd64"),
+                              reason="the processor's own SSE estimates need x86-64")
+
+
+def tie_image():
+    """B = 20 + 5x and R = 120 - 3x - 4y: at every pixel (borders too, one-sided) their gradients
+    (I[p+1] - I[p-1])/2 are (5, 0) and (-3, -4), both of magnitude 5; G is flat. Orientation
+    atan2(gy, gx) (rows down): B 0° -> bin 0 of 18; R 233.13° -> 11.66 bins -> bin 12."""
+    y, x = np.mgrid[0:16, 0:16]
+    image = np.zeros((16, 16, 3), np.uint8)
+    image[..., 0] = 20 + 5 * x
+    image[..., 1] = 50
+    image[..., 2] = 120 - 3 * x - 4 * y
+    return image
+
+
+@pytest.mark.parametrize("arithmetic", ["exact", "sse", pytest.param("sse_cpu", marks=X86_ONLY)])
+@pytest.mark.parametrize("order, winner", [("bgr", 0), ("rgb", 12)])
+def test_fhog_channel_order_decides_ties(arithmetic, order, winner):
+    feats = fhog(tie_image(), 4, channel_order=order, arithmetic=arithmetic)
+    sensitive = feats[:18].sum(axis=(1, 2))
+    loser = 12 if winner == 0 else 0
+    assert sensitive[winner] > 0
+    assert sensitive[loser] == 0
+    assert np.count_nonzero(sensitive) == 1
+
+
+def strongest_gradients(image):
+    """Piotr's grad1/gradMag (gradientMex.cpp:14-36, 69-78): per pixel the channel with the largest
+    gx² + gy² (the first on ties), gx = (I[x+1] - I[x-1])/2, one-sided on the border. float64."""
+    img = image.astype(np.float64)
+    if img.ndim == 2:
+        img = img[..., None]
+    gy, gx = np.gradient(img, axis=(0, 1))  # centred /2 inside, one-sided on the border: the same
+    m2 = gx**2 + gy**2
+    c = np.argmax(m2, axis=2)[..., None]
+    return np.take_along_axis(gx, c, 2)[..., 0], np.take_along_axis(gy, c, 2)[..., 0]
+
+
+def boundary_band(angle):
+    """How close to a bin boundary an orientation may come before Piotr's table and SSE estimates
+    could put it in the other bin: the table's step 1e-4/sin(o) plus a 4e-4 relative error of
+    rsqrt in the cosine (4e-4 |cot(o)| rad), and some margin."""
+    return 1e-4 / np.abs(np.sin(angle)) + 4e-4 / np.abs(np.tan(angle)) + 2e-4
+
+
+@pytest.mark.parametrize("arithmetic", ["sse", pytest.param("sse_cpu", marks=X86_ONLY)])
+def test_fhog_sse_is_close_to_exact_away_from_bin_boundaries(arithmetic):
+    """With no pixel's orientation within the table/estimate uncertainty of a bin boundary (checked
+    with the test's own gradients), every pixel lands in the same bin both ways and the features
+    differ only by the SSE estimates of the magnitudes (~12 bits)."""
+    rng = np.random.default_rng(22)  # a seed whose image meets the precondition
+    image = cv2.GaussianBlur(rng.uniform(0, 255, (16, 24, 3)).astype(np.float32), (0, 0), 1.2)
+    gx, gy = strongest_gradients(image)
+    o = np.mod(np.arctan2(gy, gx), 2 * np.pi)
+    boundaries = 2 * np.pi * (np.arange(18) + 0.5) / 18
+    distance = np.abs(o[..., None] - boundaries).min(axis=-1)
+    nearest = boundaries[np.abs(o[..., None] - boundaries).argmin(axis=-1)]
+    assert np.all(distance > boundary_band(nearest))  # the precondition, so no bin can flip
+    exact = fhog(image, 4)
+    sse = fhog(image, 4, arithmetic=arithmetic)
+    assert np.abs(sse - exact).max() < 2e-3
+    assert np.abs(sse - exact).max() > 0  # the estimates are not exact arithmetic
+
+
+def piotr_bin(gx, gy):
+    """gradMag + gradQuantize (gradientMex.cpp:46-56, 80-95, 140) with an EXACT 1/|g|: idx =
+    trunc(10000 gx/|g|), negated when gy < 0; o = acos(idx/10000) (float32), + π when gy < 0;
+    bin = trunc(o * 18/(2π) + 0.5), 18 -> 0. PI is Piotr's 3.14159265f."""
+    pi = np.float32(3.14159265)
+    r = 1.0 / np.hypot(gx, gy)
+    cosine = (gx * r * 10000.0) * np.where(gy < 0, -1, 1)
+    idx = np.trunc(cosine)
+    o = np.arccos(idx / 10000.0).astype(np.float32)
+    o = np.where(gy < 0, o + pi, o).astype(np.float32)
+    o_mult = np.float32(18) / (np.float32(2) * pi)
+    b = np.trunc(o * o_mult + np.float32(0.5)).astype(int)
+    return np.where(b >= 18, 0, b), idx
+
+
+@pytest.mark.parametrize("arithmetic", ["sse", pytest.param("sse_cpu", marks=X86_ONLY)])
+def test_fhog_sse_takes_the_acos_table_bin_near_a_boundary(arithmetic):
+    """Brute force over integer gradients (gx, gy) for one whose exact orientation is within 1e-4 rad
+    of a bin boundary and whose bin by Piotr's table differs from the nearest bin, robustly: every
+    table index reachable with a ±4e-4 relative error of the rsqrt estimate gives the same bin. Such
+    cases are near 90° and 270° (cos ≈ 0, where the estimate's error vanishes): gx/|g| < 1e-4
+    truncates to index 0, acos(0) = π/2 rounds up to bin 5 (or 13.5 -> 14), while the true angle is
+    just short of the boundary. A float32 ramp I = gx x + gy y gives every pixel that gradient."""
+    gx, gy = np.meshgrid(np.arange(-3, 4), np.concatenate([np.arange(-30000, -9000), np.arange(9000, 30001)]))
+    gx, gy = gx.ravel().astype(float), gy.ravel().astype(float)
+    angle = np.mod(np.arctan2(gy, gx), 2 * np.pi)
+    position = angle * 18 / (2 * np.pi)
+    exact_bin = np.floor(position + 0.5).astype(int) % 18
+    near = np.abs(position - np.floor(position) - 0.5) * 2 * np.pi / 18
+    table_bin, _ = piotr_bin(gx, gy)
+    # robust: the truncated index is the same for 1/|g| anywhere within ±4e-4 of its exact value
+    cosine = np.abs(gx) / np.hypot(gx, gy) * 10000
+    robust = np.trunc(cosine * (1 - 4e-4)) == np.trunc(cosine * (1 + 4e-4))
+    candidates = np.flatnonzero((near < 1e-4) & (near > 1e-6) & robust & (table_bin != exact_bin))
+    assert candidates.size > 0
+    for k in (candidates[0], candidates[-1]):  # (-2, -30000) near 270° and (2, 30000) near 90°
+        a, b = int(gx[k]), int(gy[k])
+        yy, xx = np.mgrid[0:8, 0:8]
+        image = (a * xx + b * yy - min(0, 7 * b) - min(0, 7 * a)).astype(np.float32)
+        exact = fhog(image, 4)[:18].sum(axis=(1, 2))
+        sse = fhog(image, 4, arithmetic=arithmetic)[:18].sum(axis=(1, 2))
+        assert np.flatnonzero(exact).tolist() == [exact_bin[k]], (a, b)
+        assert np.flatnonzero(sse).tolist() == [table_bin[k]], (a, b)
+
+
+@pytest.mark.parametrize("arithmetic", ["sse", pytest.param("sse_cpu", marks=X86_ONLY)])
+def test_fhog_sse_flat_image_has_the_magnitude_floor(arithmetic):
+    """gradientMex.cpp:82-84: M = rcp(min(rsqrt(0) = inf, 1e10)) ≈ 1e-10 (an estimate: ±4e-4), not 0,
+    and cos = 0 -> acos(0) = π/2 -> trunc(4.5 + 0.5) = bin 5. Every cell's histogram is then M (the
+    bilinear weights of cell² pixels over cell², Piotr's 8/7 restoring a border cell's outer half);
+    each of its 4 block norms is 1/sqrt(~4M² + eps) = 1/sqrt(eps) = 3200, eps = 1e-4/4/4⁴; so bin 5 and
+    its contrast-insensitive twin 18 + 5 are 4 · 0.5 · 3200 M = 6.4e-7 and each texture channel
+    0.2357 · 3200 M. The exact fhog of a flat image is zero."""
+    flat = np.full((12, 16, 3), 77, np.uint8)
+    assert not fhog(flat, 4).any()
+    feats = fhog(flat, 4, arithmetic=arithmetic)
+    orient = feats[:27].reshape(27, -1)
+    assert np.flatnonzero(orient.any(axis=1)).tolist() == [5, 23]
+    np.testing.assert_allclose(feats[[5, 23]], 6.4e-7, rtol=1e-3)
+    np.testing.assert_allclose(feats[27:], 0.2357 * 3200 * 1e-10, rtol=1e-3)

@@ -1,13 +1,17 @@
 """Label generators: Eq. (1)'s Gaussian and Eq. (3)'s distractor repression."""
+import collections
+import itertools
+
 import numpy as np
 import pytest
 
 import dcfkit
 from dcfkit.components.labels.base import Detection, Label, gaussian_label
-from dcfkit.components.labels.distractors import DistractorRepressed
+from dcfkit.components.labels.distractors import DistractorRepressed, authors_distractors, regional_maxima
 from dcfkit.components.labels.gaussian import Gaussian
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.errors import ConfigError
+from dcfkit.numerics.patches import round_half_away
 from dcfkit.numerics.response import local_maxima
 from dcfkit.params import parse_params
 
@@ -118,3 +122,214 @@ def test_init_resets_the_label_before_the_first_frame_of_a_target():
         tracker.init(seq.frames[0], seq.ground_truth[0])
         tracker.update(seq.frames[1])
     assert calls == ["reset", "first", "later"] * 2
+
+
+# The authors' MATLAB detail this option reproduces, against an independent reference (the
+# line worked out by hand or re-run in numpy, a brute-force loop, a dense solve). file.m:line
+# cites ../shared/reference/DR2Track/DR2Track1 unless STRCF's (../shared/reference/STRCF) is named.
+# --------------------------------------------------------------------------------------------
+# the authors' MATLAB: DR²Track's distractor selection: imregionalmax, its exclusion box, find(bg == value)
+# --------------------------------------------------------------------------------------------
+
+def imregionalmax_brute(r):
+    """MATLAB's imregionalmax (8-connected, default conn for 2-D): every connected plateau of equal
+    values whose neighbours outside it (inside the image; not circular) are all strictly lower."""
+    h, w = r.shape
+    out = np.zeros((h, w), bool)
+    seen = np.zeros((h, w), bool)
+    for start in itertools.product(range(h), range(w)):
+        if seen[start]:
+            continue
+        plateau, queue, seen[start] = [], collections.deque([start]), True
+        is_max = True
+        while queue:
+            p = queue.popleft()
+            plateau.append(p)
+            for dy, dx in itertools.product((-1, 0, 1), repeat=2):
+                q = (p[0] + dy, p[1] + dx)
+                if (dy, dx) == (0, 0) or not (0 <= q[0] < h and 0 <= q[1] < w):
+                    continue
+                if r[q] == r[start]:
+                    if not seen[q]:
+                        seen[q] = True
+                        queue.append(q)
+                elif r[q] > r[start]:
+                    is_max = False
+        for p in plateau:
+            out[p] = is_max
+    return out
+
+
+@pytest.mark.parametrize("seed, shape, levels", [(0, (9, 11), 3), (1, (12, 12), 4), (2, (7, 16), 2),
+                                                 (3, (10, 10), 6), (4, (13, 9), 3), (5, (6, 6), 1000)])
+def test_regional_maxima_match_imregionalmax(seed, shape, levels):
+    rng = np.random.default_rng(seed)
+    r = (rng.integers(0, levels, shape) / levels).astype(np.float32)  # quantised: many plateaus
+    expected = imregionalmax_brute(r)
+    assert np.array_equal(regional_maxima(r), expected)
+
+
+def test_regional_maxima_of_special_maps():
+    flat = np.full((4, 5), 0.3, np.float32)
+    assert regional_maxima(flat).all()  # one plateau with no outer neighbour: a maximum
+    r = np.zeros((6, 6), np.float32)
+    r[0:3, 0:3] = 1.0
+    r[2, 2] = 2.0  # the plateau has a higher pixel inside its own neighbourhood: not a maximum
+    expected = np.zeros((6, 6), bool)
+    expected[2, 2] = True
+    assert np.array_equal(regional_maxima(r), expected)
+    r = np.zeros((5, 5), np.float32)
+    r[0, 0] = r[0, 1] = r[1, 2] = 1.0  # a diagonal step joins (1, 2) to the plateau: 8-connected
+    r[4, 4] = 0.5
+    expected = (r > 0)
+    assert np.array_equal(regional_maxima(r), expected)
+    # a diagonal chain (1, 1), (2, 2), (3, 3) is one plateau; (3, 3) touches the higher (4, 4), so none
+    # of it is a maximum, although (1, 1) only touches the plateau's (2, 2)
+    r = np.zeros((6, 6), np.float32)
+    r[1, 1] = r[2, 2] = r[3, 3] = 1.0
+    r[4, 4] = 2.0
+    expected = np.zeros((6, 6), bool)
+    expected[4, 4] = True
+    assert np.array_equal(regional_maxima(r), expected)
+
+
+# A hand-built 12x12 map in the frame tracker.m works in after its two circshifts (lines 67-69):
+# the detection at index (6, 6) = floor(size/2) (0-based). target_cells (5.5, 3.9): reg_sz = (5, 3).
+#   target box (init_regwindow, w = 1e-3 inside): rows 4..8, columns 5..7   (0-based)
+#   exclusion box (tracker.m:73-75): Bys = floor(6 - 2.5):floor(6 + 2.5) = 3:8, Bxs = floor(6 - 1.5):
+#   floor(6 + 1.5) = 4:7 (1-based): rows 2..7, columns 3..6 (0-based).
+# Values are multiples of 1/16 (exact in float32); the background 1/16 borders higher pixels, so it
+# is not a regional maximum.
+H = W = 12
+CENTRE = 6
+TARGET_CELLS = (5.5, 3.9)
+PEAKS = {
+    (6, 6): 1.0,                       # the detection: inside the exclusion box
+    (9, 9): 0.75, (9, 10): 0.75,       # B: a two-pixel plateau, one component
+    (1, 2): 0.5,                       # A
+    (2, 9): 0.5,                       # C: A's value again: find() returns rows {1, 2} and columns {2, 9}
+    (8, 7): 7 / 16,                    # F: a component (row 8 is outside the exclusion box) but inside the
+                                       #    target box, where bg_response = R * 1e-8 never equals 7/16
+    (4, 1): 0.375,                     # D
+    (1, 5): 0.25, (2, 5): 0.25,        # G: a plateau across the exclusion box's edge ((2, 5) is inside it,
+                                       #    outside the target box): its outside part is a component, and
+                                       #    find() returns both pixels
+    (5, 4): 0.625,                     # E: inside the exclusion box but outside the target box: not a
+                                       #    component, never looked up
+}
+
+
+def centred_map(peaks, background=1 / 16):
+    m = np.full((H, W), background, np.float32)
+    for p, v in peaks.items():
+        m[p] = v
+    return m
+
+
+def expected_label(g, repressed, mu, mirrored=False):
+    """y(row, col) = -beta * value (tracker.m:93) at centred (row, col), i.e. at the label's circular
+    offset (row - 6, col - 6) (tracker.m:71 and :98 shift y by floor(size/2) and back); with
+    ``mirrored`` the result turned by 180° about the origin, by explicit index negation."""
+    y = g.copy()
+    for (row, col), value in repressed:
+        y[(row - CENTRE) % H, (col - CENTRE) % W] = -mu * value
+    if mirrored:
+        y = np.array([[y[(-i) % H, (-j) % W] for j in range(W)] for i in range(H)], np.float32)
+    return y
+
+
+# (top_n, repressed in order): tracker.m:79-95, local_max sorted descending = 0.75, 0.5, 0.5, 7/16,
+# 0.375, 0.25 (E and the detection are in the exclusion box)
+ALL_REPRESSED = ([((9, 9), 0.75), ((9, 10), 0.75)]
+                 + [((r, c), 0.5) for r in (1, 2) for c in (2, 9)]   # the cross product of rows and columns
+                 + [((4, 1), 0.375)]
+                 + [((1, 5), 0.25), ((2, 5), 0.25)])
+CASES = {
+    30: ALL_REPRESSED,
+    4: ALL_REPRESSED[:6],   # 0.75, 0.5, 0.5, 7/16: F takes the fourth place (and represses nothing)
+    1: ALL_REPRESSED[:2],
+}
+
+
+def detection_for(centred, offset, scale=4.0):
+    """The circular response R whose normalised, double-circshifted version is ``centred``:
+    tracker.m:67-69 shift by floor(size/2) and by round(-disp): R = circshift(C, -(6 - round(disp)))."""
+    ry, rx = (int(round_half_away(v)) for v in offset)
+    response = np.roll(centred * np.float32(scale), (-(CENTRE - ry), -(CENTRE - rx)), axis=(0, 1))
+    peak = np.unravel_index(int(np.argmax(response)), response.shape)
+    return Detection(response.astype(np.float32), (int(peak[0]), int(peak[1])), TARGET_CELLS, offset)
+
+
+@pytest.mark.parametrize("top_n", sorted(CASES))
+@pytest.mark.parametrize("mirrored", [False, True])
+def test_authors_label_hand_built_map(top_n, mirrored):
+    # offset (2.5, -1.5): MATLAB's round gives (3, -2) (numpy's round would give (2, -2))
+    det = detection_for(centred_map(PEAKS), (2.5, -1.5))
+    g = np.random.default_rng(6).uniform(0.1, 1.0, (H, W)).astype(np.float32)
+    label = DistractorRepressed(DistractorRepressed.Params(top_n=top_n, mu=0.25, variant="overwrite",
+                                                           selection="authors", mirrored=mirrored))
+    y, offsets = label.make(g, det)
+    repressed = CASES[top_n]
+    np.testing.assert_array_equal(y, expected_label(g, repressed, 0.25, mirrored))
+    sign = -1 if mirrored else 1
+    assert {tuple(o) for o in offsets.tolist()} == {(sign * (r - CENTRE), sign * (c - CENTRE))
+                                                    for (r, c), _ in repressed}
+
+
+def test_authors_distractors_values_and_offsets():
+    det = detection_for(centred_map(PEAKS), (2.5, -1.5))
+    offsets, values = authors_distractors(det, 30)
+    got = collections.Counter((tuple(o), float(v)) for o, v in zip(offsets.tolist(), values))
+    expected = collections.Counter(((r - CENTRE, c - CENTRE), v) for (r, c), v in ALL_REPRESSED)
+    expected.update({((r - CENTRE, c - CENTRE), 0.5): 1 for r in (1, 2) for c in (2, 9)})  # looked up twice
+    assert got == expected
+    assert np.all(np.diff(values) <= 0)  # highest first
+
+
+@pytest.mark.parametrize("pixel, in_box", [
+    ((2, 4), True), ((7, 3), True), ((4, 3), True), ((2, 6), True),     # the exclusion box's edges, inside
+    ((1, 4), False), ((8, 3), False), ((5, 2), False), ((3, 7), False),  # just outside each edge
+])
+def test_authors_exclusion_box_edges(pixel, in_box):
+    """One maximum (0.5) at an edge of the exclusion box (rows 2..7, columns 3..6), outside the target
+    box, and two far away, (10, 0) and (0, 10), so that there are always two components or more: it
+    is repressed exactly when it is outside the exclusion box."""
+    det = detection_for(centred_map({(6, 6): 1.0, (10, 0): 0.3125, (0, 10): 0.1875, pixel: 0.5}), (0.0, 0.0))
+    g = np.random.default_rng(10).uniform(0.1, 1.0, (H, W)).astype(np.float32)
+    label = DistractorRepressed(DistractorRepressed.Params(top_n=30, mu=0.25, variant="overwrite",
+                                                           selection="authors"))
+    y, _ = label.make(g, det)
+    repressed = [((10, 0), 0.3125), ((0, 10), 0.1875)] + ([] if in_box else [(pixel, 0.5)])
+    np.testing.assert_array_equal(y, expected_label(g, repressed, 0.25))
+
+
+def test_authors_label_one_component_means_none():
+    """One regional maximum outside the exclusion box: tracker.m:77 keeps local_max = [max 0] = [1 0];
+    the detection (value 1) is in the target box, where bg_response = R * 1e-8 is not 1, and no pixel
+    is 0: nothing is repressed, not even the clear distractor at (1, 2)."""
+    det = detection_for(centred_map({(6, 6): 1.0, (1, 2): 0.5}), (0.0, 0.0))
+    g = np.random.default_rng(7).uniform(0.1, 1.0, (H, W)).astype(np.float32)
+    label = DistractorRepressed(DistractorRepressed.Params(top_n=30, mu=0.25, variant="overwrite",
+                                                           selection="authors"))
+    y, offsets = label.make(g, det)
+    np.testing.assert_array_equal(y, g)
+    assert offsets.shape == (0, 2)
+
+
+def test_authors_label_fallback_finds_the_maximum_and_exact_zeros():
+    """The global maximum (1.0 after normalising) at (1, 2), outside the target box, is the only
+    component outside the exclusion box (the 0.75 at the middle is inside it): local_max = [1 0].
+    find(bg_response == 1) is (1, 2); find(bg_response == 0) the two exact zeros (1, 6) and (6, 1),
+    whose rows x columns {1, 6} x {1, 6} include the middle (6, 6) itself: y there becomes -0.25 * 0."""
+    det = detection_for(centred_map({(6, 6): 0.75, (1, 2): 1.0, (1, 6): 0.0, (6, 1): 0.0}), (0.0, 0.0))
+    g = np.random.default_rng(8).uniform(0.1, 1.0, (H, W)).astype(np.float32)
+    label = DistractorRepressed(DistractorRepressed.Params(top_n=30, mu=0.25, variant="overwrite",
+                                                           selection="authors"))
+    y, _ = label.make(g, det)
+    repressed = [((1, 2), 1.0)] + [((r, c), 0.0) for r in (1, 6) for c in (1, 6)]
+    np.testing.assert_array_equal(y, expected_label(g, repressed, 0.25))
+    assert y[0, 0] == 0  # the label's peak, overwritten
+    # top_n = 1: only the first of [1 0] is looked up
+    label1 = DistractorRepressed(DistractorRepressed.Params(top_n=1, mu=0.25, variant="overwrite",
+                                                            selection="authors"))
+    np.testing.assert_array_equal(label1.make(g, det)[0], expected_label(g, repressed[:1], 0.25))

@@ -1,0 +1,30 @@
+"""Gray: the authors' MATLAB conversion (get_colorspace's rgb2gray) and OpenCV's."""
+import numpy as np
+import pytest
+
+from dcfkit.components.features.gray import Gray
+
+# The authors' MATLAB detail this option reproduces, against an independent reference (the
+# line worked out by hand or re-run in numpy, a brute-force loop, a dense solve). file.m:line
+# cites ../shared/reference/DR2Track/DR2Track1 unless STRCF's (../shared/reference/STRCF) is named.
+# --------------------------------------------------------------------------------------------
+# the authors' MATLAB: gray: get_colorspace's rgb2gray
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("bgr", [(30, 200, 90), (255, 0, 0), (0, 0, 255), (13, 77, 251)])
+def test_gray_matlab_conversion_of_a_uniform_patch(bgr):
+    # get_colorspace.m:5,10: rgb2gray(single(im)/255) - 0.5, rgb2gray = 0.298936 R + 0.587043 G + 0.114021 B
+    b, g, r = bgr
+    patch = np.empty((8, 12, 3), np.uint8)
+    patch[:] = bgr  # dcfkit's images are BGR
+    expected = (0.298936 * r + 0.587043 * g + 0.114021 * b) / 255 - 0.5
+    got = Gray(Gray.Params(conversion="matlab")).extract(patch, 4)
+    assert got.shape == (1, 2, 3)
+    np.testing.assert_allclose(got, expected, atol=2e-7)
+
+
+def test_gray_opencv_conversion_rounds_to_whole_levels():
+    patch = np.full((8, 8, 3), (30, 200, 90), np.uint8)
+    got = Gray().extract(patch, 4)
+    np.testing.assert_allclose(got, round(0.299 * 90 + 0.587 * 200 + 0.114 * 30) / 255 - 0.5, atol=2e-7)
