@@ -6,7 +6,7 @@ import dataclasses
 import numpy as np
 
 from dcfkit.config.tracker_params import TrackerParams
-from dcfkit.numerics.patches import round_half_away
+from dcfkit.numerics.patches import centre_size_to_box, round_half_away
 
 
 def hann2d(shape: tuple[int, int], interior: bool = True) -> np.ndarray:
@@ -49,3 +49,19 @@ def geometry(p: TrackerParams, target: np.ndarray) -> tuple[Geometry, float]:
     target_cells = tuple(float(v) for v in base_target / cell)
     geom = Geometry(base_target, cells * cell, (int(cells[0]), int(cells[1])), target_cells, cell)
     return geom, float(scale)
+
+
+def reported_box(centre: np.ndarray, size: np.ndarray, convention: str) -> tuple[float, float, float, float]:
+    """The (x, y, w, h) box, 0-based, of a target at ``centre`` (y, x) of ``size`` (h, w), as
+    ``tracker.box_output`` says: 'exact', 'rounded', or the authors' 'half_size' / 'floor_half'."""
+    (cy, cx) = centre
+    if convention == "half_size":  # DR²Track's [pos - round(size) / 2, round(size)]
+        h, w = round_half_away(size)
+        return float(cx - w / 2), float(cy - h / 2), float(w), float(h)
+    if convention == "floor_half":  # BACF's [pos - floor(floor(size) / 2), floor(size)]
+        h, w = np.floor(size)
+        return float(cx - np.floor(w / 2)), float(cy - np.floor(h / 2)), float(w), float(h)
+    box = centre_size_to_box(centre, size)
+    if convention == "rounded":  # round([pos - (sz - 1)/2, sz]), 1-based
+        return tuple(float(v) for v in round_half_away(np.add(box, (1, 1, 0, 0))) - (1, 1, 0, 0))
+    return box

@@ -38,7 +38,7 @@ from dcfkit.numerics.response import newton_peak, shift_spectrum, subpixel_peak
 from dcfkit.registry import get_registry
 from dcfkit.tracker.checks import check_box, check_config_budget, check_first_frame, check_image, check_terms, read_only
 from dcfkit.tracker.confidence import Confidence
-from dcfkit.tracker.geometry import Geometry, geometry, hann2d
+from dcfkit.tracker.geometry import Geometry, geometry, hann2d, reported_box
 
 
 class Tracker:
@@ -249,17 +249,7 @@ class Tracker:
     @property
     def box(self) -> tuple[float, float, float, float]:
         """Current (x, y, w, h), 0-based pixels (``tracker.box_output``)."""
-        size = self.geometry.base_target * self.scale
-        if self.params.box_output == "half_size":  # DR²Track's [pos - round(size) / 2, round(size)]
-            (cy, cx), (h, w) = self.position, round_half_away(size)
-            return float(cx - w / 2), float(cy - h / 2), float(w), float(h)
-        if self.params.box_output == "floor_half":  # BACF's [pos - floor(floor(size) / 2), floor(size)]
-            (cy, cx), (h, w) = self.position, np.floor(size)
-            return float(cx - np.floor(w / 2)), float(cy - np.floor(h / 2)), float(w), float(h)
-        box = centre_size_to_box(self.position, size)
-        if self.params.box_output == "rounded":  # round([pos - (sz - 1)/2, sz]), 1-based
-            return tuple(float(v) for v in round_half_away(np.add(box, (1, 1, 0, 0))) - (1, 1, 0, 0))
-        return box
+        return reported_box(self.position, self.geometry.base_target * self.scale, self.params.box_output)
 
 
 def load_tracker(config: str | Mapping[str, Any], **overrides: Any) -> Tracker:
