@@ -21,9 +21,7 @@ layouts.
 """
 from dcfkit.datasets.annotations import read_boxes
 from dcfkit.datasets.base import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
-from dcfkit.datasets.images import DatasetWarning, read_frame
-from dcfkit.datasets.layout import Evidence, Layout, register_layout, registered_layout, unregister_layout
-from dcfkit.datasets.registry import (
+from dcfkit.datasets.catalog import (
                                      DATASETS,
                                      benchmark_protocol,
                                      canonical_name,
@@ -32,6 +30,8 @@ from dcfkit.datasets.registry import (
                                      layouts,
                                      load_dataset,
 )
+from dcfkit.datasets.images import DatasetWarning, read_frame
+from dcfkit.datasets.layout import Evidence, Layout, register_layout, registered_layout, unregister_layout
 
 # Importing a layout module registers it; the import order is the order of the names in
 # messages ("valid names: uav123, uav123_10fps, ..."), so it is not alphabetical.

@@ -2,7 +2,7 @@
 
 Built-in layouts register here when :mod:`dcfkit.datasets` is imported, as a script does with
 :func:`register_layout`; a plugin's go through ``registry.register_dataset`` (:mod:`dcfkit.registry`),
-which makes them with :func:`new_layout`. Lookups are in :mod:`dcfkit.datasets.registry`.
+which makes them with :func:`new_layout`. Lookups are in :mod:`dcfkit.datasets.catalog`.
 """
 from __future__ import annotations
 

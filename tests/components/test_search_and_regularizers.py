@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from dcfkit.components.regularizers import BoxWindow, Crop, SmoothWindow, target_mask
-from dcfkit.components.search.strategies import Fixed, MotionAware
+from dcfkit.components.search.strategies import LastPosition, MotionAware
 
 
 def test_motion_aware_search_centres_on_the_last_position_plus_the_last_displacement():
@@ -21,7 +21,7 @@ def test_motion_aware_search_centres_on_the_last_position_plus_the_last_displace
 
 
 def test_fixed_search_centres_on_the_last_position():
-    search = Fixed()
+    search = LastPosition()
     search.reset(np.array([10.0, 20.0]))
     search.observe(np.array([13.0, 18.0]))
     np.testing.assert_array_equal(search.centre(), [13.0, 18.0])

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from dcfkit.components.scale.base import MAX_SCALES, MIN_LAM, ScaleEstimator, scale_limits
 from dcfkit.components.scale.dsst import DSST
-from dcfkit.components.scale.pyramid import Fixed, Pyramid
+from dcfkit.components.scale.pyramid import FixedScale, Pyramid
 
-BUILTIN = (Fixed, Pyramid, DSST)
+BUILTIN = (FixedScale, Pyramid, DSST)
 
-__all__ = ["BUILTIN", "DSST", "Fixed", "MAX_SCALES", "MIN_LAM", "Pyramid", "ScaleEstimator", "scale_limits"]
+__all__ = ["BUILTIN", "DSST", "FixedScale", "MAX_SCALES", "MIN_LAM", "Pyramid", "ScaleEstimator", "scale_limits"]

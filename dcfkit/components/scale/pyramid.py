@@ -7,7 +7,7 @@ from dcfkit.components.scale.base import MAX_SCALES, ScaleEstimator, _check_span
 from dcfkit.params import param
 
 
-class Fixed(ScaleEstimator):
+class FixedScale(ScaleEstimator):
     """No scale estimation: the box keeps its initial size (KCF). The base class's one search
     scale, 1, and an update that returns the scale it is given (within the limits, which
     hold the initial scale)."""

@@ -4,8 +4,8 @@ Where to add one: subclass :class:`~dcfkit.components.search.base.Search`."""
 from __future__ import annotations
 
 from dcfkit.components.search.base import MAX_COORDINATE, Search
-from dcfkit.components.search.strategies import MAX_GAIN, Fixed, MotionAware
+from dcfkit.components.search.strategies import MAX_GAIN, LastPosition, MotionAware
 
-BUILTIN = (Fixed, MotionAware)
+BUILTIN = (LastPosition, MotionAware)
 
-__all__ = ["BUILTIN", "Fixed", "MAX_COORDINATE", "MAX_GAIN", "MotionAware", "Search"]
+__all__ = ["BUILTIN", "LastPosition", "MAX_COORDINATE", "MAX_GAIN", "MotionAware", "Search"]

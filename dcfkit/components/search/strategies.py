@@ -9,7 +9,7 @@ from dcfkit.components.search.base import Search
 from dcfkit.params import param
 
 
-class Fixed(Search):
+class LastPosition(Search):
     """Search around the last position (STRCF, BACF)."""
 
     name = "fixed"
