@@ -12,7 +12,7 @@ def test_installed_package_finds_its_configs_and_runs_the_demo(pip_install_copy,
     assert (site / "dcfkit" / "configs" / "dr2track.yaml").is_file()
     assert (site / "dcfkit" / "configs" / "ablations" / "table3.yaml").is_file()
     assert (site / "dcfkit" / "data" / "uav123_sequences.tsv").is_file()
-    assert all((site / "dcfkit" / "report_html" / name).is_file() for name in ("report.js", "report.css"))
+    assert all((site / "dcfkit" / "analysis" / "report_html" / name).is_file() for name in ("report.js", "report.css"))
     env = {**os.environ, "PYTHONPATH": str(site)}
     where = subprocess.run([sys.executable, "-c", "import dcfkit.config as c; print(c.__file__); "
                             "print(c.load_config('dr2track')['name'])"],

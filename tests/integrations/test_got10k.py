@@ -181,6 +181,6 @@ def test_experiment_dtb70_writes_what_dcfkit_eval_writes(adapter, shared_data, t
     assert json.loads((tmp_path / "reports" / "DTB70" / "strcf" / "performance.json").read_text())["strcf"] \
         ["overall"]["success_score"] == overall["success_score"]
     scores = evaluate({"strcf": load_results(tmp_path / "dcfkit", "strcf", sequences)}, sequences,
-                      protocol="pysot")["overall"][0]
+                      protocol="pysot").overall[0]
     assert overall["success_score"] == pytest.approx(scores["auc"], abs=1e-12)
     assert overall["precision_score"] == pytest.approx(scores["precision"], abs=1e-12)

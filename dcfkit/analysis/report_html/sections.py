@@ -79,7 +79,7 @@ def attribute_charts(evaluation: Mapping, trackers: Seq[str]) -> dict | None:
     if not evaluation.attribute_curves:
         return None
     charts = [curve_chart("success", curves, evaluation.thresholds["success"], trackers, small=True,
-                          title=f"{ATTRIBUTE_NAMES.get(attr, attr)} ({evaluation['attributes'][attr]})")
+                          title=f"{ATTRIBUTE_NAMES.get(attr, attr)} ({evaluation.attributes[attr]})")
               for attr, curves in evaluation.attribute_curves.items()]
     return {"kind": "charts", "id": "attribute-plots", "title": "Success plots per attribute", "charts": charts}
 
