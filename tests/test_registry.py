@@ -196,6 +196,8 @@ def test_a_name_two_plugins_register_is_withdrawn_and_their_other_components_sta
      r"failed and was skipped: KeyError: 'label_class' \(at <string>:\d+\)"),
     (PLUGIN.replace("registry.register(Flat)", "registry.register(Flat)\n    registry.register(Flat)"),
      r"failed and was skipped: label 'flat' from dcfkit_test_problem .* already registered by dcfkit_test_problem"),
+    (PLUGIN.replace("registry.register(Flat)", "registry.accept_layouts(lambda *a, **k: None)"),
+     r"failed and was skipped: dcfkit_test_problem .*: only dcfkit's own plugin says how layouts are made"),
 ])
 def test_plugin_problems_say_what_and_where(monkeypatch, source, message):
     ep = install_plugin(monkeypatch, "dcfkit_test_problem", "")
@@ -512,3 +514,10 @@ def test_plugins_load_off_the_main_thread_as_a_dask_worker_does():
     worker.join()
     assert outcome and not isinstance(outcome[0], Exception), outcome
     assert "gaussian" in outcome[0]
+
+
+def test_without_its_own_entry_point_dcfkit_says_to_install_it(monkeypatch):
+    monkeypatch.setattr(importlib.metadata, "entry_points", lambda group=None: [])  # a folder on sys.path, not installed
+    with pytest.raises(RegistryError, match=r"dcfkit's own plugin \(entry point 'builtin' of group 'dcfkit'\) is not "
+                                            r"installed.*pip install -e \."):
+        reg.build_registry()

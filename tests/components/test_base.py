@@ -381,3 +381,32 @@ def test_every_builtin_meets_its_contract():
     for kind, cls in builtins():
         base = base_of(cls, kind, cls.name)
         assert contract_problems(cls, base) == [], (kind, cls.name)
+
+
+def test_a_base_class_declares_its_kind_with_a_contract(monkeypatch):
+    from dcfkit.components import base  # deferred: its table of kinds is patched here
+
+    monkeypatch.setattr(base, "_BASES", dict(base._BASES))
+    with pytest.raises(TypeError, match="declares kind 'tracklet' without a Contract"):
+        class NoContract(Component, declares="tracklet"):
+            pass
+
+    class Tracklet(Component, declares="tracklet"):
+        contract = base.Contract(required={"step": ("x",)})
+
+    class Mine(Tracklet):
+        name = "mine"
+
+        def step(self, x):
+            return x
+
+    assert Tracklet.kind == "tracklet" and "tracklet" in base.kinds()
+    registry = reg.Registry()
+    registry.register(Mine)
+    assert registry.names("tracklet") == ["mine"] and registry.kinds() == ["tracklet"]
+    with pytest.raises(RegistryError, match=r"a tracklet must subclass .*Tracklet"):
+        registry.register(type("Loose", (Component,), {"kind": "tracklet", "name": "loose"}))
+
+
+def test_the_built_registry_lists_the_kinds_in_the_order_of_the_slots():
+    assert reg.get_registry().kinds() == list(KINDS)
