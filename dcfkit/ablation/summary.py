@@ -13,7 +13,8 @@ from dcfkit.analysis.plots import plot_curves
 from dcfkit.analysis.report import json_ready
 from dcfkit.analysis.report_html import PAGE, write_page
 from dcfkit.analysis.scoring import evaluate, protocol_record
-from dcfkit.analysis.tables import format_table
+from dcfkit.analysis.statistics import versus_baseline
+from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.datasets import Sequence
 from dcfkit.protocols import DEFAULT, get_protocol
 from dcfkit.running.files import atomic_write, read_json
@@ -47,8 +48,11 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     precision is the precision at 20 px, auc the area under the success curve (and under
     ``got10k`` also ao, sr50, sr75), fps the mean per-sequence frames per second of tracker
     time (:mod:`dcfkit.analysis.report`). A job without result (failed or not run) is scored as a
-    total failure and counted in ``failed``. Returns ``{"overall", "per_sequence", "jobs",
-    "files", "protocol"}`` (the :class:`~dcfkit.protocols.Protocol`).
+    total failure and counted in ``failed``. ``statistics`` compares each variant with the
+    grid's base (when it names a variant) or the first variant
+    (:func:`~dcfkit.analysis.statistics.versus_baseline`). Returns ``{"overall",
+    "per_sequence", "statistics", "jobs", "files", "protocol"}`` (the
+    :class:`~dcfkit.protocols.Protocol`).
     """
     out = Path(out)
     jobs = jobs if jobs is not None else expand(spec, sequences)
@@ -58,12 +62,15 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
         scores = evaluate({variant: stored[key] for variant, key in keys.items()}, sequences, protocol=protocol)
     protocol = scores.protocol
     overall, per_sequence = _rows(scores, keys, sequences, status, protocol)
+    variants = list(keys)
+    baseline = spec.grid.base if spec.grid is not None and spec.grid.base in keys else variants[0]
+    statistics = versus_baseline(scores.per_sequence, variants, (protocol.rank_key, "precision"), baseline)
     job_rows = [{"variant": j.variant, "sequence": j.sequence, "key": j.key,
                  "status": status[j.key, j.sequence][0], "error": status[j.key, j.sequence][1]} for j in jobs]
     info = {"spec": str(spec.path), "name": spec.name, "description": spec.description,
             "protocol": protocol_record(scores.protocol),
             "dataset": spec.dataset, "root": str(spec.root), "sequences": [s.name for s in sequences],
-            "overall": overall, "per_sequence": per_sequence, "jobs": job_rows,
+            "overall": overall, "per_sequence": per_sequence, "statistics": statistics, "jobs": job_rows,
             "grid": ({"base": spec.grid.base, "mode": spec.grid.mode,
                       "parameters": {k: {"label": lab, "values": vals}
                                      for k, (lab, vals) in spec.grid.parameters.items()}}
@@ -72,8 +79,8 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     page = ablation_page(spec, out, info, summary_columns("summary", protocol), scores, sequences,
                          {variant: stored[key] for variant, key in keys.items()}, keys)
     files.append(write_page(page, out / PAGE))
-    return {"overall": overall, "per_sequence": per_sequence, "jobs": job_rows, "files": files,
-            "protocol": protocol}
+    return {"overall": overall, "per_sequence": per_sequence, "statistics": statistics, "jobs": job_rows,
+            "files": files, "protocol": protocol}
 
 
 def _stored_runs(spec: AblationSpec, out: Path, sequences: list[Sequence], jobs: list[Job]) -> tuple[dict, dict]:
@@ -119,6 +126,9 @@ def _write_files(spec: AblationSpec, out: Path, info: dict, curves: dict, protoc
             atomic_write(path, format_table(info["overall" if stem == "summary" else stem], fmt,
                                             summary_columns(stem, protocol), protocol))
             files.append(path)
+    path = out / "statistics.txt"
+    atomic_write(path, "\n".join(statistics_lines(info["statistics"])) + "\n")
+    files.append(path)
     path = out / "summary.json"
     atomic_write(path, json.dumps(json_ready(info), indent=1, ensure_ascii=False, default=str) + "\n")
     files.append(path)

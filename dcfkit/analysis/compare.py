@@ -31,13 +31,14 @@ from typing import Iterable
 import numpy as np
 
 from dcfkit.analysis import metrics
+from dcfkit.analysis.statistics import METHOD, mean_interval, paired_difference
 from dcfkit.datasets import DatasetError, Sequence, benchmark_protocol, read_boxes, scored_sequences
 from dcfkit.errors import clip, shown
 from dcfkit.protocols import Protocol, get_protocol
 from dcfkit.running import platforms
 from dcfkit.running.results import ResultStore, result_files
 
-__all__ = ["COLUMNS", "compare_folders", "first_divergence", "series_iou"]
+__all__ = ["COLUMNS", "compare_folders", "first_divergence", "score_statistics", "series_iou"]
 
 COLUMNS = ("sequence", "frames", "precision", "precision_ref", "d_precision", "auc", "auc_ref", "d_auc",
            "iou", "diverges_at")
@@ -76,8 +77,10 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     Returns a plain dict: ``protocol`` (name), ``divergence_px``, ``results`` and
     ``reference`` (the folders), ``rows`` (one per compared sequence, keys
     :data:`COLUMNS`), ``mean`` (the same keys, ``sequence`` "mean", ``frames`` the total,
-    ``diverges_at`` None), ``diverged`` (how many sequences diverge) and ``left_out``
-    (``only_in_results``, ``only_in_reference``, ``not_in_dataset``, ``damaged``: sequence names).
+    ``diverges_at`` None), ``diverged`` (how many sequences diverge), ``left_out``
+    (``only_in_results``, ``only_in_reference``, ``not_in_dataset``, ``damaged``: sequence names)
+    and the statistics of :func:`score_statistics`: ``statistics``, ``auc_difference``,
+    ``wilcoxon_p`` (AUC's), ``precision_difference`` and ``precision_wilcoxon_p``.
     Raises :class:`DatasetError` for a missing folder, a malformed line (naming file and
     line), two files of one sequence with different line counts, or a line count that is
     not the sequence's frame count (naming the sequence). Sequences whose ground truth is
@@ -113,12 +116,28 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     ours_platforms = _distinct(our_platforms[s.name] for s in both)
     theirs_platforms = _distinct(their_platforms[s.name] for s in both)
     return {"protocol": proto.name, "divergence_px": float(divergence_px), "results": str(results),
-            "reference": str(reference), "rows": rows, "mean": mean,
+            "reference": str(reference), "rows": rows, "mean": mean, **score_statistics(rows),
             "diverged": sum(r["diverges_at"] is not None for r in rows), "left_out": left_out,
             "platforms": {"results": sorted({platforms.describe(p) for p in ours_platforms}),
                           "reference": sorted({platforms.describe(p) for p in theirs_platforms})},
             "platform_differences": sorted({d for a in ours_platforms for b in theirs_platforms
                                             for d in platforms.differences(a, b)})}
+
+
+def score_statistics(rows: list[dict]) -> dict:
+    """Per score (AUC, precision): each folder's mean with its interval, and the paired
+    difference results - reference (:mod:`dcfkit.analysis.statistics`); the AUC's and the
+    precision's difference and Wilcoxon p also at the top level, for scripts."""
+    found = {}
+    for score in ("auc", "precision"):
+        ours, theirs = [r[score] for r in rows], [r[f"{score}_ref"] for r in rows]
+        found[score] = {"results": mean_interval(ours).as_record(), "reference": mean_interval(theirs).as_record(),
+                        "difference": paired_difference(ours, theirs).as_record()}
+    pick = lambda d: {k: d[k] for k in ("mean", "ci_low", "ci_high")}  # noqa: E731
+    return {"statistics": {"method": METHOD, **found},
+            "auc_difference": pick(found["auc"]["difference"]), "wilcoxon_p": found["auc"]["difference"]["wilcoxon_p"],
+            "precision_difference": pick(found["precision"]["difference"]),
+            "precision_wilcoxon_p": found["precision"]["difference"]["wilcoxon_p"]}
 
 
 def _distinct(records: Iterable) -> list:

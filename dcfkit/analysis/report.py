@@ -26,7 +26,7 @@ import numpy as np
 
 from dcfkit.analysis.plots import plot_curves
 from dcfkit.analysis.scoring import Evaluation, evaluate
-from dcfkit.analysis.tables import columns, format_rows, format_table, score_line
+from dcfkit.analysis.tables import columns, format_rows, format_table, score_line, statistics_lines
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
 from dcfkit.errors import clip, shown
 from dcfkit.protocols import Protocol
@@ -130,7 +130,7 @@ def report_file_names(sequences: Seq[Sequence]) -> list[str]:
     """Every file a report on ``sequences`` may write."""
     attributes = sorted({a for s in sequences for a, present in s.attributes.items() if present})
     plots = ["precision", "success"] + [f"success_{a}" for a in attributes]
-    return ([f"{t}.{ext}" for t in REPORT_TABLES for _, ext in TABLE_FORMATS] + ["report.json", "report.html"]
+    return ([f"{t}.{ext}" for t in REPORT_TABLES for _, ext in TABLE_FORMATS] + ["statistics.txt", "report.json", "report.html"]
             + [f"{p}.{ext}" for p in plots for ext in ("png", "svg")])
 
 
@@ -148,6 +148,7 @@ def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
     for stem in tables:
         for fmt, ext in TABLE_FORMATS:
             text(f"{stem}.{ext}", format_table(getattr(evaluation, stem), fmt, columns(stem, protocol), protocol))
+    text("statistics.txt", "\n".join(statistics_lines(evaluation.statistics)) + "\n")
     text("report.json", json.dumps(json_ready(evaluation.as_record()), indent=1) + "\n")
     for kind in ("precision", "success"):
         paths += plot_curves(evaluation.curves, kind, report_dir / kind, protocol=protocol)

@@ -10,6 +10,7 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from dcfkit.analysis import metrics
+from dcfkit.analysis.statistics import versus_baseline
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, benchmark_protocol, scored_sequences
 from dcfkit.errors import shown
 from dcfkit.protocols import Protocol, get_protocol
@@ -38,7 +39,9 @@ class Evaluation:
     ``overall``, ``per_sequence`` and ``per_attribute`` are row lists (trackers best first by
     the protocol's ranking score); ``curves`` maps tracker -> averaged curves,
     ``attribute_curves`` attribute -> tracker -> curves, ``attributes`` attribute -> number of
-    sequences; ``platforms`` tracker -> ``[[platform, sequences], ...]``.
+    sequences; ``platforms`` tracker -> ``[[platform, sequences], ...]``; ``statistics`` each
+    tracker's ranking score and precision with confidence intervals and its paired difference
+    from the best (:func:`dcfkit.analysis.statistics.versus_baseline`).
     """
 
     protocol: Protocol
@@ -51,6 +54,7 @@ class Evaluation:
     thresholds: dict
     settings: dict
     platforms: dict
+    statistics: dict
 
     def as_record(self) -> dict:
         """The scores as plain data (``report.json``): the protocol as its name, title and source."""
@@ -112,7 +116,8 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
         curves=curves, attribute_curves=attribute_curves,
         attributes={a: len(n) for a, n in attributes.items()}, thresholds=_thresholds(proto),
         settings={"protocol": proto.name, "include_first": include_first, "weighting": weighting},
-        platforms={t: _platforms(res.values()) for t, res in results.items()})
+        platforms={t: _platforms(res.values()) for t, res in results.items()},
+        statistics=versus_baseline(per_sequence, ranked, (proto.rank_key, "precision")) if ranked else {})
 
 
 def _platforms(results: Iterable) -> list[list]:

@@ -98,3 +98,45 @@ def format_table(rows: Seq[Mapping], fmt: str, columns: Seq[str], protocol: str 
     if fmt == "csv":
         return format_rows([{**r, "protocol": proto.name} for r in rows], fmt, (*columns, "protocol"))
     return f"{proto.describe()}\n\n" + format_rows(rows, fmt, columns)
+
+
+def interval_text(interval: Mapping, signed: bool = False) -> str:
+    """``0.452 [0.401, 0.498]``: a mean and its confidence interval (none: the mean alone)."""
+    fmt = "{:+.3f}" if signed else "{:.3f}"
+    low, high = interval["ci_low"], interval["ci_high"]
+    bounds = f" [{fmt.format(low)}, {fmt.format(high)}]" if math.isfinite(low) and math.isfinite(high) else ""
+    return fmt.format(interval["mean"]) + bounds
+
+
+def comparison_lines(statistics: Mapping, names: tuple[str, str] = ("results", "reference")) -> list[str]:
+    """One line per score of :func:`dcfkit.analysis.compare.score_statistics`: both means with
+    their intervals, the difference with its interval, the Wilcoxon p and won/lost/tied."""
+    lines = [f"statistics: {statistics['method']}"]
+    for score in ("auc", "precision"):
+        s = statistics[score]
+        d = s["difference"]
+        lines.append(f"  {SCORE_LABELS.get(score, score):<9} {names[0]} {interval_text(s['results'])}   "
+                     f"{names[1]} {interval_text(s['reference'])}   difference {interval_text(d, signed=True)}   "
+                     f"Wilcoxon p {d['wilcoxon_p']:.3g}   won {d['won']}, lost {d['lost']}, tied {d['tied']} "
+                     f"of {d['n']}")
+    return lines
+
+
+def statistics_lines(statistics: Mapping) -> list[str]:
+    """The statistics of :func:`dcfkit.analysis.statistics.versus_baseline` as text: each
+    tracker's means with their intervals, then each difference from the baseline ('*': significant)."""
+    if not statistics:
+        return []
+    means, width = statistics["means"], max(len(t) for t in statistics["means"])
+    keys = list(next(iter(means.values())))
+    lines = [f"statistics over {statistics['sequences']} sequences: {statistics['method']}; "
+             f"{statistics['correction']}"]
+    lines += [f"  {t:<{width}}  " + "   ".join(f"{SCORE_LABELS.get(k, k)} {interval_text(m[k])}" for k in keys)
+              for t, m in means.items()]
+    for tracker, found in statistics["differences"].items():
+        for key in keys:
+            d = found[key]
+            lines.append(f"  {tracker} - {statistics['baseline']}: {SCORE_LABELS.get(key, key)} "
+                         f"{interval_text(d, signed=True)}, Wilcoxon p {d['wilcoxon_p']:.3g} (Holm {d['holm_p']:.3g})"
+                         f"{' *' if d['significant'] else ''}, won {d['won']}, lost {d['lost']}, tied {d['tied']}")
+    return lines

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from dcfkit.ablation import expand, job_dir, load_spec, run_ablation, summary_columns, variant_names
 from dcfkit.ablation.spec import MAX_VARIANTS
-from dcfkit.analysis.tables import format_table
+from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.cli.common import add_protocol_argument, variant_count
 from dcfkit.errors import DcfkitError
 from dcfkit.running.results import ResultStore
@@ -61,6 +61,7 @@ def run(args: argparse.Namespace) -> int:
     summary = res["summary"]
     protocol = summary["protocol"]  # --protocol, else the benchmark's own
     print(format_table(summary["overall"], "markdown", summary_columns("summary", protocol), protocol), end="")
+    print("\n" + "\n".join(statistics_lines(summary["statistics"])))
     print(f"\n{spec.name}: {len(res['jobs'])} jobs ({res['runs']} distinct runs): {len(res['done'])} run, "
           f"{len(res['skipped'])} already done, {len(res['failed'])} failed -> {Path(args.out)}")
     variants = variant_names(res["jobs"])

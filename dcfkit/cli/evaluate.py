@@ -12,7 +12,7 @@ from dcfkit.analysis.compare import COLUMNS, compare_folders
 from dcfkit.analysis.report import columns, json_ready, score_and_write
 from dcfkit.analysis.report_html import write_html_report
 from dcfkit.analysis.scoring import evaluate
-from dcfkit.analysis.tables import format_table, score_line
+from dcfkit.analysis.tables import comparison_lines, format_table, score_line, statistics_lines
 from dcfkit.cli.common import add_dataset_arguments, add_protocol_argument, pixels
 from dcfkit.config import load_config
 from dcfkit.config.overrides import parse_overrides
@@ -129,6 +129,7 @@ def run_report(args: argparse.Namespace) -> int:
         if len(recorded) > 1:
             print(f"warning: these results come from {len(recorded)} platforms; their boxes may part where a float "
                   f"decision is close (docs/architecture.md)", file=sys.stderr)
+        print("\n" + "\n".join(statistics_lines(evaluation.statistics)))
         print(f"\n{len(paths)} files written to {paths[0].parent}")
         if args.html:
             print(f"open {paths[-1]}")
@@ -164,6 +165,7 @@ def run_compare(args: argparse.Namespace) -> int:
     for side in ("results", "reference"):
         print(f"{side} platform: {'; '.join(res['platforms'][side])}",
               file=sys.stderr if args.format == "csv" else sys.stdout)
+    print("\n".join(comparison_lines(res["statistics"])), file=sys.stderr if args.format == "csv" else sys.stdout)
     if res["platform_differences"]:
         print(f"warning: the two folders come from different platforms ({'; '.join(res['platform_differences'])}); "
               f"their boxes may part where a float decision is close (docs/architecture.md)", file=sys.stderr)

@@ -17,6 +17,7 @@ import pytest
 
 from dcfkit import ablation, cli
 from dcfkit.ablation import expand, load_spec, run_ablation
+from dcfkit.analysis.statistics import holm
 from dcfkit.config import load_config, shipped_config_dir
 from dcfkit.datasets import load_dataset, read_boxes
 from dcfkit.datasets.synthetic import make_sequence
@@ -357,6 +358,12 @@ grid: {base: dr2, parameters: {label.mu: [0, 0.5]}}
     assert [r["variant"] for r in summary["overall"]] == ["dr2", "strcf", "label.mu=0", "label.mu=0.5"]
     assert all(r["failed"] == 0 and 0 <= r["precision"] <= 1 for r in summary["overall"])
     assert summary["protocol"]["name"] == "otb"
+    stats = summary["statistics"]  # every variant against the grid's base, Holm across the three
+    assert stats["baseline"] == "dr2" and set(stats["differences"]) == {"strcf", "label.mu=0", "label.mu=0.5"}
+    ps = [stats["differences"][v]["auc"]["wilcoxon_p"] for v in ("strcf", "label.mu=0", "label.mu=0.5")]
+    assert [stats["differences"][v]["auc"]["holm_p"] for v in ("strcf", "label.mu=0", "label.mu=0.5")] == \
+        pytest.approx(holm(ps))
+    assert (out / "statistics.txt").read_text().startswith("statistics over 4 sequences: 95% BCa bootstrap")
     assert (out / "summary.md").read_text().splitlines()[2].startswith("| variant | precision | auc | fps |")
     assert (out / "per_sequence.csv").read_text().count("\n") == 1 + total
     assert (out / "per_sequence.csv").read_text().splitlines()[0].endswith(",status,protocol")
