@@ -268,6 +268,19 @@ def run_report(tmp_path, root: Path, dataset: str, sequences: list[str], configs
     return out / "report" / "report.html"
 
 
+def check_statistics(page, statistics: dict, trackers: list[str]) -> None:
+    """Each tracker's row: its AUC with the interval report.json holds, a bar per interval, and
+    the baseline's own difference empty; the method is named under the table."""
+    rows = page.locator("#statistics-table tbody tr")
+    assert rows.count() == len(trackers)
+    for i, tracker in enumerate(trackers):
+        auc = statistics["means"][tracker]["auc"]
+        text = rows.nth(i).inner_text()
+        assert f"{auc['mean']:.3f} [{auc['ci_low']:.3f}, {auc['ci_high']:.3f}]" in text, text
+    assert page.locator("#statistics-table svg.ci").count() >= 2 * len(trackers)
+    assert "BCa bootstrap" in page.locator("#statistics").inner_text()
+
+
 def check_report(browser, path: Path, sequences) -> None:
     html = path.read_text(encoding="utf-8")
     assert not URL.search(html), URL.search(html)
@@ -279,6 +292,7 @@ def check_report(browser, path: Path, sequences) -> None:
     trackers = [r["tracker"] for r in evaluation["overall"]]
     check_tooltip_and_legend(page, evaluation["curves"], evaluation["thresholds"]["success"], trackers)
     check_filter(page, "#per-sequence-table", sequences[-1].name)
+    check_statistics(page, evaluation["statistics"], trackers)
     check_thumbnails(page, sequences)
     assert page.locator("#provenance").inner_text().count("dcfkit eval") >= len(trackers)
     assert not problems, problems

@@ -39,12 +39,14 @@ def report_page(evaluation: Mapping, sequences: Seq[Sequence], results: Mapping[
     datasets = sorted({s.dataset for s in sequences if s.dataset})
     overall = sections.table("overall", "Overall", evaluation.overall, columns("overall", protocol.name),
                              trackers, note="Click a column's name to sort by it.")
+    statistics = sections.statistics_table(evaluation.statistics, trackers)
     on = ", ".join(datasets) or "sequences"
     return {"title": f"dcfkit report: {sections.count(len(trackers), 'tracker')} on {on}",
             "protocol": protocol.describe(),
             "subtitle": f"{sections.count(len(sequences), 'sequence')}, {sum(len(s) for s in sequences)} frames",
             "trackers": trackers,
-            "sections": [overall, *evaluation_sections(evaluation, sequences, results, trackers),
+            "sections": [overall, *([statistics] if statistics else []),
+                         *evaluation_sections(evaluation, sequences, results, trackers),
                          sections.provenance(folders, [s.name for s in sequences], trackers, this_process())]}
 
 

@@ -180,7 +180,24 @@
   }
 
   /* ---------------------------------------------------------------- tables */
+  /* a mean, its confidence interval as a bar on the column's scale, '*' if significant */
+  function intervalCell(col, v) {
+    if (!v) return h('td', {class: 'num'});
+    const [mean, low, high, significant] = v;
+    const width = 90, span = (col.domain[1] - col.domain[0]) || 1;
+    const x = (value) => (4 + (width - 8) * (value - col.domain[0]) / span).toFixed(1);
+    const bar = s('svg', {class: 'ci', width: width, height: 10, 'aria-hidden': 'true'});
+    if (col.domain[0] <= 0 && col.domain[1] >= 0) s('line', {class: 'zero', x1: x(0), x2: x(0), y1: 0, y2: 10}, bar);
+    const known = low !== null && high !== null;
+    if (known) s('line', {class: 'bar', x1: x(low), x2: x(high), y1: 5, y2: 5}, bar);
+    if (mean !== null) s('circle', {cx: x(mean), cy: 5, r: 2.5}, bar);
+    const text = fmt(mean, col.digits) + (known ? ` [${fmt(low, col.digits)}, ${fmt(high, col.digits)}]` : '')
+      + (significant ? ' *' : '');
+    return h('td', {class: 'num interval'}, h('span', {text: text}), bar);
+  }
+
   function cell(col, v) {
+    if (col.type === 'interval') return intervalCell(col, v);
     if (col.type === 'tracker') return h('td', {class: 'tracker'}, swatch(v), h('span', {text: trackers[v]}));
     if (col.type === 'lines') return h('td', {class: 'lines'}, ...(v || []).map((line) => h('div', {text: line})));
     if (col.type === 'num') return h('td', {class: 'num', text: fmt(v, col.digits)});
@@ -206,10 +223,11 @@
     let current = {col: -1, desc: false};
     const sortBy = (j) => {
       const col = spec.columns[j];
-      const desc = current.col === j ? !current.desc : col.type === 'num';
+      const desc = current.col === j ? !current.desc : col.type === 'num' || col.type === 'interval';
       current = {col: j, desc: desc};
       const value = (tr) => col.type === 'tracker' ? trackers[tr.dataRow[j]]
-        : col.type === 'lines' ? (tr.dataRow[j] || []).join(' ') : tr.dataRow[j];
+        : col.type === 'lines' ? (tr.dataRow[j] || []).join(' ')
+        : col.type === 'interval' ? (tr.dataRow[j] || [null])[0] : tr.dataRow[j];
       rows.sort((a, b) => compare(value(a), value(b), desc));
       body.append(...rows);
       head.querySelectorAll('th').forEach((th, k) =>

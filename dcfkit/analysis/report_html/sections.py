@@ -104,3 +104,46 @@ def provenance(folders: Mapping[str, Path], names: Iterable[str], trackers: Seq[
     entries = [{"t": trackers.index(t), **folder_provenance(folder, names)} for t, folder in folders.items()]
     return {"kind": "provenance", "id": "provenance", "title": "Provenance", "report": dict(this_run),
             "extra": [list(e) for e in extra], "trackers": entries}
+
+
+def statistics_table(statistics: Mapping, trackers: Seq[str], tracker_label: str = "tracker") -> dict | None:
+    """The statistics of :func:`dcfkit.analysis.statistics.versus_baseline` as a table: each
+    tracker's scores with their intervals (drawn as bars), its difference from the baseline
+    ('*': significant after Holm's correction) and the corrected p; the method as its note."""
+    if not statistics:
+        return None
+    names = list(statistics["means"])
+    keys = list(statistics["means"][names[0]])
+    columns = [{"key": "tracker", "label": tracker_label, "type": "tracker", "digits": 0}]
+    rows = [[trackers.index(t)] for t in names]
+    for key in keys:
+        label = COLUMN_LABELS.get(key, key)
+        means = [statistics["means"][t][key] for t in names]
+        diffs = [statistics["differences"].get(t, {}).get(key) for t in names]
+        columns += [_interval_column(f"{key}_ci", label, means),
+                    _interval_column(f"d_{key}", f"{label} \u2212 {statistics['baseline']}", [d for d in diffs if d]),
+                    {"key": f"{key}_holm_p", "label": f"{label} Holm p", "type": "num", "digits": 3}]
+        for row, mean, diff in zip(rows, means, diffs):
+            row += [_interval(mean), _interval(diff), diff["holm_p"] if diff else None]
+    note = (f"Over the {statistics['sequences']} sequences every tracker ran: {statistics['method']}; "
+            f"{statistics['correction']} (marked *).")
+    return {"kind": "table", "id": "statistics", "title": "Confidence and significance", "columns": columns,
+            "rows": rows, "filter": False, "note": note}
+
+
+def _interval(found: Mapping | None) -> list | None:
+    """[mean, low, high, significant] of an interval (None values where undefined)."""
+    if not found:
+        return None
+    finite = lambda v: v if v is not None and math.isfinite(v) else None  # noqa: E731
+    return [finite(found["mean"]), finite(found["ci_low"]), finite(found["ci_high"]), bool(found.get("significant"))]
+
+
+def _interval_column(key: str, label: str, intervals: Seq[Mapping]) -> dict:
+    """A column of intervals on a common scale: from the lowest to the highest bound (and 0 for
+    differences, whose bars are read against it)."""
+    values = [v for i in intervals for v in (i["ci_low"], i["mean"], i["ci_high"]) if v is not None and math.isfinite(v)]
+    if key.startswith("d_"):
+        values.append(0.0)
+    low, high = (min(values), max(values)) if values else (0.0, 1.0)
+    return {"key": key, "label": label, "type": "interval", "digits": 3, "domain": [low, high]}
