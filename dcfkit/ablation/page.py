@@ -94,6 +94,9 @@ def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[s
     (variant -> sequence -> result), ``keys`` variant -> run key."""
     trackers = list(keys)
     head = [variants_table(spec, info["overall"], columns, trackers)]
+    statistics = sections.statistics_table(info["statistics"], trackers, tracker_label="variant")
+    if statistics is not None:
+        head.append(statistics)
     if spec.grid is not None:
         head.append(sensitivity_charts(spec, info["overall"]))
     folders = {v: job_dir(out, spec.dataset, k) for v, k in keys.items()}

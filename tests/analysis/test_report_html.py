@@ -352,5 +352,6 @@ def test_ablation_page_in_chromium(tmp_path, browser):
     assert sensitivity.count() == 1 and sensitivity.locator("circle").count() == 4  # 2 values x precision, AUC
     assert sensitivity.locator("line.vline").count() == 1  # the base, σ=0.5
     check_plots(page, 3 + 1 + 0)  # the OTB plots and the sensitivity plot; no attributes in OTB-layout data
+    check_statistics(page, summary["statistics"], list(summary["statistics"]["means"]))
     check_thumbnails(page, ["seqA", "seqB"])
     assert not problems, problems
