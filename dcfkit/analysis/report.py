@@ -161,7 +161,7 @@ def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
 
 def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,
                  report_dir=None, include_first: bool = True, weighting: str | None = None,
-                 protocol: str | Protocol | None = None) -> list[Path]:
+                 protocol: str | Protocol | None = None, *, missing: str = "skip") -> list[Path]:
     """Score every tracker in ``out_dir`` under ``protocol`` (by default the benchmark's,
     :func:`evaluate`) and write tables and plots to ``report_dir``.
 
@@ -169,17 +169,20 @@ def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | No
     and (when sequences have attributes) ``per_attribute`` tables as ``.txt``, ``.md`` and
     ``.csv``; ``report.json`` with all rows and curves; ``precision`` and ``success`` plots
     and one ``success_<ATTR>`` plot per attribute, each as PNG and SVG. Every file names
-    the protocol. Returns the paths.
+    the protocol. ``missing`` is :func:`evaluate`'s: by default the sequences every tracker
+    has a result for are scored, the others named. Returns the paths.
     """
-    return score_and_write(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol)[1]
+    return score_and_write(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol,
+                           missing=missing)[1]
 
 
 def score_and_write(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None, report_dir=None,
                     include_first: bool = True, weighting: str | None = None,
-                    protocol: str | Protocol | None = None) -> tuple[dict, list[Path]]:
+                    protocol: str | Protocol | None = None, *, missing: str = "skip") -> tuple[dict, list[Path]]:
     """:func:`write_report` that also returns what :func:`evaluate` returned: (evaluation, paths)."""
     report_dir = default_report_dir(out_dir, report_dir)
-    _, _, evaluation = score_folders(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol)
+    _, _, evaluation = score_folders(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol,
+                                     missing=missing)
     return evaluation, write_files(evaluation, report_dir)
 
 
@@ -189,8 +192,8 @@ def default_report_dir(out_dir, report_dir=None) -> Path:
 
 
 def score_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None, report_dir: Path,
-                  include_first: bool = True, weighting: str | None = None,
-                  protocol: str | Protocol | None = None) -> tuple[dict[str, Path], dict[str, dict], dict]:
+                  include_first: bool = True, weighting: str | None = None, protocol: str | Protocol | None = None,
+                  *, missing: str = "skip") -> tuple[dict[str, Path], dict[str, dict], dict]:
     """(tracker folders, their results, :func:`evaluate` of them) for a report into
     ``report_dir``, which is checked to take the report's files before the scoring. A test
     split (ground truth withheld after frame 1) stops here, before any folder is made."""
@@ -202,4 +205,4 @@ def score_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | N
     if not results:
         raise DatasetError(f"no tracker results found under {clip(str(out_dir))}")
     ensure_writable(report_dir, report_file_names(sequences), "the report")  # before the scoring
-    return folders, results, evaluate(results, sequences, include_first, weighting, protocol)
+    return folders, results, evaluate(results, sequences, include_first, weighting, protocol, missing)

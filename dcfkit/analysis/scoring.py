@@ -67,30 +67,29 @@ def protocol_record(protocol: Protocol) -> dict:
     return {"name": protocol.name, "title": protocol.title, "source": protocol.source}
 
 
+MISSING = ("skip", "fail")  # what evaluate() does with a sequence a tracker has no result for
+
+
 def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
              include_first: bool = True, weighting: str | None = None,
-             protocol: str | Protocol | None = None) -> Evaluation:
+             protocol: str | Protocol | None = None, missing: str = "fail") -> Evaluation:
     """Score ``results`` (tracker -> sequence name -> boxes) on ``sequences`` under ``protocol``
     (by default the rules of the benchmark's published tables,
     :func:`~dcfkit.datasets.benchmark_protocol`: LaSOT's for LaSOT, the OTB toolkit's for UAV123).
 
     A result is a :class:`dcfkit.running.results.SequenceResult`, a dict with ``boxes`` (and
     optional ``fps``) or an ``(N, 4)`` array of 0-based boxes. ``weighting`` ``None`` averages
-    as the protocol does. Returns a plain dict with ``overall``, ``per_sequence`` and
-    ``per_attribute`` row lists (trackers best first by the protocol's ranking score: AO for
-    ``got10k``, else AUC), ``curves`` (tracker -> averaged ``precision``/``success``/
-    ``norm_precision`` curves), ``attribute_curves`` (attribute -> tracker -> curves),
-    ``attributes`` (attribute -> number of sequences), ``thresholds``, ``protocol`` (name,
-    title, source), ``settings`` and ``platforms`` (tracker -> ``[[platform, sequences], ...]``
-    of :func:`dcfkit.running.platforms.describe`). Sequences whose ground truth is withheld after
-    frame 1 (test splits) are left out (:func:`~dcfkit.datasets.scored_sequences`: a
-    :class:`DatasetError` if that leaves none).
+    as the protocol does. ``missing``: ``"skip"`` scores the sequences every tracker has a
+    result for and names the others in ``settings["left_out"]`` (sequence -> the trackers
+    without a result); ``"fail"`` scores a missing result as a total failure, as the toolkits
+    do. Sequences whose ground truth is withheld after frame 1 (test splits) are left out
+    (:func:`~dcfkit.datasets.scored_sequences`: a :class:`DatasetError` if that leaves none).
     """
     sequences = list(sequences)
     proto = get_protocol(protocol or benchmark_protocol(sequences))
     weighting = weighting or proto.weighting
     keys = proto.score_keys
-    sequences = scored_sequences(sequences)
+    sequences, left_out = _complete(scored_sequences(sequences), results, missing)
     per_seq, fps, missing = {}, {}, {}
     for tracker, res in results.items():
         per_seq[tracker], fps[tracker], missing[tracker] = _score_tracker(tracker, res, sequences, include_first,
@@ -115,9 +114,29 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
         protocol=proto, overall=overall, per_sequence=per_sequence, per_attribute=per_attribute,
         curves=curves, attribute_curves=attribute_curves,
         attributes={a: len(n) for a, n in attributes.items()}, thresholds=_thresholds(proto),
-        settings={"protocol": proto.name, "include_first": include_first, "weighting": weighting},
+        settings={"protocol": proto.name, "include_first": include_first, "weighting": weighting,
+                  "missing": "skip" if left_out is not None else "fail", "left_out": left_out or {}},
         platforms={t: _platforms(res.values()) for t, res in results.items()},
         statistics=versus_baseline(per_sequence, ranked, (proto.rank_key, "precision")) if ranked else {})
+
+
+def _complete(sequences: list[Sequence], results: Mapping[str, Mapping], missing: str) -> tuple[list, dict | None]:
+    """(the sequences to score, sequence -> trackers without a result; None under "fail")."""
+    if missing not in MISSING:
+        raise ValueError(f"missing must be one of {', '.join(MISSING)}, got {shown(missing)}")
+    if missing == "fail":
+        return sequences, None
+    left_out = {s.name: [t for t, res in results.items() if s.name not in res] for s in sequences}
+    left_out = {name: trackers for name, trackers in left_out.items() if trackers}
+    kept = [s for s in sequences if s.name not in left_out]
+    if not kept:
+        raise DatasetError(f"no sequence has a result from every tracker ({len(sequences)} sequences, "
+                           f"{len(results)} trackers): report fewer trackers, or score missing results as "
+                           f"failures (--missing fail)")
+    if left_out:
+        log.warning("%d of %d sequences left out, without a result from every tracker (--missing fail scores "
+                    "them as failures): %s", len(left_out), len(sequences), ", ".join(list(left_out)[:10]))
+    return kept, left_out
 
 
 def _platforms(results: Iterable) -> list[list]:

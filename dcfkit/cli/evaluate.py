@@ -11,7 +11,7 @@ from typing import Any, Callable, Mapping
 from dcfkit.analysis.compare import COLUMNS, compare_folders
 from dcfkit.analysis.report import columns, json_ready, score_and_write
 from dcfkit.analysis.report_html import write_html_report
-from dcfkit.analysis.scoring import evaluate
+from dcfkit.analysis.scoring import MISSING, evaluate
 from dcfkit.analysis.tables import comparison_lines, format_table, score_line, statistics_lines
 from dcfkit.cli.common import add_dataset_arguments, add_protocol_argument, pixels
 from dcfkit.config import load_config
@@ -110,6 +110,10 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--frame-weighted", action="store_true",
                         help="pool the frames of all sequences (default: as the protocol; otb and pysot "
                              "weigh sequences equally, got10k pools frames)")
+    parser.add_argument("--missing", choices=MISSING, default="skip",
+                        help="a sequence some tracker has no result for: skip (default) scores the sequences "
+                             "every tracker completed and names the others; fail scores a missing result as a "
+                             "total failure, as the toolkits do")
 
 
 def run_report(args: argparse.Namespace) -> int:
@@ -118,7 +122,8 @@ def run_report(args: argparse.Namespace) -> int:
     trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
     write = write_html_report if args.html else score_and_write
     evaluation, paths = write(args.out, sequences, trackers, args.report_dir, include_first=not args.skip_first,
-                              weighting="frame" if args.frame_weighted else None, protocol=args.protocol)
+                              weighting="frame" if args.frame_weighted else None, protocol=args.protocol,
+                              missing=args.missing)
     protocol = evaluation.protocol.name  # --protocol, else the benchmark's
     print(format_table(evaluation.overall, args.format, columns("overall", protocol), protocol), end="")
     if args.format == "table":
@@ -129,6 +134,8 @@ def run_report(args: argparse.Namespace) -> int:
         if len(recorded) > 1:
             print(f"warning: these results come from {len(recorded)} platforms; their boxes may part where a float "
                   f"decision is close (docs/architecture.md)", file=sys.stderr)
+        for name, without in evaluation.settings["left_out"].items():
+            print(f"left out: {name} (no result from {', '.join(without)}; --missing fail scores it as a failure)")
         print("\n" + "\n".join(statistics_lines(evaluation.statistics)))
         print(f"\n{len(paths)} files written to {paths[0].parent}")
         if args.html:

@@ -67,3 +67,46 @@ def test_report_prints_and_writes_the_statistics(tmp_path, monkeypatch, capsys):
     assert "statistics over 5 sequences: 95% BCa bootstrap" in out and "far - " in out and "(Holm " in out
     written = (tmp_path / "out" / "report" / "statistics.txt").read_text()
     assert written.splitlines()[0] == out.split("\n\n")[-2].splitlines()[0]
+
+
+def test_a_missing_result_is_left_out_and_named_unless_asked_to_fail():
+    partial = {**RESULTS, "far": {k: v for k, v in RESULTS["far"].items() if k != "c"}}
+    skipped = evaluate(partial, SEQUENCES, missing="skip")
+    assert skipped.settings["left_out"] == {"c": ["far"]} and skipped.settings["missing"] == "skip"
+    assert {r["sequence"] for r in skipped.per_sequence} == {"a", "b", "d", "e"}
+    assert all(r["sequences"] == 4 and r["missing"] == 0 for r in skipped.overall)
+    near = np.mean([r["auc"] for r in evaluate(RESULTS, SEQUENCES).per_sequence
+                    if r["tracker"] == "near" and r["sequence"] != "c"])
+    assert next(r for r in skipped.overall if r["tracker"] == "near")["auc"] == pytest.approx(near)
+    failed = evaluate(partial, SEQUENCES, missing="fail")  # the toolkits' way: c scores 0 for far
+    far = next(r for r in failed.overall if r["tracker"] == "far")
+    assert far["missing"] == 1 and far["sequences"] == 5 and failed.settings["left_out"] == {}
+    assert next(r for r in failed.per_sequence if r["tracker"] == "far" and r["sequence"] == "c")["auc"] == 0
+
+
+def test_no_complete_sequence_is_an_error_that_says_what_to_do():
+    disjoint = {"x": {"a": RESULTS["near"]["a"]}, "y": {"b": RESULTS["near"]["b"]}}
+    with pytest.raises(Exception, match=r"no sequence has a result from every tracker .*--missing fail"):
+        evaluate(disjoint, SEQUENCES[:2], missing="skip")
+    with pytest.raises(ValueError, match="missing must be one of skip, fail"):
+        evaluate(RESULTS, SEQUENCES, missing="drop")
+
+
+def test_report_names_what_it_left_out(tmp_path, monkeypatch, capsys):
+    import dcfkit.cli.evaluate
+
+    for tracker, by_sequence in RESULTS.items():
+        folder = tmp_path / "out" / tracker
+        folder.mkdir(parents=True)
+        for name, boxes in by_sequence.items():
+            if not (tracker == "far" and name == "c"):
+                (folder / f"{name}.txt").write_text("".join(f"{x + 1:.3f},{y + 1:.3f},{w:.3f},{h:.3f}\n"
+                                                            for x, y, w, h in boxes))
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: SEQUENCES)
+    assert cli.main(["report", str(tmp_path / "out"), "--root", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "left out: c (no result from far; --missing fail scores it as a failure)" in out
+    assert "statistics over 4 sequences" in out
+    assert cli.main(["report", str(tmp_path / "out"), "--root", str(tmp_path), "--missing", "fail"]) == 0
+    out = capsys.readouterr().out
+    assert "left out" not in out and "statistics over 5 sequences" in out

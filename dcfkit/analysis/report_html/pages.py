@@ -52,14 +52,14 @@ def report_page(evaluation: Mapping, sequences: Seq[Sequence], results: Mapping[
 
 def write_html_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None, report_dir=None,
                       include_first: bool = True, weighting: str | None = None,
-                      protocol: str | Protocol | None = None) -> tuple[dict, list[Path]]:
+                      protocol: str | Protocol | None = None, *, missing: str = "skip") -> tuple[dict, list[Path]]:
     """:func:`dcfkit.analysis.report.score_and_write` plus ``report.html``: one self-contained page with
     the tables (sortable, filterable), the plots, every sequence's frames with the boxes, and
     what produced the results. Returns (evaluation, paths), the page last."""
     report_dir = default_report_dir(out_dir, report_dir)
     sequences = scored_sequences(sequences)  # the page shows the frames of the sequences scored only
     folders, results, evaluation = score_folders(out_dir, sequences, trackers, report_dir, include_first,
-                                                 weighting, protocol)
+                                                 weighting, protocol, missing=missing)
     paths = write_files(evaluation, report_dir)
     page = report_page(evaluation, sequences, results, folders)
     return evaluation, paths + [write_page(page, report_dir / PAGE)]
