@@ -129,7 +129,7 @@ TABLE_FORMATS = (("table", "txt"), ("markdown", "md"), ("csv", "csv"))
 def report_file_names(sequences: Seq[Sequence]) -> list[str]:
     """Every file a report on ``sequences`` may write."""
     attributes = sorted({a for s in sequences for a, present in s.attributes.items() if present})
-    plots = ["precision", "success"] + [f"success_{a}" for a in attributes]
+    plots = ["precision", "success"] + [f"{kind}_{a}" for a in attributes for kind in ("precision", "success")]
     return ([f"{t}.{ext}" for t in REPORT_TABLES for _, ext in TABLE_FORMATS] + ["statistics.txt", "report.json", "report.html"]
             + [f"{p}.{ext}" for p in plots for ext in ("png", "svg")])
 
@@ -153,9 +153,10 @@ def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
     for kind in ("precision", "success"):
         paths += plot_curves(evaluation.curves, kind, report_dir / kind, protocol=protocol)
     for attr, curves in evaluation.attribute_curves.items():
-        n = evaluation.attributes[attr]
-        title = f"Success plots of OPE - {ATTRIBUTE_NAMES.get(attr, attr)} ({n})"
-        paths += plot_curves(curves, "success", report_dir / f"success_{attr}", title=title, protocol=protocol)
+        name = f"{ATTRIBUTE_NAMES.get(attr, attr)} ({evaluation.attributes[attr]})"
+        for kind in ("precision", "success"):
+            title = f"{kind.capitalize()} plots of OPE - {name}"
+            paths += plot_curves(curves, kind, report_dir / f"{kind}_{attr}", title=title, protocol=protocol)
     return paths
 
 
@@ -168,7 +169,7 @@ def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | No
     ``report_dir`` defaults to ``out_dir/report``. Writes ``overall``, ``per_sequence``
     and (when sequences have attributes) ``per_attribute`` tables as ``.txt``, ``.md`` and
     ``.csv``; ``report.json`` with all rows and curves; ``precision`` and ``success`` plots
-    and one ``success_<ATTR>`` plot per attribute, each as PNG and SVG. Every file names
+    and ``precision_<ATTR>`` and ``success_<ATTR>`` plots per attribute, each as PNG and SVG. Every file names
     the protocol. ``missing`` is :func:`evaluate`'s: by default the sequences every tracker
     has a result for are scored, the others named. Returns the paths.
     """

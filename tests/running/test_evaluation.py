@@ -473,7 +473,7 @@ def test_write_report_files(tmp_path, seqs):
         (other / f"{s.name}.txt").write_text(results.format_boxes(gt_boxes()))
     paths = report.write_report(out, seqs, trackers=["drift", "slow", str(other)])
     names = {p.name for p in paths}
-    for stem in ("precision", "success", "success_SV", "success_FM"):
+    for stem in ("precision", "success", "success_SV", "success_FM", "precision_SV", "precision_FM"):
         assert {f"{stem}.png", f"{stem}.svg"} <= names
     for stem in ("overall", "per_sequence", "per_attribute"):
         assert {f"{stem}.txt", f"{stem}.md", f"{stem}.csv"} <= names
