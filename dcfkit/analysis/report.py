@@ -123,7 +123,7 @@ def json_ready(obj):
 
 
 REPORT_TABLES = ("overall", "per_sequence", "per_attribute")
-TABLE_FORMATS = (("table", "txt"), ("markdown", "md"), ("csv", "csv"))
+TABLE_FORMATS = (("table", "txt"), ("markdown", "md"), ("csv", "csv"), ("latex", "tex"))
 
 
 def report_file_names(sequences: Seq[Sequence]) -> list[str]:
@@ -147,7 +147,8 @@ def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
     tables = REPORT_TABLES if evaluation.per_attribute else REPORT_TABLES[:2]
     for stem in tables:
         for fmt, ext in TABLE_FORMATS:
-            text(f"{stem}.{ext}", format_table(getattr(evaluation, stem), fmt, columns(stem, protocol), protocol))
+            text(f"{stem}.{ext}", format_table(getattr(evaluation, stem), fmt, columns(stem, protocol), protocol,
+                                               evaluation.statistics if stem == "overall" else None))
     text("statistics.txt", "\n".join(statistics_lines(evaluation.statistics)) + "\n")
     text("report.json", json.dumps(json_ready(evaluation.as_record()), indent=1) + "\n")
     for kind in ("precision", "success"):

@@ -7,6 +7,7 @@ import math
 from typing import Mapping
 from typing import Sequence as Seq
 
+from dcfkit.analysis.latex import latex_table
 from dcfkit.errors import shown
 from dcfkit.protocols import DEFAULT, Protocol, get_protocol
 
@@ -91,10 +92,14 @@ def score_line(row: Mapping, protocol: str | Protocol = DEFAULT) -> str:
     return f"{scores} on {row['sequences']} sequences (protocol {proto.name})"
 
 
-def format_table(rows: Seq[Mapping], fmt: str, columns: Seq[str], protocol: str | Protocol = DEFAULT) -> str:
+def format_table(rows: Seq[Mapping], fmt: str, columns: Seq[str], protocol: str | Protocol = DEFAULT,
+                 statistics: Mapping | None = None) -> str:
     """:func:`format_rows` naming the scoring protocol: a first line (``table``,
-    ``markdown``) or a last ``protocol`` column (``csv``, so the file stays one table)."""
+    ``markdown``), a last ``protocol`` column (``csv``, so the file stays one table), or the
+    caption of a LaTeX table (``latex``, with the intervals of ``statistics`` if given)."""
     proto = get_protocol(protocol)
+    if fmt == "latex":
+        return latex_table(rows, columns, proto, statistics)
     if fmt == "csv":
         return format_rows([{**r, "protocol": proto.name} for r in rows], fmt, (*columns, "protocol"))
     return f"{proto.describe()}\n\n" + format_rows(rows, fmt, columns)

@@ -97,8 +97,9 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
     add_dataset_arguments(parser)
     parser.add_argument("--trackers", default=None,
                         help="comma-separated tracker folders (names in OUT or paths; default: all)")
-    parser.add_argument("--format", choices=("table", "markdown", "csv"), default="table",
-                        help="format of the table printed to stdout")
+    parser.add_argument("--format", choices=("table", "markdown", "csv", "latex"), default="table",
+                        help="format of the table printed to stdout (latex: booktabs, best per score bold, second "
+                             "underlined, confidence intervals in brackets)")
     parser.add_argument("--report-dir", type=Path, default=None, help="default: OUT/report")
     parser.add_argument("--html", action="store_true",
                         help="also write report.html: one self-contained page with sortable tables, interactive "
@@ -125,7 +126,8 @@ def run_report(args: argparse.Namespace) -> int:
                               weighting="frame" if args.frame_weighted else None, protocol=args.protocol,
                               missing=args.missing)
     protocol = evaluation.protocol.name  # --protocol, else the benchmark's
-    print(format_table(evaluation.overall, args.format, columns("overall", protocol), protocol), end="")
+    print(format_table(evaluation.overall, args.format, columns("overall", protocol), protocol,
+                       evaluation.statistics), end="")
     if args.format == "table":
         for tracker, rows in evaluation.platforms.items():
             lines = [f"{line} ({n} sequences)" if len(rows) > 1 else line for line, n in rows]
