@@ -74,7 +74,8 @@ def tracker_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] |
                     exclude: Iterable[Path] = ()) -> dict[str, Path]:
     """Tracker name -> results folder, for a report on ``sequences``.
 
-    A tracker is a sub-folder name of ``out_dir`` or a path to a folder of result files.
+    A tracker is a sub-folder name of ``out_dir``, a path to a folder of result files, or
+    ``NAME=PATH`` to name such a folder (published results beside one's own).
     ``None`` takes every sub-folder of ``out_dir`` holding a ``<sequence>.txt`` of one of
     ``sequences``, except the folders in ``exclude`` that hold no tracker results (a
     report's own folder). A tracker is named by its folder's name, or by ``parent/name``
@@ -90,18 +91,38 @@ def tracker_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] |
         trackers = [p.name for p in sorted(out_dir.iterdir())
                     if p.is_dir() and not p.name.startswith(".") and any((p / f"{n}.txt").is_file() for n in names)
                     and (p.resolve() not in exclude or _holds_results(p, names))]
-    folders: dict[Path, Path] = {}
+    folders: dict[Path, tuple[str | None, Path]] = {}
     for tracker in trackers:
-        # os.path.isdir: a name too long for the file system is no folder (Path.is_dir raises)
-        folder = out_dir / tracker if os.path.isdir(out_dir / tracker) else Path(tracker)
-        if not os.path.isdir(folder):
-            raise DatasetError(f"no results for tracker {shown(tracker)}: neither {clip(str(out_dir / tracker))} "
-                               f"nor {clip(tracker)} is a folder")
-        folders.setdefault(folder.resolve(), folder)
-    shared = {name for name in (f.name for f in folders.values())
-              if sum(g.name == name for g in folders.values()) > 1}
-    return {f"{folder.resolve().parent.name}/{folder.name}" if folder.name in shared else folder.name: folder
-            for folder in folders.values()}
+        name, folder = named_folder(out_dir, tracker)
+        if folder.resolve() in folders and folders[folder.resolve()][0] != name:
+            raise DatasetError(f"{clip(str(folder))} is named twice: as {folders[folder.resolve()][0] or folder.name} "
+                               f"and as {name or folder.name}")
+        folders.setdefault(folder.resolve(), (name, folder))
+    given = [n for n, _ in folders.values() if n is not None]
+    if len(set(given)) < len(given):
+        raise DatasetError(f"two folders are given one name: {', '.join(sorted(n for n in given if given.count(n) > 1))}")
+    shared = {name for name in (f.name for _, f in folders.values())
+              if sum(g.name == name for _, g in folders.values()) > 1}
+    return {name or (f"{folder.resolve().parent.name}/{folder.name}" if folder.name in shared else folder.name): folder
+            for name, folder in folders.values()}
+
+
+def named_folder(out_dir: Path, tracker: str) -> tuple[str | None, Path]:
+    """(the name given, the folder) of a tracker: a sub-folder name of ``out_dir``, a path, or
+    ``NAME=PATH`` (a published result folder under a name of its own). A folder whose name
+    holds '=' is taken as a folder."""
+    # os.path.isdir: a name too long for the file system is no folder (Path.is_dir raises)
+    for candidate in (out_dir / tracker, Path(tracker)):
+        if os.path.isdir(candidate):
+            return None, candidate
+    name, sep, path = tracker.partition("=")
+    if sep and name.strip() and path and name.isprintable():
+        folder = out_dir / path if os.path.isdir(out_dir / path) else Path(path)
+        if os.path.isdir(folder):
+            return name.strip(), folder
+        raise DatasetError(f"no results for tracker {shown(name)}: {clip(path)} is not a folder")
+    raise DatasetError(f"no results for tracker {shown(tracker)}: neither {clip(str(out_dir / tracker))} "
+                       f"nor {clip(tracker)} is a folder")
 
 
 def _holds_results(folder: Path, names: set[str]) -> bool:

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from dcfkit.analysis.compare import COLUMNS, compare_folders
-from dcfkit.analysis.report import columns, json_ready, score_and_write
+from dcfkit.analysis.report import columns, json_ready, named_folder, score_and_write
 from dcfkit.analysis.report_html import write_html_report
 from dcfkit.analysis.scoring import MISSING, evaluate
 from dcfkit.analysis.tables import comparison_lines, format_table, score_line, statistics_lines
@@ -146,9 +147,10 @@ def run_report(args: argparse.Namespace) -> int:
 
 
 def add_compare_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("results", type=Path, metavar="RESULTS",
-                   help="folder of <sequence>.txt result files (1-based x,y,w,h), e.g. OUT/<tracker>")
-    p.add_argument("reference", type=Path, metavar="REFERENCE", help="folder of result files to compare with")
+    p.add_argument("results", metavar="RESULTS",
+                   help="folder of <sequence>.txt result files (1-based x,y,w,h), e.g. OUT/<tracker>; NAME=FOLDER "
+                        "names it")
+    p.add_argument("reference", metavar="REFERENCE", help="folder of result files to compare with (or NAME=FOLDER)")
     add_dataset_arguments(p, "benchmark root folder (the ground truth)")
     add_protocol_argument(p)
     p.add_argument("--divergence-px", type=pixels, default=2.0,
@@ -158,10 +160,17 @@ def add_compare_arguments(p: argparse.ArgumentParser) -> None:
                         "divergences, left-out sequences) go to stderr")
 
 
+def _named(folder: str) -> tuple[str | None, Path]:
+    """(its name, the folder) of a RESULTS or REFERENCE argument: ``NAME=FOLDER`` or a folder."""
+    return named_folder(Path.cwd(), folder) if "=" in folder and not os.path.isdir(folder) else (None, Path(folder))
+
+
 def run_compare(args: argparse.Namespace) -> int:
     """Print the per-sequence comparison."""
     sequences = load_dataset(args.dataset, args.root, args.sequences)
-    res = compare_folders(args.results, args.reference, sequences, args.protocol, args.divergence_px)
+    (name, results), (name_ref, reference) = _named(args.results), _named(args.reference)
+    res = compare_folders(results, reference, sequences, args.protocol, args.divergence_px)
+    res["names"] = [name or "results", name_ref or "reference"]
     if args.format == "json":
         print(json.dumps(json_ready(res), indent=1))
         return 0
@@ -174,7 +183,8 @@ def run_compare(args: argparse.Namespace) -> int:
     for side in ("results", "reference"):
         print(f"{side} platform: {'; '.join(res['platforms'][side])}",
               file=sys.stderr if args.format == "csv" else sys.stdout)
-    print("\n".join(comparison_lines(res["statistics"])), file=sys.stderr if args.format == "csv" else sys.stdout)
+    print("\n".join(comparison_lines(res["statistics"], tuple(res["names"]))),
+          file=sys.stderr if args.format == "csv" else sys.stdout)
     if res["platform_differences"]:
         print(f"warning: the two folders come from different platforms ({'; '.join(res['platform_differences'])}); "
               f"their boxes may part where a float decision is close (docs/architecture.md)", file=sys.stderr)

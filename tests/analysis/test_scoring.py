@@ -110,3 +110,28 @@ def test_report_names_what_it_left_out(tmp_path, monkeypatch, capsys):
     assert cli.main(["report", str(tmp_path / "out"), "--root", str(tmp_path), "--missing", "fail"]) == 0
     out = capsys.readouterr().out
     assert "left out" not in out and "statistics over 5 sequences" in out
+
+
+def test_published_results_join_a_report_under_a_name_of_their_own(tmp_path, monkeypatch, capsys):
+    import dcfkit.cli.evaluate
+
+    for tracker, by_sequence in (("near", RESULTS["near"]), ("published/far", RESULTS["far"])):
+        folder = tmp_path / tracker
+        folder.mkdir(parents=True)
+        for name, boxes in by_sequence.items():
+            (folder / f"{name}.txt").write_text("".join(f"{x + 1:.3f},{y + 1:.3f},{w:.3f},{h:.3f}\n"
+                                                        for x, y, w, h in boxes))
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: SEQUENCES)
+    named = f"Far (paper)={tmp_path / 'published' / 'far'}"
+    assert cli.main(["report", str(tmp_path), "--root", str(tmp_path), "--trackers", f"near,{named}",
+                     "--report-dir", str(tmp_path / "rep")]) == 0
+    out = capsys.readouterr().out
+    assert "Far (paper) - near: AUC" in out and "\nnear " in out
+    for bad, message in ((f"near,Near={tmp_path / 'near'}", "is named twice"),
+                         (f"X={tmp_path / 'near'},X={tmp_path / 'published' / 'far'}", "given one name: X"),
+                         ("X=nowhere", "no results for tracker 'X': nowhere is not a folder")):
+        assert cli.main(["report", str(tmp_path), "--root", str(tmp_path), "--trackers", bad,
+                         "--report-dir", str(tmp_path / "rep")]) == 2
+        assert message in capsys.readouterr().err
+    assert cli.main(["compare", f"mine={tmp_path / 'near'}", named, "--root", str(tmp_path)]) == 0
+    assert "AUC       mine " in capsys.readouterr().out
