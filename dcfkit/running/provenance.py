@@ -7,12 +7,16 @@ import contextvars
 import dataclasses
 import functools
 import hashlib
+import importlib.metadata
 import json
 import os
 import platform
 import shlex
+import subprocess
 import sys
+import urllib.parse
 from datetime import datetime, timezone
+from pathlib import Path
 from typing import Mapping
 
 import numpy as np
@@ -110,3 +114,50 @@ def machine() -> dict:
     """The machine this process runs on: host name, OS, CPU model, cores, Python version."""
     return {"host": platform.node(), "system": platform.platform(terse=True), "cpu": cpu_model(),
             "cores": os.cpu_count(), "python": platform.python_version()}
+
+
+@functools.lru_cache(maxsize=None)
+def git_state(folder: str) -> dict | None:
+    """``{"commit", "dirty"}`` of the git work tree whose top is ``folder`` (dirty: tracked files
+    changed since the commit), or None if it is none or git cannot say."""
+    if not os.path.isdir(os.path.join(folder, ".git")):
+        return None
+    try:
+        run = [subprocess.run(["git", "-C", folder, *args], capture_output=True, text=True, timeout=10)
+               for args in (("rev-parse", "HEAD"), ("status", "--porcelain", "--untracked-files=no"))]
+    except (OSError, subprocess.SubprocessError):  # no git, or it hung
+        return None
+    if any(r.returncode != 0 for r in run):
+        return None
+    return {"commit": run[0].stdout.strip(), "dirty": bool(run[1].stdout.strip())}
+
+
+def package_source(distribution: str, package_dir: str | None = None) -> dict | None:
+    """Where an installed package's code came from: the git state of the work tree it runs from
+    (``package_dir``'s parent holds ``.git``: a checkout, an editable install), else the commit
+    pip recorded for a VCS install or the git state of the folder of an editable one (PEP 610
+    ``direct_url.json``); None when nothing says (a release from an index)."""
+    if package_dir is not None and (found := git_state(os.path.dirname(os.path.abspath(package_dir)))):
+        return found
+    try:
+        direct = json.loads(importlib.metadata.distribution(distribution).read_text("direct_url.json") or "null")
+    except (importlib.metadata.PackageNotFoundError, ValueError):
+        return None
+    if not isinstance(direct, dict):
+        return None
+    if isinstance(direct.get("vcs_info"), dict) and direct["vcs_info"].get("commit_id"):
+        return {"commit": str(direct["vcs_info"]["commit_id"]), "dirty": None}
+    url = str(direct.get("url", ""))
+    if url.startswith("file://") and isinstance(direct.get("dir_info"), dict) and direct["dir_info"].get("editable"):
+        return git_state(urllib.parse.unquote(url.removeprefix("file://")))
+    return None
+
+
+def sources(config: Mapping) -> dict:
+    """:func:`package_source` of dcfkit and of each plugin whose components ``config`` uses,
+    by distribution name (results sidecars record it)."""
+    found = {"dcfkit": package_source("dcfkit", str(Path(__file__).resolve().parents[1]))}
+    for plugin in plugin_versions(config):
+        name = plugin.rsplit(" ", 1)[0]
+        found[name] = package_source(name)
+    return found

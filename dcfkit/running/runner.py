@@ -28,7 +28,7 @@ from dcfkit.errors import DcfkitError, shown
 from dcfkit.registry import PluginWarning
 from dcfkit.running import platforms
 from dcfkit.running.files import StoreError
-from dcfkit.running.provenance import dcfkit_version, invocation, machine, now, plugin_versions, run_key
+from dcfkit.running.provenance import dcfkit_version, invocation, machine, now, plugin_versions, run_key, sources
 from dcfkit.running.results import ResultStore
 from dcfkit.running.tracking import TrackerFailure, track
 
@@ -99,6 +99,7 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
     meta = {"sequence": seq.name, "dataset": seq.dataset, "tracker": task.config.get("name"),
             "init_box": [float(v) for v in seq.init_box], "fps": run.fps, "total_time": float(run.times.sum()),
             "run_key": task.key, "dcfkit_version": version, "plugins": plugin_versions(task.config),
+            "source": sources(task.config),
             "time": now(), **(origin or invocation()), "machine": machine(), "platform": platforms.record(),
             "config": task.config,
             "times": run.times.tolist()}

@@ -43,9 +43,23 @@ def _command(meta: Mapping) -> str:
     return f"cd {meta['cwd']} && {line}" if isinstance(meta.get("cwd"), str) else line
 
 
+def describe_sources(record) -> str:
+    """A sidecar's ``source`` as ``dcfkit 1a2b3c4d5e6f (uncommitted changes); plugin ...``."""
+    if not isinstance(record, dict):
+        return NOT_RECORDED
+    parts = []
+    for name, found in record.items():
+        if not isinstance(found, dict) or not found.get("commit"):
+            parts.append(f"{name}: no git commit recorded (a release)")
+        else:
+            parts.append(f"{name} {str(found['commit'])[:12]}" + (" with uncommitted changes" if found.get("dirty") else ""))
+    return "; ".join(parts)
+
+
 def folder_provenance(folder: Path, names: Iterable[str]) -> dict:
     """What the sidecars of sequences ``names`` in ``folder`` record: ``folder``,
-    ``sequences`` (sidecars read), ``run_keys``, ``versions``, ``plugins``, ``commands``,
+    ``sequences`` (sidecars read), ``run_keys``, ``versions``, ``plugins``, ``sources`` (git
+    commits), ``commands``,
     ``machines``, ``platforms`` (each ``[[value, sequences], ...]``), ``times`` (first, last) and
     ``config`` (the first sidecar's)."""
     store = ResultStore(folder)
@@ -59,6 +73,7 @@ def folder_provenance(folder: Path, names: Iterable[str]) -> dict:
         "run_keys": _counted(str(m.get("run_key", m.get("config_hash", NOT_RECORDED))) for m in metas),
         "versions": _counted(str(m.get("dcfkit_version", NOT_RECORDED)) for m in metas),
         "plugins": _counted(", ".join(map(str, m.get("plugins") or [])) or "none" for m in metas),
+        "sources": _counted(describe_sources(m.get("source")) for m in metas),
         "commands": _counted(_command(m) for m in metas),
         "machines": _counted(describe_machine(m.get("machine")) for m in metas),
         "platforms": _counted(platforms.describe(m.get("platform")) for m in metas),

@@ -324,6 +324,7 @@
         entry(dl, 'run key (config hash)', ...counted(tr.run_keys));
         entry(dl, 'dcfkit', ...counted(tr.versions));
         entry(dl, 'plugins', ...counted(tr.plugins));
+        entry(dl, 'source', ...counted(tr.sources || []));
         entry(dl, 'command', ...counted(tr.commands));
         entry(dl, 'machine', ...counted(tr.machines));
         entry(dl, 'platform', ...counted(tr.platforms || []));
