@@ -131,3 +131,21 @@ def test_the_architecture_page_opens_with_every_layer_and_stays_short():
     assert all(f"{name}/" in picture for name in layers), sorted(n for n in layers if f"{n}/" not in picture)
     assert all(name in text[:text.index("## ")] for name in modules), modules
     assert len(text.encode()) <= 20_000
+
+
+def test_the_readme_and_the_integrations_page_run_got10k_into_one_folder():
+    readme = (DOCS.parent / "README.md").read_text(encoding="utf-8")
+    page = (DOCS / "integrations.md").read_text(encoding="utf-8")
+    for text in (readme, page):
+        assert 'ExperimentDTB70("../shared/data/DTB70", result_dir="results/got10k", report_dir="results/got10k")' \
+            in text
+
+
+def test_ablate_help_names_every_shipped_spec():
+    from dcfkit.cli.parser import build_parser  # deferred: the parser is only needed here
+
+    specs = {p.stem for p in (DOCS.parent / "configs" / "ablations").glob("*.yaml")
+             if "\nvariants:" in p.read_text(encoding="utf-8") or "\ngrid:" in p.read_text(encoding="utf-8")}
+    helps = build_parser()._subparsers._group_actions[0].choices["ablate"].format_help()
+    assert specs == {"departures", "family", "sensitivity", "table3"}
+    assert all(name in " ".join(helps.split()) for name in specs), helps

@@ -2,19 +2,23 @@
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 from dcfkit.ablation import expand, job_dir, load_spec, run_ablation, summary_columns, variant_names
 from dcfkit.ablation.spec import MAX_VARIANTS
 from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.cli.common import add_protocol_argument, variant_count
+from dcfkit.config import shipped_config_dir
 from dcfkit.errors import DcfkitError
 from dcfkit.running.results import ResultStore
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    shipped = sorted(p.stem for p in (shipped_config_dir() / "ablations").glob("*.yaml")  # the others: configs
+                     if re.search(r"^(variants|grid):", p.read_text(encoding="utf-8"), re.MULTILINE))
     parser.add_argument("spec", metavar="SPEC",
-                        help="ablation spec YAML, or a shipped name (table3, sensitivity)")
+                        help=f"ablation spec YAML, or a shipped one by name ({', '.join(shipped)})")
     parser.add_argument("--out", required=True, type=Path,
                         help="results folder (OUT/jobs/..., OUT/summary.md, ...); reruns resume")
     parser.add_argument("--jobs", type=int, default=None,

@@ -79,10 +79,20 @@ def _metadata(config: Mapping[str, Any]) -> dict:
 
 
 def ascii_text(text: str) -> str:
-    """``text`` in ASCII ('é' as 'e', '—' as '?'): libtrax reads a byte over 127 as the end of
-    the stream (a signed ``char``), so one in the handshake or a quit's reason ends the session."""
+    """``text`` in ASCII ('é' as 'e', 'θ' as 'theta', '²' as '2', '—' as '-', others '?'): libtrax
+    reads a byte over 127 as the end of the stream (a signed ``char``), so one in the handshake
+    or a quit's reason ends the session."""
     letters = (c for c in unicodedata.normalize("NFKD", text) if not unicodedata.combining(c))  # é: e + ´
-    return "".join(letters).encode("ascii", "replace").decode("ascii")
+    return "".join(c if c.isascii() else _ascii_name(c) for c in letters)
+
+
+def _ascii_name(char: str) -> str:
+    """A Greek letter by its name ('theta', 'Delta'), a dash as '-', anything else as '?'."""
+    name = unicodedata.name(char, "")
+    if name.startswith(("GREEK SMALL LETTER ", "GREEK CAPITAL LETTER ")):
+        letter = name.rsplit(" ", 1)[1].lower()
+        return letter.capitalize() if "CAPITAL" in name else letter
+    return "-" if "DASH" in name or name == "MINUS SIGN" else "?"
 
 
 class _Link:

@@ -18,6 +18,7 @@ import pytest
 
 import dcfkit
 from dcfkit.cli import main
+from dcfkit.config import load_config
 from dcfkit.datasets import read_frame
 from dcfkit.datasets.synthetic import make_sequence
 
@@ -210,7 +211,10 @@ def test_memory_images_become_bgr_or_gray_and_16_bits_are_refused(trax):
 def test_handshake_text_is_ascii(trax):
     from dcfkit.integrations.trax import ascii_text
 
-    assert ascii_text("STRCF — θ=15, café") == "STRCF ? ?=15, cafe"
+    assert ascii_text("STRCF — θ=15, café") == "STRCF - theta=15, cafe"
+    assert ascii_text("DR²Track μ, Δ, 中") == "DR2Track mu, Delta, ?"
+    assert all(ascii_text(load_config(name)["description"]).isascii() and "?" not in ascii_text(
+        load_config(name)["description"]) for name in ("kcf", "dsst", "strcf", "bacf", "arcf", "autotrack", "dr2track"))
 
 
 def test_a_clobbered_opencv_is_warned_of_at_start_up(trax, clobbered_opencv, monkeypatch, capsys):
