@@ -104,7 +104,7 @@ def test_handshake_then_frames_give_the_boxes_of_the_tracker_run_directly(trax, 
     config = dcfkit.load_config("strcf")
     with served(trax, "strcf") as (client, process, log, stderr):
         assert (client.tracker_name, client.tracker_family) == ("strcf", "dcfkit")
-        assert client.tracker_description == config["description"].replace("—", "?").replace("θ", "?")
+        assert client.tracker_description == config["description"].replace("—", "-").replace("θ", "theta")
         assert client.region_formats == ["rectangle", "polygon", "mask"] and client.image_formats == ["path", "memory"]
         assert client.channels == ["color"] and client.get("dcfkit.version") == dcfkit.__version__
         assert client.get("multiobject") is False
