@@ -15,24 +15,25 @@ without it). Importing this module imports got10k (``pip install "dcfkit[got10k]
 from __future__ import annotations
 
 import os
-from typing import Any, Mapping
+from typing import Any, Iterable, Mapping
 
 import numpy as np
 from PIL import Image
 
 from dcfkit.config import load_config
-from dcfkit.datasets import read_frame
+from dcfkit.datasets import Sequence, read_frame
 from dcfkit.errors import DcfkitError, InputError, TrackingError
 from dcfkit.running.evaluation import tracker_name
 from dcfkit.tracker.tracker import Tracker as DcfTracker
 
 try:
+    from got10k.experiments import ExperimentUAV123
     from got10k.trackers import Tracker as Got10kTracker
 except ImportError as exc:  # the toolkit is an optional extra
     raise ModuleNotFoundError(f"dcfkit.integrations.got10k needs the got10k toolkit ({exc}), an optional extra: "
                               f'pip install "dcfkit[got10k]"', name="got10k") from exc
 
-__all__ = ["Tracker", "to_bgr"]
+__all__ = ["Experiment", "SequenceList", "Tracker", "to_bgr"]
 
 ONE_BASED = np.array([1.0, 1.0, 0.0, 0.0])  # added to (x, y, w, h): 0-based -> 1-based
 ONE_BASED.setflags(write=False)  # every adapter's offset
@@ -99,3 +100,37 @@ class Tracker(Got10kTracker):
         if raw.dtype.kind not in "iuf" or raw.size != 4:
             return box  # not 4 numbers: dcfkit's init says what it got
         return raw.astype(np.float64).reshape(4) - self.offset
+
+
+class SequenceList:
+    """dcfkit's sequences as a got10k dataset: ``seq_names``, and ``dataset[i]`` or
+    ``dataset[name]`` -> (frame paths, ``(N, 4)`` boxes, 1-based as got10k's datasets read them)."""
+
+    def __init__(self, sequences: Iterable[Sequence]):
+        self.sequences = list(sequences)
+        self.seq_names = [s.name for s in self.sequences]
+
+    def __len__(self) -> int:
+        return len(self.sequences)
+
+    def __getitem__(self, index: int | str) -> tuple[list[str], np.ndarray]:
+        seq = self.sequences[self.seq_names.index(index) if isinstance(index, str) else index]
+        return [str(f) for f in seq.frames], seq.ground_truth + ONE_BASED
+
+
+class Experiment(ExperimentUAV123):
+    """got10k's OTB-family experiment (``run``, ``report``, ``show``) on any sequences dcfkit
+    loads, UAV123@10fps included, which got10k's own datasets cannot read. Scored as got10k's
+    UAV123 experiment scores (rows of NaN ground truth left out)::
+
+        experiment = Experiment(load_dataset("uav123_10fps", root), "UAV123_10fps")
+        experiment.run(Tracker("strcf"))            # results/got10k/UAV123_10fps/strcf/<seq>.txt
+        experiment.report(["strcf"])
+    """
+
+    def __init__(self, sequences: Iterable[Sequence], name: str, result_dir: str = "results/got10k",
+                 report_dir: str = "results/got10k"):
+        self.dataset = SequenceList(sequences)
+        self.result_dir = os.path.join(result_dir, name)
+        self.report_dir = os.path.join(report_dir, name)
+        self.nbins_iou, self.nbins_ce = 21, 51  # got10k's OTB-family thresholds

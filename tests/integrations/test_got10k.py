@@ -184,3 +184,24 @@ def test_experiment_dtb70_writes_what_dcfkit_eval_writes(adapter, shared_data, t
                       protocol="pysot").overall[0]
     assert overall["success_score"] == pytest.approx(scores["auc"], abs=1e-12)
     assert overall["precision_score"] == pytest.approx(scores["precision"], abs=1e-12)
+
+
+def test_experiment_on_uav123_10fps_writes_what_dcfkit_eval_writes(adapter, shared_data, tmp_path):
+    """UAV123@10fps, which got10k's ExperimentUAV123 cannot load, through the adapter's
+    Experiment: got10k's run and report on a dcfkit dataset, the result files dcfkit eval's."""
+    root = shared_data / "UAV123_10fps"
+    sequences = load_dataset("uav123_10fps", root, ["wakeboard7"])
+    experiment = adapter.Experiment(sequences, "UAV123_10fps", result_dir=str(tmp_path / "results"),
+                                    report_dir=str(tmp_path / "reports"))
+    assert experiment.dataset.seq_names == ["wakeboard7"] and len(experiment.dataset) == 1
+    files, anno = experiment.dataset["wakeboard7"]
+    assert files[0] == str(sequences[0].frames[0]) and np.array_equal(anno, sequences[0].ground_truth + [1, 1, 0, 0])
+    experiment.run(adapter.Tracker("kcf"))
+    overall = experiment.report(["kcf"])["kcf"]["overall"]
+    run_one_pass(load_config("kcf"), sequences, tmp_path / "dcfkit", progress=False)
+    written = np.loadtxt(tmp_path / "results" / "UAV123_10fps" / "kcf" / "wakeboard7.txt", delimiter=",")
+    ours = np.loadtxt(tmp_path / "dcfkit" / "kcf" / "wakeboard7.txt", delimiter=",")
+    np.testing.assert_allclose(written, ours, rtol=0, atol=1e-3)
+    scores = evaluate({"kcf": load_results(tmp_path / "dcfkit", "kcf", sequences)}, sequences,
+                      protocol="pysot").overall[0]
+    assert overall["success_score"] == pytest.approx(scores["auc"], abs=1e-12)
