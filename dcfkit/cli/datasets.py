@@ -6,8 +6,11 @@ import argparse
 import json
 import sys
 import warnings
+from pathlib import Path
 
-from dcfkit.datasets import layouts
+from dcfkit.cli.common import add_dataset_arguments
+from dcfkit.datasets import layouts, load_dataset
+from dcfkit.integrations.vot import export_sequences
 from dcfkit.protocols import DEFAULT
 from dcfkit.registry import PluginWarning, get_registry
 
@@ -43,3 +46,19 @@ def run(args: argparse.Namespace) -> int:
     for failure in registry.failures:
         print(f"warning: {failure}", file=sys.stderr)
     return 1 if registry.failures else 0
+
+
+def add_export_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("format", choices=("vot",), help="vot: a VOT toolkit workspace's sequences")
+    add_dataset_arguments(parser)
+    parser.add_argument("--out", required=True, type=Path, help="the workspace folder (its sequences/ is written)")
+    parser.add_argument("--copy", action="store_true", help="copy the frames (default: link them)")
+
+
+def run_export(args: argparse.Namespace) -> int:
+    """Write the sequences of a dataset in another toolkit's layout."""
+    sequences = load_dataset(args.dataset, args.root, args.sequences)
+    names = export_sequences(sequences, args.out, copy=args.copy)
+    print(f"{len(names)} sequences written to {args.out / 'sequences'} (list.txt, <sequence>/sequence, "
+          f"groundtruth.txt, color/)")
+    return 0

@@ -11,8 +11,8 @@ DESCRIPTION = """dcfkit: discriminative correlation filter trackers assembled fr
 
 Commands: track (one video), demo (a generated sequence, no data needed), components,
 datasets (the benchmark layouts --dataset accepts), eval (one-pass evaluation on a
-benchmark), report, compare (two result folders side by side), ablate, trax (serve the
-VOT toolkit's TraX protocol)."""
+benchmark), report, compare (two result folders side by side), ablate, export (a dataset
+as a VOT workspace's sequences), trax (serve the VOT toolkit's TraX protocol)."""
 
 #: name -> (help, add_arguments, run)
 COMMANDS = {
@@ -28,6 +28,8 @@ COMMANDS = {
     "compare": ("two folders of result files side by side per sequence: scores, their differences, box "
                 "agreement (parity checks)", evaluate.add_compare_arguments, evaluate.run_compare),
     "ablate": ("run an ablation spec: variants x parameter grids x sequences", ablate.add_arguments, ablate.run),
+    "export": ("write a dataset's sequences in another toolkit's layout (vot: a VOT workspace's sequences/)",
+               datasets.add_export_arguments, datasets.run_export),
     "trax": ("serve a config over the TraX protocol on stdin/stdout, for the VOT toolkit (needs dcfkit[trax])",
              trax.add_arguments, trax.run),
 }

@@ -139,10 +139,12 @@ def numbered_frames(folder: Path, pattern: str, first: int, last: int, what: str
 
 def annotated_frames(folder: Path, pattern: str, boxes: np.ndarray, anno: Path, what: str,
                      first: int = 1) -> tuple[Path, ...]:
-    """Frames ``first``.. of a folder holding exactly the N annotated ``.jpg`` frames; the error
-    names either the missing frames or, when the images simply run out, the annotation's length."""
-    n_jpgs = count_jpgs(folder, what)
-    counted = f"{n_jpgs} .jpg files in {folder}"
+    """Frames ``first``.. of a folder holding exactly the N annotated frames (the files of the
+    ``pattern``'s type, ``.jpg`` for every benchmark but an exported one); the error names either
+    the missing frames or, when the images simply run out, the annotation's length."""
+    suffix = os.path.splitext(pattern)[1].lower() or ".jpg"
+    n_jpgs = count_jpgs(folder, what, suffix)
+    counted = f"{n_jpgs} {suffix} files in {folder}"
     last = first + len(boxes) - 1
     if n_jpgs < len(boxes) and all((folder / (pattern % k)).is_file() for k in range(first, first + n_jpgs)):
         raise DatasetError(f"{anno}: {len(boxes)} annotation lines but {counted}: either the annotation has "
@@ -152,11 +154,12 @@ def annotated_frames(folder: Path, pattern: str, boxes: np.ndarray, anno: Path, 
     return frames
 
 
-def count_jpgs(folder: Path, what: str) -> int:
-    """How many ``.jpg`` files ``folder`` holds; :class:`DatasetError` if it is not a folder."""
+def count_jpgs(folder: Path, what: str, suffix: str = ".jpg") -> int:
+    """How many ``.jpg`` (or ``suffix``) files ``folder`` holds; :class:`DatasetError` if it is not
+    a folder."""
     if not folder.is_dir():
         raise DatasetError(f"{what}: image folder not found: {folder}")
-    return sum(1 for f in os.listdir(folder) if f.lower().endswith(".jpg"))
+    return sum(1 for f in os.listdir(folder) if f.lower().endswith(suffix))
 
 
 def held_out_sequence(name: str, folder: Path, pattern: str, first: int, anno: Path, dataset: str, what: str,
