@@ -66,6 +66,7 @@ class AblationSpec:
     sequences: tuple | None   # None: every sequence present under root
     variants: tuple           # of Variant: named variants first, then the grid's, in spec order
     grid: Grid | None
+    max_frames: int | None = None  # a smoke run: each sequence's first frames only
 
     def load_sequences(self) -> list:
         """The :class:`dcfkit.datasets.Sequence` objects to run: the spec's subset, else all under root."""
@@ -76,7 +77,8 @@ class AblationSpec:
             hint = "" if self.root_origin == "--root" else f"; pass --root DIR (the {self.dataset} benchmark folder)"
             raise ConfigError(f"{self.path}: dataset root {clip(str(self.root))} ({self.root_origin}) "
                               f"is not a folder{hint}")
-        return load_dataset(self.dataset, self.root, list(self.sequences) if self.sequences is not None else None)
+        found = load_dataset(self.dataset, self.root, list(self.sequences) if self.sequences is not None else None)
+        return [s.head(self.max_frames) for s in found]
 
 
 @dataclasses.dataclass(frozen=True)

@@ -2,13 +2,14 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import re
 from pathlib import Path
 
 from dcfkit.ablation import expand, job_dir, load_spec, run_ablation, summary_columns, variant_names
 from dcfkit.ablation.spec import MAX_VARIANTS
 from dcfkit.analysis.tables import format_table, statistics_lines
-from dcfkit.cli.common import add_protocol_argument, variant_count
+from dcfkit.cli.common import add_max_frames_argument, add_protocol_argument, variant_count
 from dcfkit.config import shipped_config_dir
 from dcfkit.errors import DcfkitError
 from dcfkit.running.results import ResultStore
@@ -39,6 +40,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dry-run", action="store_true",
                         help="list the jobs and whether each is done; run nothing")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_max_frames_argument(parser)
 
 
 def _dry_run(spec, out: Path) -> int:
@@ -58,6 +60,7 @@ def run(args: argparse.Namespace) -> int:
     if args.scheduler and executor != "dask":
         raise DcfkitError("--scheduler needs --executor dask")
     spec = load_spec(args.spec, root=args.root, sequences=args.sequences, max_variants=args.max_variants)
+    spec = dataclasses.replace(spec, max_frames=args.max_frames)
     if args.dry_run:
         return _dry_run(spec, args.out.expanduser().resolve())
     res = run_ablation(spec, args.out, jobs=args.jobs, executor=executor, scheduler=args.scheduler,

@@ -59,3 +59,20 @@ def add_dataset_arguments(parser: argparse.ArgumentParser, root_help: str = "ben
                         help="dataset name, as `dcfkit datasets` lists them (default: detect from --root)")
     parser.add_argument("--root", required=True, type=Path, help=root_help)
     parser.add_argument("--sequences", default=None, help="comma-separated sequence names (default: all)")
+
+
+def frame_limit(text: str) -> int:
+    """``--max-frames``: a whole number of frames, at least 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number of frames, got {shown(text)}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected at least 1 frame, got {value}")
+    return value
+
+
+def add_max_frames_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--max-frames", type=frame_limit, default=None, metavar="N",
+                        help="each sequence's first N frames only: a smoke run (its results are of the cut "
+                             "sequences, never taken for full ones: score them with the same --max-frames)")

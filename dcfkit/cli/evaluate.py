@@ -14,7 +14,7 @@ from dcfkit.analysis.report import columns, json_ready, named_folder, score_and_
 from dcfkit.analysis.report_html import write_html_report
 from dcfkit.analysis.scoring import MISSING, evaluate
 from dcfkit.analysis.tables import comparison_lines, format_table, score_line, statistics_lines
-from dcfkit.cli.common import add_dataset_arguments, add_protocol_argument, pixels
+from dcfkit.cli.common import add_dataset_arguments, add_max_frames_argument, add_protocol_argument, pixels
 from dcfkit.config import load_config
 from dcfkit.config.overrides import parse_overrides
 from dcfkit.datasets import load_dataset
@@ -34,6 +34,7 @@ def add_eval_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                         help="override a config value (repeatable), e.g. --set solver.iterations=3")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_max_frames_argument(parser)
     add_protocol_argument(parser)
 
 
@@ -65,7 +66,7 @@ def distinct_names(specs: list[str], resolved: list[tuple[dict, Callable | None]
 
 def run_eval(args: argparse.Namespace) -> int:
     """Run each config on the dataset and print its scores; exit status 1 if a sequence failed."""
-    sequences = load_dataset(args.dataset, args.root, args.sequences)
+    sequences = [s.head(args.max_frames) for s in load_dataset(args.dataset, args.root, args.sequences)]
     overrides = parse_overrides(args.overrides)
     resolved = distinct_names(args.configs, [_resolve_config(spec, overrides) for spec in args.configs])
     for config, _ in resolved:  # every config's folder and results checked before the first runs
@@ -112,6 +113,7 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--frame-weighted", action="store_true",
                         help="pool the frames of all sequences (default: as the protocol; otb and pysot "
                              "weigh sequences equally, got10k pools frames)")
+    add_max_frames_argument(parser)
     parser.add_argument("--missing", choices=MISSING, default="skip",
                         help="a sequence some tracker has no result for: skip (default) scores the sequences "
                              "every tracker completed and names the others; fail scores a missing result as a "
@@ -120,7 +122,7 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run_report(args: argparse.Namespace) -> int:
     """Print the overall table and write the report files."""
-    sequences = load_dataset(args.dataset, args.root, args.sequences)
+    sequences = [s.head(args.max_frames) for s in load_dataset(args.dataset, args.root, args.sequences)]
     trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
     write = write_html_report if args.html else score_and_write
     evaluation, paths = write(args.out, sequences, trackers, args.report_dir, include_first=not args.skip_first,

@@ -97,6 +97,14 @@ class Sequence:
     def __len__(self) -> int:
         return len(self.frames)
 
+    def head(self, n: int | None) -> Sequence:
+        """The first ``n`` frames (all of them when ``n`` is None or not shorter): smoke runs."""
+        if n is None or n >= len(self):
+            return self
+        if n < 1:
+            raise DatasetError(f"a sequence needs at least 1 frame, got a limit of {n}")
+        return dataclasses.replace(self, frames=self.frames[:n], ground_truth=self.ground_truth[:n])
+
     def __repr__(self) -> str:
         flags = ",".join(k for k, v in self.attributes.items() if v)
         withheld = ", ground truth withheld" if self.ground_truth_withheld else ""
