@@ -120,7 +120,7 @@ def machine() -> dict:
 def git_state(folder: str) -> dict | None:
     """``{"commit", "dirty"}`` of the git work tree whose top is ``folder`` (dirty: tracked files
     changed since the commit), or None if it is none or git cannot say."""
-    if not os.path.isdir(os.path.join(folder, ".git")):
+    if not os.path.exists(os.path.join(folder, ".git")):  # a folder, or a file in a worktree or submodule
         return None
     try:
         run = [subprocess.run(["git", "-C", folder, *args], capture_output=True, text=True, timeout=10)

@@ -41,6 +41,9 @@ def test_the_git_state_of_a_work_tree(tmp_path):
     assert git_state(str(repo))["dirty"] is True
     assert package_source("no-such-distribution", str(repo / "pkg")) == git_state(str(repo))
     assert git_state(str(tmp_path)) is None and package_source("no-such-distribution") is None
+    git(repo, "worktree", "add", "-q", str(tmp_path / "other"), "HEAD")  # its .git is a file
+    git_state.cache_clear()
+    assert git_state(str(tmp_path / "other")) == {"commit": git(repo, "rev-parse", "HEAD"), "dirty": False}
 
 
 def test_dcfkit_records_the_commit_it_runs_from_or_none(tmp_path):
