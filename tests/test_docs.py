@@ -2,6 +2,7 @@
 import dataclasses
 import difflib
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -149,3 +150,16 @@ def test_ablate_help_names_every_shipped_spec():
     helps = build_parser()._subparsers._group_actions[0].choices["ablate"].format_help()
     assert specs == {"departures", "family", "sensitivity", "table3"}
     assert all(name in " ".join(helps.split()) for name in specs), helps
+
+
+def test_the_helpers_plugins_md_lists_are_where_it_says():
+    import importlib  # deferred: only this test imports by name
+
+    text = (DOCS / "plugins.md").read_text(encoding="utf-8")
+    table = text.split("### Grids, helpers and bounds")[1].split("\n\n")[2]
+    rows = [line.split("|")[1:3] for line in table.splitlines()[2:]]
+    assert len(rows) >= 8
+    for names, module in rows:
+        loaded = importlib.import_module(module.strip().strip("`"))
+        for name in re.findall(r"`(\w+)", names):  # `gaussian_label(shape, sigma)`: the name before '('
+            assert hasattr(loaded, name), f"{module.strip()} has no {name}"
