@@ -64,6 +64,12 @@ class Protocol:
         return self.overlap_keys + ("auc", "precision", "norm_precision")
 
     @property
+    def thresholds(self) -> dict[str, np.ndarray]:
+        """Each curve's thresholds, by the curve's name."""
+        return {"precision": self.precision_thresholds, "success": self.success_thresholds,
+                "norm_precision": self.norm_precision_thresholds}
+
+    @property
     def rank_key(self) -> str:
         """The score trackers are ranked by (AO for GOT-10k, AUC otherwise)."""
         return "ao" if self.overlap_scores else "auc"

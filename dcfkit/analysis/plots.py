@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Mapping
 from typing import Sequence as Seq
 
-from dcfkit.analysis.scoring import _sort_key, _thresholds
+from dcfkit.analysis.scoring import best_first
 from dcfkit.protocols import DEFAULT, Protocol, get_protocol
 from dcfkit.running.files import atomic_write
 
@@ -38,11 +38,11 @@ def plot_curves(curves: Mapping[str, Mapping], kind: str, path_stem, title: str 
 
     proto = get_protocol(protocol)
     style = PLOT_STYLE[kind]
-    x = _thresholds(proto)[kind]
+    x = proto.thresholds[kind]
     fig = Figure(figsize=(5.2, 4.2))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(1, 1, 1)
-    order = sorted(curves, key=lambda t: _sort_key(curves[t][style["score"]]))
+    order = sorted(curves, key=lambda t: best_first(curves[t][style["score"]]))
     colours = [f"C{i}" for i in range(10)]
     styles = ["-", "--", "-.", ":"]
     for i, tracker in enumerate(order):

@@ -113,7 +113,7 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
     return Evaluation(
         protocol=proto, overall=overall, per_sequence=per_sequence, per_attribute=per_attribute,
         curves=curves, attribute_curves=attribute_curves,
-        attributes={a: len(n) for a, n in attributes.items()}, thresholds=_thresholds(proto),
+        attributes={a: len(n) for a, n in attributes.items()}, thresholds=proto.thresholds,
         settings={"protocol": proto.name, "include_first": include_first, "weighting": weighting,
                   "missing": "skip" if left_out is not None else "fail", "left_out": left_out or {}},
         platforms={t: _platforms(res.values()) for t, res in results.items()},
@@ -170,7 +170,7 @@ def _score_tracker(tracker: str, res: Mapping, sequences: list[Sequence], includ
 
 
 def _rank(rows: list[dict], proto: Protocol) -> list[dict]:
-    return sorted(rows, key=lambda r: _sort_key(r[proto.rank_key]))
+    return sorted(rows, key=lambda r: best_first(r[proto.rank_key]))
 
 
 def _attribute_members(sequences: list[Sequence]) -> dict[str, list[str]]:
@@ -200,16 +200,12 @@ def _per_attribute(attributes: dict, per_seq: dict, ranked: list[str], weighting
     return per_attribute, attribute_curves
 
 
-def _thresholds(proto: Protocol) -> dict[str, np.ndarray]:
-    return {"precision": proto.precision_thresholds, "success": proto.success_thresholds,
-            "norm_precision": proto.norm_precision_thresholds}
-
-
 def _curves(avg: dict) -> dict:
     return {"precision": avg["precision_curve"], "success": avg["success_curve"],
             "norm_precision": avg["norm_precision_curve"], "precision_score": avg["precision"],
             "auc": avg["auc"], "norm_precision_score": avg["norm_precision"]}
 
 
-def _sort_key(score) -> float:
+def best_first(score) -> float:
+    """Sort key of a score: highest first, a missing or NaN score last."""
     return -score if score is not None and math.isfinite(score) else math.inf

@@ -33,7 +33,7 @@ LARGE = "more than {} values, each alias counted as the values it stands for (dc
 LONG = "more than {} characters, each alias counted as the text it stands for (dcfkit.config.MAX_TEXT)"
 
 
-class _OverLimit(Exception):
+class OverLimit(Exception):
     """A value over one of the bounds above: ``problem`` says which, ``path`` lists the keys
     down to the part refused, ``at`` is that part (a YAML node while loading)."""
 
@@ -48,7 +48,7 @@ class _OverLimit(Exception):
 
 
 def _measure(root: Any, items) -> None:
-    """Raise :class:`_OverLimit` if ``root`` nests deeper than MAX_DEPTH, holds more than
+    """Raise :class:`OverLimit` if ``root`` nests deeper than MAX_DEPTH, holds more than
     MAX_VALUES values or MAX_TEXT characters with a shared part counted at each use, or
     contains itself.
 
@@ -67,15 +67,15 @@ def _measure(root: Any, items) -> None:
             known[id(item)] = None
             known[id(item)] = add_up(item, children)
         if known[id(item)] is None:
-            raise _OverLimit("contains itself (an alias inside its own anchor)", path, item)
+            raise OverLimit("contains itself (an alias inside its own anchor)", path, item)
         values, characters, height = known[id(item)]
         if len(path) + height > MAX_DEPTH:
-            raise _OverLimit(DEEP.format(MAX_DEPTH), path, item)
+            raise OverLimit(DEEP.format(MAX_DEPTH), path, item)
         return values, characters, height
 
     def add_up(item: Any, children: list) -> tuple[int, int, int]:
         if len(path) >= MAX_DEPTH:
-            raise _OverLimit(DEEP.format(MAX_DEPTH), path, item)
+            raise OverLimit(DEEP.format(MAX_DEPTH), path, item)
         values, characters, height = 1, 0, 0
         for key, child in children:
             path.append(key)
@@ -83,9 +83,9 @@ def _measure(root: Any, items) -> None:
             path.pop()
             values, characters, height = values + more, characters + longer, max(height, below + 1)
             if values > MAX_VALUES:
-                raise _OverLimit(LARGE.format(MAX_VALUES), path, item)
+                raise OverLimit(LARGE.format(MAX_VALUES), path, item)
             if characters > MAX_TEXT:
-                raise _OverLimit(LONG.format(MAX_TEXT), path, item)
+                raise OverLimit(LONG.format(MAX_TEXT), path, item)
         return values, characters, height
 
     visit(root)
@@ -116,7 +116,7 @@ def check_value(value: Any, where: str) -> None:
     nested too deeply, too large or contains itself: checked before anything walks it."""
     try:
         _measure(value, _python_items)
-    except _OverLimit as exc:
+    except OverLimit as exc:
         raise ConfigError(f"{where}: {exc.describe()}") from None
 
 
@@ -134,9 +134,9 @@ class _BoundedLoader(yaml.SafeLoader):
         self._depth, self._nodes = self._depth + 1, self._nodes + 1
         try:
             if self._depth > MAX_DEPTH + 1:  # + 1: the scalars in the deepest list
-                raise _OverLimit(DEEP.format(MAX_DEPTH), [], self.peek_event())
+                raise OverLimit(DEEP.format(MAX_DEPTH), [], self.peek_event())
             if self._nodes > MAX_VALUES:
-                raise _OverLimit(LARGE.format(MAX_VALUES), [], self.peek_event())
+                raise OverLimit(LARGE.format(MAX_VALUES), [], self.peek_event())
             return super().compose_node(parent, index)
         finally:
             self._depth -= 1
@@ -179,10 +179,10 @@ def unshared(value: Any) -> Any:
     return value
 
 
-def _load_yaml(text: str) -> Any:
-    """``text`` read by :class:`_BoundedLoader`: raises yaml.YAMLError (not YAML) or :class:`_OverLimit`."""
+def load_yaml(text: str) -> Any:
+    """``text`` read by :class:`_BoundedLoader`: raises yaml.YAMLError (not YAML) or :class:`OverLimit`."""
     if len(text) > MAX_YAML_BYTES:
-        raise _OverLimit(f"longer than {MAX_YAML_BYTES} characters (dcfkit.config.MAX_YAML_BYTES)", [])
+        raise OverLimit(f"longer than {MAX_YAML_BYTES} characters (dcfkit.config.MAX_YAML_BYTES)", [])
     return yaml.load(text, Loader=_BoundedLoader)
 
 
@@ -203,10 +203,10 @@ def read_yaml(path: Path) -> dict:
         raise ConfigError(f"{path}: larger than {MAX_YAML_BYTES} bytes (dcfkit.config.MAX_YAML_BYTES); "
                           f"is it a config?")
     try:
-        data = _load_yaml(raw.decode("utf-8"))
+        data = load_yaml(raw.decode("utf-8"))
     except UnicodeDecodeError as exc:
         raise ConfigError(f"{path}: not a UTF-8 text file (byte {exc.start} is not UTF-8)") from None
-    except _OverLimit as exc:
+    except OverLimit as exc:
         mark = getattr(exc.at, "start_mark", None)
         raise ConfigError(f"{_at(str(path), mark)}: {exc.describe()}") from None
     except yaml.YAMLError as exc:

@@ -6,7 +6,7 @@ from typing import Any, Mapping
 
 import yaml
 
-from dcfkit.config.bounded_yaml import _load_yaml, _OverLimit
+from dcfkit.config.bounded_yaml import OverLimit, load_yaml
 from dcfkit.errors import ConfigError, clip, shown
 
 
@@ -29,8 +29,8 @@ def parse_value(text: str, where: str = "--set value") -> Any:
     """A CLI override value: YAML scalars/lists ('0.3', 'true', '[1, 2]', 'null'); text that is
     not YAML stays text. A value over the bounds of a config is a ConfigError naming ``where``."""
     try:
-        return _load_yaml(text)
-    except _OverLimit as exc:
+        return load_yaml(text)
+    except OverLimit as exc:
         raise ConfigError(f"{where}: {exc.describe()}") from None
     except yaml.YAMLError:
         return text

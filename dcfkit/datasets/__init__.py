@@ -22,13 +22,13 @@ layouts.
 from dcfkit.datasets.annotations import read_boxes
 from dcfkit.datasets.base import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
 from dcfkit.datasets.catalog import (
-                                     DATASETS,
-                                     benchmark_protocol,
-                                     canonical_name,
-                                     detect_dataset,
-                                     get_layout,
-                                     layouts,
-                                     load_dataset,
+    DATASETS,
+    benchmark_protocol,
+    canonical_name,
+    detect_dataset,
+    get_layout,
+    layouts,
+    load_dataset,
 )
 from dcfkit.datasets.images import DatasetWarning, read_frame
 from dcfkit.datasets.layout import Evidence, Layout, register_layout, registered_layout, unregister_layout

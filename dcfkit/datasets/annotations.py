@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from dcfkit.datasets.images import _regular_file_bytes
+from dcfkit.datasets.images import regular_file_bytes
 from dcfkit.errors import DatasetError, shown
 
 _SEPARATORS = re.compile(r"[,\s]+")
@@ -33,7 +33,7 @@ def read_text(path: Path) -> str:
     /dev/zero never end) of at most :data:`MAX_TEXT_BYTES`; :class:`DatasetError` naming it
     otherwise."""
     try:
-        data = _regular_file_bytes(path, str(path), MAX_TEXT_BYTES,
+        data = regular_file_bytes(path, str(path), MAX_TEXT_BYTES,
                                    f": an annotation file of more than {MAX_TEXT_BYTES:.3g} bytes is not one")
         return data.decode("utf-8-sig")
     except FileNotFoundError:

@@ -9,25 +9,31 @@ from pathlib import Path
 from typing import Iterable, Iterator, Mapping
 
 from dcfkit.datasets.base import DatasetError, Sequence, require_root
-from dcfkit.datasets.layout import _EVIDENCE_TEXT, _LAYOUTS, _NAMES, Evidence, Layout, Loader, _key
+from dcfkit.datasets.layout import Evidence, Layout, Loader, layout_in_code, layout_key, layouts_in_code
 from dcfkit.errors import RegistryError, describe_error, shown
 from dcfkit.protocols import DEFAULT
 from dcfkit.registry import PluginWarning, get_registry
+
+# How the candidates fit, in the error when several fit equally well (not read from docstrings,
+# which python -OO strips).
+_EVIDENCE_TEXT = {
+    Evidence.FOLDERS: "by the folder structure only",
+    Evidence.FILES: "by file names or counts",
+    Evidence.NAME: "by folder names",
+}
 
 
 def layouts() -> tuple[Layout, ...]:
     """Every registered layout: dcfkit's and those registered in code, in registration order,
     then the plugins' (one whose name was since registered in code is shadowed by it)."""
-    return tuple(_LAYOUTS.values()) + tuple(p for p in get_registry().datasets() if p.name not in _NAMES)
+    return layouts_in_code() + tuple(p for p in get_registry().datasets() if layout_in_code(p.name) is None)
 
 
 def _find(name: str) -> Layout | None:
     """The layout called ``name`` (or an alias): one registered here first, then a plugin's;
     None if there is none; a RegistryError if two plugins register the name."""
-    key = _key(name)
-    if key in _NAMES:
-        return _LAYOUTS[_NAMES[key]]
-    return get_registry().dataset(key)
+    found = layout_in_code(name)
+    return found if found is not None else get_registry().dataset(layout_key(name))
 
 
 class _Loaders(Mapping):

@@ -18,7 +18,7 @@ from dcfkit.limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 _FEW_LEVELS_WARNED: set[str] = set()
 
 
-def _regular_file_bytes(path, name: str, limit: int, over: str) -> bytes:
+def regular_file_bytes(path, name: str, limit: int, over: str) -> bytes:
     """The bytes of ``path``: a regular file (a FIFO would block, /dev/zero never end) of at
     most ``limit`` bytes, else a :class:`DatasetError` ``cannot read <name> (...)`` (``over``
     ends the one of a file too large); an OSError of the file system passes."""
@@ -35,7 +35,7 @@ def _read_image_bytes(path, what: str) -> bytes:
     """The bytes of an image file: a regular file no larger than an uncompressed image of the
     pixel limit could be."""
     try:
-        return _regular_file_bytes(path, f"{what}: {path}", 6 * max_image_pixels() + 2**20,  # 16-bit BGR, headers
+        return regular_file_bytes(path, f"{what}: {path}", 6 * max_image_pixels() + 2**20,  # 16-bit BGR, headers
                                    f", more than an image of the limit of {max_image_pixels():.3g} pixels can take: "
                                    f"${IMAGE_PIXELS_VARIABLE}")
     except OSError as exc:

@@ -32,15 +32,6 @@ class Evidence(enum.IntEnum):
     NAME = 3  # a folder is named after this benchmark
 
 
-# How the candidates fit, in the error when several fit equally well (not read from docstrings,
-# which python -OO strips).
-_EVIDENCE_TEXT = {
-    Evidence.FOLDERS: "by the folder structure only",
-    Evidence.FILES: "by file names or counts",
-    Evidence.NAME: "by folder names",
-}
-
-
 @dataclasses.dataclass(frozen=True)
 class Layout:
     """One registered benchmark layout (see :func:`register_layout`)."""
@@ -63,9 +54,20 @@ _LAYOUTS: dict[str, Layout] = {}  # canonical name -> layout, in registration or
 _NAMES: dict[str, str] = {}  # every name and alias -> canonical name
 
 
-def _key(name: str) -> str:
+def layout_key(name: str) -> str:
     """The one spelling of a name: case-insensitive, and ``-`` read as ``_`` (``uav123-20l``)."""
     return str(name).strip().lower().replace("-", "_")
+
+
+def layouts_in_code() -> tuple[Layout, ...]:
+    """The layouts registered in code (dcfkit's own first), in registration order."""
+    return tuple(_LAYOUTS.values())
+
+
+def layout_in_code(name: str) -> Layout | None:
+    """The layout registered in code as ``name`` or one of its aliases, or None."""
+    key = layout_key(name)
+    return _LAYOUTS[_NAMES[key]] if key in _NAMES else None
 
 
 def register_layout(name: str, load: Loader, description: str, *,
@@ -92,8 +94,8 @@ def new_layout(name: str, load: Loader, description: str, *, detect: Detector | 
     """A checked :class:`Layout`, not yet registered (:func:`register_layout` registers it here, a
     plugin's ``registry.register_dataset`` in :mod:`dcfkit.registry`); a :class:`RegistryError`
     if it is malformed or a name is taken here."""
-    layout = Layout(_key(name), load, str(description).strip(), detect,
-                    tuple(dict.fromkeys(_key(a) for a in aliases if _key(a) != _key(name))), provider,
+    layout = Layout(layout_key(name), load, str(description).strip(), detect,
+                    tuple(dict.fromkeys(layout_key(a) for a in aliases if layout_key(a) != layout_key(name))), provider,
                     str(protocol or ""))
     _check_new_layout(layout)
     return layout
@@ -123,9 +125,9 @@ def _check_new_layout(layout: Layout) -> None:
 def unregister_layout(name: str) -> Layout:
     """Remove the layout called ``name`` (or one of its aliases) with all its names; a plugin's
     cannot be (uninstall the plugin, or set DCFKIT_DISABLE_PLUGINS)."""
-    if _key(name) not in _NAMES:
+    if layout_key(name) not in _NAMES:
         raise DatasetError(f"no dataset layout {shown(name)} registered in code; layouts: {', '.join(_LAYOUTS)}")
-    layout = _LAYOUTS.pop(_NAMES[_key(name)])
+    layout = _LAYOUTS.pop(_NAMES[layout_key(name)])
     for n in (layout.name,) + layout.aliases:
         del _NAMES[n]
     return layout

@@ -16,13 +16,13 @@ from __future__ import annotations
 
 from dcfkit.components.regularizers.adaptive import GlobalVariation, LocalVariation, response_variation
 from dcfkit.components.regularizers.base import (
-           MAX_POWER,
-           MAX_THETA,
-           MAX_WEIGHT,
-           PLACEMENTS,
-           SpatialRegularizer,
-           TemporalRegularizer,
-           target_mask,
+    MAX_POWER,
+    MAX_THETA,
+    MAX_WEIGHT,
+    PLACEMENTS,
+    SpatialRegularizer,
+    TemporalRegularizer,
+    target_mask,
 )
 from dcfkit.components.regularizers.windows import BoxWindow, Crop, SmoothWindow, Temporal
 

@@ -50,7 +50,8 @@ class ScaleEstimator(Component, declares="scale"):
         return float(np.clip(scale, *self.limits))
 
 
-def _factors(n: int, step: float) -> np.ndarray:
+def scale_factors(n: int, step: float) -> np.ndarray:
+    """``n`` relative scales ``step`` apart, centred on 1: step ** (k - (n - 1) / 2)."""
     return step ** (np.arange(n) - (n - 1) / 2)
 
 
@@ -60,7 +61,7 @@ MAX_SCALES = 101  # n_scales of either estimator: beyond it the samples stop fit
 MIN_LAM = 1e-10  # the DSST's λ, as the ADMM's penalty γ (solvers.PENALTY_RANGE)
 
 
-def _check_span(n: int, step: float) -> str | None:
+def check_span(n: int, step: float) -> str | None:
     """The span both estimators share: at most x10 each way (beyond it the samples stop fitting
     in memory)."""
     if (n - 1) / 2 * math.log(step) > math.log(10):

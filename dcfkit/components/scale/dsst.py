@@ -6,7 +6,7 @@ import dataclasses
 import numpy as np
 
 from dcfkit.components.features.fhog import ARITHMETICS, fhog
-from dcfkit.components.scale.base import MAX_SCALES, MIN_LAM, ScaleEstimator, _check_span, _factors
+from dcfkit.components.scale.base import MAX_SCALES, MIN_LAM, ScaleEstimator, check_span, scale_factors
 from dcfkit.numerics.patches import resize_auto, sample, sampler, whole_pixel_crop
 from dcfkit.params import param
 
@@ -49,13 +49,13 @@ class DSST(ScaleEstimator):
 
         def validate(self):
             """step ** ((n_scales - 1) / 2) <= 10: the scales span at most x10 each way."""
-            return _check_span(self.n_scales, self.step)
+            return check_span(self.n_scales, self.step)
 
     def init(self, image, centre, base_target, scale, limits):
         super().init(image, centre, base_target, scale, limits)
         p = self.params
         n = p.n_scales
-        self.factors = _factors(n, p.step)
+        self.factors = scale_factors(n, p.step)
         offsets = np.arange(n) - (n - 1) // 2
         sigma = n / np.sqrt(33) * p.sigma_factor
         with np.errstate(over="ignore"):  # a σ so small that σ² underflows: a delta label, not NaN

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from dcfkit.components.scale.base import MAX_SCALES, ScaleEstimator, _check_span, _factors
+from dcfkit.components.scale.base import MAX_SCALES, ScaleEstimator, check_span, scale_factors
 from dcfkit.params import param
 
 
@@ -27,7 +27,7 @@ class Pyramid(ScaleEstimator):
 
         def validate(self):
             """step ** ((n_scales - 1) / 2) <= 10: the scales span at most x10 each way."""
-            return _check_span(self.n_scales, self.step)
+            return check_span(self.n_scales, self.step)
 
     def search_factors(self):
-        return _factors(self.params.n_scales, self.params.step)
+        return scale_factors(self.params.n_scales, self.params.step)

@@ -20,14 +20,14 @@ from dcfkit.components.solvers.base import Solver
 from dcfkit.components.solvers.dsst import Ridge, RidgeParams
 from dcfkit.components.solvers.kcf import KernelParams, KernelRidge, kernel_correlation
 from dcfkit.components.solvers.strcf_bacf import (
-           ADMMBacf,
-           ADMMParams,
-           ADMMStrcf,
-           BACFParams,
-           admm,
-           penalties,
-           schedule_problem,
-           sherman_morrison_solve,
+    ADMMBacf,
+    ADMMParams,
+    ADMMStrcf,
+    BACFParams,
+    admm,
+    penalties,
+    schedule_problem,
+    sherman_morrison_solve,
 )
 
 BUILTIN = (ADMMStrcf, ADMMBacf, ADMMArcf, ADMMAutoTrack, KernelRidge, Ridge)
