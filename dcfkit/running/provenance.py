@@ -132,6 +132,7 @@ def git_state(folder: str) -> dict | None:
     return {"commit": run[0].stdout.strip(), "dirty": bool(run[1].stdout.strip())}
 
 
+@functools.lru_cache(maxsize=None)
 def package_source(distribution: str, package_dir: str | None = None) -> dict | None:
     """Where an installed package's code came from: the git state of the work tree it runs from
     (``package_dir``'s parent holds ``.git``: a checkout, an editable install), else the commit
@@ -153,11 +154,11 @@ def package_source(distribution: str, package_dir: str | None = None) -> dict | 
     return None
 
 
-def sources(config: Mapping) -> dict:
-    """:func:`package_source` of dcfkit and of each plugin whose components ``config`` uses,
-    by distribution name (results sidecars record it)."""
+def sources(plugins: list[str]) -> dict:
+    """:func:`package_source` of dcfkit and of each of ``plugins`` (``"name version"``, as
+    :func:`plugin_versions` lists them), by distribution name (results sidecars record it)."""
     found = {"dcfkit": package_source("dcfkit", str(Path(__file__).resolve().parents[1]))}
-    for plugin in plugin_versions(config):
+    for plugin in plugins:
         name = plugin.rsplit(" ", 1)[0]
         found[name] = package_source(name)
     return found

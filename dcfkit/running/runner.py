@@ -96,10 +96,10 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
     except Exception as exc:
         frame = exc.frame if isinstance(exc, TrackerFailure) else reading[0] or None
         return record_failure(task, version, _failure_message(seq, exc, tracker is None, frame), exc, frame)
+    plugins = plugin_versions(task.config)
     meta = {"sequence": seq.name, "dataset": seq.dataset, "tracker": task.config.get("name"),
             "init_box": [float(v) for v in seq.init_box], "fps": run.fps, "total_time": float(run.times.sum()),
-            "run_key": task.key, "dcfkit_version": version, "plugins": plugin_versions(task.config),
-            "source": sources(task.config),
+            "run_key": task.key, "dcfkit_version": version, "plugins": plugins, "source": sources(plugins),
             "time": now(), **(origin or invocation()), "machine": machine(), "platform": platforms.record(),
             "config": task.config,
             "times": run.times.tolist()}
