@@ -9,7 +9,7 @@ from scipy import stats
 
 from dcfkit import cli
 from dcfkit.analysis.scoring import evaluate
-from dcfkit.datasets import Sequence
+from dcfkit.datasets import DatasetError, Sequence
 
 GT = np.array([[20.0, 20.0, 10.0, 10.0]] * 10)
 
@@ -86,7 +86,7 @@ def test_a_missing_result_is_left_out_and_named_unless_asked_to_fail():
 
 def test_no_complete_sequence_is_an_error_that_says_what_to_do():
     disjoint = {"x": {"a": RESULTS["near"]["a"]}, "y": {"b": RESULTS["near"]["b"]}}
-    with pytest.raises(Exception, match=r"no sequence has a result from every tracker .*--missing fail"):
+    with pytest.raises(DatasetError, match=r"no sequence has a result from every tracker .*--missing fail"):
         evaluate(disjoint, SEQUENCES[:2], missing="skip")
     with pytest.raises(ValueError, match="missing must be one of skip, fail"):
         evaluate(RESULTS, SEQUENCES, missing="drop")

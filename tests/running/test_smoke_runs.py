@@ -3,12 +3,14 @@ are never taken for a full run's."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
+import numpy as np
 import pytest
 from test_ablation import write_otb
 
 from dcfkit import cli
-from dcfkit.datasets import DatasetError, load_dataset
+from dcfkit.datasets import DatasetError, Sequence, load_dataset
 
 
 @pytest.fixture
@@ -49,18 +51,10 @@ def test_a_frame_limit_is_a_positive_whole_number(data, tmp_path, capsys, bad):
 
 
 def test_head_keeps_a_sequence_whole_or_cuts_it():
-    (seq, _) = _two()
+    seq = Sequence("x", (Path("a.jpg"), Path("b.jpg"), Path("c.jpg")), np.ones((3, 4)), {}, "t")
     assert seq.head(None) is seq and seq.head(len(seq) + 5) is seq
     cut = seq.head(2)
     assert len(cut) == 2 and cut.frames == seq.frames[:2] and (cut.ground_truth == seq.ground_truth[:2]).all()
     with pytest.raises(DatasetError, match="at least 1 frame"):
         seq.head(0)
 
-
-def _two():
-    import numpy as np
-    from pathlib import Path
-
-    from dcfkit.datasets import Sequence
-
-    return [Sequence(n, (Path("a.jpg"), Path("b.jpg"), Path("c.jpg")), np.ones((3, 4)), {}, "t") for n in "xy"]
