@@ -6,9 +6,10 @@ import contextlib
 import json
 from pathlib import Path
 
-from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir, variant_names
+from dcfkit.ablation.spec import AblationSpec, Job, expand, runs_dir, variant_names
 from dcfkit.ablation.summary import output_names, summarize
 from dcfkit.errors import DcfkitError, shown
+from dcfkit.experiments import runs_by_sequence
 from dcfkit.running.files import atomic_write, ensure_writable, exclusive, read_json
 from dcfkit.running.provenance import LABEL_KEYS, dcfkit_version
 from dcfkit.running.results import ResultStore
@@ -28,7 +29,8 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     recorded (``.error``) and does not stop the others.
 
     Returns a plain dict: ``jobs`` (the :class:`Job` list), ``runs`` (distinct
-    (key, sequence) pairs), ``done`` / ``skipped`` / ``failed`` (run -> message) and
+    (key, run) pairs; a run is a sequence, or one of its runs in the spec's ``experiment``),
+    ``done`` / ``skipped`` / ``failed`` (run -> message) and
     ``summary`` (what :func:`summarize` returned).
     """
     jobs = jobs if jobs is not None else usable_cores()
@@ -40,11 +42,11 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     seqs = spec.load_sequences()
     version = dcfkit_version()
     job_list = expand(spec, seqs, version)
-    by_name = {s.name: s for s in seqs}
+    runs = runs_by_sequence(seqs, spec.experiment)
     tasks: dict[tuple[str, str], RunTask] = {}
     for job in job_list:
-        tasks.setdefault((job.key, job.sequence), RunTask(job.config, by_name[job.sequence],
-                                                          job_dir(out, spec.dataset, job.key), job.key))
+        for run in runs[job.sequence]:
+            tasks.setdefault((job.key, run.name), RunTask(job.config, run, runs_dir(out, spec, job.key), job.key))
     ensure_writable(out, output_names(spec), "the ablation")
     with exclusive(out / ".lock", "dcfkit ablate", f"to {out}"):
         _prepare(out, tasks.values(), job_list, version)
@@ -53,14 +55,15 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
         result = {"jobs": job_list, "runs": len(tasks), "done": [],
                   "skipped": [k for k, t in tasks.items() if t not in todo], "failed": {}}
         _run(spec, result, todo, len(tasks), variant_names(job_list), jobs, executor, scheduler, progress, version)
-        result["summary"] = summarize(spec, out, seqs, job_list, protocol)
+        result["summary"] = summarize(spec, out, seqs, job_list, protocol, runs)
     return result
 
 
 def _prepare(out: Path, tasks, job_list: list[Job], version: str) -> None:
     """Before anything runs: stale temporary files removed, every result folder checked
     writable, and ``OUT/configs/<key>.json`` written for each run key."""
-    for stale in (out / "jobs").glob("*/*/.*.tmp"):  # left by a killed run; never read
+    # left by a killed run (in a run key's folder or its experiment's sub-folder); never read
+    for stale in [*(out / "jobs").glob("*/*/.*.tmp"), *(out / "jobs").glob("*/*/*/.*.tmp")]:
         with contextlib.suppress(OSError):
             stale.unlink()
     by_folder: dict[Path, list[str]] = {}

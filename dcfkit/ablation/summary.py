@@ -8,7 +8,7 @@ from pathlib import Path
 
 from dcfkit.ablation.page import ablation_page
 from dcfkit.ablation.sensitivity import plot_sensitivity, sensitivity_file
-from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir
+from dcfkit.ablation.spec import AblationSpec, Job, expand, runs_dir
 from dcfkit.analysis.plots import plot_curves
 from dcfkit.analysis.report import json_ready
 from dcfkit.analysis.report_html import PAGE, write_page
@@ -16,6 +16,7 @@ from dcfkit.analysis.scoring import evaluate, protocol_record
 from dcfkit.analysis.statistics import versus_baseline
 from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.datasets import Sequence
+from dcfkit.experiments import runs_by_sequence
 from dcfkit.protocols import DEFAULT, get_protocol
 from dcfkit.running.files import atomic_write, read_json
 from dcfkit.running.results import ResultStore
@@ -32,15 +33,21 @@ def summary_columns(table: str, protocol: str = DEFAULT) -> tuple[str, ...]:
     return base[:i] + get_protocol(protocol).overlap_keys + base[i:]
 
 
-def _status(folder: Path, seq: Sequence) -> tuple[str, str | None]:
-    """The run's status in its store (done, failed, damaged, missing) and its error if failed."""
+_WORST_FIRST = ("failed", "damaged", "missing", "done")
+
+
+def _status(folder: Path, key: str, runs: list[Sequence]) -> tuple[str, str | None]:
+    """A sequence's status in its store (done, failed, damaged, missing: its runs' worst) and
+    the first error if failed."""
     store = ResultStore(folder)
-    status = store.status(seq, folder.name)
-    return status, (read_json(store.error_path(seq.name)) or {}).get("error") if status == "failed" else None
+    found = [store.status(run, key) for run in runs]
+    status = min(found, key=_WORST_FIRST.index)
+    failed = [run for run, s in zip(runs, found) if s == "failed"]
+    return status, (read_json(store.error_path(failed[0].name)) or {}).get("error") if failed else None
 
 
 def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None = None,
-              protocol: str | None = None) -> dict:
+              protocol: str | None = None, runs: dict[str, list[Sequence]] | None = None) -> dict:
     """Score the stored results of ``jobs`` under ``protocol`` (by default the benchmark's,
     :func:`dcfkit.analysis.scoring.evaluate`) and write the tables,
     ``summary.json`` and plots, each naming the protocol.
@@ -50,16 +57,19 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     time (:mod:`dcfkit.analysis.report`). A job without result (failed or not run) is scored as a
     total failure and counted in ``failed``. ``statistics`` compares each variant with the
     grid's base (when it names a variant) or the first variant
-    (:func:`~dcfkit.analysis.statistics.versus_baseline`). Returns ``{"overall",
+    (:func:`~dcfkit.analysis.statistics.versus_baseline`). Under a spec's ``tre`` or ``sre``
+    experiment a sequence's runs (``runs``, by default made here) are pooled. Returns ``{"overall",
     "per_sequence", "statistics", "jobs", "files", "protocol"}`` (the
     :class:`~dcfkit.protocols.Protocol`).
     """
     out = Path(out)
     jobs = jobs if jobs is not None else expand(spec, sequences)
     keys = {j.variant: j.key for j in jobs}
-    status, stored = _stored_runs(spec, out, sequences, jobs)
-    with _quiet(logging.getLogger("dcfkit.analysis.report")):  # missing runs are counted in 'failed'
-        scores = evaluate({variant: stored[key] for variant, key in keys.items()}, sequences, protocol=protocol)
+    runs = runs if runs is not None else runs_by_sequence(sequences, spec.experiment)
+    status, stored = _stored_runs(spec, out, runs, jobs)
+    with _quiet(logging.getLogger("dcfkit.analysis.scoring")):  # missing runs are counted in 'failed'
+        scores = evaluate({variant: stored[key] for variant, key in keys.items()}, sequences, protocol=protocol,
+                          experiment=spec.experiment)
     protocol = scores.protocol
     overall, per_sequence = _rows(scores, keys, sequences, status, protocol)
     variants = list(keys)
@@ -68,7 +78,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     job_rows = [{"variant": j.variant, "sequence": j.sequence, "key": j.key,
                  "status": status[j.key, j.sequence][0], "error": status[j.key, j.sequence][1]} for j in jobs]
     info = {"spec": str(spec.path), "name": spec.name, "description": spec.description,
-            "protocol": protocol_record(scores.protocol),
+            "protocol": protocol_record(scores.protocol), "experiment": spec.experiment,
             "dataset": spec.dataset, "root": str(spec.root), "sequences": [s.name for s in sequences],
             "overall": overall, "per_sequence": per_sequence, "statistics": statistics, "jobs": job_rows,
             "grid": ({"base": spec.grid.base, "mode": spec.grid.mode,
@@ -83,17 +93,18 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
             "files": files, "protocol": protocol}
 
 
-def _stored_runs(spec: AblationSpec, out: Path, sequences: list[Sequence], jobs: list[Job]) -> tuple[dict, dict]:
-    """``status[key, sequence]`` = (status, error) and ``stored[key]`` = the intact results."""
-    by_name = {s.name: s for s in sequences}
+def _stored_runs(spec: AblationSpec, out: Path, runs: dict[str, list[Sequence]], jobs: list[Job]
+                 ) -> tuple[dict, dict]:
+    """``status[key, sequence]`` = (status, error) and ``stored[key]`` = the intact results (run
+    name -> result) of the sequences whose every run is done."""
     status: dict[tuple[str, str], tuple[str, str | None]] = {}
     stored: dict[str, dict] = {}
     for key in dict.fromkeys(j.key for j in jobs):
-        folder = job_dir(out, spec.dataset, key)
+        folder = runs_dir(out, spec, key)
         names = list(dict.fromkeys(j.sequence for j in jobs if j.key == key))
         for name in names:
-            status[key, name] = _status(folder, by_name[name])
-        done = [by_name[n] for n in names if status[key, n][0] == "done"]
+            status[key, name] = _status(folder, key, runs[name])
+        done = [run for n in names if status[key, n][0] == "done" for run in runs[n]]
         stored[key] = ResultStore(folder).load(done) if done else {}
     return status, stored
 

@@ -23,6 +23,7 @@ two box series (centre ``x + w/2``, boxes ``[x, x + w)``), with no protocol's ru
 """
 from __future__ import annotations
 
+import dataclasses
 from typing import Iterable, Mapping
 
 import numpy as np
@@ -36,6 +37,7 @@ __all__ = [
     "centre_error",
     "iou",
     "normalized_centre_error",
+    "pool_runs",
     "precision_curve",
     "score_sequence",
     "success_curve",
@@ -204,3 +206,11 @@ def average(scores: Iterable[Mapping], weighting: str | None = None,
                       means["precision_curve"], means["success_curve"], means["norm_precision_curve"],
                       **overlap_scores)
 
+
+
+def pool_runs(scores: Iterable[Mapping], protocol: str | Protocol = DEFAULT) -> dict:
+    """The scores of a sequence's runs (TRE, SRE) as one: their frames pooled, as the OTB
+    toolkit's ``perfPlot.m`` sums the successes of all runs and divides by all their frames
+    (no run is left out for an all-zero curve; :func:`average` may leave the sequence out)."""
+    proto = get_protocol(protocol)
+    return average(scores, "frame", dataclasses.replace(proto, drop_zero_curves=False))

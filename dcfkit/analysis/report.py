@@ -29,7 +29,9 @@ from dcfkit.analysis.scoring import Evaluation, evaluate
 from dcfkit.analysis.tables import columns, format_rows, format_table, score_line, statistics_lines
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
 from dcfkit.errors import clip, shown
+from dcfkit.experiments import Experiment, get_experiment
 from dcfkit.protocols import Protocol
+from dcfkit.running.evaluation import experiment_runs
 from dcfkit.running.files import atomic_write, ensure_writable
 from dcfkit.running.results import import_results, load_results
 
@@ -71,7 +73,7 @@ def read_folder(folder: Path, sequences: Seq[Sequence]) -> dict:
 
 
 def tracker_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,
-                    exclude: Iterable[Path] = ()) -> dict[str, Path]:
+                    exclude: Iterable[Path] = (), sub: str = "") -> dict[str, Path]:
     """Tracker name -> results folder, for a report on ``sequences``.
 
     A tracker is a sub-folder name of ``out_dir``, a path to a folder of result files, or
@@ -80,7 +82,9 @@ def tracker_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] |
     ``sequences``, except the folders in ``exclude`` that hold no tracker results (a
     report's own folder). A tracker is named by its folder's name, or by ``parent/name``
     where two folders share a name (``reference_results/BACF/UAV123_10fps`` and
-    ``.../DR2Track/UAV123_10fps``).
+    ``.../DR2Track/UAV123_10fps``). ``sub``: an experiment's sub-folder of each tracker's
+    folder (:mod:`dcfkit.experiments`), which then holds the results of ``sequences`` (its
+    runs); a folder given that has no such sub-folder is taken as it is.
     """
     out_dir = Path(out_dir)
     exclude = {Path(p).resolve() for p in exclude}
@@ -89,7 +93,7 @@ def tracker_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] |
         if not out_dir.is_dir():
             raise DatasetError(f"results folder not found: {clip(str(out_dir))}")
         trackers = [p.name for p in sorted(out_dir.iterdir())
-                    if p.is_dir() and not p.name.startswith(".") and any((p / f"{n}.txt").is_file() for n in names)
+                    if p.is_dir() and not p.name.startswith(".") and any((p / sub / f"{n}.txt").is_file() for n in names)
                     and (p.resolve() not in exclude or _holds_results(p, names))]
     folders: dict[Path, tuple[str | None, Path]] = {}
     for tracker in trackers:
@@ -103,8 +107,8 @@ def tracker_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] |
         raise DatasetError(f"two folders are given one name: {', '.join(sorted(n for n in given if given.count(n) > 1))}")
     shared = {name for name in (f.name for _, f in folders.values())
               if sum(g.name == name for _, g in folders.values()) > 1}
-    return {name or (f"{folder.resolve().parent.name}/{folder.name}" if folder.name in shared else folder.name): folder
-            for name, folder in folders.values()}
+    return {name or (f"{folder.resolve().parent.name}/{folder.name}" if folder.name in shared else folder.name):
+            folder / sub if sub and (folder / sub).is_dir() else folder for name, folder in folders.values()}
 
 
 def named_folder(out_dir: Path, tracker: str) -> tuple[str | None, Path]:
@@ -172,19 +176,22 @@ def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
                                                evaluation.statistics if stem == "overall" else None))
     text("statistics.txt", "\n".join(statistics_lines(evaluation.statistics)) + "\n")
     text("report.json", json.dumps(json_ready(evaluation.as_record()), indent=1) + "\n")
+    run = evaluation.settings.get("experiment", "ope").upper()
     for kind in ("precision", "success"):
-        paths += plot_curves(evaluation.curves, kind, report_dir / kind, protocol=protocol)
+        paths += plot_curves(evaluation.curves, kind, report_dir / kind, title=f"{kind.capitalize()} plots of {run}",
+                             protocol=protocol)
     for attr, curves in evaluation.attribute_curves.items():
         name = f"{ATTRIBUTE_NAMES.get(attr, attr)} ({evaluation.attributes[attr]})"
         for kind in ("precision", "success"):
-            title = f"{kind.capitalize()} plots of OPE - {name}"
+            title = f"{kind.capitalize()} plots of {run} - {name}"
             paths += plot_curves(curves, kind, report_dir / f"{kind}_{attr}", title=title, protocol=protocol)
     return paths
 
 
 def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,
                  report_dir=None, include_first: bool = True, weighting: str | None = None,
-                 protocol: str | Protocol | None = None, *, missing: str = "skip") -> list[Path]:
+                 protocol: str | Protocol | None = None, *, missing: str = "skip",
+                 experiment: str | Experiment = "ope") -> list[Path]:
     """Score every tracker in ``out_dir`` under ``protocol`` (by default the benchmark's,
     :func:`evaluate`) and write tables and plots to ``report_dir``.
 
@@ -193,19 +200,21 @@ def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | No
     ``.csv``; ``report.json`` with all rows and curves; ``precision`` and ``success`` plots
     and ``precision_<ATTR>`` and ``success_<ATTR>`` plots per attribute, each as PNG and SVG. Every file names
     the protocol. ``missing`` is :func:`evaluate`'s: by default the sequences every tracker
-    has a result for are scored, the others named. Returns the paths.
+    has a result for are scored, the others named. ``experiment`` ``tre`` or ``sre`` scores
+    each tracker's runs of it (``<tracker>/<experiment>/``), pooled per sequence. Returns the paths.
     """
     return score_and_write(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol,
-                           missing=missing)[1]
+                           missing=missing, experiment=experiment)[1]
 
 
 def score_and_write(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None, report_dir=None,
                     include_first: bool = True, weighting: str | None = None,
-                    protocol: str | Protocol | None = None, *, missing: str = "skip") -> tuple[dict, list[Path]]:
+                    protocol: str | Protocol | None = None, *, missing: str = "skip",
+                    experiment: str | Experiment = "ope") -> tuple[dict, list[Path]]:
     """:func:`write_report` that also returns what :func:`evaluate` returned: (evaluation, paths)."""
     report_dir = default_report_dir(out_dir, report_dir)
     _, _, evaluation = score_folders(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol,
-                                     missing=missing)
+                                     missing=missing, experiment=experiment)
     return evaluation, write_files(evaluation, report_dir)
 
 
@@ -216,16 +225,23 @@ def default_report_dir(out_dir, report_dir=None) -> Path:
 
 def score_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None, report_dir: Path,
                   include_first: bool = True, weighting: str | None = None, protocol: str | Protocol | None = None,
-                  *, missing: str = "skip") -> tuple[dict[str, Path], dict[str, dict], dict]:
+                  *, missing: str = "skip", experiment: str | Experiment = "ope"
+                  ) -> tuple[dict[str, Path], dict[str, dict], dict]:
     """(tracker folders, their results, :func:`evaluate` of them) for a report into
     ``report_dir``, which is checked to take the report's files before the scoring. A test
     split (ground truth withheld after frame 1) stops here, before any folder is made."""
     sequences = scored_sequences(sequences)
     if _holds_results(report_dir, {s.name for s in sequences}):
         raise DatasetError(f"{report_dir} holds a tracker's results; write the report elsewhere with --report-dir")
-    folders = tracker_folders(out_dir, sequences, trackers, exclude=[report_dir])
-    results = {name: read_folder(folder, sequences) for name, folder in folders.items()}
+    experiment = get_experiment(experiment)
+    if experiment.resets:
+        raise DatasetError("reset-based results are scored by dcfkit.analysis.reset_report (dcfkit report "
+                           "--experiment reset)")
+    runs = experiment_runs(sequences, experiment)
+    folders = tracker_folders(out_dir, runs, trackers, exclude=[report_dir], sub=experiment.folder)
+    results = {name: read_folder(folder, runs) for name, folder in folders.items()}
     if not results:
-        raise DatasetError(f"no tracker results found under {clip(str(out_dir))}")
+        raise DatasetError(f"no tracker results{' of experiment ' + experiment.name if experiment.folder else ''} "
+                           f"found under {clip(str(out_dir))}")
     ensure_writable(report_dir, report_file_names(sequences), "the report")  # before the scoring
-    return folders, results, evaluate(results, sequences, include_first, weighting, protocol, missing)
+    return folders, results, evaluate(results, sequences, include_first, weighting, protocol, missing, experiment)

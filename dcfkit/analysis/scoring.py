@@ -13,6 +13,7 @@ from dcfkit.analysis import metrics
 from dcfkit.analysis.statistics import versus_baseline
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, benchmark_protocol, scored_sequences
 from dcfkit.errors import shown
+from dcfkit.experiments import Experiment, get_experiment
 from dcfkit.protocols import Protocol, get_protocol
 from dcfkit.running import platforms
 
@@ -72,7 +73,8 @@ MISSING = ("skip", "fail")  # what evaluate() does with a sequence a tracker has
 
 def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
              include_first: bool = True, weighting: str | None = None,
-             protocol: str | Protocol | None = None, missing: str = "fail") -> Evaluation:
+             protocol: str | Protocol | None = None, missing: str = "fail",
+             experiment: str | Experiment = "ope") -> Evaluation:
     """Score ``results`` (tracker -> sequence name -> boxes) on ``sequences`` under ``protocol``
     (by default the rules of the benchmark's published tables,
     :func:`~dcfkit.datasets.benchmark_protocol`: LaSOT's for LaSOT, the OTB toolkit's for UAV123).
@@ -84,16 +86,24 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
     without a result); ``"fail"`` scores a missing result as a total failure, as the toolkits
     do. Sequences whose ground truth is withheld after frame 1 (test splits) are left out
     (:func:`~dcfkit.datasets.scored_sequences`: a :class:`DatasetError` if that leaves none).
+
+    ``experiment`` ``tre`` or ``sre`` (:mod:`dcfkit.experiments`): results are keyed by run
+    name, and a sequence's score pools the frames of its runs (:func:`metrics.pool_runs`); a
+    sequence lacks a result unless it has all its runs.
     """
     sequences = list(sequences)
     proto = get_protocol(protocol or benchmark_protocol(sequences))
     weighting = weighting or proto.weighting
     keys = proto.score_keys
-    sequences, left_out = _complete(scored_sequences(sequences), results, missing)
+    experiment = get_experiment(experiment)
+    if experiment.resets:
+        raise ValueError("reset-based runs are scored by dcfkit.analysis.reset_scores, not evaluate()")
+    runs = {s.name: experiment.runs(s) for s in scored_sequences(sequences)}
+    sequences, left_out = _complete(scored_sequences(sequences), results, missing, runs)
     per_seq, fps, missing = {}, {}, {}
     for tracker, res in results.items():
-        per_seq[tracker], fps[tracker], missing[tracker] = _score_tracker(tracker, res, sequences, include_first,
-                                                                          proto)
+        per_seq[tracker], fps[tracker], missing[tracker] = _score_tracker(tracker, res, sequences, runs,
+                                                                          include_first, proto)
 
     overall, curves = [], {}
     for tracker in results:
@@ -114,19 +124,23 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
         protocol=proto, overall=overall, per_sequence=per_sequence, per_attribute=per_attribute,
         curves=curves, attribute_curves=attribute_curves,
         attributes={a: len(n) for a, n in attributes.items()}, thresholds=proto.thresholds,
-        settings={"protocol": proto.name, "include_first": include_first, "weighting": weighting,
+        settings={"protocol": proto.name, "experiment": experiment.name, "include_first": include_first,
+                  "weighting": weighting,
                   "missing": "skip" if left_out is not None else "fail", "left_out": left_out or {}},
         platforms={t: _platforms(res.values()) for t, res in results.items()},
         statistics=versus_baseline(per_sequence, ranked, (proto.rank_key, "precision")) if ranked else {})
 
 
-def _complete(sequences: list[Sequence], results: Mapping[str, Mapping], missing: str) -> tuple[list, dict | None]:
-    """(the sequences to score, sequence -> trackers without a result; None under "fail")."""
+def _complete(sequences: list[Sequence], results: Mapping[str, Mapping], missing: str,
+              runs: Mapping[str, list[Sequence]]) -> tuple[list, dict | None]:
+    """(the sequences to score, sequence -> trackers without a result of every run; None
+    under "fail")."""
     if missing not in MISSING:
         raise ValueError(f"missing must be one of {', '.join(MISSING)}, got {shown(missing)}")
     if missing == "fail":
         return sequences, None
-    left_out = {s.name: [t for t, res in results.items() if s.name not in res] for s in sequences}
+    left_out = {s.name: [t for t, res in results.items() if any(r.name not in res for r in runs[s.name])]
+                for s in sequences}
     left_out = {name: trackers for name, trackers in left_out.items() if trackers}
     kept = [s for s in sequences if s.name not in left_out]
     if not kept:
@@ -145,28 +159,40 @@ def _platforms(results: Iterable) -> list[list]:
         platforms.describe(getattr(r, "platform", None)) for r in results).most_common()]
 
 
-def _score_tracker(tracker: str, res: Mapping, sequences: list[Sequence], include_first: bool,
-                   proto: Protocol) -> tuple[dict, dict, list]:
-    """(sequence -> scores, sequence -> fps, missing sequence names) of one tracker's results."""
+def _score_tracker(tracker: str, res: Mapping, sequences: list[Sequence], runs: Mapping[str, list[Sequence]],
+                   include_first: bool, proto: Protocol) -> tuple[dict, dict, list]:
+    """(sequence -> scores, sequence -> fps, names of the sequences missing a run) of one
+    tracker's results, each sequence's runs pooled."""
     scores, fps, missing = {}, {}, []
     for seq in sequences:
-        if seq.name in res:
-            boxes, fps[seq.name] = _boxes_and_fps(res[seq.name])
-            if len(boxes) > len(seq):
-                raise DatasetError(f"tracker {shown(tracker)}, sequence {seq.name!r}: {len(boxes)} boxes for "
-                                   f"{len(seq)} frames")
-            if len(boxes) < len(seq):
-                log.warning("tracker %r, sequence %r: %d boxes for %d frames; the last %d frames are "
-                            "scored as failures", tracker, seq.name, len(boxes), len(seq), len(seq) - len(boxes))
-        else:
-            boxes, fps[seq.name] = np.empty((0, 4)), None
+        pooled, speeds = [], []
+        for run in runs[seq.name]:
+            boxes, speed = _run_boxes(tracker, res, run)
+            pooled.append(metrics.score_sequence(boxes, run.ground_truth, include_first, proto))
+            speeds.append(speed)
+        scores[seq.name] = pooled[0] if len(pooled) == 1 else metrics.pool_runs(pooled, proto)
+        fps[seq.name] = _mean_or_none(speeds)
+        if any(run.name not in res for run in runs[seq.name]):
             missing.append(seq.name)
-        scores[seq.name] = metrics.score_sequence(boxes, seq.ground_truth, include_first, proto)
     if missing:
         log.warning("tracker %r has no results for %d of %d sequences (scored as failures; "
                     "report on the sequences that were run, e.g. with --sequences, to leave them out): %s",
                     tracker, len(missing), len(sequences), ", ".join(missing[:10]))
     return scores, fps, missing
+
+
+def _run_boxes(tracker: str, res: Mapping, run: Sequence) -> tuple[np.ndarray, float | None]:
+    """(boxes, fps) of ``run`` in ``res`` (no boxes when it has none), checked not too long."""
+    if run.name not in res:
+        return np.empty((0, 4)), None
+    boxes, fps = _boxes_and_fps(res[run.name])
+    if len(boxes) > len(run):
+        raise DatasetError(f"tracker {shown(tracker)}, sequence {run.name!r}: {len(boxes)} boxes for "
+                           f"{len(run)} frames")
+    if len(boxes) < len(run):
+        log.warning("tracker %r, sequence %r: %d boxes for %d frames; the last %d frames are "
+                    "scored as failures", tracker, run.name, len(boxes), len(run), len(run) - len(boxes))
+    return boxes, fps
 
 
 def _rank(rows: list[dict], proto: Protocol) -> list[dict]:

@@ -6,12 +6,13 @@ import dataclasses
 import re
 from pathlib import Path
 
-from dcfkit.ablation import expand, job_dir, load_spec, run_ablation, summary_columns, variant_names
-from dcfkit.ablation.spec import MAX_VARIANTS
+from dcfkit.ablation import expand, load_spec, run_ablation, summary_columns, variant_names
+from dcfkit.ablation.spec import ABLATION_EXPERIMENTS, MAX_VARIANTS, runs_dir
 from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.cli.common import add_max_frames_argument, add_protocol_argument, variant_count
 from dcfkit.config import shipped_config_dir
 from dcfkit.errors import DcfkitError
+from dcfkit.experiments import runs_by_sequence
 from dcfkit.running.results import ResultStore
 
 
@@ -41,16 +42,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="list the jobs and whether each is done; run nothing")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_max_frames_argument(parser)
+    parser.add_argument("--experiment", choices=ABLATION_EXPERIMENTS, default=None,
+                        help="the runs of each sequence (default: the spec's 'experiment', else ope); tre and sre "
+                             "pool each sequence's 20 or 12 runs (docs/evaluation.md, 'Experiments')")
 
 
 def _dry_run(spec, out: Path) -> int:
     seqs = spec.load_sequences()
-    by_name = {s.name: s for s in seqs}
+    runs = runs_by_sequence(seqs, spec.experiment)
     jobs = expand(spec, seqs)
     for job in jobs:
-        status = ResultStore(job_dir(out, spec.dataset, job.key)).status(by_name[job.sequence], job.key)
-        print(f"{'done' if status == 'done' else 'todo'}  {job.key}  {job.variant}  {job.sequence}")
-    print(f"{len(jobs)} jobs, {len({(j.key, j.sequence) for j in jobs})} distinct runs")
+        store = ResultStore(runs_dir(out, spec, job.key))
+        done = sum(store.status(run, job.key) == "done" for run in runs[job.sequence])
+        state = "done" if done == len(runs[job.sequence]) else "todo"
+        count = f" ({done} of {len(runs[job.sequence])} {spec.experiment} runs done)" if spec.experiment != "ope" else ""
+        print(f"{state}  {job.key}  {job.variant}  {job.sequence}{count}")
+    print(f"{len(jobs)} jobs, {len({(j.key, j.sequence) for j in jobs})} distinct runs"
+          + (f" ({spec.experiment}: {sum(len(r) for r in runs.values())} runs of {len(seqs)} sequences per variant)"
+             if spec.experiment != "ope" else ""))
     return 0
 
 
@@ -60,13 +69,15 @@ def run(args: argparse.Namespace) -> int:
     if args.scheduler and executor != "dask":
         raise DcfkitError("--scheduler needs --executor dask")
     spec = load_spec(args.spec, root=args.root, sequences=args.sequences, max_variants=args.max_variants)
-    spec = dataclasses.replace(spec, max_frames=args.max_frames)
+    spec = dataclasses.replace(spec, max_frames=args.max_frames, experiment=args.experiment or spec.experiment)
     if args.dry_run:
         return _dry_run(spec, args.out.expanduser().resolve())
     res = run_ablation(spec, args.out, jobs=args.jobs, executor=executor, scheduler=args.scheduler,
                        progress=not args.no_progress, protocol=args.protocol)
     summary = res["summary"]
     protocol = summary["protocol"]  # --protocol, else the benchmark's own
+    if spec.experiment != "ope":
+        print(f"experiment {spec.experiment}: each sequence's runs pooled, as the OTB toolkit's perfPlot.m")
     print(format_table(summary["overall"], "markdown", summary_columns("summary", protocol), protocol), end="")
     print("\n" + "\n".join(statistics_lines(summary["statistics"])))
     print(f"\n{spec.name}: {len(res['jobs'])} jobs ({res['runs']} distinct runs): {len(res['done'])} run, "

@@ -76,3 +76,12 @@ def add_max_frames_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--max-frames", type=frame_limit, default=None, metavar="N",
                         help="each sequence's first N frames only: a smoke run (its results are of the cut "
                              "sequences, never taken for full ones: score them with the same --max-frames)")
+
+
+def add_experiment_argument(parser: argparse.ArgumentParser) -> None:
+    from dcfkit.experiments import EXPERIMENTS  # lazy: the parser is built before any command runs
+
+    parser.add_argument("--experiment", choices=tuple(EXPERIMENTS), default="ope",
+                        help="ope: one pass from frame 1 (default); tre: 20 later starts; sre: 12 shifted or scaled "
+                             "first boxes (OTB, Wu et al. 2015); reset: VOT's re-initialisation 5 frames after each "
+                             "failure (accuracy, failures, EAO). Results other than ope go to OUT/<tracker>/<experiment>/")

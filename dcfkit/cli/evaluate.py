@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import os
 import sys
@@ -12,15 +13,23 @@ from typing import Any, Callable, Mapping
 from dcfkit.analysis.compare import COLUMNS, compare_folders
 from dcfkit.analysis.report import columns, json_ready, named_folder, score_and_write
 from dcfkit.analysis.report_html import write_html_report
+from dcfkit.analysis.reset_report import RESET_COLUMNS, reset_runs, write_reset_report
+from dcfkit.analysis.reset_scores import score_resets
 from dcfkit.analysis.scoring import MISSING, evaluate
-from dcfkit.analysis.tables import comparison_lines, format_table, score_line, statistics_lines
-from dcfkit.cli.common import add_dataset_arguments, add_max_frames_argument, add_protocol_argument, pixels
+from dcfkit.analysis.tables import comparison_lines, format_rows, format_table, score_line, statistics_lines
+from dcfkit.cli.common import (
+    add_dataset_arguments,
+    add_experiment_argument,
+    add_max_frames_argument,
+    add_protocol_argument,
+    pixels,
+)
 from dcfkit.config import load_config
 from dcfkit.config.overrides import parse_overrides
-from dcfkit.datasets import load_dataset
+from dcfkit.datasets import load_dataset, scored_sequences
 from dcfkit.errors import ConfigError, shown
 from dcfkit.integrations.opencv import opencv_tracker
-from dcfkit.running.evaluation import check_one_pass, run_one_pass, tracker_name
+from dcfkit.running.evaluation import check_one_pass, experiment_runs, results_folder, run_one_pass, tracker_name
 from dcfkit.running.results import load_results
 
 
@@ -36,6 +45,7 @@ def add_eval_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_max_frames_argument(parser)
     add_protocol_argument(parser)
+    add_experiment_argument(parser)
 
 
 def _resolve_config(spec: str, overrides: Mapping[str, Any]) -> tuple[dict, Callable | None]:
@@ -70,11 +80,11 @@ def run_eval(args: argparse.Namespace) -> int:
     overrides = parse_overrides(args.overrides)
     resolved = distinct_names(args.configs, [_resolve_config(spec, overrides) for spec in args.configs])
     for config, _ in resolved:  # every config's folder and results checked before the first runs
-        check_one_pass(config, sequences, args.out)
+        check_one_pass(config, sequences, args.out, args.experiment)
     status = 0
     for config, factory in resolved:
         summary = run_one_pass(config, sequences, args.out, make_tracker=factory,
-                               jobs=args.jobs, progress=not args.no_progress)
+                               jobs=args.jobs, progress=not args.no_progress, experiment=args.experiment)
         print(f"{summary['tracker']}: {len(summary['done'])} run, {len(summary['skipped'])} "
               f"already done, {len(summary['failed'])} failed -> {summary['dir']}")
         print(f"  {_scores(args, summary['tracker'], sequences)}")
@@ -90,8 +100,17 @@ def _scores(args: argparse.Namespace, tracker: str, sequences: list) -> str:
         return (f"no scores: the ground truth of these {len(sequences)} sequences is withheld after frame 1 "
                 f"(a test split); submit {Path(args.out) / tracker}/<sequence>.txt to the benchmark's server "
                 f"(docs/evaluation.md, 'Test splits')")
-    scores = evaluate({tracker: load_results(args.out, tracker, sequences)}, sequences, protocol=args.protocol)
-    return score_line(scores.overall[0], scores.protocol.name)
+    folder = results_folder(args.out, {"name": tracker}, args.experiment)
+    if args.experiment == "reset":
+        scored = scored_sequences(sequences)
+        row = score_resets({tracker: reset_runs(folder, scored)}, {s.name: len(s) for s in scored})["overall"][0]
+        return (f"EAO {row['eao']:.3f}, accuracy {row['accuracy']:.3f}, {row['failures']} failures on "
+                f"{row['sequences']} sequences (reset-based, VOT2016)")
+    runs = experiment_runs(sequences, args.experiment)
+    scores = evaluate({tracker: load_results(folder.parent, folder.name, runs)}, sequences, protocol=args.protocol,
+                      experiment=args.experiment)
+    line = score_line(scores.overall[0], scores.protocol.name)
+    return line if args.experiment == "ope" else f"{line}, {args.experiment.upper()} runs pooled per sequence"
 
 
 def add_report_arguments(parser: argparse.ArgumentParser) -> None:
@@ -118,16 +137,23 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
                         help="a sequence some tracker has no result for: skip (default) scores the sequences "
                              "every tracker completed and names the others; fail scores a missing result as a "
                              "total failure, as the toolkits do")
+    add_experiment_argument(parser)
 
 
 def run_report(args: argparse.Namespace) -> int:
     """Print the overall table and write the report files."""
     sequences = [s.head(args.max_frames) for s in load_dataset(args.dataset, args.root, args.sequences)]
     trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
-    write = write_html_report if args.html else score_and_write
+    if args.experiment != "ope" and args.html:
+        raise ConfigError("--html shows one-pass results; leave it out for --experiment " + args.experiment)
+    if args.experiment == "reset":
+        return _reset_report(args, sequences, trackers)
+    write = write_html_report if args.html else functools.partial(score_and_write, experiment=args.experiment)
     evaluation, paths = write(args.out, sequences, trackers, args.report_dir, include_first=not args.skip_first,
                               weighting="frame" if args.frame_weighted else None, protocol=args.protocol,
                               missing=args.missing)
+    if args.format == "table" and args.experiment != "ope":
+        print(f"experiment {args.experiment}: each sequence's runs pooled, as the OTB toolkit's perfPlot.m")
     protocol = evaluation.protocol.name  # --protocol, else the benchmark's
     print(format_table(evaluation.overall, args.format, columns("overall", protocol), protocol,
                        evaluation.statistics), end="")
@@ -145,6 +171,19 @@ def run_report(args: argparse.Namespace) -> int:
         print(f"\n{len(paths)} files written to {paths[0].parent}")
         if args.html:
             print(f"open {paths[-1]}")
+    return 0
+
+
+def _reset_report(args: argparse.Namespace, sequences: list, trackers: list[str] | None) -> int:
+    """``report --experiment reset``: the accuracy, failures and EAO table and the statistics."""
+    scores, paths = write_reset_report(args.out, sequences, trackers, args.report_dir)
+    fmt = args.format if args.format != "latex" else "table"
+    low, high = scores["interval"]
+    print(f"reset-based experiment (VOT2016), EAO over sequence lengths {low}..{high}\n")
+    print(format_rows(scores["overall"], fmt, RESET_COLUMNS["overall"]), end="")
+    if args.format == "table":
+        print("\n" + "\n".join(statistics_lines(scores["statistics"])))
+        print(f"\n{len(paths)} files written to {paths[0].parent}")
     return 0
 
 

@@ -71,6 +71,8 @@ class Sequence:
     ground truth was read from (None for sequences made in code). ``ground_truth_withheld``
     is True for a test split that publishes frame 1's box only (GOT-10k, TrackingNet): rows
     2..N are NaN, so the sequence can be tracked but not scored (:func:`scored_sequences`).
+    ``start_box`` is the 0-based box the tracker starts from when it is not frame 1's ground
+    truth (a run of a robustness experiment, :mod:`dcfkit.experiments`).
     """
 
     name: str
@@ -80,6 +82,7 @@ class Sequence:
     dataset: str = ""
     annotation: Path | None = None
     ground_truth_withheld: bool = False
+    start_box: np.ndarray | None = None
 
     def __post_init__(self):
         gt = np.array(self.ground_truth, dtype=np.float64, copy=True).reshape(-1, 4)
@@ -93,6 +96,8 @@ class Sequence:
         object.__setattr__(self, "ground_truth", gt)
         object.__setattr__(self, "frames", tuple(Path(f) for f in self.frames))
         object.__setattr__(self, "attributes", dict(self.attributes))
+        if self.start_box is not None:
+            object.__setattr__(self, "start_box", np.array(self.start_box, dtype=np.float64).reshape(4))
 
     def __len__(self) -> int:
         return len(self.frames)
@@ -112,8 +117,9 @@ class Sequence:
 
     @property
     def init_box(self) -> np.ndarray:
-        """Frame 1's ground-truth box, ``(4,) float64`` 0-based (may contain NaN)."""
-        return self.ground_truth[0].copy()
+        """The box the tracker starts from, ``(4,) float64`` 0-based: ``start_box`` if given,
+        else frame 1's ground truth (which may contain NaN)."""
+        return (self.ground_truth[0] if self.start_box is None else self.start_box).copy()
 
     def frame(self, i: int) -> np.ndarray:
         """Frame ``i`` (0-based index) as ``(H, W, 3) uint8`` BGR; a :class:`DatasetError` if

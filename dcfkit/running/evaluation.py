@@ -1,15 +1,16 @@
-"""One-pass evaluation (OPE): a tracker config on every sequence of a benchmark.
+"""Evaluation: a tracker config on every sequence of a benchmark, in one experiment
+(:mod:`dcfkit.experiments`: one pass, TRE, SRE or reset-based).
 
 Trackers come from a factory ``make_tracker(config) -> tracker``, called once per sequence
 (default: :func:`dcfkit.load_tracker`); a tracker is any object with ``init(image, box)``
 and ``update(image) -> box`` (:mod:`dcfkit.running.tracking`). Results go to
-``OUT/<config name>/``, a :class:`dcfkit.running.results.ResultStore`: one file of 1-based boxes and
-one sidecar per sequence (per-frame tracker seconds, image decoding excluded; before its
+``OUT/<config name>/`` (``OUT/<config name>/<experiment>/`` but for one pass), a
+:class:`dcfkit.running.results.ResultStore`: one file of 1-based boxes and one sidecar per run (per-frame tracker seconds, image decoding excluded; before its
 first sequence of a dcfkit config a process runs a throw-away copy of the tracker on the
 first frame, untimed, so that one-time loading of compiled code is not counted).
 
-On rerun a sequence is skipped when its results are intact and from the same run key
-(:func:`dcfkit.running.provenance.run_key`); damaged and failed sequences are run again.
+On rerun a run is skipped when its results are intact and from the same run key
+(:func:`dcfkit.running.provenance.run_key`); damaged and failed runs are run again.
 """
 from __future__ import annotations
 
@@ -23,12 +24,13 @@ import numpy as np
 
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.errors import ConfigError, shown
+from dcfkit.experiments import Experiment, get_experiment
 from dcfkit.running.files import ensure_writable, exclusive, make_dir, remove_temporary_files
 from dcfkit.running.provenance import dcfkit_version, json_default, run_key
 from dcfkit.running.results import ResultStore
 from dcfkit.running.runner import RunTask, execute
 
-__all__ = ["check_one_pass", "run_one_pass", "tracker_name"]
+__all__ = ["check_one_pass", "experiment_runs", "results_folder", "run_one_pass", "tracker_name"]
 
 log = logging.getLogger(__name__)
 
@@ -77,60 +79,78 @@ def _say_what_is_recomputed(store: ResultStore, metas: dict, todo: list[Sequence
                     ", ".join(replaced[:10]))
 
 
-def _plan(config: dict, sequences: list[Sequence], out_dir) -> tuple[ResultStore, str, list[Sequence], dict]:
-    """(store, run key, sequences to run, their sidecars), after every check that needs no
+def results_folder(out_dir, config: Mapping, experiment: str | Experiment = "ope") -> Path:
+    """Where ``config``'s results of ``experiment`` go: ``OUT/<name>/`` or ``OUT/<name>/<experiment>/``."""
+    folder = Path(out_dir) / tracker_name(config)
+    sub = get_experiment(experiment).folder
+    return folder / sub if sub else folder
+
+
+def experiment_runs(sequences: Iterable[Sequence], experiment: str | Experiment = "ope") -> list[Sequence]:
+    """Every run of ``experiment`` on ``sequences``, in order (:mod:`dcfkit.experiments`)."""
+    runs = get_experiment(experiment).runs
+    return [run for seq in sequences for run in runs(seq)]
+
+
+def _plan(config: dict, sequences: list[Sequence], runs: list[Sequence], out_dir, experiment: Experiment
+          ) -> tuple[ResultStore, str, list[Sequence], dict]:
+    """(store, run key, runs to do, every run's sidecar), after every check that needs no
     tracking: the first boxes, the benchmark of the results there, and (when anything is to
     run) that the folder takes the result files."""
-    name = tracker_name(config)
     _check_first_boxes(sequences)
     key = run_key(config)
-    store = ResultStore(Path(out_dir) / name)
-    metas = {s.name: store.sidecar(s.name) for s in sequences}  # each read once
-    todo = [s for s in sequences if store.status(s, key, metas[s.name]) != "done"]
+    store = ResultStore(results_folder(out_dir, config, experiment))
+    metas = {s.name: store.sidecar(s.name) for s in runs}  # each read once
+    todo = [s for s in runs if store.status(s, key, metas[s.name]) != "done"]
     _check_same_dataset(store, metas, todo)
     if todo:
-        ensure_writable(store.folder, [f for s in todo for f in store.file_names(s.name)], f"{name}'s results")
+        ensure_writable(store.folder, [f for s in todo for f in store.file_names(s.name)],
+                        f"{tracker_name(config)}'s results")
     return store, key, todo, metas
 
 
-def check_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir) -> None:
+def check_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, experiment: str = "ope") -> None:
     """Raise now what :func:`run_one_pass` would raise before tracking (``dcfkit eval`` checks
     every config this way before it runs the first)."""
-    _plan(dict(config), list(sequences), out_dir)
+    sequences = list(sequences)
+    _plan(dict(config), sequences, experiment_runs(sequences, experiment), out_dir, get_experiment(experiment))
 
 
 def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_tracker=None,
-                 jobs: int = 1, progress: bool = True) -> dict:
-    """One-pass evaluation of the tracker described by ``config`` on ``sequences``.
+                 jobs: int = 1, progress: bool = True, experiment: str | Experiment = "ope") -> dict:
+    """Evaluate the tracker described by ``config`` on ``sequences`` in ``experiment``
+    (default one pass: each sequence once, from frame 1's ground truth).
 
-    Each sequence starts from a fresh tracker initialised on frame 1's ground truth; results
-    go to ``out_dir/<config['name']>/``. Sequences with intact results of the same run key
-    are skipped; before anything is tracked, the folder is checked to take the others. A
-    tracker exception fails only its sequence; a write failure (:class:`StoreError`) stops
-    the run. ``jobs > 1`` runs sequences in spawned worker processes; ``make_tracker`` must
-    then be picklable.
+    Each run starts from a fresh tracker; results go to :func:`results_folder`. Runs with
+    intact results of the same run key are skipped; before anything is tracked, the folder is
+    checked to take the others. A tracker exception fails only its run; a write failure
+    (:class:`StoreError`) stops the evaluation. ``jobs > 1`` runs in spawned worker
+    processes; ``make_tracker`` must then be picklable.
 
     Returns a plain dict: ``tracker``, ``dir``, ``run_key``, ``done`` (computed now),
-    ``skipped`` (already done), ``failed`` (sequence -> message).
+    ``skipped`` (already done), ``failed`` (run -> message), runs named as
+    :mod:`dcfkit.experiments` names them (one pass: the sequences' names).
     """
-    config, sequences = dict(config), list(sequences)
-    folder = Path(out_dir) / tracker_name(config)
+    config, sequences, experiment = dict(config), list(sequences), get_experiment(experiment)
+    folder = results_folder(out_dir, config, experiment)
     if not folder.is_dir():
         make_dir(folder)  # a first run: the locks need the folder
+    runs = experiment_runs(sequences, experiment)
     with contextlib.ExitStack() as locks:  # a run on other sequences of this folder may go on alongside
         with contextlib.suppress(OSError):  # e.g. read-only results to score: exclusive() warns and goes on
             (folder / ".locks").mkdir(exist_ok=True)
-        for seq in sequences:
-            locks.enter_context(exclusive(folder / ".locks" / f"{seq.name}.lock", "dcfkit eval",
-                                          f"{folder.name}'s results of sequence {seq.name!r} to {folder}"))
-        store, key, todo, metas = _plan(config, sequences, out_dir)
+        for run in runs:
+            what = f"{'sequence' if experiment.name == 'ope' else 'run'} {run.name!r}"
+            locks.enter_context(exclusive(folder / ".locks" / f"{run.name}.lock", "dcfkit eval",
+                                          f"{tracker_name(config)}'s results of {what} to {folder}"))
+        store, key, todo, metas = _plan(config, sequences, runs, out_dir, experiment)
         _say_what_is_recomputed(store, metas, todo, config, key)
         remove_temporary_files(store.folder, [f for s in todo for f in store.file_names(s.name)])
-        summary = {"tracker": folder.name, "dir": store.folder, "run_key": key,
-                   "done": [], "skipped": [s.name for s in sequences if s not in todo], "failed": {}}
-        _run(summary, [RunTask(config, s, store.folder, key, make_tracker) for s in todo], jobs, progress,
-             dcfkit_version())
-    order = {s.name: i for i, s in enumerate(sequences)}
+        summary = {"tracker": tracker_name(config), "dir": store.folder, "run_key": key,
+                   "done": [], "skipped": [s.name for s in runs if s not in todo], "failed": {}}
+        _run(summary, [RunTask(config, s, store.folder, key, make_tracker, experiment.resets) for s in todo],
+             jobs, progress, dcfkit_version())
+    order = {s.name: i for i, s in enumerate(runs)}
     summary["done"].sort(key=order.get)
     return summary
 

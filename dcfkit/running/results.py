@@ -47,13 +47,16 @@ TOOLKIT_TIME_SUFFIX, TOOLKIT_CONFIDENCE_SUFFIX = "_time", "_confidence"  # <sequ
 class SequenceResult:
     """A tracker's result on one sequence: ``boxes`` ``(N, 4) float64`` 0-based;
     ``times`` ``(N,) float64`` seconds per frame and ``fps`` when known (None for imports);
-    ``platform`` the :func:`dcfkit.running.platforms.record` of the run when its sidecar has one."""
+    ``platform`` the :func:`dcfkit.running.platforms.record` of the run when its sidecar has one;
+    ``resets`` the 1-based ``starts`` and ``failures`` of a reset-based run
+    (:mod:`dcfkit.running.resets`)."""
 
     boxes: np.ndarray
     times: np.ndarray | None = None
     fps: float | None = None
     run_key: str | None = None
     platform: dict | None = None
+    resets: dict | None = None
 
 
 class ResultStore:
@@ -177,7 +180,8 @@ class ResultStore:
             key = meta.get("run_key", meta.get("config_hash"))  # config_hash: dcfkit < 0.4
             results[name] = SequenceResult(read_boxes(self.boxes_path(name)), _times(meta),
                                            None if meta.get("fps") is None else float(meta["fps"]), key,
-                                           meta.get("platform") if isinstance(meta.get("platform"), dict) else None)
+                                           meta.get("platform") if isinstance(meta.get("platform"), dict) else None,
+                                           meta.get("resets"))
             keys.setdefault(key, []).append(name)
         if len(keys) > 1:
             detail = "; ".join(f"{k}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}" for k, v in keys.items())
@@ -199,9 +203,13 @@ def _check_sidecar(meta: dict) -> None:
               "confidence_sha256": lambda v: isinstance(v, str),
               "run_key": lambda v: isinstance(v, str), "config_hash": lambda v: isinstance(v, str),
               "fps": lambda v: v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)),
-              "times": lambda v: isinstance(v, list) and all(isinstance(t, (int, float)) for t in v)}
+              "times": lambda v: isinstance(v, list) and all(isinstance(t, (int, float)) for t in v),
+              "resets": lambda v: isinstance(v, dict) and all(
+                  isinstance(v.get(k), list) and all(isinstance(i, int) and not isinstance(i, bool) and 1 <= i <= frames
+                                                     for i in v[k]) for k in ("starts", "failures"))}
     if not isinstance(meta.get("frames"), int):
         raise ValueError("no frame count")
+    frames = meta["frames"]
     for field, ok in checks.items():
         if field in meta and not ok(meta[field]):
             raise TypeError(f"{field} is {meta[field]!r:.60}")

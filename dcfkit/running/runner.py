@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Mapping
 
 import cv2
+import numpy as np
 
 from dcfkit.datasets import Sequence
 from dcfkit.errors import DcfkitError, shown
@@ -29,6 +30,7 @@ from dcfkit.registry import PluginWarning
 from dcfkit.running import platforms
 from dcfkit.running.files import StoreError
 from dcfkit.running.provenance import dcfkit_version, invocation, machine, now, plugin_versions, run_key, sources
+from dcfkit.running.resets import ResetTrack, track_with_resets
 from dcfkit.running.results import ResultStore
 from dcfkit.running.tracking import TrackerFailure, track
 
@@ -39,13 +41,15 @@ _THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS",
 @dataclasses.dataclass(frozen=True)
 class RunTask:
     """One run to do: ``config`` on ``seq`` into the store at ``folder`` under ``key``.
-    ``make_tracker(config)`` builds the tracker (None: :func:`dcfkit.load_tracker`)."""
+    ``make_tracker(config)`` builds the tracker (None: :func:`dcfkit.load_tracker`);
+    ``resets``: VOT's reset-based run (:mod:`dcfkit.running.resets`)."""
 
     config: dict
     seq: Sequence
     folder: Path
     key: str
     make_tracker: Callable | None = None
+    resets: bool = False
 
 
 # --------------------------------------------------------------------------- one run
@@ -84,25 +88,35 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
     _warm_up(task)
     reading = [0]  # the 1-based number of the frame being read, for errors in decoding
 
-    def frames():
-        for i in range(len(seq)):
-            reading[0] = i + 1
-            yield seq.frame(i)
+    def read(i: int):
+        reading[0] = i + 1
+        return seq.frame(i)
+
+    def make():
+        return (task.make_tracker or load_dcfkit_tracker)(dict(task.config))
 
     tracker = None
+    tick = (lambda *_: on_frame()) if on_frame else None
     try:
-        tracker = (task.make_tracker or load_dcfkit_tracker)(dict(task.config))
-        run = track(tracker, frames(), seq.init_box, (lambda *_: on_frame()) if on_frame else None)
+        tracker = make()
+        if task.resets:
+            first = [tracker]  # the tracker made above starts the run; each restart gets a fresh one
+            run = track_with_resets(lambda: first.pop() if first else make(), seq, read, tick)
+        else:
+            run = track(tracker, (read(i) for i in range(len(seq))), seq.init_box, tick)
     except Exception as exc:
         frame = exc.frame if isinstance(exc, TrackerFailure) else reading[0] or None
         return record_failure(task, version, _failure_message(seq, exc, tracker is None, frame), exc, frame)
     plugins = plugin_versions(task.config)
     meta = {"sequence": seq.name, "dataset": seq.dataset, "tracker": task.config.get("name"),
-            "init_box": [float(v) for v in seq.init_box], "fps": run.fps, "total_time": float(run.times.sum()),
+            "init_box": [float(v) for v in seq.init_box], "fps": run.fps,
+            "total_time": float(np.nansum(run.times)),
             "run_key": task.key, "dcfkit_version": version, "plugins": plugins, "source": sources(plugins),
             "time": now(), **(origin or invocation()), "machine": machine(), "platform": platforms.record(),
             "config": task.config,
             "times": run.times.tolist()}
+    if isinstance(run, ResetTrack):  # 1-based, as every frame number dcfkit shows
+        meta["resets"] = {"starts": [i + 1 for i in run.starts], "failures": [i + 1 for i in run.failures]}
     store.write(seq, run.boxes, meta, run.times, run.confidence)
     return {"sequence": seq.name, "status": "done", "fps": run.fps, "frames": len(seq)}
 

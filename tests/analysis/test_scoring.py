@@ -135,3 +135,43 @@ def test_published_results_join_a_report_under_a_name_of_their_own(tmp_path, mon
         assert message in capsys.readouterr().err
     assert cli.main(["compare", f"mine={tmp_path / 'near'}", named, "--root", str(tmp_path)]) == 0
     assert "AUC       mine " in capsys.readouterr().out
+
+
+def test_tre_pools_the_frames_of_a_sequences_runs_as_perfplot_does(tmp_path):
+    """A sequence's TRE score: successes summed over its 20 runs / their frames (perfPlot.m),
+    brute-forced here from the per-frame overlaps of each run; sequences then weigh alike."""
+    from dcfkit.experiments.otb import tre_runs
+
+    rng = np.random.default_rng(3)
+    seqs = [Sequence(name, tuple(tmp_path / f"{k}.jpg" for k in range(n)),
+                     np.column_stack([np.arange(n) + 5.0, np.full(n, 5.0), np.full(n, 20.0), np.full(n, 30.0)]))
+            for name, n in (("long", 60), ("short", 30))]
+    results, by_hand = {}, {}
+    for seq in seqs:
+        successes, frames = np.zeros(21), 0
+        for run in tre_runs(seq):
+            boxes = run.ground_truth + rng.normal(0, 4, run.ground_truth.shape) * [1, 1, 0, 0]
+            boxes[0] = run.ground_truth[0]  # frame 1 of each run is scored with the ground truth
+            results[run.name] = boxes
+            overlap = np.array([metrics_overlap(b, g) for b, g in zip(boxes, run.ground_truth)])
+            successes += (overlap[:, None] > np.linspace(0, 1, 21)[None, :]).sum(axis=0)
+            frames += len(run)
+        by_hand[seq.name] = (successes / frames).mean()
+    scores = evaluate({"t": results}, seqs, protocol="otb", experiment="tre")
+    rows = {r["sequence"]: r for r in scores.per_sequence}
+    assert rows["long"]["auc"] == pytest.approx(by_hand["long"])
+    assert rows["short"]["auc"] == pytest.approx(by_hand["short"])
+    assert scores.overall[0]["auc"] == pytest.approx((by_hand["long"] + by_hand["short"]) / 2)
+    assert scores.settings["experiment"] == "tre"
+    assert len(tre_runs(seqs[1])) == 19  # 30 frames: E = 11, 1:11/19:11 has 18 values, then 11
+    del results["short_005"]  # one run missing: the sequence lacks a result
+    partial = evaluate({"t": results}, seqs, protocol="otb", experiment="tre", missing="skip")
+    assert partial.settings["left_out"] == {"short": ["t"]}
+
+
+def metrics_overlap(box, gt) -> float:
+    """calcRectInt.m's overlap of two 1-based-pixel boxes (x, y, w, h), by hand."""
+    left, top = max(box[0], gt[0]), max(box[1], gt[1])
+    right, bottom = min(box[0] + box[2] - 1, gt[0] + gt[2] - 1), min(box[1] + box[3] - 1, gt[1] + gt[3] - 1)
+    inter = max(0.0, right - left + 1) * max(0.0, bottom - top + 1)
+    return inter / (box[2] * box[3] + gt[2] * gt[3] - inter)

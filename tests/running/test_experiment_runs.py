@@ -1,0 +1,158 @@
+"""TRE, SRE and reset-based runs through `run_one_pass`, `dcfkit eval`, `report` and `ablate`:
+where they are stored, that they resume (after kill -9 too), and how they are scored."""
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from test_ablation import write_otb, write_spec
+from test_evaluation import Counter
+
+from dcfkit import cli
+from dcfkit.ablation import load_spec
+from dcfkit.datasets import Sequence, load_dataset, read_boxes
+from dcfkit.errors import ConfigError
+from dcfkit.experiments.otb import sre_box, tre_starts
+from dcfkit.running.evaluation import run_one_pass
+
+N = 25
+
+
+@pytest.fixture
+def seqs(tmp_path):
+    out = []
+    for name in "ab":
+        folder = tmp_path / "data" / name
+        folder.mkdir(parents=True)
+        frames = []
+        for k in range(N):
+            frames.append(folder / f"{k + 1:05d}.jpg")
+            cv2.imwrite(str(frames[-1]), np.full((40, 50, 3), 5 * k, np.uint8))
+        gt = np.array([[2.0 + k, 3, 6, 7] for k in range(N)])
+        out.append(Sequence(name, tuple(frames), gt, {}, "fake"))
+    return out
+
+
+CONFIG = {"name": "drift", "drift": 1.0}
+
+
+def test_tre_runs_are_stored_per_run_and_resume(tmp_path, seqs):
+    made = Counter()
+    summary = run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=made, progress=False, experiment="tre")
+    folder = tmp_path / "out" / "drift" / "tre"
+    starts = tre_starts(seqs[0].ground_truth)
+    assert summary["dir"] == folder and len(summary["done"]) == made.made == 2 * len(starts)
+    assert summary["done"][:2] == ["a_001", "a_002"]
+    for k, start in enumerate(starts, 1):
+        meta = json.loads((folder / f"b_{k:03d}.json").read_text())
+        assert meta["frames"] == N - start and meta["init_box"] == seqs[1].ground_truth[start].tolist()
+        assert len(read_boxes(folder / f"b_{k:03d}.txt")) == N - start
+    assert not list((tmp_path / "out" / "drift").glob("*.txt"))  # one-pass results stay apart
+    again = run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=made, progress=False, experiment="tre")
+    assert again["done"] == [] and len(again["skipped"]) == 2 * len(starts) and made.made == 2 * len(starts)
+
+
+def test_sre_runs_start_from_the_shifted_boxes(tmp_path, seqs):
+    run_one_pass(CONFIG, seqs[:1], tmp_path / "out", make_tracker=Counter(), progress=False, experiment="sre")
+    folder = tmp_path / "out" / "drift" / "sre"
+    first = seqs[0].ground_truth[0]
+    assert json.loads((folder / "a_009.json").read_text())["init_box"] == sre_box(first, "scale_8", (40, 50)).tolist()
+    boxes = read_boxes(folder / "a_001.txt")  # left: x - ceil(0.6) in 1-based pixels
+    np.testing.assert_allclose(boxes[0], first - [1, 0, 0, 0])
+    assert len(list(folder.glob("a_*.json"))) == 12
+
+
+def test_reset_runs_record_their_starts_and_failures(tmp_path, seqs):
+    config = {"name": "fast", "drift": 4.0}  # 4 px a frame on a 6 px wide target that moves 1 px
+    run_one_pass(config, seqs[:1], tmp_path / "out", make_tracker=Counter(), progress=False, experiment="reset")
+    meta = json.loads((tmp_path / "out" / "fast" / "reset" / "a.json").read_text())
+    # drifting 3 px a frame from the target: no overlap on the 2nd frame after a start (3 px: 3 of 6
+    # wide still overlap; 6 px: none); a start on frame 1, restarts 5 frames after each failure
+    assert meta["resets"] == {"starts": [1, 8, 15, 22], "failures": [3, 10, 17, 24]}
+    boxes = read_boxes(tmp_path / "out" / "fast" / "reset" / "a.txt")
+    assert np.isnan(boxes[3:7]).all() and np.isfinite(boxes[7]).all()
+
+
+def test_eval_and_report_of_each_experiment(tmp_path, capsys):
+    root = tmp_path / "data"
+    for i, name in enumerate(("seqA", "seqB")):
+        write_otb(root, name, seed=i, n_frames=N)
+    out, report_dir = tmp_path / "out", tmp_path / "report"
+    for experiment in ("tre", "sre", "reset"):
+        assert cli.main(["eval", "kcf", "--dataset", "otb", "--root", str(root), "--out", str(out),
+                         "--experiment", experiment, "--no-progress"]) == 0
+        said = capsys.readouterr().out
+        assert f"-> {out / 'kcf' / experiment}" in said
+        assert cli.main(["report", str(out), "--dataset", "otb", "--root", str(root), "--experiment", experiment,
+                         "--report-dir", str(report_dir / experiment)]) == 0
+        printed = capsys.readouterr().out
+        if experiment == "reset":
+            scores = json.loads((report_dir / "reset" / "reset.json").read_text())
+            assert scores["overall"][0]["tracker"] == "kcf" and scores["overall"][0]["sequences"] == 2
+            assert "EAO over sequence lengths" in printed and scores["interval"] == [N, N]
+        else:
+            record = json.loads((report_dir / experiment / "report.json").read_text())
+            assert record["settings"]["experiment"] == experiment and record["overall"][0]["sequences"] == 2
+            assert f"experiment {experiment}: each sequence's runs pooled" in printed
+            assert (report_dir / experiment / "success.png").is_file()
+    assert cli.main(["report", str(out), "--dataset", "otb", "--root", str(root), "--experiment", "tre",
+                     "--html"]) != 0
+    assert "--html shows one-pass results; leave it out for --experiment tre" in capsys.readouterr().err
+
+
+def test_an_ablation_runs_and_pools_an_experiment(tmp_path, capsys):
+    root = tmp_path / "data"
+    write_otb(root, "seqA", seed=0, n_frames=N)
+    spec = write_spec(tmp_path / "spec.yaml", """
+name: tre
+dataset: {name: otb, root: data}
+experiment: tre
+variants:
+  kcf: {config: kcf}
+  dsst: {config: dsst}
+""")
+    assert load_spec(spec).experiment == "tre"
+    assert cli.main(["ablate", str(spec), "--out", str(tmp_path / "out"), "--jobs", "1", "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    runs = len(tre_starts(load_dataset("otb", root)[0].ground_truth))
+    assert f"2 jobs ({2 * runs} distinct runs)" in printed
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["experiment"] == "tre" and all(r["failed"] == 0 for r in summary["overall"])
+    assert len(list((tmp_path / "out" / "jobs").glob(f"otb/*/tre/seqA_{runs:03d}.json"))) == 2
+    bad = write_spec(tmp_path / "bad.yaml", "name: x\ndataset: otb\nexperiment: reset\nvariants: {k: kcf}\n")
+    with pytest.raises(ConfigError, match=r"bad.yaml: experiment: expected one of ope, tre, sre, got 'reset' "
+                                          r"\(reset-based runs: dcfkit eval --experiment reset"):
+        load_spec(bad)
+
+
+@pytest.mark.slow
+def test_an_experiment_killed_with_sigkill_resumes_where_it_stopped(tmp_path):
+    root = tmp_path / "data"
+    write_otb(root, "seqA", seed=0, n_frames=60)
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "dcfkit.cli", "eval", "strcf", "--dataset", "otb", "--root", str(root),
+           "--out", str(out), "--experiment", "tre", "--no-progress"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    try:
+        deadline = time.monotonic() + 120
+        while len(list(out.glob("strcf/tre/*.json"))) < 3 and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.01)
+        proc.send_signal(signal.SIGKILL)
+    finally:
+        proc.kill()
+        output = proc.communicate()[0].decode(errors="replace")
+    assert proc.returncode == -signal.SIGKILL, output
+    before = {p: p.read_bytes() for p in out.glob("strcf/tre/*.json")}
+    assert 3 <= len(before) < 20, f"{len(before)} of 20 runs finished when killed: cannot test resume"
+    rerun = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert rerun.returncode == 0, rerun.stdout + rerun.stderr
+    assert f"{20 - len(before)} run, {len(before)} already done, 0 failed" in rerun.stdout
+    assert all(path.read_bytes() == content for path, content in before.items())
+    assert len(list(out.glob("strcf/tre/*.json"))) == 20 and not list(out.rglob("*.tmp"))
