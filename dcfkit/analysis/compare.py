@@ -38,12 +38,20 @@ from dcfkit.protocols import Protocol, get_protocol
 from dcfkit.running import platforms
 from dcfkit.running.results import ResultStore, result_files
 
-__all__ = ["COLUMNS", "compare_folders", "first_divergence", "score_statistics", "series_iou"]
+__all__ = ["COLUMNS", "PLATFORM_NOISE", "compare_folders", "first_divergence", "noise_floor", "score_statistics",
+           "series_iou"]
 
 COLUMNS = ("sequence", "frames", "precision", "precision_ref", "d_precision", "auc", "auc_ref", "d_auc",
            "iou", "diverges_at")
 
 log = logging.getLogger(__name__)
+
+#: How far a last-bit change in the arithmetic (FFTW for pocketfft) moved the shipped configs'
+#: AUC, measured by benchmarks/platform_noise.py on the eight development sequences: on one
+#: sequence and on their mean (docs/results.md, "Platform noise", where the BACF preset's
+#: 0.338 and 0.042 are also given). tests/analysis/test_compare.py holds these to that page.
+PLATFORM_NOISE = {"auc_sequence": 0.012, "auc_mean_of_8": 0.001, "precision_mean_of_8": 0.003,
+                  "source": 'docs/results.md, "Platform noise" (benchmarks/platform_noise.py, dcfkit 0.6.0)'}
 
 
 def series_iou(a, b) -> np.ndarray:
@@ -117,6 +125,7 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     theirs_platforms = _distinct(their_platforms[s.name] for s in both)
     return {"protocol": proto.name, "divergence_px": float(divergence_px), "results": str(results),
             "reference": str(reference), "rows": rows, "mean": mean, **score_statistics(rows),
+            "noise_floor": noise_floor(rows),
             "diverged": sum(r["diverges_at"] is not None for r in rows), "left_out": left_out,
             "platforms": {"results": sorted({platforms.describe(p) for p in ours_platforms}),
                           "reference": sorted({platforms.describe(p) for p in theirs_platforms})},
@@ -138,6 +147,17 @@ def score_statistics(rows: list[dict]) -> dict:
             "auc_difference": pick(found["auc"]["difference"]), "wilcoxon_p": found["auc"]["difference"]["wilcoxon_p"],
             "precision_difference": pick(found["precision"]["difference"]),
             "precision_wilcoxon_p": found["precision"]["difference"]["wilcoxon_p"]}
+
+
+def noise_floor(rows: list[dict]) -> dict:
+    """The measured :data:`PLATFORM_NOISE` beside ``rows``' AUC differences: ``exceeds`` when
+    the mean difference is beyond the most the platform moved a single sequence (which bounds
+    what it can do to any mean), and the sequences whose difference is beyond that."""
+    floor = PLATFORM_NOISE["auc_sequence"]
+    mean = float(np.mean([r["d_auc"] for r in rows])) if rows else float("nan")
+    beyond = [r["sequence"] for r in rows if abs(r["d_auc"]) > floor]
+    return {**PLATFORM_NOISE, "mean_auc_difference": mean, "exceeds": bool(abs(mean) > floor),
+            "sequences_beyond": beyond}
 
 
 def _distinct(records: Iterable) -> list:

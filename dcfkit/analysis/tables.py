@@ -127,6 +127,15 @@ def comparison_lines(statistics: Mapping, names: tuple[str, str] = ("results", "
     return lines
 
 
+def noise_floor_line(floor: Mapping, sequences: int) -> str:
+    """What :func:`dcfkit.analysis.compare.noise_floor` found, in one sentence."""
+    verdict = "exceeds it" if floor["exceeds"] else "is within it: not a finding"
+    return (f"noise floor: a last-bit change in the arithmetic moved one sequence by up to {floor['auc_sequence']:.3f} "
+            f"AUC and a mean of eight by up to {floor['auc_mean_of_8']:.3f} ({floor['source']}); the mean AUC "
+            f"difference, {floor['mean_auc_difference']:+.3f}, {verdict}; {len(floor['sequences_beyond'])} of "
+            f"{sequences} sequences differ by more than {floor['auc_sequence']:.3f}")
+
+
 def statistics_lines(statistics: Mapping) -> list[str]:
     """The statistics of :func:`dcfkit.analysis.statistics.versus_baseline` as text: each
     tracker's means with their intervals, then each difference from the baseline ('*': significant)."""

@@ -16,7 +16,14 @@ from dcfkit.analysis.report_html import write_html_report
 from dcfkit.analysis.reset_report import RESET_COLUMNS, reset_runs, write_reset_report
 from dcfkit.analysis.reset_scores import score_resets
 from dcfkit.analysis.scoring import MISSING, evaluate
-from dcfkit.analysis.tables import comparison_lines, format_rows, format_table, score_line, statistics_lines
+from dcfkit.analysis.tables import (
+    comparison_lines,
+    format_rows,
+    format_table,
+    noise_floor_line,
+    score_line,
+    statistics_lines,
+)
 from dcfkit.cli.common import (
     add_dataset_arguments,
     add_experiment_argument,
@@ -226,6 +233,7 @@ def run_compare(args: argparse.Namespace) -> int:
               file=sys.stderr if args.format == "csv" else sys.stdout)
     print("\n".join(comparison_lines(res["statistics"], tuple(res["names"]))),
           file=sys.stderr if args.format == "csv" else sys.stdout)
+    print(noise_floor_line(res["noise_floor"], len(res["rows"])), file=sys.stderr if args.format == "csv" else sys.stdout)
     if res["platform_differences"]:
         print(f"warning: the two folders come from different platforms ({'; '.join(res['platform_differences'])}); "
               f"their boxes may part where a float decision is close (docs/architecture.md)", file=sys.stderr)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from dcfkit import cli
-from dcfkit.analysis.compare import compare_folders, first_divergence, series_iou
+from dcfkit.analysis.compare import PLATFORM_NOISE, compare_folders, first_divergence, series_iou
 from dcfkit.datasets import DatasetError, Sequence
 
 GT = np.array([[10, 10, 10, 10]] * 5, dtype=float)  # 0-based in memory; files hold x + 1
@@ -210,3 +210,31 @@ def test_the_comparison_carries_its_uncertainty(folders, tmp_path, capsys, monke
     assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path), "--format", "json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["auc_difference"] == pytest.approx(res["auc_difference"]) and data["wilcoxon_p"] == 1.0
+
+
+def test_compare_says_whether_a_difference_exceeds_the_measured_platform_noise(folders, tmp_path, capsys,
+                                                                                monkeypatch):
+    ours, theirs = folders
+    seqs = [sequence("a"), sequence("b")]
+    floor = compare_folders(ours, theirs, seqs)["noise_floor"]
+    # a: 75/105 - 20/21 = -0.238 beyond 0.012; b: identical. Mean -0.119: beyond
+    assert floor["sequences_beyond"] == ["a"] and floor["exceeds"]
+    assert floor["mean_auc_difference"] == pytest.approx((75 / 105 - 20 / 21) / 2)
+    write(ours, "b", [[11, 11, 10, 10], [11, 11, 10, 10], [float("nan")] * 4, [11, 11, 10, 10], [11.1, 11, 10, 10]])
+    near = compare_folders(ours, theirs, [sequence("b")])["noise_floor"]  # one frame 0.1 px off: AUC unchanged
+    assert not near["exceeds"] and near["sequences_beyond"] == []
+    import dcfkit.cli.evaluate
+
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: [sequence("b")])
+    assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path)]) == 0
+    assert "the mean AUC difference, +0.000, is within it: not a finding; 0 of 1 sequences" in capsys.readouterr().out
+
+
+def test_the_noise_floor_is_what_results_md_measured():
+    """PLATFORM_NOISE restates docs/results.md: a new measurement changes both."""
+    page = (Path(__file__).resolve().parents[2] / "docs" / "results.md").read_text(encoding="utf-8")
+    section = page[page.index("**The noise floor.**"):]
+    section = section[:section.index("\n\n")]
+    assert f"up to {PLATFORM_NOISE['auc_sequence']:.3f} AUC for the shipped configs" in section
+    assert (f"up to {PLATFORM_NOISE['auc_mean_of_8']:.3f} AUC ({PLATFORM_NOISE['precision_mean_of_8']:.3f} precision) "
+            f"on the mean of eight") in section
