@@ -21,6 +21,26 @@ def kinds() -> tuple[str, ...]:
     return tuple(_BASES)
 
 
+@dataclasses.dataclass(frozen=True)
+class Target:
+    """The geometry of a new target, given to every component at each ``init``
+    (:meth:`Component.start`). Sizes are ``(h, w)``; cells are feature cells of the training
+    grid, whose middle (the target's, and the label's peak) is cell ``(0, 0)`` in the circular
+    layout every map uses (docs/plugins.md, "Where the target's middle lies").
+
+    ``image_size``: frame 1's ``(H, W)`` pixels; ``filter_size``: the ``(H, W)`` cells of the
+    filter, the label and the response; ``target_cells``: the target in cells; ``cell_size``:
+    pixels per cell (the config's, or smaller for a small target); ``scale``: pixels of the
+    image per pixel of the resampled patch; ``sigma``: the base label's σ in cells (Eq. 1)."""
+
+    image_size: tuple[int, int]
+    filter_size: tuple[int, int]
+    target_cells: tuple[float, float]
+    cell_size: int
+    scale: float
+    sigma: float
+
+
 class Component:
     """Base of all components: a ``kind``, a ``name`` and a ``Params`` schema."""
 
@@ -45,6 +65,10 @@ class Component:
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.params})"
 
+    def start(self, target: Target) -> None:
+        """Called at every ``init``, after ``reset``, with the new target's geometry (a label that
+        needs σ or the cell size reads them here). The built-ins need nothing from it."""
+
 
 @dataclasses.dataclass(frozen=True)
 class Contract:
@@ -67,7 +91,11 @@ class Contract:
 
     def hooks(self) -> dict[str, Callable | None]:
         """Every method the tracker calls -> its return check (None: none)."""
-        return {m: self.returns.get(m) for m in (*self.required, *self.optional)}
+        return {m: self.returns.get(m) for m in (*self.required, *self.optional, *EVERY_KIND)}
+
+
+#: what the tracker calls on a component of any kind, beyond its kind's contract
+EVERY_KIND: Mapping[str, tuple[str, ...]] = {"start": ("target",)}
 
 
 def _as_called(cls: type, method: str) -> tuple[Any, bool]:
@@ -111,7 +139,7 @@ def contract_problems(cls: type, base: type) -> list[str]:
     """What ``cls`` lacks of ``base.contract`` (an empty list: it meets it)."""
     contract: Contract = base.__dict__["contract"]
     problems = []
-    for method, args in {**contract.required, **contract.optional}.items():
+    for method, args in {**contract.required, **contract.optional, **EVERY_KIND}.items():
         if method in contract.required and getattr(cls, method, None) is getattr(base, method, None):
             problems.append(f"it does not implement {method}({', '.join(args)})")
         elif problem := _signature_problem(cls, method, args):

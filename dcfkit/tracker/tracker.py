@@ -20,6 +20,7 @@ import cv2
 import numpy as np
 
 from dcfkit.components.features.base import extract_stack
+from dcfkit.components.base import Target
 from dcfkit.components.labels.base import Detection, gaussian_label
 from dcfkit.components.scale.base import scale_limits
 from dcfkit.config import load_config
@@ -132,6 +133,9 @@ class Tracker:
         regularizers = [r for r in (self.spatial, self.temporal) if r is not None]
         for component in (*self.features, self.label, self.solver, *regularizers):  # a new target: nothing kept
             component.reset()
+        target = Target(self.image_size, g.filter_size, g.target_cells, g.cell_size, scale, float(sigma))
+        for component in (*self.features, self.label, self.solver, *regularizers, self.search, self.scale_estimator):
+            component.start(target)
         self.w2 = read_only(self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
                              else np.zeros(g.filter_size, np.float32))
         self.search.reset(centre)

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 import dcfkit
 from dcfkit import registry as reg
-from dcfkit.components.base import base_of, contract_problems
+from dcfkit.components.base import Target, base_of, contract_problems
 from dcfkit.components.features.base import Feature
 from dcfkit.components.labels.base import Label
 from dcfkit.components.regularizers import SpatialRegularizer, TemporalRegularizer
@@ -410,3 +410,49 @@ def test_a_base_class_declares_its_kind_with_a_contract(monkeypatch):
 
 def test_the_built_registry_lists_the_kinds_in_the_order_of_the_slots():
     assert reg.get_registry().kinds() == list(KINDS)
+
+
+class Sized(Label):
+    """A label that needs the target's geometry on frame 1, where ``detection`` is None."""
+
+    name = "sized"
+
+    def start(self, target):
+        self.target = target
+
+    def make(self, g, detection):
+        assert g.shape == self.target.filter_size  # start came first, with the label's grid
+        return g, np.zeros((0, 2), int)
+
+
+def test_every_component_gets_the_new_targets_geometry_at_init():
+    seq = tiny_sequence()
+    tracker = dcfkit.load_tracker(TINY, overrides={"scale.n_scales": 1})
+    tracker.label = Sized()
+    tracker.init(seq.frames[0], seq.ground_truth[0])
+    target, g = tracker.label.target, tracker.geometry
+    assert isinstance(target, Target) and target.image_size == seq.frames[0].shape[:2]
+    assert (target.filter_size, target.target_cells, target.cell_size) == (g.filter_size, g.target_cells, g.cell_size)
+    assert target.scale == tracker.scale
+    # σ of Eq. (1) is the base label's: one cell from its peak it is exp(-1 / 2σ²)
+    assert tracker.base_label[1, 0] == pytest.approx(np.exp(-0.5 / target.sigma ** 2), rel=1e-6)
+    expected = np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * tracker.params.output_sigma_factor
+    assert target.sigma == pytest.approx(expected)
+    other = seq.ground_truth[0] + [2, 2, 4, 4]  # a new target: new geometry
+    tracker.init(seq.frames[0], other)
+    assert tracker.label.target.target_cells == tracker.geometry.target_cells != g.target_cells
+
+
+def test_start_is_checked_like_every_hook():
+    class TakesNothing(Label):
+        name = "takes_nothing"
+
+        def start(self):  # the tracker passes the target
+            pass
+
+        def make(self, g, detection):
+            return g, np.zeros((0, 2), int)
+
+    problems = contract_problems(TakesNothing, Label)
+    assert problems == ["start(self) cannot be called as start(self, target) (the tracker passes 1 argument)"]
+    assert contract_problems(Remembering, Label) == []  # a label without start (0.5 plugins) meets the contract
