@@ -55,8 +55,9 @@ def variants_table(spec: AblationSpec, overall: list[dict], columns: tuple[str, 
     changes from the base."""
     base_name, base = _base(spec)
     configs = {v.name: v.config for v in spec.variants}
-    rows = [{**r, "changes": config_changes(base, configs[r["variant"]]) or ["(same as the base)"]}
-            for r in overall]
+    published = dict(spec.published)
+    rows = [{**r, "changes": [f"published results: {published[r['variant']]}"] if r["variant"] in published
+             else config_changes(base, configs[r["variant"]]) or ["(same as the base)"]} for r in overall]
     table = sections.table("variants", "Variants", rows, ("variant", "changes", *columns[1:], "key"), trackers,
                            tracker_column="variant",
                            note=f"Changes from {base_name}, config key by config key. Click a column's name to "
@@ -92,14 +93,14 @@ def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[s
     """The page of an ablation: ``info`` is its ``summary.json`` (the summary table in
     ``columns``), ``scores`` what :func:`dcfkit.analysis.scoring.evaluate` returned for ``results``
     (variant -> sequence -> result), ``keys`` variant -> run key."""
-    trackers = list(keys)
+    trackers = [*keys, *(name for name, _ in spec.published)]
     head = [variants_table(spec, info["overall"], columns, trackers)]
     statistics = sections.statistics_table(info["statistics"], trackers, tracker_label="variant")
     if statistics is not None:
         head.append(statistics)
     if spec.grid is not None:
         head.append(sensitivity_charts(spec, info["overall"]))
-    folders = {v: job_dir(out, spec.dataset, k) for v, k in keys.items()}
+    folders = {**{v: job_dir(out, spec.dataset, k) for v, k in keys.items()}, **dict(spec.published)}
     extra = [("spec", str(spec.path)), ("dataset", f"{spec.dataset} at {spec.root}")]
     return {"title": f"dcfkit ablation {spec.name}: {sections.count(len(trackers), 'variant')} on {spec.dataset}",
             "protocol": scores.protocol.describe(),

@@ -6,7 +6,8 @@ import contextlib
 import json
 from pathlib import Path
 
-from dcfkit.ablation.spec import AblationSpec, Job, expand, runs_dir, variant_names
+from dcfkit.ablation.experiment import runs_dir
+from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir, variant_names
 from dcfkit.ablation.summary import output_names, summarize
 from dcfkit.errors import DcfkitError, shown
 from dcfkit.experiments import runs_by_sequence
@@ -46,7 +47,7 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
     tasks: dict[tuple[str, str], RunTask] = {}
     for job in job_list:
         for run in runs[job.sequence]:
-            tasks.setdefault((job.key, run.name), RunTask(job.config, run, runs_dir(out, spec, job.key), job.key))
+            tasks.setdefault((job.key, run.name), RunTask(job.config, run, runs_dir(job_dir(out, spec.dataset, job.key), spec.experiment), job.key))
     ensure_writable(out, output_names(spec), "the ablation")
     with exclusive(out / ".lock", "dcfkit ablate", f"to {out}"):
         _prepare(out, tasks.values(), job_list, version)

@@ -13,16 +13,16 @@ from typing import Any, Iterable, Mapping
 import yaml
 
 from dcfkit import limits
+from dcfkit.ablation.experiment import check_experiment
+from dcfkit.ablation.published import parse_published
 from dcfkit.config import load_config, shipped_config, shipped_config_dir
 from dcfkit.config.bounded_yaml import read_yaml
 from dcfkit.datasets import DatasetError, canonical_name, load_dataset
 from dcfkit.errors import ConfigError, DcfkitError, clip, shown
-from dcfkit.experiments import get_experiment
 from dcfkit.params import closest
 from dcfkit.running.provenance import dcfkit_version, run_key
 
-SPEC_KEYS = ("name", "description", "dataset", "sequences", "experiment", "variants", "grid")
-ABLATION_EXPERIMENTS = ("ope", "tre", "sre")  # scored as one-pass results are (dcfkit.experiments)
+SPEC_KEYS = ("name", "description", "dataset", "sequences", "experiment", "variants", "grid", "published")
 VARIANT_KEYS = ("config", "overrides", "description")
 GRID_KEYS = ("base", "overrides", "mode", "parameters")
 GRID_MODES = ("sweep", "product")
@@ -70,6 +70,7 @@ class AblationSpec:
     grid: Grid | None
     max_frames: int | None = None  # a smoke run: each sequence's first frames only
     experiment: str = "ope"  # the runs of each sequence: one of ABLATION_EXPERIMENTS
+    published: tuple = ()  # (name, folder) of result files scored beside the variants, never run
 
     def load_sequences(self) -> list:
         """The :class:`dcfkit.datasets.Sequence` objects to run: the spec's subset, else all under root."""
@@ -297,17 +298,9 @@ def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
                         description=str(data.get("description") or ""), dataset=dataset_name,
                         root=root_path, root_origin=origin, sequences=_parse_sequences(path, data, sequences),
                         variants=tuple(named.values()) + tuple(grid_variants), grid=grid,
-                        experiment=check_experiment(data.get("experiment", "ope"), f"{path}: experiment"))
-
-
-def check_experiment(value: Any, where: str) -> str:
-    """``value`` as the name of an experiment an ablation can run, or a :class:`ConfigError`."""
-    name = value.lower() if isinstance(value, str) else value
-    if name not in ABLATION_EXPERIMENTS:
-        reset = (" (reset-based runs: dcfkit eval --experiment reset, then dcfkit report --experiment reset)"
-                 if name == "reset" else "")
-        raise ConfigError(f"{where}: expected one of {', '.join(ABLATION_EXPERIMENTS)}, got {shown(value)}{reset}")
-    return name
+                        experiment=(experiment := check_experiment(data.get("experiment", "ope"), f"{path}: experiment")),
+                        published=parse_published(path, data.get("published"), [*named, *(v.name for v in grid_variants)],
+                                                  experiment))
 
 
 def _parse_dataset(path: Path, dataset: Any, root) -> tuple[str, Path | None, str]:
@@ -391,9 +384,3 @@ def job_dir(out: Path, dataset: str, key: str) -> Path:
     """The result store of run ``key``: ``OUT/jobs/<dataset>/<key>/``."""
     return out / "jobs" / dataset / key
 
-
-def runs_dir(out: Path, spec: AblationSpec, key: str) -> Path:
-    """Where the runs of ``key`` in the spec's experiment go: :func:`job_dir`, and its
-    ``<experiment>/`` sub-folder but for one pass."""
-    folder = get_experiment(spec.experiment).folder
-    return job_dir(out, spec.dataset, key) / folder if folder else job_dir(out, spec.dataset, key)

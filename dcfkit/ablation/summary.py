@@ -6,9 +6,11 @@ import json
 import logging
 from pathlib import Path
 
+from dcfkit.ablation.experiment import runs_dir
 from dcfkit.ablation.page import ablation_page
+from dcfkit.ablation.published import STATUS, read_published
 from dcfkit.ablation.sensitivity import plot_sensitivity, sensitivity_file
-from dcfkit.ablation.spec import AblationSpec, Job, expand, runs_dir
+from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir
 from dcfkit.analysis.plots import plot_curves
 from dcfkit.analysis.report import json_ready
 from dcfkit.analysis.report_html import PAGE, write_page
@@ -57,7 +59,8 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     time (:mod:`dcfkit.analysis.report`). A job without result (failed or not run) is scored as a
     total failure and counted in ``failed``. ``statistics`` compares each variant with the
     grid's base (when it names a variant) or the first variant
-    (:func:`~dcfkit.analysis.statistics.versus_baseline`). Under a spec's ``tre`` or ``sre``
+    (:func:`~dcfkit.analysis.statistics.versus_baseline`); the spec's published results are
+    scored and compared beside the variants (key and status ``published``). Under a spec's ``tre`` or ``sre``
     experiment a sequence's runs (``runs``, by default made here) are pooled. Returns ``{"overall",
     "per_sequence", "statistics", "jobs", "files", "protocol"}`` (the
     :class:`~dcfkit.protocols.Protocol`).
@@ -67,12 +70,16 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     keys = {j.variant: j.key for j in jobs}
     runs = runs if runs is not None else runs_by_sequence(sequences, spec.experiment)
     status, stored = _stored_runs(spec, out, runs, jobs)
+    results = {variant: stored[key] for variant, key in keys.items()}
+    published = read_published(spec.published, sequences)
     with _quiet(logging.getLogger("dcfkit.analysis.scoring")):  # missing runs are counted in 'failed'
-        scores = evaluate({variant: stored[key] for variant, key in keys.items()}, sequences, protocol=protocol,
-                          experiment=spec.experiment)
+        scores = evaluate({**results, **published}, sequences, protocol=protocol, experiment=spec.experiment)
     protocol = scores.protocol
-    overall, per_sequence = _rows(scores, keys, sequences, status, protocol)
-    variants = list(keys)
+    states = {(v, s.name): status[key, s.name] for v, key in keys.items() for s in sequences}
+    states.update({(name, s.name): (STATUS if s.name in found else "missing", None)
+                   for name, found in published.items() for s in sequences})
+    overall, per_sequence = _rows(scores, {**keys, **dict.fromkeys(published, STATUS)}, sequences, states, protocol)
+    variants = [*keys, *published]
     baseline = spec.grid.base if spec.grid is not None and spec.grid.base in keys else variants[0]
     statistics = versus_baseline(scores.per_sequence, variants, (protocol.rank_key, "precision"), baseline)
     job_rows = [{"variant": j.variant, "sequence": j.sequence, "key": j.key,
@@ -87,7 +94,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
                      if spec.grid else None)}
     files = _write_files(spec, out, info, scores.curves, protocol)
     page = ablation_page(spec, out, info, summary_columns("summary", protocol), scores, sequences,
-                         {variant: stored[key] for variant, key in keys.items()}, keys)
+                         {**results, **published}, keys)
     files.append(write_page(page, out / PAGE))
     return {"overall": overall, "per_sequence": per_sequence, "statistics": statistics, "jobs": job_rows,
             "files": files, "protocol": protocol}
@@ -100,7 +107,7 @@ def _stored_runs(spec: AblationSpec, out: Path, runs: dict[str, list[Sequence]],
     status: dict[tuple[str, str], tuple[str, str | None]] = {}
     stored: dict[str, dict] = {}
     for key in dict.fromkeys(j.key for j in jobs):
-        folder = runs_dir(out, spec, key)
+        folder = runs_dir(job_dir(out, spec.dataset, key), spec.experiment)
         names = list(dict.fromkeys(j.sequence for j in jobs if j.key == key))
         for name in names:
             status[key, name] = _status(folder, key, runs[name])
@@ -110,7 +117,8 @@ def _stored_runs(spec: AblationSpec, out: Path, runs: dict[str, list[Sequence]],
 
 
 def _rows(scores: dict, keys: dict, sequences: list[Sequence], status: dict, protocol: str) -> tuple[list, list]:
-    """The summary's rows (one per variant, spec order) and per-sequence rows."""
+    """The summary's rows (one per variant, spec order, then the published results) and
+    per-sequence rows; ``status[variant, sequence]`` is (status, error)."""
     extra = get_protocol(protocol).overlap_keys
     frames = {s.name: len(s) for s in sequences}
     order = {v: i for i, v in enumerate(keys)}
@@ -122,7 +130,7 @@ def _rows(scores: dict, keys: dict, sequences: list[Sequence], status: dict, pro
     per_sequence = sorted(({"variant": r["tracker"], "sequence": r["sequence"], "precision": r["precision"],
                             "auc": r["auc"], **{k: r[k] for k in extra}, "fps": r["fps"],
                             "frames": frames[r["sequence"]],
-                            "status": status[keys[r["tracker"]], r["sequence"]][0]}
+                            "status": status[r["tracker"], r["sequence"]][0]}
                            for r in scores.per_sequence),
                           key=lambda r: (order[r["variant"]], seq_order[r["sequence"]]))
     return overall, per_sequence

@@ -7,7 +7,8 @@ import re
 from pathlib import Path
 
 from dcfkit.ablation import expand, load_spec, run_ablation, summary_columns, variant_names
-from dcfkit.ablation.spec import ABLATION_EXPERIMENTS, MAX_VARIANTS, runs_dir
+from dcfkit.ablation.experiment import ABLATION_EXPERIMENTS, runs_dir
+from dcfkit.ablation.spec import MAX_VARIANTS, job_dir
 from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.cli.common import add_max_frames_argument, add_protocol_argument, variant_count
 from dcfkit.config import shipped_config_dir
@@ -52,7 +53,7 @@ def _dry_run(spec, out: Path) -> int:
     runs = runs_by_sequence(seqs, spec.experiment)
     jobs = expand(spec, seqs)
     for job in jobs:
-        store = ResultStore(runs_dir(out, spec, job.key))
+        store = ResultStore(runs_dir(job_dir(out, spec.dataset, job.key), spec.experiment))
         done = sum(store.status(run, job.key) == "done" for run in runs[job.sequence])
         state = "done" if done == len(runs[job.sequence]) else "todo"
         count = f" ({done} of {len(runs[job.sequence])} {spec.experiment} runs done)" if spec.experiment != "ope" else ""

@@ -7,7 +7,6 @@ times slower on these maps. Loaded on first use (numba's import costs 0.25 s), c
 from __future__ import annotations
 
 import numba
-import numpy as np
 
 
 @numba.njit(cache=True, nogil=True)

@@ -19,8 +19,8 @@ from typing import Any, Mapping
 import cv2
 import numpy as np
 
-from dcfkit.components.features.base import extract_stack
 from dcfkit.components.base import Target
+from dcfkit.components.features.base import extract_stack
 from dcfkit.components.labels.base import Detection, gaussian_label
 from dcfkit.components.scale.base import scale_limits
 from dcfkit.config import load_config
