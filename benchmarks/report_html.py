@@ -99,7 +99,7 @@ def measure(trackers: int, count: int, frames: int, browser: bool, seed: int = 0
         (tmp / "frames").mkdir()
         sequences = make_sequences(make_frames(tmp / "frames"), count, frames, rng)
         write_results(tmp / "out", trackers, sequences, rng)
-        report_dir = tmp / "out" / "report"
+        report_dir = tmp / "out_report"
         start = time.perf_counter()
         folders, results, evaluation = score_folders(tmp / "out", sequences, None, report_dir)
         write_files(evaluation, report_dir)

@@ -195,7 +195,7 @@ def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | No
     """Score every tracker in ``out_dir`` under ``protocol`` (by default the benchmark's,
     :func:`evaluate`) and write tables and plots to ``report_dir``.
 
-    ``report_dir`` defaults to ``out_dir/report``. Writes ``overall``, ``per_sequence``
+    ``report_dir`` defaults to :func:`default_report_dir`. Writes ``overall``, ``per_sequence``
     and (when sequences have attributes) ``per_attribute`` tables as ``.txt``, ``.md`` and
     ``.csv``; ``report.json`` with all rows and curves; ``precision`` and ``success`` plots
     and ``precision_<ATTR>`` and ``success_<ATTR>`` plots per attribute, each as PNG and SVG. Every file names
@@ -212,15 +212,22 @@ def score_and_write(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] |
                     protocol: str | Protocol | None = None, *, missing: str = "skip",
                     experiment: str | Experiment = "ope") -> tuple[dict, list[Path]]:
     """:func:`write_report` that also returns what :func:`evaluate` returned: (evaluation, paths)."""
-    report_dir = default_report_dir(out_dir, report_dir)
+    report_dir = default_report_dir(out_dir, report_dir, experiment)
     _, _, evaluation = score_folders(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol,
                                      missing=missing, experiment=experiment)
     return evaluation, write_files(evaluation, report_dir)
 
 
-def default_report_dir(out_dir, report_dir=None) -> Path:
-    """``report_dir``, by default ``out_dir/report``."""
-    return Path(report_dir) if report_dir is not None else Path(out_dir) / "report"
+def default_report_dir(out_dir, report_dir=None, experiment: str | Experiment = "ope") -> Path:
+    """``report_dir``, by default ``<out_dir>_report`` beside ``out_dir`` (and its
+    ``<experiment>/`` but for one pass): not in ``out_dir``, whose every folder pysot's
+    ``eval.py`` takes for a tracker."""
+    if report_dir is not None:
+        return Path(report_dir)
+    out = Path(out_dir).resolve()
+    sub = get_experiment(experiment).folder
+    folder = out.with_name(f"{out.name}_report")
+    return folder / sub if sub else folder
 
 
 def score_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None, report_dir: Path,

@@ -44,9 +44,9 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
     """Score the reset-based runs (``<tracker>/reset/``) of every tracker in ``out_dir`` on the
     sequences all of them ran, and write ``reset_overall`` and ``reset_per_sequence`` tables
     (``.txt``, ``.md``, ``.csv``), ``statistics.txt`` and ``reset.json`` to ``report_dir``
-    (default ``out_dir/report``). Returns (the scores, the paths)."""
+    (default ``<out_dir>_report/reset``). Returns (the scores, the paths)."""
     sequences = scored_sequences(sequences)
-    report_dir = default_report_dir(out_dir, report_dir)
+    report_dir = default_report_dir(out_dir, report_dir, EXPERIMENT)
     folders = tracker_folders(out_dir, sequences, trackers, exclude=[report_dir], sub=EXPERIMENT.folder)
     results = {name: reset_runs(folder, sequences) for name, folder in folders.items()}
     if not results:

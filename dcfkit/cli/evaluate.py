@@ -128,7 +128,9 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--format", choices=("table", "markdown", "csv", "latex"), default="table",
                         help="format of the table printed to stdout (latex: booktabs, best per score bold, second "
                              "underlined, confidence intervals in brackets)")
-    parser.add_argument("--report-dir", type=Path, default=None, help="default: OUT/report")
+    parser.add_argument("--report-dir", type=Path, default=None,
+                        help="default: OUT_report beside OUT (OUT_report/<experiment> but for ope): out of the folder "
+                             "whose sub-folders are trackers")
     parser.add_argument("--html", action="store_true",
                         help="also write report.html: one self-contained page with sortable tables, interactive "
                              "plots, each sequence's frames with every tracker's box, and the provenance")

@@ -265,7 +265,7 @@ def run_report(tmp_path, root: Path, dataset: str, sequences: list[str], configs
         assert cli.main(["eval", *args]) == 0
     assert cli.main(["report", str(out), "--dataset", dataset, "--root", str(root),
                      "--sequences", ",".join(sequences), "--html"]) == 0
-    return out / "report" / "report.html"
+    return out.parent / "out_report" / "report.html"
 
 
 def check_statistics(page, statistics: dict, trackers: list[str]) -> None:

@@ -65,7 +65,7 @@ def test_report_prints_and_writes_the_statistics(tmp_path, monkeypatch, capsys):
     assert cli.main(["report", str(tmp_path / "out"), "--root", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "statistics over 5 sequences: 95% BCa bootstrap" in out and "far - " in out and "(Holm " in out
-    written = (tmp_path / "out" / "report" / "statistics.txt").read_text()
+    written = (tmp_path / "out_report" / "statistics.txt").read_text()
     assert written.splitlines()[0] == out.split("\n\n")[-2].splitlines()[0]
 
 

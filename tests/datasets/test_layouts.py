@@ -447,12 +447,12 @@ def test_eval_and_report_on_lasot_give_per_attribute_tables(tmp_path, jpg, capsy
                      "--protocol", "lasot"]) == 0
     assert "kcf: 4 run, 0 already done, 0 failed" in capsys.readouterr().out
     assert cli.main(["report", str(out), "--dataset", "lasot", "--root", str(root), "--protocol", "lasot"]) == 0
-    table = (out / "report" / "per_attribute.txt").read_text()
+    table = (out.parent / "out_report" / "per_attribute.txt").read_text()
     assert "Illumination Variation" in table and "Aspect Ratio Change" in table
     assert table.splitlines()[0].startswith("protocol lasot: LaSOT toolkit")
-    rows = [r for r in json.loads((out / "report" / "report.json").read_text())["per_attribute"]]
+    rows = [r for r in json.loads((out.parent / "out_report" / "report.json").read_text())["per_attribute"]]
     assert {(r["attribute"], r["sequences"]) for r in rows} == {("IV", 3), ("ARC", 1)}
-    assert (out / "report" / "success_IV.png").is_file()
+    assert (out.parent / "out_report" / "success_IV.png").is_file()
 
 
 def test_a_benchmark_is_scored_by_its_own_toolkit_unless_protocol_says_otherwise(tmp_path, jpg, capsys):
@@ -463,7 +463,7 @@ def test_a_benchmark_is_scored_by_its_own_toolkit_unless_protocol_says_otherwise
     assert cli.main(["report", str(out), "--dataset", "lasot", "--root", str(root)]) == 0
     assert cli.main(["report", str(out), "--dataset", "lasot", "--root", str(root), "--protocol", "otb",
                      "--report-dir", str(tmp_path / "otb")]) == 0
-    default, otb = (json.loads((d / "report.json").read_text()) for d in (out / "report", tmp_path / "otb"))
+    default, otb = (json.loads((d / "report.json").read_text()) for d in (out.parent / "out_report", tmp_path / "otb"))
     assert default["protocol"]["name"] == "lasot" and otb["protocol"]["name"] == "otb"
     # the absent frames fail under LaSOT's rules and are skipped under the OTB toolkit's
     assert default["overall"][0]["precision"] < otb["overall"][0]["precision"]
@@ -486,7 +486,7 @@ def test_eval_on_a_test_split_runs_and_report_says_there_is_nothing_to_score(tmp
     assert cli.main(["report", str(out), "--dataset", "got10k_test", "--root", str(root)]) == 2
     err = capsys.readouterr().err
     assert "no scores: got10k_test publishes the ground truth of frame 1 only" in err and "evaluation server" in err
-    assert not (out / "report").exists()
+    assert not (out.parent / "out_report").exists()
 
 
 # --------------------------------------------------------------------------- dataset plugins

@@ -477,12 +477,12 @@ def test_write_report_files(tmp_path, seqs):
         assert {f"{stem}.png", f"{stem}.svg"} <= names
     for stem in ("overall", "per_sequence", "per_attribute"):
         assert {f"{stem}.txt", f"{stem}.md", f"{stem}.csv"} <= names
-    assert all(p.parent == out / "report" and p.stat().st_size > 0 for p in paths)
-    data = json.loads((out / "report" / "report.json").read_text())
+    assert all(p.parent == out.parent / "out_report" and p.stat().st_size > 0 for p in paths)
+    data = json.loads((out.parent / "out_report" / "report.json").read_text())
     rows = {r["tracker"]: r for r in data["overall"]}
     assert set(rows) == {"drift", "slow", "imported"} and rows["drift"]["fps"] > 0
     assert rows["imported"]["fps"] is None
-    assert "drift [0.952]" in (out / "report" / "success.svg").read_text()
+    assert "drift [0.952]" in (out.parent / "out_report" / "success.svg").read_text()
     # default trackers: the folders of OUT holding sequence results (not OUT/report)
     assert sorted(report.gather_results(out, seqs)) == ["drift", "slow"]
 
@@ -554,13 +554,13 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
     assert cli_evaluate.run_report(args) == 0
     out = capsys.readouterr().out
     assert out.startswith("protocol otb: ") and "\n\n| tracker | auc |" in out and "| fast |" in out
-    assert (tmp_path / "out" / "report" / "success.png").is_file()
+    assert (tmp_path / "out_report" / "success.png").is_file()
     args = parser.parse_args([str(tmp_path / "out"), "--root", str(root), "--dataset", "dtb70",
                               "--sequences", "a,c", "--format", "csv", "--protocol", "got10k"])
     assert cli_evaluate.run_report(args) == 0
     assert capsys.readouterr().out.splitlines()[0] == (
         "tracker,ao,sr50,sr75,auc,precision,norm_precision,fps,sequences,missing,protocol")
-    assert json.loads((tmp_path / "out" / "report" / "report.json").read_text())["protocol"]["name"] == "got10k"
+    assert json.loads((tmp_path / "out_report" / "report.json").read_text())["protocol"]["name"] == "got10k"
 
 
 def test_real_sequence_with_opencv_kcf(tmp_path, shared_data):

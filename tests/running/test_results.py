@@ -140,23 +140,44 @@ def test_atomic_write_names_the_file_it_cannot_write(tmp_path, monkeypatch):
 
 def test_report_into_an_unwritable_folder_is_a_clear_error(tmp_path, seqs, monkeypatch):
     run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
-    with unwritable(monkeypatch, tmp_path / "out" / "report"):
-        with pytest.raises(DcfkitError, match=r"cannot write the report to .*report: Permission denied"):
+    with unwritable(monkeypatch, tmp_path / "out_report"):
+        with pytest.raises(DcfkitError, match=r"cannot write the report to .*out_report: Permission denied"):
             report.write_report(tmp_path / "out", seqs)
 
 
-def test_a_tracker_named_report_is_not_shadowed_by_the_report_folder(tmp_path, seqs):
+def test_the_report_goes_beside_the_results_where_a_tracker_named_report_is_a_tracker(tmp_path, seqs):
+    """pysot's eval.py takes every folder of OUT for a tracker: a report is written beside it."""
     run_one_pass({**CONFIG, "name": "report"}, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
     run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
-    with pytest.raises(DcfkitError, match=r"report holds a tracker's results; .*--report-dir"):
-        report.write_report(tmp_path / "out", seqs)  # would write into the tracker's folder
-    report.write_report(tmp_path / "out", seqs, report_dir=tmp_path / "tables")
-    data = json.loads((tmp_path / "tables" / "report.json").read_text())
+    paths = report.write_report(tmp_path / "out", seqs)
+    assert {p.parent for p in paths} == {tmp_path / "out_report"}
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["drift", "report"]
+    data = json.loads((tmp_path / "out_report" / "report.json").read_text())
     assert sorted(r["tracker"] for r in data["overall"]) == ["drift", "report"]
-    # and a report folder of its own is still not taken for a tracker
+    assert report.default_report_dir(tmp_path / "out", experiment="tre") == tmp_path / "out_report" / "tre"
+    # a report folder put in OUT is still not taken for a tracker
     report.write_report(tmp_path / "out", seqs, trackers=["drift"], report_dir=tmp_path / "out" / "tables")
     assert sorted(report.gather_results(tmp_path / "out", seqs, exclude=[tmp_path / "out" / "tables"])) == \
         ["drift", "report"]
+
+
+@pytest.mark.parametrize("blocked", ["precision.png", "overall.txt", "success_SV.svg"])
+def test_a_folder_where_a_report_file_goes_is_refused_before_scoring(tmp_path, seqs, blocked, monkeypatch):
+    run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
+    (tmp_path / "out_report" / blocked).mkdir(parents=True)
+    monkeypatch.setattr(report, "evaluate", lambda *a, **k: pytest.fail("scored before the check"))
+    with pytest.raises(DcfkitError, match=rf"cannot write the report to .*report: {re.escape(blocked)} is a folder"):
+        report.write_report(tmp_path / "out", seqs)
+
+
+def test_a_report_folder_that_holds_a_trackers_results_is_refused(tmp_path, seqs):
+    run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
+    (tmp_path / "out" / "report").mkdir()
+    for s in seqs:
+        (tmp_path / "out" / "report" / f"{s.name}.txt").write_text((tmp_path / "out" / "drift" / f"{s.name}.txt")
+                                                                   .read_text())
+    with pytest.raises(DcfkitError, match=r"report holds a tracker's results; write the report elsewhere"):
+        report.write_report(tmp_path / "out", seqs, report_dir=tmp_path / "out" / "report")
 
 
 def test_eval_and_ablate_share_one_run_key():
@@ -237,25 +258,6 @@ def test_a_file_named_locks_only_costs_the_locks(tmp_path, seqs, caplog):
     (tmp_path / "drift" / ".locks").write_text("")
     assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["done"] == ["a", "b", "c"]
     assert "running without it" in caplog.text
-
-
-@pytest.mark.parametrize("blocked", ["precision.png", "overall.txt", "success_SV.svg"])
-def test_a_folder_where_a_report_file_goes_is_refused_before_scoring(tmp_path, seqs, blocked, monkeypatch):
-    run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
-    (tmp_path / "out" / "report" / blocked).mkdir(parents=True)
-    monkeypatch.setattr(report, "evaluate", lambda *a, **k: pytest.fail("scored before the check"))
-    with pytest.raises(DcfkitError, match=rf"cannot write the report to .*report: {re.escape(blocked)} is a folder"):
-        report.write_report(tmp_path / "out", seqs)
-
-
-def test_an_imported_tracker_folder_named_report_is_refused_as_report_folder(tmp_path, seqs):
-    run_one_pass(CONFIG, seqs, tmp_path / "out", make_tracker=Counter(), progress=False)
-    (tmp_path / "out" / "report").mkdir()
-    for s in seqs:
-        (tmp_path / "out" / "report" / f"{s.name}.txt").write_text((tmp_path / "out" / "drift" / f"{s.name}.txt")
-                                                                   .read_text())
-    with pytest.raises(DcfkitError, match=r"report holds a tracker's results"):
-        report.write_report(tmp_path / "out", seqs)
 
 
 def test_any_sequence_names_have_files_of_their_own(tmp_path, capsys):

@@ -29,7 +29,7 @@ def test_a_smoke_run_tracks_the_first_frames_and_a_full_run_recomputes(data, tmp
     assert cli.main(base + ["--max-frames", "4"]) == 0 and "0 run, 2 already done" in capsys.readouterr().out
     assert cli.main(["report", str(tmp_path / "out"), "--dataset", "otb", "--root", str(data), "--max-frames", "4"]) == 0
     capsys.readouterr()
-    scored = json.loads((tmp_path / "out" / "report" / "report.json").read_text())["per_sequence"]
+    scored = json.loads((tmp_path / "out_report" / "report.json").read_text())["per_sequence"]
     assert [(r["sequence"], r["frames"]) for r in scored] == [("seqA", 4), ("seqB", 4)]
     assert cli.main(base) == 0 and "2 run, 0 already done" in capsys.readouterr().out  # cut results: not full ones
     assert (tmp_path / "out" / "kcf" / "seqA.txt").read_text().count("\n") == n
