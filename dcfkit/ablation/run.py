@@ -14,7 +14,7 @@ from dcfkit.experiments import runs_by_sequence
 from dcfkit.running.files import atomic_write, ensure_writable, exclusive, read_json
 from dcfkit.running.provenance import LABEL_KEYS, dcfkit_version
 from dcfkit.running.results import ResultStore
-from dcfkit.running.runner import RunTask, execute, usable_cores
+from dcfkit.running.runner import RunTask, execute, usable_cores, warm_up_compiled
 
 
 def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str = "local",
@@ -85,6 +85,7 @@ def _run(spec, result, todo, total, variants, jobs, executor, scheduler, progres
     """Execute ``todo`` with a progress bar in runs, recording each outcome in ``result``."""
     from tqdm.auto import tqdm  # lazy: tqdm.auto probes for Jupyter on import
 
+    warm_up_compiled(todo)  # numba compiles here, not in the first jobs the bar times
     bar = tqdm(total=total, initial=total - len(todo), unit="job", desc=spec.name,
                disable=not progress or not todo, dynamic_ncols=True)
 

@@ -28,7 +28,7 @@ from dcfkit.experiments import Experiment, get_experiment
 from dcfkit.running.files import ensure_writable, exclusive, make_dir, remove_temporary_files
 from dcfkit.running.provenance import dcfkit_version, json_default, run_key
 from dcfkit.running.results import ResultStore
-from dcfkit.running.runner import RunTask, execute
+from dcfkit.running.runner import RunTask, execute, warm_up_compiled
 
 __all__ = ["check_one_pass", "experiment_runs", "results_folder", "run_one_pass", "tracker_name"]
 
@@ -159,6 +159,7 @@ def _run(summary: dict, tasks: list[RunTask], jobs: int, progress: bool, version
     """Execute ``tasks`` with a progress bar in frames, recording each outcome in ``summary``."""
     from tqdm.auto import tqdm  # lazy: tqdm.auto probes for Jupyter on import
 
+    warm_up_compiled(tasks)  # numba compiles here, not in the first runs the bar times
     bar = tqdm(total=sum(len(t.seq) for t in tasks), unit="frame", desc=summary["tracker"],
                disable=not progress or not tasks, dynamic_ncols=True)
     done_frames = [0]

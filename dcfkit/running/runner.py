@@ -78,6 +78,20 @@ def _warm_up(task: RunTask) -> None:
         tracker.update(image)
 
 
+def warm_up_compiled(tasks: Iterable[RunTask]) -> None:
+    """Before a progress bar starts: one throw-away run (:func:`_warm_up`) per solver among
+    ``tasks``, in this process, so that numba compiles its kernels (and caches them for the
+    workers) here, not inside the first timed runs, whose slowness made the first estimate of
+    the time left ten times too long."""
+    seen = set()
+    for task in tasks:
+        solver = task.config.get("solver")
+        name = solver.get("name") if isinstance(solver, dict) else None
+        if task.make_tracker is None and name not in seen:
+            seen.add(name)
+            _warm_up(task)
+
+
 def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | None = None,
                  origin: Mapping | None = None) -> dict:
     """Run ``task`` and store its boxes or its failure; returns ``{"sequence", "status",

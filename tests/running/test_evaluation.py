@@ -282,6 +282,26 @@ def test_default_trackers_are_warmed_up_once_per_process_and_config(tmp_path, se
     assert "cannot read frame 1 " in summary["failed"]["a"]
 
 
+def test_compiled_code_is_warmed_up_before_the_progress_bar_starts(tmp_path, seqs, monkeypatch):
+    """A first run that compiles numba's kernels made the first time-left estimate ten times too
+    long: one throw-away run per solver comes before eval's bar (ablate's _run calls the same)."""
+    import tqdm.auto
+
+    events = []
+    monkeypatch.setattr(runner, "_warmed_up", set())
+    monkeypatch.setattr(runner, "load_dcfkit_tracker", lambda config: events.append(("tracker", config["solver"]))
+                        or DriftTracker(config))
+    real_bar = tqdm.auto.tqdm
+    monkeypatch.setattr(tqdm.auto, "tqdm", lambda *a, **k: events.append("bar") or real_bar(*a, **k))
+    configs = [{**CONFIG, "solver": {"name": name}, "drift": d} for name, d in (("a", 1.0), ("a", 2.0), ("b", 3.0))]
+    (tmp_path / "x").mkdir()
+    tasks = [runner.RunTask(c, s, tmp_path / "x", provenance.run_key(c)) for c in configs for s in seqs]
+    evaluation._run({"tracker": "t", "done": [], "failed": {}}, tasks, 1, True, provenance.dcfkit_version())
+    first_bar = events.index("bar")
+    assert events[:first_bar] == [("tracker", {"name": "a"}), ("tracker", {"name": "b"})]  # one per solver
+    assert events.count("bar") == 1 and len(events) == 1 + 2 + 1 + len(tasks)  # drift 2.0: its own warm-up, later
+
+
 def test_crash_mid_sequence_leaves_no_partial_result(tmp_path, seqs):
     with pytest.raises(Crash):
         run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter({2: (3, Crash)}), progress=False)
