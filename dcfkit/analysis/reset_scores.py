@@ -143,7 +143,8 @@ def eao(runs: Sequence[ResetRun], interval: tuple[int, int]) -> float:
 
 
 def _eao_interval_ci(runs: Sequence[ResetRun], interval: tuple[int, int]) -> tuple[float, float]:
-    """The bootstrap interval of the EAO over sequences (statistics' settings)."""
+    """The percentile bootstrap interval of the EAO over sequences (statistics' settings), of the
+    resamples that have an EAO (one of sequences all shorter than the interval has none)."""
     lengths = np.arange(interval[0], interval[1] + 1)
     sums = [_sums(fragments(r), lengths) for r in runs]
     total, count = np.array([s[0] for s in sums]), np.array([s[1] for s in sums])
@@ -156,12 +157,17 @@ def _eao_interval_ci(runs: Sequence[ResetRun], interval: tuple[int, int]) -> tup
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.nanmean(np.where(c > 0, t / np.maximum(c, 1), np.nan), axis=-1)
 
-    with warnings.catch_warnings():
+    with warnings.catch_warnings():  # a resample of sequences all too short for the interval has no EAO
         warnings.simplefilter("ignore", (stats.DegenerateDataWarning, RuntimeWarning))
-        ci = stats.bootstrap((np.arange(len(runs)),), statistic, confidence_level=statistics.CONFIDENCE,
-                             n_resamples=statistics.RESAMPLES, method="percentile", vectorized=True,
-                             rng=np.random.default_rng(statistics.SEED)).confidence_interval
-    return float(ci.low), float(ci.high)
+        found = stats.bootstrap((np.arange(len(runs)),), statistic, confidence_level=statistics.CONFIDENCE,
+                                n_resamples=statistics.RESAMPLES, method="percentile", vectorized=True,
+                                rng=np.random.default_rng(statistics.SEED)).bootstrap_distribution
+    found = found[np.isfinite(found)]  # scipy's percentile interval is NaN if one resample is: those are left out
+    if not found.size:
+        return math.nan, math.nan
+    tail = (1 - statistics.CONFIDENCE) / 2 * 100
+    low, high = np.percentile(found, [tail, 100 - tail])
+    return float(low), float(high)
 
 
 def score_resets(results: Mapping[str, Mapping[str, ResetRun]], lengths: Mapping[str, int],

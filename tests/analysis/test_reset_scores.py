@@ -101,3 +101,12 @@ def test_score_resets_rows_and_statistics():
     assert rows["a"]["eao_ci_low"] <= rows["a"]["eao"] <= rows["a"]["eao_ci_high"]
     differences = scores["statistics"]["differences"]["a"]
     assert differences["failures"]["mean"] == 0.5 and differences["accuracy"]["mean"] == pytest.approx(-0.05)
+
+
+def test_the_eao_interval_leaves_out_resamples_without_an_eao():
+    # no failures: a 20-frame sequence has no fragment reaching 25, so a resample of it alone has no EAO
+    short = ResetRun(np.tile(GT_BOX, (20, 1)), np.tile(GT_BOX, (20, 1)), (0,), ())
+    long = ResetRun(np.tile(GT_BOX, (40, 1)), np.tile(GT_BOX, (40, 1)), (0,), ())
+    scores = score_resets({"t": {"s": short, "l": long}}, {"s": 20, "l": 40}, interval=(25, 30))
+    row = scores["overall"][0]
+    assert row["eao"] == 1.0 and row["eao_ci_low"] == row["eao_ci_high"] == 1.0
