@@ -102,3 +102,46 @@ def test_authors_octave(tmp_path, synthetic_uav123):
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     boxes = (tmp_path / "out" / "UAV123_10fps" / "wakeboard7.txt").read_text().splitlines()
     assert len(boxes) == 67 and all(len(line.split(",")) == 4 for line in boxes)
+
+
+def fake_snapshot(mirror: Path, repo: str, frames: int) -> str:
+    """A git repository holding a synthetic sequence (seq/img/*.jpg, seq/gt.txt); its annotation."""
+    work = mirror / repo.replace("/", "+") / "repo"
+    (work / "seq" / "img").mkdir(parents=True)
+    seq = make_sequence(n_frames=frames, size=(60, 80), target=(12, 14), seed=1)
+    for i, image in enumerate(seq.frames, 1):
+        cv2.imwrite(str(work / "seq" / "img" / f"{i:04d}.jpg"), image)
+    text = "".join(f"{x + 1:g}\t{y + 1:g}\t{w:g}\t{h:g}\n" for x, y, w, h in seq.ground_truth)
+    (work / "seq" / "gt.txt").write_text(text)
+    for command in (["init", "-q"], ["add", "."], ["-c", "user.email=t@t", "-c", "user.name=t", "commit", "-qm", "s"]):
+        subprocess.run(["git", *command], cwd=work, check=True, capture_output=True)
+    return text
+
+
+@pytest.mark.skipif(shutil.which("git") is None, reason="needs git")
+def test_validation_set(tmp_path):
+    import hashlib
+
+    text = fake_snapshot(tmp_path / "mirror", "someone/tracker", 6)
+    annotation = "".join(",".join(row.split("\t")) + "\n" for row in text.splitlines())
+    entry = {"dataset": "UAV123_10fps", "name": "boat5", "repo": "someone/tracker", "img_dir": "seq/img",
+             "gt": "seq/gt.txt", "frames": 6, "annotation_sha256": hashlib.sha256(annotation.encode()).hexdigest()}
+    (tmp_path / "manifest.json").write_text(json.dumps([entry]))
+    (tmp_path / "reserved.tsv").write_text("# kept out\nbenchmark\tsequence\nUAV123_10fps\tbike1\n")
+    common = [str(tmp_path / "mirror"), str(tmp_path / "out"), "--manifest", str(tmp_path / "manifest.json"),
+              "--reserved", str(tmp_path / "reserved.tsv"), "--manifest-only"]
+    out = run("validation_set.py", *common, tmp_path=tmp_path)
+    assert "UAV123_10fps/boat5: 6 frames" in out and "all: 1 sequences, 6 frames" in out
+    assert (tmp_path / "out" / "all" / "boat5" / "img" / "000006.jpg").is_file()
+    assert (tmp_path / "out" / "UAV123_10fps" / "boat5" / "groundtruth_rect.txt").read_text() == annotation
+    # a reserved sequence is refused before anything is written, in any UAV123 version
+    (tmp_path / "manifest.json").write_text(json.dumps([entry, {**entry, "name": "bike1", "dataset": "UAV123"}]))
+    done = subprocess.run([sys.executable, str(BENCHMARKS / "validation_set.py"), *common[:1], str(tmp_path / "out2"),
+                           *common[2:]], capture_output=True, text=True)
+    assert done.returncode != 0 and "reserved" in done.stderr and "UAV123/bike1" in done.stderr
+    assert not (tmp_path / "out2").exists()
+    # an annotation that is not the recorded one is an error
+    (tmp_path / "manifest.json").write_text(json.dumps([{**entry, "annotation_sha256": "0" * 64}]))
+    done = subprocess.run([sys.executable, str(BENCHMARKS / "validation_set.py"), *common[:1], str(tmp_path / "out3"),
+                           *common[2:]], capture_output=True, text=True)
+    assert done.returncode != 0 and "is not the one recorded" in done.stderr
