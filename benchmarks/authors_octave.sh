@@ -8,7 +8,7 @@
 #   bash benchmarks/authors_octave.sh {strcf|dr2track|bacf|arcf|autotrack} DATASET_ROOT OUT_DIR [sequence ...]
 #
 # DATASET_ROOT is read by dcfkit.datasets (UAV123, UAV123@10fps, UAV123@20L, DTB70, UAVDT, OTB
-# layouts). Writes OUT_DIR/<DATASET>/<sequence>.txt (1-based x,y,w,h, one '%.4f' line per frame)
+# layouts; DATASET=otb names the layout where two fit, as the validation set's OUT/all). Writes OUT_DIR/<DATASET>/<sequence>.txt (1-based x,y,w,h, one '%.4f' line per frame)
 # and OUT_DIR/<DATASET>/<tracker>_fps.tsv (the fps the authors' code reports, wall seconds).
 # Needs: apt-get install -y octave liboctave-dev octave-image libopencv-imgproc-dev
 # The authors' code comes from $DCFKIT_REFERENCE (default: ../shared/reference next to the repo)
@@ -106,11 +106,11 @@ case $TRK in
 esac
 # frame lists and 1-based first boxes, from dcfkit's own dataset loader
 DS=$(PYTHONPATH="$HERE/..${PYTHONPATH:+:$PYTHONPATH}" python3 - "$ROOT" "$BUILD/seqs" "$@" <<'EOF'
-import sys, pathlib
+import os, sys, pathlib
 from dcfkit.datasets import load_dataset
 root, dest, names = sys.argv[1], pathlib.Path(sys.argv[2]), sys.argv[3:] or None
 dest.mkdir(parents=True, exist_ok=True)
-seqs = load_dataset(None, root, names)
+seqs = load_dataset(os.environ.get("DATASET") or None, root, names)
 for s in seqs:
     (dest / f"{s.name}.frames").write_text("".join(f"{f}\n" for f in s.frames))
     x, y, w, h = s.init_box
