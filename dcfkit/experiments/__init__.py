@@ -24,7 +24,9 @@ __all__ = ["EXPERIMENTS", "Experiment", "get_experiment", "runs_by_sequence"]
 class Experiment:
     """``runs(sequence)`` gives the runs of one sequence; ``folder`` is the sub-folder of a
     tracker's results that holds them (``""`` for one-pass results); ``resets`` marks VOT's
-    reset-based runs, which re-initialise the tracker after each failure."""
+    reset-based runs, which re-initialise the tracker after each failure; ``first_box``
+    whether the runs need frame 1's ground truth (TRE and reset-based runs start at the first
+    valid one)."""
 
     name: str
     title: str
@@ -32,6 +34,7 @@ class Experiment:
     runs: Callable[[Sequence], list[Sequence]]
     folder: str
     resets: bool = False
+    first_box: bool = True
 
 
 def _one_run(seq: Sequence) -> list[Sequence]:
@@ -41,11 +44,11 @@ def _one_run(seq: Sequence) -> list[Sequence]:
 EXPERIMENTS: dict[str, Experiment] = {e.name: e for e in (
     Experiment("ope", "one-pass evaluation", "Wu et al., TPAMI 2015", _one_run, ""),
     Experiment("tre", "temporal robustness: 20 starts", "Wu et al., TPAMI 2015; OTB toolkit splitSeqTRE.m",
-               tre_runs, "tre"),
+               tre_runs, "tre", first_box=False),
     Experiment("sre", "spatial robustness: 8 shifts, 4 scales", "Wu et al., TPAMI 2015; OTB toolkit shiftInitBB.m",
                sre_runs, "sre"),
     Experiment("reset", "reset-based: re-initialised 5 frames after each failure",
-               "Kristan et al., TPAMI 2016 (VOT2016); vot-toolkit", _one_run, "reset", resets=True),
+               "Kristan et al., TPAMI 2016 (VOT2016); vot-toolkit", _one_run, "reset", resets=True, first_box=False),
 )}
 
 

@@ -110,6 +110,9 @@ def sre_box(box, shift: str, image_size: tuple[int, int]) -> np.ndarray:
 
 def sre_runs(seq: Sequence) -> list[Sequence]:
     """One run of the whole sequence per SRE shift of frame 1's box (its image's size read)."""
+    first = seq.ground_truth[0]
+    if not (np.isfinite(first).all() and (first[2:] > 0).all()):
+        raise DatasetError(f"sequence {seq.name!r}: SRE shifts frame 1's ground truth, which is NaN or empty")
     height, width = seq.frame(0).shape[:2]
     return [dataclasses.replace(seq, name=run_name(seq, k), start_box=sre_box(seq.ground_truth[0], shift,
                                                                                 (height, width)))

@@ -97,7 +97,8 @@ def _plan(config: dict, sequences: list[Sequence], runs: list[Sequence], out_dir
     """(store, run key, runs to do, every run's sidecar), after every check that needs no
     tracking: the first boxes, the benchmark of the results there, and (when anything is to
     run) that the folder takes the result files."""
-    _check_first_boxes(sequences)
+    if experiment.first_box:
+        _check_first_boxes(sequences)
     key = run_key(config)
     store = ResultStore(results_folder(out_dir, config, experiment))
     metas = {s.name: store.sidecar(s.name) for s in runs}  # each read once

@@ -16,7 +16,7 @@ from test_evaluation import Counter
 
 from dcfkit import cli
 from dcfkit.ablation import load_spec
-from dcfkit.datasets import Sequence, load_dataset, read_boxes
+from dcfkit.datasets import DatasetError, Sequence, load_dataset, read_boxes
 from dcfkit.errors import ConfigError
 from dcfkit.experiments.otb import sre_box, tre_starts
 from dcfkit.running.evaluation import run_one_pass
@@ -155,3 +155,18 @@ def test_an_experiment_killed_with_sigkill_resumes_where_it_stopped(tmp_path):
     assert f"{20 - len(before)} run, {len(before)} already done, 0 failed" in rerun.stdout
     assert all(path.read_bytes() == content for path, content in before.items())
     assert len(list(out.glob("strcf/tre/*.json"))) == 20 and not list(out.rglob("*.tmp"))
+
+
+def test_tre_and_reset_runs_start_at_the_first_valid_box(tmp_path, seqs):
+    gt = seqs[0].ground_truth.copy()
+    gt[:2] = np.nan  # frames 1-2 without ground truth: one pass and SRE cannot start, TRE and reset can
+    seq = Sequence("late", seqs[0].frames, gt, {}, "fake")
+    for experiment in ("ope", "sre"):
+        with pytest.raises(DatasetError, match="NaN or empty"):
+            run_one_pass(CONFIG, [seq], tmp_path / "out", make_tracker=Counter(), progress=False, experiment=experiment)
+    tre = run_one_pass(CONFIG, [seq], tmp_path / "out", make_tracker=Counter(), progress=False, experiment="tre")
+    assert tre["done"] and not tre["failed"]
+    first = json.loads((tmp_path / "out" / "drift" / "tre" / "late_001.json").read_text())
+    assert first["init_box"] == gt[2].tolist() and first["frames"] == N - 2
+    run_one_pass(CONFIG, [seq], tmp_path / "out", make_tracker=Counter(), progress=False, experiment="reset")
+    assert json.loads((tmp_path / "out" / "drift" / "reset" / "late.json").read_text())["resets"]["starts"][0] == 3
