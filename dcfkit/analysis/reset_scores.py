@@ -176,10 +176,11 @@ def score_resets(results: Mapping[str, Mapping[str, ResetRun]], lengths: Mapping
     every tracker ran; ``lengths`` are all sequences' lengths, for the EAO interval (by
     default :func:`eao_interval` of them). Returns plain data: ``interval``, ``overall`` rows
     (``tracker``, ``accuracy``, ``failures``, ``eao`` with ``eao_ci_low`` and ``eao_ci_high``, ``sequences``, best EAO
-    first), ``per_sequence`` rows and ``statistics``
+    first), ``per_sequence`` rows, ``left_out`` (sequence -> the trackers without its run) and ``statistics``
     (:func:`~dcfkit.analysis.statistics.versus_baseline` of accuracy and failures)."""
     interval = interval or eao_interval(list(lengths.values()))
     names = [s for s in lengths if all(s in res for res in results.values())]
+    left_out = {s: [t for t, res in results.items() if s not in res] for s in lengths if s not in names}
     per_sequence, overall = [], []
     for tracker, res in results.items():
         rows = [{"tracker": tracker, "sequence": s, **sequence_scores(res[s])} for s in names]
@@ -191,6 +192,6 @@ def score_resets(results: Mapping[str, Mapping[str, ResetRun]], lengths: Mapping
                         "sequences": len(rows)})
     overall.sort(key=lambda r: -r["eao"] if math.isfinite(r["eao"]) else math.inf)
     ranked = [r["tracker"] for r in overall]
-    return {"interval": list(interval), "overall": overall, "per_sequence": per_sequence,
+    return {"interval": list(interval), "overall": overall, "per_sequence": per_sequence, "left_out": left_out,
             "statistics": statistics.versus_baseline(per_sequence, ranked, ("accuracy", "failures"))
             if ranked else {}}

@@ -185,12 +185,15 @@ def run_report(args: argparse.Namespace) -> int:
 
 def _reset_report(args: argparse.Namespace, sequences: list, trackers: list[str] | None) -> int:
     """``report --experiment reset``: the accuracy, failures and EAO table and the statistics."""
+    if args.format == "latex":
+        raise ConfigError("--format latex: the reset-based table has no LaTeX form; use table, markdown or csv")
     scores, paths = write_reset_report(args.out, sequences, trackers, args.report_dir)
-    fmt = args.format if args.format != "latex" else "table"
     low, high = scores["interval"]
     print(f"reset-based experiment (VOT2016), EAO over sequence lengths {low}..{high}\n")
-    print(format_rows(scores["overall"], fmt, RESET_COLUMNS["overall"]), end="")
+    print(format_rows(scores["overall"], args.format, RESET_COLUMNS["overall"]), end="")
     if args.format == "table":
+        for name, without in scores["left_out"].items():
+            print(f"left out: {name} (no result from {', '.join(without)})")
         print("\n" + "\n".join(statistics_lines(scores["statistics"])))
         print(f"\n{len(paths)} files written to {paths[0].parent}")
     return 0

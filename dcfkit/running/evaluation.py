@@ -5,9 +5,10 @@ Trackers come from a factory ``make_tracker(config) -> tracker``, called once pe
 (default: :func:`dcfkit.load_tracker`); a tracker is any object with ``init(image, box)``
 and ``update(image) -> box`` (:mod:`dcfkit.running.tracking`). Results go to
 ``OUT/<config name>/`` (``OUT/<config name>/<experiment>/`` but for one pass), a
-:class:`dcfkit.running.results.ResultStore`: one file of 1-based boxes and one sidecar per run (per-frame tracker seconds, image decoding excluded; before its
-first sequence of a dcfkit config a process runs a throw-away copy of the tracker on the
-first frame, untimed, so that one-time loading of compiled code is not counted).
+:class:`dcfkit.running.results.ResultStore`: one file of 1-based boxes and one sidecar per run
+(per-frame tracker seconds, image decoding excluded; before its first run of a dcfkit config
+a process runs a throw-away copy of the tracker on the first frame, untimed, so that one-time
+loading of compiled code is not counted).
 
 On rerun a run is skipped when its results are intact and from the same run key
 (:func:`dcfkit.running.provenance.run_key`); damaged and failed runs are run again.
@@ -24,7 +25,7 @@ import numpy as np
 
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.errors import ConfigError, shown
-from dcfkit.experiments import Experiment, get_experiment
+from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
 from dcfkit.running.files import ensure_writable, exclusive, make_dir, remove_temporary_files
 from dcfkit.running.provenance import dcfkit_version, json_default, run_key
 from dcfkit.running.results import ResultStore
@@ -88,8 +89,7 @@ def results_folder(out_dir, config: Mapping, experiment: str | Experiment = "ope
 
 def experiment_runs(sequences: Iterable[Sequence], experiment: str | Experiment = "ope") -> list[Sequence]:
     """Every run of ``experiment`` on ``sequences``, in order (:mod:`dcfkit.experiments`)."""
-    runs = get_experiment(experiment).runs
-    return [run for seq in sequences for run in runs(seq)]
+    return [run for runs in runs_by_sequence(sequences, experiment).values() for run in runs]
 
 
 def _plan(config: dict, sequences: list[Sequence], runs: list[Sequence], out_dir, experiment: Experiment

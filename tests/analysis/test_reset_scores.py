@@ -91,7 +91,7 @@ def test_score_resets_rows_and_statistics():
     clean = ResetRun(np.tile(GT_BOX, (30, 1)), np.tile(GT_BOX, (30, 1)), (0,), ())
     results = {"a": {"s1": good, "s2": clean}, "b": {"s1": clean, "s2": clean}}
     scores = score_resets(results, {"s1": 30, "s2": 30, "s3": 40}, interval=(12, 14))
-    assert scores["interval"] == [12, 14]
+    assert scores["interval"] == [12, 14] and scores["left_out"] == {"s3": ["a", "b"]}
     rows = {r["tracker"]: r for r in scores["overall"]}
     assert [r["tracker"] for r in scores["overall"]] == ["b", "a"]  # best EAO first
     assert rows["a"]["failures"] == 1 and rows["b"]["failures"] == 0 and rows["a"]["sequences"] == 2
