@@ -142,7 +142,7 @@ def eao(runs: Sequence[ResetRun], interval: tuple[int, int]) -> float:
     return float(np.nanmean(phi)) if np.isfinite(phi).any() else math.nan
 
 
-def _eao_interval_ci(runs: Sequence[ResetRun], interval: tuple[int, int]) -> tuple[float, float]:
+def _eao_ci(runs: Sequence[ResetRun], interval: tuple[int, int]) -> tuple[float, float]:
     """The percentile bootstrap interval of the EAO over sequences (statistics' settings), of the
     resamples that have an EAO (one of sequences all shorter than the interval has none)."""
     lengths = np.arange(interval[0], interval[1] + 1)
@@ -188,7 +188,7 @@ def score_resets(results: Mapping[str, Mapping[str, ResetRun]], lengths: Mapping
         runs = [res[s] for s in names]
         overall.append({"tracker": tracker, "accuracy": pooled_accuracy(runs), "failures": sum(r["failures"] for r in rows),
                         "eao": eao(runs, interval), **dict(zip(("eao_ci_low", "eao_ci_high"),
-                                                                    _eao_interval_ci(runs, interval))),
+                                                                    _eao_ci(runs, interval))),
                         "sequences": len(rows)})
     overall.sort(key=lambda r: -r["eao"] if math.isfinite(r["eao"]) else math.inf)
     ranked = [r["tracker"] for r in overall]
