@@ -28,6 +28,10 @@ class TrackerParams:
     init_position: str = param("exact", "'exact': the box's centre x + (w-1)/2; 'whole_pixel': the authors' BACF and "
                                "DR²Track, centre floor(x + floor(w/2)) and size floor(w) (1-based)",
                                choices=("exact", "whole_pixel"))
+    init_area: str = param("floored", "the size frame 1's search area is computed from under init_position "
+                           "'whole_pixel': 'floored', floor(w) as the authors' BACF, STRCF and AutoTrack; 'given', "
+                           "the annotation's own size, as the authors' DR²Track (prod(wsize * search_area_scale) "
+                           "before floor)", choices=("floored", "given"))
     sampling: str = param("subpixel", "'subpixel': the search region around the exact centre, area-averaged and "
                           "bilinearly mapped onto the sample grid; 'whole_pixel': the authors' get_pixels, whole "
                           "pixels around round(centre), then OpenCV's resize (bilinear when the width grows, else "

@@ -28,11 +28,13 @@ class Geometry:
     cell_size: int               # pixels per cell (tracker.cell_size, or smaller for a small target)
 
 
-def geometry(p: TrackerParams, target: np.ndarray) -> tuple[Geometry, float]:
+def geometry(p: TrackerParams, target: np.ndarray, area_of: np.ndarray | None = None) -> tuple[Geometry, float]:
     """STRCF's init_size, in its arithmetic (a floor of a size decides a sample's pixels), with
-    BACF's smaller cells for a target whose search area has too few of them."""
+    BACF's smaller cells for a target whose search area has too few of them. ``area_of``: the
+    size the search area is computed from (default ``target``; DR²Track's code takes the
+    annotation's size before its floor, ``tracker.init_area: given``)."""
     cell, low, high = p.cell_size, p.min_image_sample_size, p.max_image_sample_size
-    area = float(np.prod(target * p.search_area_scale))
+    area = float(np.prod((target if area_of is None else area_of) * p.search_area_scale))
     if p.cell_selection_thresh > 0 and area / cell**2 < p.cell_selection_thresh * high / cell**2:
         smaller = min(cell, max(1, int(np.ceil(np.sqrt(area / (p.cell_selection_thresh * high / cell**2))))))
         low, high = low * (smaller / cell) ** 2, high * (smaller / cell) ** 2  # the same areas in cells

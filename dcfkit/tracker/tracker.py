@@ -108,10 +108,11 @@ class Tracker:
         image = check_image(image, 1)
         box = check_box(box, image.shape)
         centre, target = box_to_centre_size(box)
+        given = target
         if self.params.init_position == "whole_pixel":  # 1-based floor([y x] + floor([h w] / 2))
             target = np.floor(target)
             centre = np.floor(box[[1, 0]] + np.floor(target / 2))
-        g, scale = geometry(self.params, target)
+        g, scale = geometry(self.params, target, given if self.params.init_area == "given" else target)
         limits = scale_limits(g.base_target, g.sample_size, image.shape, initial=scale)
         scale = float(np.clip(scale, *limits))
         check_first_frame(self, image.shape, centre, g, scale, box)

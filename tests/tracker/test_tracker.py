@@ -527,3 +527,28 @@ def test_authors_exclusion_box_as_tall_as_the_map_does_not_wrap():
     offsets, values = authors_distractors(detection, top_n=30)
     assert sorted(map(tuple, offsets.tolist())) == [(-3, 6), (2, -7)]
     np.testing.assert_allclose(sorted(values), [0.3, 0.4])
+
+
+def test_dr2track_computes_its_first_search_area_from_the_annotations_own_size():
+    """The authors' DR²Track: search_area = prod(wsize * search_area_scale) with wsize before its
+    floor, target_sz = floor(wsize) (tracker.m); BACF, STRCF and AutoTrack use the floored size.
+    A fractional box (VOT's bag: 145.96 x 132.47) parted from their code on frame 3 without it."""
+    from dcfkit.tracker.geometry import geometry
+
+    preset = dcfkit.load_tracker("reference/dr2track")
+    assert preset.params.init_area == "given"
+    p = preset.params
+    given, floored = np.array([132.47, 145.96]), np.array([132.0, 145.0])
+    area = float(np.prod(given * p.search_area_scale))  # above the sample size: the scale is its root
+    assert area > p.max_image_sample_size
+    g, scale = geometry(p, floored, given)
+    assert scale == pytest.approx(np.sqrt(area / p.max_image_sample_size))
+    np.testing.assert_allclose(g.base_target, floored / scale)  # the sizes stay the floored ones
+    _, floored_scale = geometry(p, floored)
+    assert floored_scale == pytest.approx(np.sqrt(float(np.prod(floored * p.search_area_scale)) / p.max_image_sample_size))
+    seq = make_sequence(n_frames=2, size=(480, 640), target=(132, 145), seed=3)
+    box = seq.ground_truth[0] + [0, 0, 0.96, 0.47]
+    for init_area, expected in (("given", scale), ("floored", floored_scale)):
+        tracker = dcfkit.load_tracker("reference/dr2track", overrides={"tracker.init_area": init_area})
+        tracker.init(seq.frames[0], box)
+        assert tracker.scale == pytest.approx(expected)
