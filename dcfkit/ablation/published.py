@@ -6,6 +6,7 @@ import logging
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
+from dcfkit.analysis.report import read_folder
 from dcfkit.datasets import Sequence
 from dcfkit.errors import ConfigError, clip, shown
 
@@ -43,8 +44,6 @@ def parse_published(spec_path: Path, raw: Any, variants: Iterable[str], experime
 def read_published(published: Iterable[tuple[str, Path]], sequences: list[Sequence]) -> dict[str, dict]:
     """name -> sequence -> result of each published folder (:func:`dcfkit.analysis.report.read_folder`);
     a sequence without a file is said here, and scored as a failure."""
-    from dcfkit.analysis.report import read_folder  # the ablation's summary scores, as a report does
-
     results = {}
     for name, folder in published:
         results[name] = read_folder(folder, sequences)

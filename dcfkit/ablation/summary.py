@@ -73,7 +73,8 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     results = {variant: stored[key] for variant, key in keys.items()}
     published = read_published(spec.published, sequences)
     with _quiet(logging.getLogger("dcfkit.analysis.scoring")):  # missing runs are counted in 'failed'
-        scores = evaluate({**results, **published}, sequences, protocol=protocol, experiment=spec.experiment)
+        scores = evaluate({**results, **published}, sequences, protocol=protocol, experiment=spec.experiment,
+                          runs=runs)
     protocol = scores.protocol
     states = {(v, s.name): status[key, s.name] for v, key in keys.items() for s in sequences}
     states.update({(name, s.name): (STATUS if s.name in found else "missing", None)

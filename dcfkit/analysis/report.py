@@ -29,9 +29,8 @@ from dcfkit.analysis.scoring import Evaluation, evaluate
 from dcfkit.analysis.tables import columns, format_rows, format_table, score_line, statistics_lines
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
 from dcfkit.errors import clip, shown
-from dcfkit.experiments import Experiment, get_experiment
+from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
 from dcfkit.protocols import Protocol
-from dcfkit.running.evaluation import experiment_runs
 from dcfkit.running.files import atomic_write, ensure_writable
 from dcfkit.running.results import import_results, load_results
 
@@ -244,11 +243,13 @@ def score_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | N
     if experiment.resets:
         raise DatasetError("reset-based results are scored by dcfkit.analysis.reset_report (dcfkit report "
                            "--experiment reset)")
-    runs = experiment_runs(sequences, experiment)
+    by_sequence = runs_by_sequence(sequences, experiment)
+    runs = [run for found in by_sequence.values() for run in found]
     folders = tracker_folders(out_dir, runs, trackers, exclude=[report_dir], sub=experiment.folder)
     results = {name: read_folder(folder, runs) for name, folder in folders.items()}
     if not results:
         raise DatasetError(f"no tracker results{' of experiment ' + experiment.name if experiment.folder else ''} "
                            f"found under {clip(str(out_dir))}")
     ensure_writable(report_dir, report_file_names(sequences), "the report")  # before the scoring
-    return folders, results, evaluate(results, sequences, include_first, weighting, protocol, missing, experiment)
+    return folders, results, evaluate(results, sequences, include_first, weighting, protocol, missing, experiment,
+                                      by_sequence)

@@ -26,9 +26,9 @@ EXPERIMENT = EXPERIMENTS["reset"]
 
 def reset_runs(folder: Path, sequences: Seq[Sequence]) -> dict[str, ResetRun]:
     """Sequence name -> :class:`ResetRun` of the intact reset-based results in ``folder``."""
-    runs = {}
+    runs, by_name = {}, {s.name: s for s in sequences}
     for name, result in ResultStore(folder).load(sequences).items():
-        seq = next(s for s in sequences if s.name == name)
+        seq = by_name[name]
         if result.resets is None:
             log.warning("%s: the result of %r is not a reset-based run (no 'resets' in its sidecar): left out",
                         folder, name)

@@ -20,6 +20,7 @@ VOT2016 (MATLAB) toolkit computes them (``estimate_accuracy.m``,
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import warnings
 from typing import Mapping, Sequence
@@ -46,8 +47,10 @@ class ResetRun:
     failures: tuple[int, ...]
     bounds: tuple[float, float] | None = None
 
+    @functools.cached_property
     def overlaps(self) -> np.ndarray:
-        """Each frame's overlap with the ground truth (NaN where either is missing)."""
+        """Each frame's overlap with the ground truth (NaN where either is missing); computed
+        once, read by the accuracy, the fragments and the EAO."""
         out = np.full(len(self.gt), np.nan)
         for i, (box, gt) in enumerate(zip(self.boxes, self.gt)):
             if np.isfinite(box).all():
@@ -57,7 +60,7 @@ class ResetRun:
 
 def _accuracy_frames(run: ResetRun) -> tuple[np.ndarray, np.ndarray]:
     """(each frame's overlap, whether it counts in the accuracy)."""
-    o = run.overlaps()
+    o = run.overlaps
     counted = np.isfinite(o)
     for start in run.starts:
         counted[start:start + BURN_IN] = False
@@ -83,7 +86,7 @@ def fragments(run: ResetRun) -> list[tuple[np.ndarray, bool]]:
     """``(overlaps from the start on, padded)`` of each start: to its failure, padded with
     zeros, when the tracker was started again; the last to the sequence's end, not padded. A
     frame without an overlap (not tracked, no ground truth) counts 0."""
-    o = np.nan_to_num(run.overlaps(), nan=0.0)
+    o = np.nan_to_num(run.overlaps, nan=0.0)
     last = len(run.starts) - 1
     return [(o[s:run.failures[k] + 1], True) if k < last else (o[s:], False) for k, s in enumerate(run.starts)]
 
@@ -104,15 +107,23 @@ def _sums(frags: Sequence[tuple[np.ndarray, bool]], lengths: np.ndarray) -> tupl
     return total, count
 
 
-def expected_overlaps(runs: Sequence[ResetRun], lengths: Sequence[int]) -> np.ndarray:
-    """``Φ(Ns)`` for each sequence length ``Ns`` (>= 1) in ``lengths``; NaN where no fragment counts."""
-    lengths = np.asarray(lengths, dtype=int)
-    total, count = np.zeros(len(lengths)), np.zeros(len(lengths))
-    for run in runs:
-        t, c = _sums(fragments(run), lengths)
-        total, count = total + t, count + c
+def _run_sums(runs: Sequence[ResetRun], lengths: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_sums` of each run: ``(total, count)``, each ``(runs, lengths)``."""
+    found = [_sums(fragments(run), lengths) for run in runs]
+    shape = (len(found), len(lengths))
+    return (np.array([t for t, _ in found]).reshape(shape), np.array([c for _, c in found]).reshape(shape))
+
+
+def _phi(total: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """``Φ`` from the summed mean overlaps and fragment counts; NaN where no fragment counts."""
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(count > 0, total / np.maximum(count, 1), np.nan)
+
+
+def expected_overlaps(runs: Sequence[ResetRun], lengths: Sequence[int]) -> np.ndarray:
+    """``Φ(Ns)`` for each sequence length ``Ns`` (>= 1) in ``lengths``; NaN where no fragment counts."""
+    total, count = _run_sums(runs, np.asarray(lengths, dtype=int))
+    return _phi(total.sum(axis=0), count.sum(axis=0))
 
 
 def eao_interval(lengths: Sequence[int], mass: float = 0.5) -> tuple[int, int]:
@@ -136,26 +147,27 @@ def eao_interval(lengths: Sequence[int], mass: float = 0.5) -> tuple[int, int]:
     return lo + 1, hi + 1
 
 
-def eao(runs: Sequence[ResetRun], interval: tuple[int, int]) -> float:
-    """The mean of ``Φ(Ns)`` over ``Ns`` in ``interval`` (both ends included)."""
-    phi = expected_overlaps(runs, range(interval[0], interval[1] + 1))
+def _mean_phi(phi: np.ndarray) -> float:
     return float(np.nanmean(phi)) if np.isfinite(phi).any() else math.nan
 
 
-def _eao_ci(runs: Sequence[ResetRun], interval: tuple[int, int]) -> tuple[float, float]:
-    """The percentile bootstrap interval of the EAO over sequences (statistics' settings), of the
-    resamples that have an EAO (one of sequences all shorter than the interval has none)."""
-    lengths = np.arange(interval[0], interval[1] + 1)
-    sums = [_sums(fragments(r), lengths) for r in runs]
-    total, count = np.array([s[0] for s in sums]), np.array([s[1] for s in sums])
+def eao(runs: Sequence[ResetRun], interval: tuple[int, int]) -> float:
+    """The mean of ``Φ(Ns)`` over ``Ns`` in ``interval`` (both ends included)."""
+    return _mean_phi(expected_overlaps(runs, range(interval[0], interval[1] + 1)))
+
+
+def _eao_with_ci(runs: Sequence[ResetRun], interval: tuple[int, int]) -> tuple[float, float, float]:
+    """(the EAO, its percentile bootstrap interval over sequences) with statistics' settings,
+    from one pass over the runs; the interval of the resamples that have an EAO (one of
+    sequences all shorter than the interval has none)."""
+    total, count = _run_sums(runs, np.arange(interval[0], interval[1] + 1))
+    point = _mean_phi(_phi(total.sum(axis=0), count.sum(axis=0)))
     if len(runs) < 2:
-        return math.nan, math.nan
+        return point, math.nan, math.nan
 
     def statistic(index, axis=-1):
         index = np.asarray(index, dtype=int)
-        t, c = total[index].sum(axis=-2), count[index].sum(axis=-2)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.nanmean(np.where(c > 0, t / np.maximum(c, 1), np.nan), axis=-1)
+        return np.nanmean(_phi(total[index].sum(axis=-2), count[index].sum(axis=-2)), axis=-1)
 
     with warnings.catch_warnings():  # a resample of sequences all too short for the interval has no EAO
         warnings.simplefilter("ignore", (stats.DegenerateDataWarning, RuntimeWarning))
@@ -164,10 +176,10 @@ def _eao_ci(runs: Sequence[ResetRun], interval: tuple[int, int]) -> tuple[float,
                                 rng=np.random.default_rng(statistics.SEED)).bootstrap_distribution
     found = found[np.isfinite(found)]  # scipy's percentile interval is NaN if one resample is: those are left out
     if not found.size:
-        return math.nan, math.nan
+        return point, math.nan, math.nan
     tail = (1 - statistics.CONFIDENCE) / 2 * 100
     low, high = np.percentile(found, [tail, 100 - tail])
-    return float(low), float(high)
+    return point, float(low), float(high)
 
 
 def score_resets(results: Mapping[str, Mapping[str, ResetRun]], lengths: Mapping[str, int],
@@ -186,10 +198,9 @@ def score_resets(results: Mapping[str, Mapping[str, ResetRun]], lengths: Mapping
         rows = [{"tracker": tracker, "sequence": s, **sequence_scores(res[s])} for s in names]
         per_sequence += rows
         runs = [res[s] for s in names]
-        overall.append({"tracker": tracker, "accuracy": pooled_accuracy(runs), "failures": sum(r["failures"] for r in rows),
-                        "eao": eao(runs, interval), **dict(zip(("eao_ci_low", "eao_ci_high"),
-                                                                    _eao_ci(runs, interval))),
-                        "sequences": len(rows)})
+        found = dict(zip(("eao", "eao_ci_low", "eao_ci_high"), _eao_with_ci(runs, interval)))
+        overall.append({"tracker": tracker, "accuracy": pooled_accuracy(runs),
+                        "failures": sum(r["failures"] for r in rows), **found, "sequences": len(rows)})
     overall.sort(key=lambda r: -r["eao"] if math.isfinite(r["eao"]) else math.inf)
     ranked = [r["tracker"] for r in overall]
     return {"interval": list(interval), "overall": overall, "per_sequence": per_sequence, "left_out": left_out,

@@ -13,7 +13,7 @@ from dcfkit.analysis import metrics
 from dcfkit.analysis.statistics import versus_baseline
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, benchmark_protocol, scored_sequences
 from dcfkit.errors import shown
-from dcfkit.experiments import Experiment, get_experiment
+from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
 from dcfkit.protocols import Protocol, get_protocol
 from dcfkit.running import platforms
 
@@ -74,7 +74,7 @@ MISSING = ("skip", "fail")  # what evaluate() does with a sequence a tracker has
 def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
              include_first: bool = True, weighting: str | None = None,
              protocol: str | Protocol | None = None, missing: str = "fail",
-             experiment: str | Experiment = "ope") -> Evaluation:
+             experiment: str | Experiment = "ope", runs: Mapping[str, list[Sequence]] | None = None) -> Evaluation:
     """Score ``results`` (tracker -> sequence name -> boxes) on ``sequences`` under ``protocol``
     (by default the rules of the benchmark's published tables,
     :func:`~dcfkit.datasets.benchmark_protocol`: LaSOT's for LaSOT, the OTB toolkit's for UAV123).
@@ -89,7 +89,9 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
 
     ``experiment`` ``tre`` or ``sre`` (:mod:`dcfkit.experiments`): results are keyed by run
     name, and a sequence's score pools the frames of its runs (:func:`metrics.pool_runs`); a
-    sequence lacks a result unless it has all its runs.
+    sequence lacks a result unless it has all its runs. ``runs``: sequence name -> its runs,
+    when the caller made them already (:func:`dcfkit.experiments.runs_by_sequence`; an SRE
+    run reads its sequence's first frame).
     """
     sequences = list(sequences)
     proto = get_protocol(protocol or benchmark_protocol(sequences))
@@ -98,7 +100,7 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
     experiment = get_experiment(experiment)
     if experiment.resets:
         raise ValueError("reset-based runs are scored by dcfkit.analysis.reset_scores, not evaluate()")
-    runs = {s.name: experiment.runs(s) for s in scored_sequences(sequences)}
+    runs = runs if runs is not None else runs_by_sequence(scored_sequences(sequences), experiment)
     sequences, left_out = _complete(scored_sequences(sequences), results, missing, runs)
     per_seq, fps, missing = {}, {}, {}
     for tracker, res in results.items():

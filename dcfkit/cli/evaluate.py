@@ -35,8 +35,9 @@ from dcfkit.config import load_config
 from dcfkit.config.overrides import parse_overrides
 from dcfkit.datasets import load_dataset, scored_sequences
 from dcfkit.errors import ConfigError, shown
+from dcfkit.experiments import runs_by_sequence
 from dcfkit.integrations.opencv import opencv_tracker
-from dcfkit.running.evaluation import check_one_pass, experiment_runs, results_folder, run_one_pass, tracker_name
+from dcfkit.running.evaluation import check_one_pass, results_folder, run_one_pass, tracker_name
 from dcfkit.running.results import load_results
 
 
@@ -113,9 +114,10 @@ def _scores(args: argparse.Namespace, tracker: str, sequences: list) -> str:
         row = score_resets({tracker: reset_runs(folder, scored)}, {s.name: len(s) for s in scored})["overall"][0]
         return (f"EAO {row['eao']:.3f}, accuracy {row['accuracy']:.3f}, {row['failures']} failures on "
                 f"{row['sequences']} sequences (reset-based, VOT2016)")
-    runs = experiment_runs(sequences, args.experiment)
+    by_sequence = runs_by_sequence(scored_sequences(sequences), args.experiment)
+    runs = [run for found in by_sequence.values() for run in found]
     scores = evaluate({tracker: load_results(folder.parent, folder.name, runs)}, sequences, protocol=args.protocol,
-                      experiment=args.experiment)
+                      experiment=args.experiment, runs=by_sequence)
     line = score_line(scores.overall[0], scores.protocol.name)
     return line if args.experiment == "ope" else f"{line}, {args.experiment.upper()} runs pooled per sequence"
 

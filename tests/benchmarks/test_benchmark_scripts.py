@@ -127,7 +127,7 @@ def test_validation_set(tmp_path):
     entry = {"dataset": "UAV123_10fps", "name": "boat5", "repo": "someone/tracker", "img_dir": "seq/img",
              "gt": "seq/gt.txt", "frames": 6, "annotation_sha256": hashlib.sha256(annotation.encode()).hexdigest()}
     (tmp_path / "manifest.json").write_text(json.dumps([entry]))
-    (tmp_path / "reserved.tsv").write_text("# kept out\nbenchmark\tsequence\nUAV123_10fps\tbike1\n")
+    (tmp_path / "reserved.tsv").write_text("# kept out\nbenchmark\tsequence\nUAV123_10fps\tkept_out_1\n")
     common = [str(tmp_path / "mirror"), str(tmp_path / "out"), "--manifest", str(tmp_path / "manifest.json"),
               "--reserved", str(tmp_path / "reserved.tsv"), "--manifest-only"]
     out = run("validation_set.py", *common, tmp_path=tmp_path)
@@ -135,10 +135,10 @@ def test_validation_set(tmp_path):
     assert (tmp_path / "out" / "all" / "boat5" / "img" / "000006.jpg").is_file()
     assert (tmp_path / "out" / "UAV123_10fps" / "boat5" / "groundtruth_rect.txt").read_text() == annotation
     # a reserved sequence is refused before anything is written, in any UAV123 version
-    (tmp_path / "manifest.json").write_text(json.dumps([entry, {**entry, "name": "bike1", "dataset": "UAV123"}]))
+    (tmp_path / "manifest.json").write_text(json.dumps([entry, {**entry, "name": "kept_out_1", "dataset": "UAV123"}]))
     done = subprocess.run([sys.executable, str(BENCHMARKS / "validation_set.py"), *common[:1], str(tmp_path / "out2"),
                            *common[2:]], capture_output=True, text=True)
-    assert done.returncode != 0 and "reserved" in done.stderr and "UAV123/bike1" in done.stderr
+    assert done.returncode != 0 and "reserved" in done.stderr and "UAV123/kept_out_1" in done.stderr
     assert not (tmp_path / "out2").exists()
     # an annotation that is not the recorded one is an error
     (tmp_path / "manifest.json").write_text(json.dumps([{**entry, "annotation_sha256": "0" * 64}]))
