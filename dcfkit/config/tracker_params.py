@@ -21,6 +21,9 @@ class TrackerParams:
     cell_size: int = param(4, "feature cell size in pixels", ge=1, le=64)
     output_sigma_factor: float = param(1 / 16, "label σ as a fraction of sqrt(target area in cells)", gt=0)
     fft_backend: str = param("scipy", "FFT implementation", choices=("scipy", "pyfftw"))
+    spectra: str = param("half", "'half' spectra of real maps, or 'full' complex spectra of the whole grid as "
+                         "DR²Track's code (its shifted sample and ADMM filter are complex; resp_newton refines on "
+                         "the complex response spectrum; scipy's FFT)", choices=("half", "full"))
     training_sample: str = param("extract", "'extract' m^t at p^t (Algorithm 1) or 'shift' the detection sample "
                                  "to p^t in the Fourier domain, as DR²Track's code (by the translation over the "
                                  "scale after the scale update; one extraction less)",

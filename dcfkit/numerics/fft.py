@@ -17,6 +17,7 @@ BACKENDS = ("scipy", "pyfftw")
 
 class ScipyFFT:
     name = "scipy"
+    full = False  # half spectra (W//2 + 1 columns) of real maps
 
     def __init__(self):
         import scipy.fft  # lazy: only the chosen backend is imported
@@ -36,6 +37,7 @@ class PyFFTW:
     out of it, so callers' arrays are never touched or aliased."""
 
     name = "pyfftw"
+    full = False
 
     def __init__(self):
         import pyfftw  # lazy: only the chosen backend is imported
@@ -66,6 +68,27 @@ class PyFFTW:
         return plan().copy()
 
 
+class FullSpectra:
+    """Whole complex spectra (..., H, W) in place of half ones, with scipy.fft: ``rfft2`` is fft2
+    and ``irfft2`` the complex ifft2 (callers needing a real map take its real part). As DR²Track's
+    code computes: shift_sample's Nyquist frequency (+N/2) makes the shifted sample complex, and
+    run_training's ifft2 (no 'symmetric') keeps the filter's imaginary part."""
+
+    name = "full"
+    full = True
+
+    def __init__(self):
+        import scipy.fft  # lazy, as ScipyFFT's
+
+        self._fft = scipy.fft
+
+    def rfft2(self, x: np.ndarray) -> np.ndarray:
+        return self._fft.fft2(x, axes=(-2, -1), workers=1)
+
+    def irfft2(self, xf: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+        return self._fft.ifft2(xf, s=shape, axes=(-2, -1), workers=1)
+
+
 def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Elementwise product of complex arrays (broadcast), ``(ar br - ai bi) + i (ar bi + ai br)``
     with each product rounded: numpy's complex64 product fuses them (FMA) on processors with
@@ -77,8 +100,10 @@ def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def make_fft(backend: str = "scipy"):
-    """An FFT backend by name ('scipy' or 'pyfftw')."""
+def make_fft(backend: str = "scipy", full: bool = False):
+    """An FFT backend by name ('scipy' or 'pyfftw'); ``full``: :class:`FullSpectra` (scipy's)."""
+    if full:
+        return FullSpectra()
     if backend == "scipy":
         return ScipyFFT()
     if backend == "pyfftw":

@@ -15,7 +15,7 @@ from dcfkit.numerics.fft import multiply
 
 def response(hf: np.ndarray, sf: np.ndarray, shape: tuple[int, int], fft) -> np.ndarray:
     """Eq. (12): (C, H, Wr) filter and (..., C, H, Wr) samples -> (..., H, W) float32 response."""
-    return fft.irfft2(np.einsum("chw,...chw->...hw", hf.conj(), sf), shape).astype(np.float32, copy=False)
+    return np.real(fft.irfft2(np.einsum("chw,...chw->...hw", hf.conj(), sf), shape)).astype(np.float32, copy=False)
 
 
 def _moments(spectrum, ey, ex, fy, fx) -> tuple[complex, ...]:
@@ -71,7 +71,8 @@ def _signed_frequencies(n: int) -> np.ndarray:
     return np.where(k <= (n - 1) // 2 + (n % 2 == 0), k, k - n).astype(np.float64)
 
 
-def newton_peak(maps: np.ndarray, iterations: int = 5) -> tuple[int, float, float, float]:
+def newton_peak(maps: np.ndarray, iterations: int = 5, spectra: np.ndarray | None = None
+                ) -> tuple[int, float, float, float]:
     """The authors' ``resp_newton`` (STRCF, BACF, DR²Track): over (S, H, W) circular maps, the
     best map and its peak as a signed (dy, dx) offset in cells, with its value.
 
@@ -93,7 +94,8 @@ def newton_peak(maps: np.ndarray, iterations: int = 5) -> tuple[int, float, floa
         init_value = float(r[row, col])
         y0 = 2 * np.pi * (((row + (h - 1) // 2) % h) - (h - 1) // 2) / h
         x0 = 2 * np.pi * (((col + (w - 1) // 2) % w) - (w - 1) // 2) / w
-        spectrum = np.fft.fft2(r)
+        # resp_newton refines on the response's spectrum as computed (complex with FullSpectra)
+        spectrum = np.fft.fft2(r) if spectra is None else np.asarray(spectra[s], np.complex128)
         y, x = y0, x0
         ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
         for _ in range(iterations):
@@ -133,11 +135,13 @@ def local_maxima(r: np.ndarray, size: int = 3) -> tuple[np.ndarray, np.ndarray]:
     return rows[order], cols[order]
 
 
-def shift_spectrum(xf: np.ndarray, dy: float, dx: float, shape: tuple[int, int]) -> np.ndarray:
-    """Half spectra (..., H, W//2+1) of maps translated so that x'(p) = x(p + (dy, dx)), circularly
-    (sub-cell shifts interpolate in the Fourier domain; the Nyquist frequency of an even size
-    counts as positive, as the authors' ``shift_sample``)."""
+def shift_spectrum(xf: np.ndarray, dy: float, dx: float, shape: tuple[int, int], full: bool = False) -> np.ndarray:
+    """Spectra of maps translated so that x'(p) = x(p + (dy, dx)), circularly (sub-cell shifts
+    interpolate in the Fourier domain; the Nyquist frequency of an even size counts as positive,
+    as the authors' ``shift_sample``): half spectra (..., H, W//2+1), or whole ones (..., H, W)
+    if ``full``. Whole spectra take that grid on both axes, as ``shift_sample`` does, so a
+    shifted real map turns complex (its Nyquist bins lose their conjugate symmetry)."""
     ky = (_signed_frequencies(shape[0]) / shape[0])[:, None]
-    kx = np.fft.rfftfreq(shape[1])[None, :]
+    kx = ((_signed_frequencies(shape[1]) / shape[1]) if full else np.fft.rfftfreq(shape[1]))[None, :]
     phase = np.exp(2j * np.pi * (ky * dy + kx * dx)).astype(np.complex64)
     return multiply(xf, phase)

@@ -78,6 +78,14 @@ def check_terms(tracker) -> None:
                               f"set regularizers.{role}: null")
 
 
+def check_spectra(tracker) -> None:
+    """ConfigError if ``tracker.spectra: full`` is given a solver that works on half spectra only."""
+    if tracker.params.spectra == "full" and not tracker.solver.full_spectra:
+        raise ConfigError(f"{tracker.name}: tracker.spectra 'full' (whole complex spectra, as DR²Track's code) "
+                          f"needs a solver that takes them, such as admm_strcf; solver '{tracker.solver.name}' "
+                          f"works on half spectra: set tracker.spectra: half")
+
+
 def search_scales(tracker) -> np.ndarray:
     """The relative scales of the search samples (one sample each per frame)."""
     try:

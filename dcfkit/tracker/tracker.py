@@ -37,7 +37,15 @@ from dcfkit.numerics.patches import (
 )
 from dcfkit.numerics.response import newton_peak, shift_spectrum, subpixel_peak
 from dcfkit.registry import get_registry
-from dcfkit.tracker.checks import check_box, check_config_budget, check_first_frame, check_image, check_terms, read_only
+from dcfkit.tracker.checks import (
+    check_box,
+    check_config_budget,
+    check_first_frame,
+    check_image,
+    check_spectra,
+    check_terms,
+    read_only,
+)
 from dcfkit.tracker.confidence import Confidence
 from dcfkit.tracker.geometry import Geometry, geometry, hann2d, reported_box
 
@@ -58,9 +66,10 @@ class Tracker:
         self.temporal = build("regularizer", regs["temporal"], "regularizers.temporal") if regs.get("temporal") else None
         self.solver = build("solver", config["solver"], "solver")
         check_terms(self)
+        check_spectra(self)
         self.search = build("search", config["search"], "search")
         self.scale_estimator = build("scale", config["scale"], "scale")
-        self.fft = make_fft(self.params.fft_backend)
+        self.fft = make_fft(self.params.fft_backend, full=self.params.spectra == "full")
         self.frame = 0
         # diagnostics of the last frame: the response map (cells, centred: fftshift), the image box
         # (x, y, w, h) it covers, and the repressed distractors as (x, y) image pixels; the
@@ -172,7 +181,7 @@ class Tracker:
         if not np.all(np.isfinite(maps)):
             raise TrackingError(f"frame {self.frame}: the response map is not finite (the filter overflowed: "
                                 f"look for extreme solver, regularizer or label values in the config)")
-        best, dy, dx = self._peak(maps)
+        best, dy, dx = self._peak(maps, samples)
         step = g.cell_size * self.scale * factors[best]  # pixels per cell
         move = np.array([dy, dx]) * g.cell_size * self.scale * factors[best]  # not * step: the authors' rounding
         if p.translation == "whole_pixel":
@@ -186,7 +195,7 @@ class Tracker:
         xf = None
         if p.training_sample == "shift":  # the detection sample, moved to p^t in cells of the new scale
             sy, sx = (self.position - centre) / (g.cell_size * self.scale)
-            xf = shift_spectrum(samples[best], sy, sx, g.filter_size)
+            xf = shift_spectrum(samples[best], sy, sx, g.filter_size, self.fft.full)
         detection = Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells, (dy, dx))
         self._observe(detection)
         self._train(image, detection, xf)
@@ -207,10 +216,13 @@ class Tracker:
         """θ of this frame's training (0 without a temporal term; ``inf``: keep the last filter)."""
         return 0.0 if self.temporal is None else float(self.temporal.weight(detection))
 
-    def _peak(self, maps: np.ndarray) -> tuple[int, float, float]:
+    def _peak(self, maps: np.ndarray, samples: np.ndarray | None = None) -> tuple[int, float, float]:
         """The search scale whose response is best and its peak as a (dy, dx) offset in cells."""
         if self.params.peak == "newton":
-            best, dy, dx, _ = newton_peak(maps, self.params.newton_iterations)
+            spectra = None  # whole spectra: resp_newton's, Σ conj(ĥ) ẑ as computed (not fft2 of the real map)
+            if self.fft.full and samples is not None:
+                spectra = np.einsum("chw,schw->shw", self.hf.conj(), samples)
+            best, dy, dx, _ = newton_peak(maps, self.params.newton_iterations, spectra)
             return best, dy, dx
         best = int(np.argmax(maps.reshape(len(maps), -1).max(axis=1)))
         dy, dx, _ = subpixel_peak(maps[best], self.params.newton_iterations)

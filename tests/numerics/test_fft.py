@@ -36,3 +36,13 @@ def test_multiply_rounds_each_product():
     im = (a.real * b.imag).astype(f32) + (a.imag * b.real).astype(f32)
     assert np.array_equal(out.real, re) and np.array_equal(out.imag, im)
     np.testing.assert_allclose(out, a.astype(np.complex128) * b, rtol=1e-5, atol=1e-6)
+
+
+def test_whole_spectra_keep_a_complex_map_whole():
+    """tracker.spectra full (FullSpectra): rfft2 gives the whole spectrum and irfft2 the complex map."""
+    fft = make_fft("scipy", full=True)
+    assert fft.full and not make_fft("scipy").full and not make_fft("pyfftw").full
+    x = np.random.default_rng(1).standard_normal((2, 6, 8)) + 1j * np.random.default_rng(2).standard_normal((2, 6, 8))
+    xf = fft.rfft2(x)
+    np.testing.assert_allclose(xf, np.fft.fft2(x), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(fft.irfft2(xf, (6, 8)), x, atol=1e-12)

@@ -227,17 +227,18 @@ def test_newton_peak_may_leave_the_grid_maximum_cell_unlike_subpixel_peak():
     assert abs(sy - grid[0]) <= 1 and abs(sx - grid[1]) <= 1
 
 
-def resp_newton_sums(maps, iterations):
+def resp_newton_sums(maps, iterations, spectra=None):
     """STRCF's resp_newton.m (implementation/resp_newton.m:3-60, the multi-scale version), with its
     matrix products exp_iky * R * exp_ikx written as double sums over the full spectrum R = fft2(r):
     S_ab = Σ_k,l ky^a kx^b R e^{i(ky y + kx x)}; grad = -imag(S_10, S_01); H_yy = real(-S_20 + i S_00)
     (their ival term, lines 34-36), H_xx = real(-S_02 + i S_00), H_xy = -real(S_11). Returns the scale
-    (first maximum of the values, line 58), the signed displacement in cells (lines 59-60) and the value."""
+    (first maximum of the values, line 58), the signed displacement in cells (lines 59-60) and the value.
+    ``spectra``: R per map as DR²Track's code has it (responsef, complex when its filter is), not fft2(r)."""
     n_maps, h, w = maps.shape
     ky, kx = matlab_k(h)[:, None], matlab_k(w)[None, :]
     outcomes = []
-    for r in maps.astype(np.float64):
-        spectrum = np.fft.fft2(r)
+    for i, r in enumerate(maps.astype(np.float64)):
+        spectrum = np.fft.fft2(r) if spectra is None else spectra[i]
         row = np.argmax(r, axis=0)  # lines 3-7: the first maximum of each column, then the first column
         col = int(np.argmax(r[row, np.arange(w)]))
         row = int(row[col])
@@ -297,3 +298,32 @@ def test_shift_spectrum_uses_the_authors_nyquist(shape, dy, dx):
         numpy_ky = (np.fft.fftfreq(h) * h)[:, None]
         other = np.fft.fft2(x) * np.exp(1j * 2 * np.pi * dy / h * numpy_ky) * np.exp(1j * 2 * np.pi * dx / w * kx)
         assert np.abs(other - full).max() > 100 * tol
+
+
+@pytest.mark.parametrize("shape, dy, dx", [((8, 10), 0.3, -1.7), ((7, 10), 1.25, 2.5)])
+def test_whole_spectra_shift_as_the_authors_and_turn_complex(shape, dy, dx):
+    """tracker.spectra full: shift_sample.m's product on the whole spectrum, so the shifted map of a
+    real one is complex where an even side's Nyquist bins lose their symmetry (DR²Track's xf)."""
+    h, w = shape
+    x = np.random.default_rng(6).standard_normal((2, h, w))
+    ky, kx = matlab_k(h)[:, None], matlab_k(w)[None, :]
+    full = np.fft.fft2(x) * np.exp(1j * 2 * np.pi * dy / h * ky) * np.exp(1j * 2 * np.pi * dx / w * kx)
+    got = shift_spectrum(np.fft.fft2(x).astype(np.complex64), dy, dx, shape, full=True)
+    np.testing.assert_allclose(got, full, atol=2e-5 * np.abs(full).max())
+    assert np.abs(np.fft.ifft2(got).imag).max() > 1e-3 * np.abs(x).max()  # no longer a real map
+
+
+def test_newton_peak_refines_on_the_spectra_it_is_given():
+    """DR²Track's resp_newton refines on responsef as computed: with a complex filter that is not
+    fft2 of the real map. Given fft2 of the maps, the result is the default's."""
+    rng = np.random.default_rng(9)
+    h, w = 10, 12
+    maps = np.stack([cosine_peak_map(h, w, *rng.uniform(-2, 2, 2)) * a + 0.3 * rng.standard_normal((h, w))
+                     for a in (1.0, 1.1)]).astype(np.float32)
+    assert newton_peak(maps, 5, np.fft.fft2(maps.astype(np.float64))) == newton_peak(maps, 5)
+    spectra = np.fft.fft2(maps.astype(np.float64)) * (1 + 0.05j * rng.standard_normal((2, h, w)))
+    best, dy, dx, value = newton_peak(maps, 5, spectra)
+    ref_best, ref_dy, ref_dx, ref_value = resp_newton_sums(maps, 5, spectra)
+    assert best == ref_best and (dy, dx) == (pytest.approx(ref_dy, abs=1e-9), pytest.approx(ref_dx, abs=1e-9))
+    assert value == pytest.approx(ref_value, rel=1e-9)
+    assert (dy, dx) != pytest.approx(newton_peak(maps, 5)[1:3], abs=1e-6)

@@ -10,7 +10,7 @@ from dcfkit.components.labels.base import Detection, Label, gaussian_label
 from dcfkit.components.labels.distractors import authors_distractors
 from dcfkit.contracts import checked
 from dcfkit.datasets.synthetic import make_sequence
-from dcfkit.errors import InputError, TrackingError
+from dcfkit.errors import ConfigError, InputError, TrackingError
 from dcfkit.numerics.patches import round_half_away
 from dcfkit.numerics.response import shift_spectrum
 
@@ -499,10 +499,10 @@ def test_shift_mode_gives_the_label_the_newton_peak_and_trains_at_the_clamped_po
     tracker = dcfkit.load_tracker("reference/dr2track", overrides={"tracker.clamp_position": True})
     peaks, offsets, shifts = [], [], []
     find_peak, make_label, shift = tracker._peak, tracker.label.make, tracker_module.shift_spectrum
-    monkeypatch.setattr(tracker, "_peak", lambda maps: peaks.append(find_peak(maps)) or peaks[-1])
+    monkeypatch.setattr(tracker, "_peak", lambda maps, samples: peaks.append(find_peak(maps, samples)) or peaks[-1])
     monkeypatch.setattr(tracker.label, "make", lambda g, d: (d and offsets.append(d.offset)) or make_label(g, d))
     monkeypatch.setattr(tracker_module, "shift_spectrum",
-                        lambda xf, dy, dx, shape: shifts.append((dy, dx)) or shift(xf, dy, dx, shape))
+                        lambda xf, dy, dx, shape, full=False: shifts.append((dy, dx)) or shift(xf, dy, dx, shape, full))
     tracker.init(frames[0], (5.0, 40.6, 30.0, 30.0))  # centre x 19.5 -> -5.5: clamped at 0 at the end
     for frame in frames[1:]:
         centre = round_half_away(tracker._clamp(tracker.search.centre(), frame.shape))
@@ -552,3 +552,25 @@ def test_dr2track_computes_its_first_search_area_from_the_annotations_own_size()
         tracker = dcfkit.load_tracker("reference/dr2track", overrides={"tracker.init_area": init_area})
         tracker.init(seq.frames[0], box)
         assert tracker.scale == pytest.approx(expected)
+
+
+@pytest.mark.parametrize("config", ["autotrack", "bacf", "kcf"])
+def test_whole_spectra_need_a_solver_that_takes_them(config):
+    with pytest.raises(ConfigError, match=r"tracker\.spectra 'full'.*solver '\w+' works on half spectra"):
+        dcfkit.load_tracker(config, overrides={"tracker.spectra": "full"})
+
+
+def test_whole_spectra_keep_the_complex_filter_of_dr2tracks_code():
+    """reference/dr2track (spectra full): the shifted training sample and the filter are complex, as
+    in the authors' code; their imaginary part is small, so the boxes stay near the half-spectra ones."""
+    seq = make_sequence(n_frames=10, size=(120, 160), target=(16, 20), seed=3)
+    full, half = dcfkit.load_tracker("reference/dr2track"), dcfkit.load_tracker("reference/dr2track",
+                                                                 overrides={"tracker.spectra": "half"})
+    for t in (full, half):
+        t.init(seq.frames[0], seq.ground_truth[0])
+    boxes = [(full.update(f), half.update(f)) for f in seq.frames[1:]]
+    h, w = full.geometry.filter_size
+    assert full.hf.shape[-2:] == (h, w) and half.hf.shape[-2:] == (h, w // 2 + 1)
+    filt = np.fft.ifft2(full.hf)
+    assert np.abs(filt.imag).max() > 1e-4 * np.abs(filt.real).max()
+    np.testing.assert_allclose([b for b, _ in boxes], [b for _, b in boxes], atol=1.0)

@@ -40,6 +40,7 @@ class ADMMAutoTrack(ADMMStrcf):
     the last filter and how many frames were trained."""
 
     name = "admm_autotrack"
+    full_spectra = False  # its θ-step mirrors half spectra
     Params = AutoTrackParams
 
     def reset(self):

@@ -32,9 +32,13 @@ class Solver(Component, declares="solver"):
     ``terms`` names the regularizers whose terms ``train`` solves with (w² for 'spatial', θ
     for 'temporal'); the tracker refuses a config that gives the solver a regularizer it
     has no term for, instead of ignoring it (KCF's and DSST's closed forms have neither).
+    ``full_spectra`` says whether it also takes whole complex spectra (``tracker.spectra:
+    full``, DR²Track's code); the others are given half spectra of real maps.
     """
 
     terms: tuple[str, ...] = ("spatial", "temporal")
+    # whether train and response also work on whole complex spectra (tracker.spectra: full)
+    full_spectra: bool = False
     contract = Contract(required={"reset": (), "train": ("xf", "yf", "w2", "theta", "fft")},
                         optional={"response": ("hf", "samples", "shape", "fft"), "observe": ("detection",)},
                         # a response that is not finite is the tracker's to say: the filter overflowed

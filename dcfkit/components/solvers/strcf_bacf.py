@@ -18,9 +18,9 @@ all but vanishes). ADMM splits h = v and alternates (per frame, from h = u = 0, 
 
 The multiplier is kept unscaled (u = γ z of the paper), the standard form when γ changes
 between iterations; the paper's update z ← z + γ(v − h) agrees with it while γ = 1
-(docs/reference.md). Spectra are half spectra (rfft2) of real maps, shape
-(C, H, W//2+1) complex64; every equation above is per frequency, so solving on the half
-spectrum is exact.
+(docs/reference.md). Spectra are half spectra (rfft2) of real maps, shape (C, H, W//2+1)
+complex64; every equation above is per frequency, so solving on the half spectrum is exact.
+ADMMStrcf also takes whole complex spectra (``tracker.spectra: full``, DR²Track's code).
 """
 from __future__ import annotations
 
@@ -152,7 +152,8 @@ def admm(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, theta: float, v_prev: n
             kernels.h_input(_floats(vf), _floats(uf), 1.0 if p.h_step == "authors" else gamma, _floats(g))
         h = fft.irfft2(vf if first else g, shape)
         h *= (gamma * K) / (w2 + gamma * K)
-        hf = np.ascontiguousarray(fft.rfft2(h.astype(np.float32, copy=False)), np.complex64)
+        h = h.astype(np.complex64 if np.iscomplexobj(h) else np.float32, copy=False)  # FullSpectra: complex
+        hf = np.ascontiguousarray(fft.rfft2(h), np.complex64)
         # multiplier (Eq. 11) and penalty schedule
         kernels.multiplier(_floats(vf), _floats(hf), gamma, first, _floats(uf))
     return vf, hf
@@ -163,6 +164,7 @@ class ADMMStrcf(Solver):
 
     name = "admm_strcf"
     Params = ADMMParams
+    full_spectra = True  # its h-step keeps a complex h whole (DR²Track's run_training.m)
 
     def reset(self):
         self.v_prev = None
