@@ -125,7 +125,7 @@ def _is_spec_file(path: Path) -> bool:
     return False
 
 
-def _mapping(value: Any, where: str, what: str) -> dict:
+def as_mapping(value: Any, where: str, what: str) -> dict:
     if value is None:
         return {}
     if not isinstance(value, Mapping):
@@ -133,21 +133,21 @@ def _mapping(value: Any, where: str, what: str) -> dict:
     return dict(value)
 
 
-def _check_keys(data: Mapping, valid: tuple, where: str) -> None:
+def check_keys(data: Mapping, valid: tuple, where: str) -> None:
     for key in data:
         if key not in valid:
             raise ConfigError(f"{where}: unknown key {shown(key)}{closest(key, valid)}; valid keys: {', '.join(valid)}")
 
 
 def _overrides(value: Any, where: str) -> dict:
-    out = _mapping(value, where, "a mapping of dotted keys to values, e.g. {label.mu: 0.3}")
+    out = as_mapping(value, where, "a mapping of dotted keys to values, e.g. {label.mu: 0.3}")
     for key in out:
         if not isinstance(key, str) or not key.strip():
             raise ConfigError(f"{where}: keys must be dotted config keys such as label.mu, got {shown(key)}")
     return out
 
 
-def _load(spec_path: Path, config: Any, overrides: Mapping, where: str, key: str) -> tuple[dict, str]:
+def load_spec_config(spec_path: Path, config: Any, overrides: Mapping, where: str, key: str) -> tuple[dict, str]:
     """Resolve ``config`` (relative to the spec file, else a shipped name) with ``overrides``.
 
     ``where`` names the spec entry in errors, ``key`` the spec key holding ``config``."""
@@ -178,8 +178,8 @@ def format_value(value: Any) -> str:
 
 
 def _parse_grid(spec_path: Path, data: Any, named: dict[str, Variant], limit: int) -> tuple[Grid, list[Variant]]:
-    grid = _mapping(data, f"{spec_path}: grid", "a mapping with base, mode and parameters")
-    _check_keys(grid, GRID_KEYS, f"{spec_path}: grid")
+    grid = as_mapping(data, f"{spec_path}: grid", "a mapping with base, mode and parameters")
+    check_keys(grid, GRID_KEYS, f"{spec_path}: grid")
     mode = grid.get("mode", "sweep")
     if mode not in GRID_MODES:
         raise ConfigError(f"{spec_path}: grid.mode: expected one of {', '.join(GRID_MODES)}, got {shown(mode)}")
@@ -192,9 +192,9 @@ def _parse_grid(spec_path: Path, data: Any, named: dict[str, Variant], limit: in
         base_overrides = {**named[base].overrides, **extra}
     else:
         base_source, base_overrides = base, extra
-    base_config, base_source = _load(spec_path, base_source, base_overrides, "grid.base", "grid.base")
+    base_config, base_source = load_spec_config(spec_path, base_source, base_overrides, "grid.base", "grid.base")
 
-    params = _mapping(grid.get("parameters"), f"{spec_path}: grid.parameters",
+    params = as_mapping(grid.get("parameters"), f"{spec_path}: grid.parameters",
                       "a mapping of dotted keys to value lists, e.g. {label.mu: [0, 0.1, 0.25]}")
     if not params:
         raise ConfigError(f"{spec_path}: grid.parameters: empty; give at least one dotted key with a list of values")
@@ -203,7 +203,7 @@ def _parse_grid(spec_path: Path, data: Any, named: dict[str, Variant], limit: in
     for point in _grid_points(spec_path, parsed, mode, len(named), limit):
         name = ", ".join(f"{parsed[k][0]}={format_value(v)}" for k, v in point.items())
         where = clip("grid (" + ", ".join(f"{k}={format_value(v)}" for k, v in point.items()) + ")")
-        config, _ = _load(spec_path, base_source, {**base_overrides, **point}, where, "grid.base")
+        config, _ = load_spec_config(spec_path, base_source, {**base_overrides, **point}, where, "grid.base")
         variants.append(Variant(name, config, base_source, {**base_overrides, **point}, dict(point)))
     return Grid(str(base), mode, parsed, base_config), variants
 
@@ -215,7 +215,7 @@ def _parse_parameters(spec_path: Path, params: Mapping) -> dict[str, tuple[str, 
         where = f"{spec_path}: grid.parameters.{clip(str(key))}"
         label = key
         if isinstance(entry, Mapping):
-            _check_keys(entry, ("values", "label"), where)
+            check_keys(entry, ("values", "label"), where)
             label = str(entry.get("label") or key)
             entry = entry.get("values")
         if not isinstance(entry, list) or not entry:
@@ -279,11 +279,11 @@ def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
     limit = variant_limit(max_variants)
     path = _find_spec(source)
     data = read_yaml(path)
-    _check_keys(data, SPEC_KEYS, str(path))
+    check_keys(data, SPEC_KEYS, str(path))
     for key in ("name", "description"):
         if data.get(key) is not None and not isinstance(data[key], str):
             raise ConfigError(f"{path}: {key}: expected a string, got {shown(data[key])}")
-    dataset_name, root_path, origin = _parse_dataset(path, data.get("dataset"), root)
+    dataset_name, root_path, origin = parse_dataset(path, data.get("dataset"), root)
     named = _parse_variants(path, data.get("variants"), limit)
     grid, grid_variants = None, []
     if data.get("grid") is not None:
@@ -303,12 +303,12 @@ def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
                                                   experiment))
 
 
-def _parse_dataset(path: Path, dataset: Any, root) -> tuple[str, Path | None, str]:
+def parse_dataset(path: Path, dataset: Any, root) -> tuple[str, Path | None, str]:
     """(canonical dataset name, absolute root or None, where the root came from)."""
     if isinstance(dataset, str):
         dataset = {"name": dataset}
-    dataset = _mapping(dataset, f"{path}: dataset", "a mapping {name: uav123_10fps, root: path}")
-    _check_keys(dataset, ("name", "root"), f"{path}: dataset")
+    dataset = as_mapping(dataset, f"{path}: dataset", "a mapping {name: uav123_10fps, root: path}")
+    check_keys(dataset, ("name", "root"), f"{path}: dataset")
     if not dataset.get("name"):
         raise ConfigError(f"{path}: dataset.name: missing (e.g. uav123_10fps, dtb70, uavdt, otb)")
     if not isinstance(dataset["name"], str):
@@ -344,7 +344,7 @@ def _parse_sequences(path: Path, data: Mapping, sequences) -> tuple | None:
 
 def _parse_variants(path: Path, raw: Any, limit: int) -> dict[str, Variant]:
     """The named variants, each config resolved with its overrides."""
-    raw_variants = _mapping(raw, f"{path}: variants", "a mapping of variant names to {config: ..., overrides: {...}}")
+    raw_variants = as_mapping(raw, f"{path}: variants", "a mapping of variant names to {config: ..., overrides: {...}}")
     if len(raw_variants) > limit:
         raise ConfigError(f"{path}: variants: {len(raw_variants)} variants; a spec has at most {limit} "
                           f"({RAISE_VARIANTS})")
@@ -355,13 +355,13 @@ def _parse_variants(path: Path, raw: Any, limit: int) -> dict[str, Variant]:
             raise ConfigError(f"{path}: {where}: variant names must be unique, and {shown(name)} is given twice")
         if isinstance(entry, str):
             entry = {"config": entry}
-        entry = _mapping(entry, f"{path}: {where}", "{config: path-or-name, overrides: {dotted.key: value}}")
-        _check_keys(entry, VARIANT_KEYS, f"{path}: {where}")
+        entry = as_mapping(entry, f"{path}: {where}", "{config: path-or-name, overrides: {dotted.key: value}}")
+        check_keys(entry, VARIANT_KEYS, f"{path}: {where}")
         if "config" not in entry:
             raise ConfigError(f"{path}: {where}.config: missing (a config file relative to the spec, "
                               f"or a shipped name such as dr2track)")
         overrides = _overrides(entry.get("overrides"), f"{path}: {where}.overrides")
-        config, src = _load(path, entry["config"], overrides, where, f"{where}.config")
+        config, src = load_spec_config(path, entry["config"], overrides, where, f"{where}.config")
         named[str(name)] = Variant(str(name), config, src, overrides)
     return named
 

@@ -4,15 +4,16 @@ from __future__ import annotations
 import argparse
 
 from dcfkit import __version__
-from dcfkit.cli import ablate, components, datasets, evaluate, track, trax
+from dcfkit.cli import ablate, components, datasets, evaluate, search, track, trax
 from dcfkit.errors import SHOWN_CHARS
 
 DESCRIPTION = """dcfkit: discriminative correlation filter trackers assembled from YAML.
 
 Commands: track (one video), demo (a generated sequence, no data needed), components,
 datasets (the benchmark layouts --dataset accepts), eval (one-pass evaluation on a
-benchmark), report, compare (two result folders side by side), ablate, export (a dataset
-as a VOT workspace's sequences), trax (serve the VOT toolkit's TraX protocol)."""
+benchmark), report, compare (two result folders side by side), ablate, search (an automated
+search of the component space, judged on held-out folds), export (a dataset as a VOT
+workspace's sequences), trax (serve the VOT toolkit's TraX protocol)."""
 
 #: name -> (help, add_arguments, run)
 COMMANDS = {
@@ -28,6 +29,8 @@ COMMANDS = {
     "compare": ("two folders of result files side by side per sequence: scores, their differences, box "
                 "agreement (parity checks)", evaluate.add_compare_arguments, evaluate.run_compare),
     "ablate": ("run an ablation spec: variants x parameter grids x sequences", ablate.add_arguments, ablate.run),
+    "search": ("search the component space and its parameters (Optuna), judged on held-out folds of sequences",
+               search.add_arguments, search.run),
     "export": ("write a dataset's sequences in another toolkit's layout (vot: a VOT workspace's sequences/)",
                datasets.add_export_arguments, datasets.run_export),
     "trax": ("serve a config over the TraX protocol on stdin/stdout, for the VOT toolkit (needs dcfkit[trax])",

@@ -1,0 +1,228 @@
+"""Search specs: a base config, the space of changes to it, the folds, the budget and the
+trackers to beat (docs/search.md). Every choice is resolved against the base when the spec
+is read, so a wrong key or value fails before anything runs."""
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from pathlib import Path
+from typing import Any, Mapping
+
+from optuna.distributions import BaseDistribution, CategoricalDistribution, FloatDistribution, IntDistribution
+
+from dcfkit.ablation.experiment import check_experiment
+from dcfkit.ablation.spec import as_mapping, check_keys, load_spec_config, parse_dataset
+from dcfkit.config import load_config, shipped_config_dir
+from dcfkit.config.bounded_yaml import read_yaml
+from dcfkit.datasets import load_dataset
+from dcfkit.errors import ConfigError, DcfkitError, clip, shown
+
+SPEC_KEYS = ("name", "description", "dataset", "sequences", "base", "space", "experiments", "folds",
+             "trials", "startup_trials", "seed", "baselines")
+KINDS = ("choice", "float", "int")
+PARAMETER_KEYS = (*KINDS, "log", "when")
+
+
+@dataclasses.dataclass(frozen=True)
+class Parameter:
+    """One dimension of the space: a dotted config key, its Optuna distribution, the value
+    each choice label stands for (``choices``; empty for numbers), and ``when``: the
+    (key, label) pairs that must hold for it to be sampled (a component's own parameter)."""
+
+    key: str
+    distribution: BaseDistribution
+    choices: dict = dataclasses.field(default_factory=dict)
+    when: tuple = ()
+
+    def suggest(self, trial) -> Any:
+        """The value an Optuna ``trial`` samples for this parameter."""
+        d = self.distribution
+        if isinstance(d, CategoricalDistribution):
+            return trial.suggest_categorical(self.key, d.choices)
+        if isinstance(d, IntDistribution):
+            return trial.suggest_int(self.key, d.low, d.high, log=d.log)
+        return trial.suggest_float(self.key, d.low, d.high, log=d.log)
+
+    def value(self, sampled: Any) -> Any:
+        """The config value for a sampled value (a choice's label stands for its value)."""
+        return self.choices[sampled] if self.choices else sampled
+
+
+@dataclasses.dataclass(frozen=True)
+class SearchSpec:
+    """A parsed search spec (docs/search.md)."""
+
+    path: Path
+    name: str
+    description: str
+    dataset: str
+    root: Path | None
+    root_origin: str
+    sequences: tuple | None
+    base: dict
+    base_source: str
+    parameters: tuple
+    experiments: tuple
+    folds: int
+    trials: int
+    startup_trials: int
+    seed: int
+    baselines: dict  # name -> resolved config
+
+    def load_sequences(self) -> list:
+        if self.root is None:
+            raise ConfigError(f"{self.path}: no dataset root: give dataset.root in the spec or --root")
+        seqs = load_dataset(self.dataset, self.root)
+        if self.sequences is None:
+            return seqs
+        by_name = {s.name: s for s in seqs}
+        missing = [n for n in self.sequences if n not in by_name]
+        if missing:
+            raise ConfigError(f"{self.path}: sequences: {', '.join(map(clip, missing[:5]))} not under {self.root}")
+        return [by_name[n] for n in self.sequences]
+
+    def config(self, params: Mapping[str, Any]) -> dict:
+        """The base config with the sampled ``params`` (key -> sampled value) applied."""
+        overrides = {p.key: p.value(params[p.key]) for p in self.parameters if p.key in params}
+        return load_config(self.base, overrides)
+
+
+def find_search_spec(source: str | os.PathLike) -> Path:
+    """A spec file, or a shipped one by name (``configs/searches/<name>.yaml``)."""
+    path = Path(source)
+    if os.path.isfile(path):
+        return path.resolve()
+    folder = shipped_config_dir() / "searches"
+    for candidate in (folder / path, folder / f"{path}.yaml"):
+        if os.path.isfile(candidate):
+            return candidate.resolve()
+    shipped = sorted(p.stem for p in folder.glob("*.yaml")) if folder.is_dir() else []
+    raise ConfigError(f"search spec not found: {clip(str(source))}"
+                      + (f"; shipped: {', '.join(shipped)}" if shipped else ""))
+
+
+def load_search_spec(source: str | os.PathLike, root: str | os.PathLike | None = None) -> SearchSpec:
+    """Read and validate a search spec; ``root`` replaces its ``dataset.root``. Errors name the
+    file and the key."""
+    path = find_search_spec(source)
+    data = read_yaml(path)
+    check_keys(data, SPEC_KEYS, str(path))
+    dataset, root_path, origin = parse_dataset(path, data.get("dataset"), root)
+    if "base" not in data:
+        raise ConfigError(f"{path}: base: missing (the config every trial changes, e.g. ../dr2track.yaml)")
+    base, base_source = load_spec_config(path, data["base"], {}, "base", "base")
+    parameters = _parse_space(path, data.get("space"), base)
+    experiments = data.get("experiments", ["ope"])
+    if isinstance(experiments, str):
+        experiments = [experiments]
+    if not isinstance(experiments, list) or not experiments:
+        raise ConfigError(f"{path}: experiments: expected a list such as [ope, tre], got {shown(experiments)}")
+    experiments = tuple(dict.fromkeys(check_experiment(e, f"{path}: experiments") for e in experiments))
+    baselines = {str(name): load_spec_config(path, cfg, {}, f"baselines.{clip(str(name))}",
+                                             f"baselines.{clip(str(name))}")[0]
+                 for name, cfg in as_mapping(data.get("baselines"), f"{path}: baselines",
+                                             "a mapping {name: config file}").items()}
+    sequences = data.get("sequences")
+    if sequences is not None and (not isinstance(sequences, list) or not all(isinstance(s, str) for s in sequences)):
+        raise ConfigError(f"{path}: sequences: expected a list of sequence names, got {shown(sequences)}")
+    return SearchSpec(
+        path=path, name=str(data.get("name") or path.stem), description=str(data.get("description") or ""),
+        dataset=dataset, root=root_path, root_origin=origin,
+        sequences=tuple(sequences) if sequences is not None else None, base=base, base_source=base_source,
+        parameters=parameters, experiments=experiments, folds=_whole(path, data, "folds", 4, 2),
+        trials=_whole(path, data, "trials", 30, 1), startup_trials=_whole(path, data, "startup_trials", 10, 1),
+        seed=_whole(path, data, "seed", 0, 0), baselines=baselines)
+
+
+def _whole(path: Path, data: Mapping, key: str, default: int, least: int) -> int:
+    value = data.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int) or value < least:
+        raise ConfigError(f"{path}: {key}: expected a whole number >= {least}, got {shown(value)}")
+    return value
+
+
+def _parse_space(path: Path, raw: Any, base: dict) -> tuple:
+    space = as_mapping(raw, f"{path}: space", "a mapping {dotted.key: {choice|float|int: ...}}")
+    if not space:
+        raise ConfigError(f"{path}: space: missing or empty: nothing to search")
+    params: dict[str, Parameter] = {}
+    for key, entry in space.items():
+        where = f"{path}: space.{clip(str(key))}"
+        params[str(key)] = _parse_parameter(where, str(key), entry, params)
+    for p in params.values():
+        _check_values(where=f"{path}: space.{clip(p.key)}", base=base, parameter=p, params=params)
+    return tuple(params.values())
+
+
+def _parse_parameter(where: str, key: str, entry: Any, earlier: Mapping[str, Parameter]) -> Parameter:
+    entry = as_mapping(entry, where, "a mapping such as {float: [5, 30], log: true} or {choice: [a, b]}")
+    check_keys(entry, PARAMETER_KEYS, where)
+    kinds = [k for k in KINDS if k in entry]
+    if len(kinds) != 1:
+        raise ConfigError(f"{where}: give exactly one of {', '.join(KINDS)}, got {shown(sorted(entry))}")
+    kind, values = kinds[0], entry[kinds[0]]
+    when = _parse_when(where, entry.get("when"), earlier)
+    if kind == "choice":
+        choices = values if isinstance(values, Mapping) else \
+            {_label(v): v for v in values} if isinstance(values, list) else None
+        if not choices or len(choices) < 2:
+            raise ConfigError(f"{where}.choice: expected at least two values (a list, or a mapping label -> value), "
+                              f"got {shown(values)}")
+        if "log" in entry:
+            raise ConfigError(f"{where}.log: only for float and int ranges")
+        return Parameter(key, CategoricalDistribution([str(c) for c in choices]),
+                         {str(c): v for c, v in choices.items()}, when)
+    if not (isinstance(values, list) and len(values) == 2
+            and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in values)
+            and values[0] < values[1]):
+        raise ConfigError(f"{where}.{kind}: expected [low, high] with low < high, got {shown(values)}")
+    log = entry.get("log", False)
+    if not isinstance(log, bool) or (log and values[0] <= 0):
+        raise ConfigError(f"{where}.log: expected true or false (true needs low > 0), got {shown(log)}")
+    if kind == "int":
+        if not all(isinstance(v, int) for v in values):
+            raise ConfigError(f"{where}.int: expected whole numbers, got {shown(values)}")
+        return Parameter(key, IntDistribution(values[0], values[1], log=log), when=when)
+    return Parameter(key, FloatDistribution(float(values[0]), float(values[1]), log=log), when=when)
+
+
+def _label(value: Any) -> str:
+    if isinstance(value, Mapping) and isinstance(value.get("name"), str):
+        return value["name"]
+    return str(value)
+
+
+def _parse_when(where: str, raw: Any, earlier: Mapping[str, Parameter]) -> tuple:
+    when = as_mapping(raw, f"{where}.when", "a mapping {choice key: label or [labels]}")
+    out = []
+    for key, labels in when.items():
+        labels = labels if isinstance(labels, list) else [labels]
+        choice = earlier.get(str(key))
+        if choice is None or not choice.choices:
+            raise ConfigError(f"{where}.when: {shown(key)} is not a choice listed before it in space")
+        unknown = [x for x in labels if str(x) not in choice.choices]
+        if unknown:
+            raise ConfigError(f"{where}.when: {shown(unknown[0])} is not one of {key}'s labels "
+                              f"({', '.join(choice.choices)})")
+        out.append((str(key), tuple(str(x) for x in labels)))
+    return tuple(out)
+
+
+def active(parameter: Parameter, params: Mapping[str, Any]) -> bool:
+    """Whether ``parameter`` is sampled, given the values sampled before it."""
+    return all(params.get(key) in labels for key, labels in parameter.when)
+
+
+def _check_values(where: str, base: dict, parameter: Parameter, params: Mapping[str, Parameter]) -> None:
+    """Resolve the base with each choice (with the choices its ``when`` needs), or with each
+    end of a range, so a wrong key or value is an error now, not in trial 17."""
+    context = {key: parameter_value for key, labels in parameter.when
+               for parameter_value in [params[key].choices[labels[0]]]}
+    d = parameter.distribution
+    values = list(parameter.choices.values()) if parameter.choices else [d.low, d.high]
+    for value in values:
+        try:
+            load_config(base, {**context, parameter.key: value})
+        except DcfkitError as exc:
+            raise ConfigError(f"{where}: with the value {shown(value)}: {exc}") from None

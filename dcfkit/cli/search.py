@@ -1,0 +1,60 @@
+"""``dcfkit search``: run a search spec (docs/search.md) and print its summary."""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+from pathlib import Path
+
+from dcfkit.cli.common import add_protocol_argument
+from dcfkit.config import shipped_config_dir
+from dcfkit.errors import DcfkitError
+from dcfkit.running.runner import usable_cores
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    shipped = sorted(p.stem for p in (shipped_config_dir() / "searches").glob("*.yaml"))
+    parser.add_argument("spec", metavar="SPEC",
+                        help=f"search spec YAML, or a shipped one by name ({', '.join(shipped)})")
+    parser.add_argument("--out", required=True, type=Path,
+                        help="search folder (OUT/trials/..., OUT/jobs/..., OUT/summary.md, OUT/best.yaml); "
+                             "reruns resume, with more --trials if given")
+    parser.add_argument("--root", type=Path, default=None,
+                        help="benchmark root folder (default: the spec's dataset.root, relative to the spec)")
+    parser.add_argument("--trials", type=int, default=None,
+                        help="trials per study (default: the spec's 'trials'); a rerun with more adds trials")
+    parser.add_argument("--jobs", type=int, default=None,
+                        help="worker processes for each trial's runs (default: the usable cores)")
+    parser.add_argument("--executor", choices=("local", "dask"), default=None,
+                        help="local process pool (default) or dask.distributed (default with --scheduler)")
+    parser.add_argument("--scheduler", default=None, metavar="ADDR",
+                        help="dask scheduler address (default: a LocalCluster)")
+    add_protocol_argument(parser)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run every study not yet recorded under --out, then print summary.md."""
+    try:
+        import optuna  # noqa: F401  (lazy: Optuna is an extra, dcfkit[search])
+    except ImportError:
+        raise DcfkitError("dcfkit search needs Optuna: pip install 'dcfkit[search]'") from None
+    from dcfkit.autosearch import Search, load_search_spec  # lazy: it imports Optuna
+    from dcfkit.autosearch.summary import summary_lines  # lazy: as dcfkit.autosearch
+
+    executor = args.executor or ("dask" if args.scheduler else "local")
+    if args.scheduler and executor != "dask":
+        raise DcfkitError("--scheduler needs --executor dask")
+    jobs = args.jobs if args.jobs is not None else usable_cores()
+    if jobs < 1:
+        raise DcfkitError(f"--jobs must be >= 1, got {jobs}")
+    spec = load_search_spec(args.spec, root=args.root)
+    if args.trials is not None:
+        if args.trials < 1:
+            raise DcfkitError(f"--trials must be >= 1, got {args.trials}")
+        spec = dataclasses.replace(spec, trials=args.trials)
+    search = Search(spec, args.out, {"protocol": args.protocol, "jobs": jobs, "executor": executor,
+                                     "scheduler": args.scheduler},
+                    report=lambda line: print(line, file=sys.stderr, flush=True))
+    summary = search.run()
+    print("\n".join(summary_lines(summary)))
+    return 0
