@@ -33,8 +33,9 @@ def make_folds(names: list[str], k: int, seed: int) -> list[list[str]]:
 
 def fingerprint(spec: SearchSpec, folds: list[list[str]], evaluator: Evaluator) -> dict:
     """What a resumed search must share with the recorded one for its trials to stand."""
-    space = {p.key: [repr(p.distribution), {k: evaluator.key(v) if isinstance(v, dict) else repr(v)
-                                            for k, v in p.choices.items()}, p.when] for p in spec.parameters}
+    space = {p.key: [optuna.distributions.distribution_to_json(p.distribution),
+                     {k: evaluator.key(v) if isinstance(v, dict) else repr(v) for k, v in p.choices.items()}, p.when]
+             for p in spec.parameters}
     return {"base": evaluator.key(spec.base), "space": json.loads(json.dumps(space, default=list)),
             "experiments": list(spec.experiments), "folds": folds, "seed": spec.seed,
             "startup_trials": spec.startup_trials, "dataset": spec.dataset,
