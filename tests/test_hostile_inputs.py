@@ -214,8 +214,8 @@ def test_a_dsst_copy_over_the_image_budget_refuses_init_before_any_state_changes
     """DR²Track's scale samples are whole-pixel crops of up to 1.6 times the target: for a box
     ten times the image they hold 1.6 million pixels, far more than its search sample copies.
     The refusal comes before anything changes: the tracker goes on as if init had not been
-    called."""
-    tracking, reference = dcfkit.load_tracker("dr2track"), dcfkit.load_tracker("dr2track")
+    called. (Sub-pixel sampling: the whole-pixel search sample would copy its own region first.)"""
+    tracking, reference = (dcfkit.load_tracker("dr2track", overrides={"tracker.sampling": "subpixel"}) for _ in "ab")
     for t in (tracking, reference):
         t.init(SEQUENCE.frames[0], SEQUENCE.ground_truth[0])
     monkeypatch.setenv("DCFKIT_MAX_IMAGE_PIXELS", "1e6")
