@@ -166,6 +166,9 @@ def _parse_parameter(where: str, key: str, entry: Any, earlier: Mapping[str, Par
     if kind == "choice":
         choices = values if isinstance(values, Mapping) else \
             {_label(v): v for v in values} if isinstance(values, list) else None
+        if isinstance(values, list) and choices is not None and len(choices) < len(values):
+            raise ConfigError(f"{where}.choice: two values have the label {shown(_repeated(values))}: give a "
+                              f"mapping label -> value")
         if not choices or len(choices) < 2:
             raise ConfigError(f"{where}.choice: expected at least two values (a list, or a mapping label -> value), "
                               f"got {shown(values)}")
@@ -193,6 +196,11 @@ def _label(value: Any) -> str:
     return str(value)
 
 
+def _repeated(values: list) -> str:
+    labels = [_label(v) for v in values]
+    return next(label for label in labels if labels.count(label) > 1)
+
+
 def _parse_when(where: str, raw: Any, earlier: Mapping[str, Parameter]) -> tuple:
     when = as_mapping(raw, f"{where}.when", "a mapping {choice key: label or [labels]}")
     out = []
@@ -217,8 +225,7 @@ def active(parameter: Parameter, params: Mapping[str, Any]) -> bool:
 def _check_values(where: str, base: dict, parameter: Parameter, params: Mapping[str, Parameter]) -> None:
     """Resolve the base with each choice (with the choices its ``when`` needs), or with each
     end of a range, so a wrong key or value is an error now, not in trial 17."""
-    context = {key: parameter_value for key, labels in parameter.when
-               for parameter_value in [params[key].choices[labels[0]]]}
+    context = {key: params[key].choices[labels[0]] for key, labels in parameter.when}
     d = parameter.distribution
     values = list(parameter.choices.values()) if parameter.choices else [d.low, d.high]
     for value in values:

@@ -84,6 +84,8 @@ def test_a_spec_is_resolved_when_read(tmp_path, data):
     ("solver.iterations: {int: [1, 3], when: {label: other}}", r"'other' is not one of label's labels"),
     ("solver.iterations: {int: [1, 3], when: {nope: x}}", r"'nope' is not a choice listed before it"),
     ("solver.iterations: {int: [1, 3], log: 2}", r"\.log: expected true or false"),
+    ("scale: {choice: [{name: pyramid, n_scales: 5}, {name: pyramid, n_scales: 7}]}",
+     r"space\.scale\.choice: two values have the label 'pyramid': give a mapping label -> value"),
 ])
 def test_a_wrong_space_entry_names_the_file_and_key(tmp_path, data, change, message):
     path = write(tmp_path / "s.yaml", SPEC.replace("solver.iterations: {int: [1, 3]}", change))

@@ -4,7 +4,10 @@ Precision floors were set from measurement (one-pass, centre error <= 20 px, mea
 development sequences, OpenCV 4.14): DR²Track 0.959, STRCF 0.891, BACF 0.978 at the time of
 writing (2026-11-24, 0.3.0); KCF 0.563 and DSST 0.354 (2026-11-25, the papers' parameters:
 both lose the trucks at their occlusion and wakeboard7's rider, DSST wakeboard10's too, and
-DSST's boat1 centre drifts 15-25 px off the 155x319 px boat; OpenCV's KCF scores 0.405). Six sequences are few: a last-bit change in a feature moved a
+DSST's boat1 centre drifts 15-25 px off the 155x319 px boat; OpenCV's KCF scores 0.405). 0.8
+ships the authors' details (docs/results.md, "Defaults decided by evidence"): DR²Track 0.959,
+STRCF 0.962, BACF 0.721 (the authors' BACF loses both trucks here), and the floors follow
+the lowest measured. Six sequences are few: a last-bit change in a feature moved a
 tracker's mean by up to ±0.05 (measured), hence the margins, and no test of the ranking between
 trackers.
 """
@@ -15,7 +18,7 @@ import dcfkit
 from dcfkit.analysis.metrics import average, score_sequence
 from dcfkit.datasets import load_dataset
 
-FLOORS = {"dr2track": 0.88, "strcf": 0.81, "bacf": 0.90, "kcf": 0.48, "dsst": 0.27}  # measured minus ~0.08
+FLOORS = {"dr2track": 0.88, "strcf": 0.81, "bacf": 0.64, "kcf": 0.48, "dsst": 0.27}  # measured minus ~0.08
 
 
 @pytest.fixture(scope="module")
