@@ -72,9 +72,9 @@ class Evaluator:
         seqs = [self.sequences[n] for n in names]
         per_experiment = []
         for e, tasks in self._tasks(config, names).items():
-            folder = tasks[0].folder
-            done = [t.seq for t in tasks if ResultStore(folder).is_done(t.seq, t.key)]
-            results = ResultStore(folder).load(done) if done else {}
+            store = ResultStore(tasks[0].folder)
+            done = [t.seq for t in tasks if store.is_done(t.seq, t.key)]
+            results = store.load(done) if done else {}
             scored = evaluate({"trial": results}, seqs, protocol=self.protocol, experiment=e, runs=self.runs[e])
             per_experiment.append({row["sequence"]: row for row in scored.per_sequence})
         return {n: {k: _mean([rows[n][k] for rows in per_experiment]) for k in ("auc", "precision")}

@@ -68,7 +68,7 @@ class PyFFTW:
         return plan().copy()
 
 
-class FullSpectra:
+class FullSpectra(ScipyFFT):
     """Whole complex spectra (..., H, W) in place of half ones, with scipy.fft: ``rfft2`` is fft2
     and ``irfft2`` the complex ifft2 (callers needing a real map take its real part). As DR²Track's
     code computes: shift_sample's Nyquist frequency (+N/2) makes the shifted sample complex, and
@@ -76,11 +76,6 @@ class FullSpectra:
 
     name = "full"
     full = True
-
-    def __init__(self):
-        import scipy.fft  # lazy, as ScipyFFT's
-
-        self._fft = scipy.fft
 
     def rfft2(self, x: np.ndarray) -> np.ndarray:
         return self._fft.fft2(x, axes=(-2, -1), workers=1)

@@ -13,9 +13,14 @@ import numpy as np
 from dcfkit.numerics.fft import multiply
 
 
+def response_spectra(hf: np.ndarray, sf: np.ndarray) -> np.ndarray:
+    """The spectra of Eq. (12)'s responses: sum over channels of conj(ĥ) ẑ, (..., H, Wr)."""
+    return np.einsum("chw,...chw->...hw", hf.conj(), sf)
+
+
 def response(hf: np.ndarray, sf: np.ndarray, shape: tuple[int, int], fft) -> np.ndarray:
     """Eq. (12): (C, H, Wr) filter and (..., C, H, Wr) samples -> (..., H, W) float32 response."""
-    return np.real(fft.irfft2(np.einsum("chw,...chw->...hw", hf.conj(), sf), shape)).astype(np.float32, copy=False)
+    return np.real(fft.irfft2(response_spectra(hf, sf), shape)).astype(np.float32, copy=False)
 
 
 def _moments(spectrum, ey, ex, fy, fx) -> tuple[complex, ...]:

@@ -35,7 +35,7 @@ from dcfkit.numerics.patches import (
     sampler,
     whole_pixel_sampler,
 )
-from dcfkit.numerics.response import newton_peak, shift_spectrum, subpixel_peak
+from dcfkit.numerics.response import newton_peak, response_spectra, shift_spectrum, subpixel_peak
 from dcfkit.registry import get_registry
 from dcfkit.tracker.checks import (
     check_box,
@@ -216,12 +216,11 @@ class Tracker:
         """θ of this frame's training (0 without a temporal term; ``inf``: keep the last filter)."""
         return 0.0 if self.temporal is None else float(self.temporal.weight(detection))
 
-    def _peak(self, maps: np.ndarray, samples: np.ndarray | None = None) -> tuple[int, float, float]:
+    def _peak(self, maps: np.ndarray, samples: np.ndarray) -> tuple[int, float, float]:
         """The search scale whose response is best and its peak as a (dy, dx) offset in cells."""
         if self.params.peak == "newton":
-            spectra = None  # whole spectra: resp_newton's, Σ conj(ĥ) ẑ as computed (not fft2 of the real map)
-            if self.fft.full and samples is not None:
-                spectra = np.einsum("chw,schw->shw", self.hf.conj(), samples)
+            # whole spectra: resp_newton refines on the response spectra as computed, not fft2 of the real map
+            spectra = response_spectra(self.hf, samples) if self.fft.full else None
             best, dy, dx, _ = newton_peak(maps, self.params.newton_iterations, spectra)
             return best, dy, dx
         best = int(np.argmax(maps.reshape(len(maps), -1).max(axis=1)))
