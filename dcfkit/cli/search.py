@@ -6,6 +6,7 @@ import dataclasses
 import sys
 from pathlib import Path
 
+from dcfkit.ablation.experiment import check_experiment
 from dcfkit.cli.common import add_protocol_argument
 from dcfkit.config import shipped_config_dir
 from dcfkit.errors import DcfkitError
@@ -23,6 +24,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="benchmark root folder (default: the spec's dataset.root, relative to the spec)")
     parser.add_argument("--trials", type=int, default=None,
                         help="trials per study (default: the spec's 'trials'); a rerun with more adds trials")
+    parser.add_argument("--experiments", default=None, metavar="LIST",
+                        help="the objective's experiments, comma-separated, e.g. ope (default: the spec's "
+                             "'experiments'); recorded, so a rerun must give the same")
     parser.add_argument("--jobs", type=int, default=None,
                         help="worker processes for each trial's runs (default: the usable cores)")
     parser.add_argument("--executor", choices=("local", "dask"), default=None,
@@ -52,9 +56,18 @@ def run(args: argparse.Namespace) -> int:
         if args.trials < 1:
             raise DcfkitError(f"--trials must be >= 1, got {args.trials}")
         spec = dataclasses.replace(spec, trials=args.trials)
+    if args.experiments is not None:
+        spec = dataclasses.replace(spec, experiments=_experiments(args.experiments))
     search = Search(spec, args.out, {"protocol": args.protocol, "jobs": jobs, "executor": executor,
                                      "scheduler": args.scheduler},
                     report=lambda line: print(line, file=sys.stderr, flush=True))
     summary = search.run()
     print("\n".join(summary_lines(summary)))
     return 0
+
+
+def _experiments(text: str) -> tuple[str, ...]:
+    names = [e.strip() for e in text.split(",") if e.strip()]
+    if not names:
+        raise DcfkitError(f"--experiments: expected names such as ope,tre, got {text!r}")
+    return tuple(dict.fromkeys(check_experiment(e, "--experiments") for e in names))

@@ -172,6 +172,25 @@ def test_a_rerun_resumes_and_more_trials_extend_the_studies(tmp_path, data, caps
     assert "records a different search (these differ: folds, seed)" in capsys.readouterr().err
 
 
+def test_experiments_on_the_command_line_replace_the_specs_and_are_recorded(tmp_path, capsys):
+    data = tmp_path / "data"
+    for i, name in enumerate(("seqA", "seqB", "seqC", "seqD")):
+        write_otb(data, name, seed=i, n_frames=22)  # long enough for the spec's TRE to be read
+    spec = write(tmp_path / "s.yaml", SPEC.replace("trials: 3", "trials: 1\nexperiments: [tre]"))
+    out = tmp_path / "out"
+    assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1", "--experiments", "ope"]) == 0
+    rec = json.loads((out / "trials/all/0000.json").read_text())
+    seqs = load_dataset("otb", data)
+    scored = evaluate({"t": ResultStore(out / "jobs/otb" / rec["key"]).load(seqs)}, seqs)
+    assert rec["value"] == pytest.approx(np.mean([r["auc"] for r in scored.per_sequence]))
+    assert not (out / "jobs/otb" / rec["key"] / "tre").exists()  # the spec's TRE was not run
+    capsys.readouterr()
+    assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1"]) != 0  # the spec's tre
+    assert "these differ: experiments" in capsys.readouterr().err
+    assert cli.main(["search", str(spec), "--out", str(out), "--experiments", "ope,opt"]) != 0
+    assert "--experiments: expected one of ope, tre, sre, got 'opt'" in capsys.readouterr().err
+
+
 @pytest.mark.slow
 def test_a_search_killed_with_sigkill_resumes_to_the_same_result(tmp_path, data):
     spec = write(tmp_path / "s.yaml", SPEC)
