@@ -47,6 +47,10 @@ class TrackerParams:
                       "steps, the scale with the highest refined value)", choices=("bounded_newton", "newton"))
     translation: str = param("exact", "'exact', or 'whole_pixel': the displacement rounded to whole image pixels "
                              "(BACF's and DR²Track's translation_vec)", choices=("exact", "whole_pixel"))
+    scale_limits: str = param("exact", "the smallest and largest scale: 'exact' the ratios themselves (the search "
+                              "region keeps 5 cells, the target fits the image); 'step_powers' those rounded "
+                              "inwards to whole powers of the scale estimator's step, as the authors' STRCF, BACF, "
+                              "ARCF, AutoTrack and DR²Track", choices=("exact", "step_powers"))
     clamp_position: bool = param(True, "keep the target centre on the image (the authors' codes do not)")
     box_output: str = param("exact", "the reported box: 'exact' x = cx - (w-1)/2 with the exact size; "
                             "'rounded' the same rounded to whole 1-based pixels (STRCF's report_tracking_result); "

@@ -104,6 +104,13 @@ class Tracker:
     def _sample(self, image: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
         return self._spectrum(self._patch(image, centre, scale))
 
+    def _limit_step(self) -> float | None:
+        """The step the scale limits are whole powers of (``tracker.scale_limits``), if any: the
+        scale estimator's, as the authors' codes take their scale search's."""
+        if self.params.scale_limits != "step_powers":
+            return None
+        return getattr(getattr(self.scale_estimator, "params", None), "step", None)
+
     def _blank(self, pixels: np.ndarray) -> float | None:
         """The standard deviation of the pixel values (RMS over colour channels) if it is below
         ``blank_std``, else None."""
@@ -122,7 +129,7 @@ class Tracker:
             target = np.floor(target)
             centre = np.floor(box[[1, 0]] + np.floor(target / 2))
         g, scale = geometry(self.params, target, given if self.params.init_area == "given" else target)
-        limits = scale_limits(g.base_target, g.sample_size, image.shape, initial=scale)
+        limits = scale_limits(g.base_target, g.sample_size, image.shape, initial=scale, step=self._limit_step())
         scale = float(np.clip(scale, *limits))
         check_first_frame(self, image.shape, centre, g, scale, box)
         patch = self._patch(image, centre, scale, g)

@@ -331,6 +331,24 @@ def test_first_frame_geometry_label_and_window_hand_computed(config, scale, cell
     np.testing.assert_allclose(tracker.w2, np.where(inside, 1e-6, 1e10), rtol=1e-6)
 
 
+@pytest.mark.parametrize("config, step", [("strcf", 1.01), ("dr2track", 1.03), ("kcf", None)])
+def test_scale_limits_step_powers_rounds_the_exact_limits_by_the_estimators_step(config, step, sequence):
+    """tracker.scale_limits: step_powers is the exact limits rounded inwards to powers of the scale
+    estimator's step (the pyramid's 1.01, the DSST's 1.03); a fixed scale has no step to round by."""
+    limits = {}
+    for rule in ("exact", "step_powers"):
+        tracker = dcfkit.load_tracker(config, tracker__scale_limits=rule, tracker__clamp_position=True)
+        tracker.init(sequence.frames[0], sequence.ground_truth[0])
+        limits[rule] = tracker.limits
+    lo, hi = limits["exact"]
+    if step is None:
+        assert limits["step_powers"] == limits["exact"]
+        return
+    assert limits["step_powers"] == (step ** np.ceil(np.log(lo) / np.log(step)),
+                                     step ** np.floor(np.log(hi) / np.log(step)))
+    assert lo <= limits["step_powers"][0] < lo * step and hi / step < limits["step_powers"][1] <= hi
+
+
 class _RecordingScale:
     """Stands in for the scale estimator: keeps the scale and records where it was asked to look."""
 

@@ -70,11 +70,16 @@ def check_span(n: int, step: float) -> str | None:
 
 
 def scale_limits(base_target: np.ndarray, base_region: np.ndarray, image_shape, initial: float | None = None,
-                 min_pixels: float = 5.0) -> tuple[float, float]:
+                 min_pixels: float = 5.0, step: float | None = None) -> tuple[float, float]:
     """(min, max) scale: the search region keeps ≥ ``min_pixels`` px; the target fits in the image,
-    unless it is larger at the ``initial`` scale (a box longer than the image keeps its size)."""
+    unless it is larger at the ``initial`` scale (a box longer than the image keeps its size).
+    With a ``step``, each limit is rounded inwards to a whole power of it, as the authors' codes
+    do (``scale_step ^ ceil(log(max(5 ./ sz)) / log(scale_step))``, ``floor`` for the largest)."""
     lo = np.max(min_pixels / np.asarray(base_region, dtype=float))
     hi = np.min(np.asarray(image_shape[:2], dtype=float) / np.asarray(base_target, dtype=float))
+    if step is not None:
+        lo = step ** math.ceil(math.log(lo) / math.log(step))
+        hi = step ** math.floor(math.log(hi) / math.log(step))
     if initial is not None:
         hi = max(hi, initial)
     return float(lo), float(max(hi, lo))

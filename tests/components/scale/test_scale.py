@@ -47,6 +47,16 @@ def test_pyramid_factors_and_limits():
     assert lo == pytest.approx(0.25) and hi == pytest.approx(18.0)
 
 
+def test_limits_rounded_inwards_to_whole_powers_of_the_step():
+    """The authors' rule: min 1.03^ceil(log(0.05)/log(1.03)) = 1.03^-101 (log ratio -101.35),
+    max 1.03^floor(log(24)/log(1.03)) = 1.03^107 (107.51): each within one step inside."""
+    lo, hi = scale_limits(np.array([10.0, 20.0]), np.array([100.0, 100.0]), (360, 480), step=1.03)
+    assert lo == 1.03 ** -101 and hi == 1.03 ** 107
+    assert 0.05 <= lo < 0.05 * 1.03 and 24.0 / 1.03 < hi <= 24.0
+    lo, hi = scale_limits(np.array([10.0, 20.0]), np.array([100.0, 100.0]), (360, 480), initial=30.0, step=1.03)
+    assert hi == 30.0  # a target larger than the image at its start keeps its size, as without a step
+
+
 def test_dsst_model_update_keeps_the_size_while_the_appearance_changes():
     """The scale model is a running average of the scale samples (``learning_rate``), so it
     follows a target whose appearance changes: here the texture of the target and its
