@@ -118,7 +118,7 @@ def load_search_spec(source: str | os.PathLike, root: str | os.PathLike | None =
         experiments = [experiments]
     if not isinstance(experiments, list) or not experiments:
         raise ConfigError(f"{path}: experiments: expected a list such as [ope, tre], got {shown(experiments)}")
-    experiments = tuple(dict.fromkeys(check_experiment(e, f"{path}: experiments") for e in experiments))
+    experiments = check_experiments(experiments, f"{path}: experiments")
     baselines = {str(name): load_spec_config(path, cfg, {}, f"baselines.{clip(str(name))}",
                                              f"baselines.{clip(str(name))}")[0]
                  for name, cfg in as_mapping(data.get("baselines"), f"{path}: baselines",
@@ -188,6 +188,11 @@ def _parse_parameter(where: str, key: str, entry: Any, earlier: Mapping[str, Par
             raise ConfigError(f"{where}.int: expected whole numbers, got {shown(values)}")
         return Parameter(key, IntDistribution(values[0], values[1], log=log), when=when)
     return Parameter(key, FloatDistribution(float(values[0]), float(values[1]), log=log), when=when)
+
+
+def check_experiments(names: list, where: str) -> tuple[str, ...]:
+    """The objective's experiments: each one an ablation can run, repeats dropped."""
+    return tuple(dict.fromkeys(check_experiment(e, where) for e in names))
 
 
 def _label(value: Any) -> str:

@@ -6,7 +6,6 @@ import dataclasses
 import sys
 from pathlib import Path
 
-from dcfkit.ablation.experiment import check_experiment
 from dcfkit.cli.common import add_protocol_argument
 from dcfkit.config import shipped_config_dir
 from dcfkit.errors import DcfkitError
@@ -43,6 +42,7 @@ def run(args: argparse.Namespace) -> int:
     except ImportError:
         raise DcfkitError("dcfkit search needs Optuna: pip install 'dcfkit[search]'") from None
     from dcfkit.autosearch import Search, load_search_spec  # lazy: it imports Optuna
+    from dcfkit.autosearch.space import check_experiments  # lazy: as dcfkit.autosearch
     from dcfkit.autosearch.summary import summary_lines  # lazy: as dcfkit.autosearch
 
     executor = args.executor or ("dask" if args.scheduler else "local")
@@ -57,17 +57,13 @@ def run(args: argparse.Namespace) -> int:
             raise DcfkitError(f"--trials must be >= 1, got {args.trials}")
         spec = dataclasses.replace(spec, trials=args.trials)
     if args.experiments is not None:
-        spec = dataclasses.replace(spec, experiments=_experiments(args.experiments))
+        names = [e.strip() for e in args.experiments.split(",") if e.strip()]
+        if not names:
+            raise DcfkitError(f"--experiments: expected names such as ope,tre, got {args.experiments!r}")
+        spec = dataclasses.replace(spec, experiments=check_experiments(names, "--experiments"))
     search = Search(spec, args.out, {"protocol": args.protocol, "jobs": jobs, "executor": executor,
                                      "scheduler": args.scheduler},
                     report=lambda line: print(line, file=sys.stderr, flush=True))
     summary = search.run()
     print("\n".join(summary_lines(summary)))
     return 0
-
-
-def _experiments(text: str) -> tuple[str, ...]:
-    names = [e.strip() for e in text.split(",") if e.strip()]
-    if not names:
-        raise DcfkitError(f"--experiments: expected names such as ope,tre, got {text!r}")
-    return tuple(dict.fromkeys(check_experiment(e, "--experiments") for e in names))
