@@ -14,8 +14,11 @@ VOT2016 (MATLAB) toolkit computes them (``estimate_accuracy.m``,
 * **EAO**: each start begins a fragment that runs to the next start (its overlap 0 from the
   failure on, and after its end) or, the last, to the sequence's end (nothing after it).
   ``Φ(Ns)`` is the mean over the fragments that reach length ``Ns`` (padded ones always) of
-  their mean overlap over the ``Ns - 1`` frames after the start; the EAO is the mean of
-  ``Φ(Ns)`` for ``Ns`` in ``[low, high]``, both included (:func:`eao_interval`).
+  their mean overlap over the ``Ns - 1`` frames after the start (``Φ(1)`` is 1, as the toolkit
+  defines it: no frame after the start); the EAO is the mean of ``Φ(Ns)`` for ``Ns`` in
+  ``[low, high]``, both included (:func:`eao_interval`). An interval of ``Ns = 1`` alone (one-frame
+  sequences) averages no tracked frame: its EAO is NaN, where the toolkit's definition of ``Φ(1)``
+  gives 1 (and the VOT Python toolkit's, 0).
 """
 from __future__ import annotations
 
@@ -152,7 +155,9 @@ def _mean_phi(phi: np.ndarray) -> float:
 
 
 def eao(runs: Sequence[ResetRun], interval: tuple[int, int]) -> float:
-    """The mean of ``Φ(Ns)`` over ``Ns`` in ``interval`` (both ends included)."""
+    """The mean of ``Φ(Ns)`` over ``Ns`` in ``interval`` (both ends included); NaN for ``(1, 1)``."""
+    if interval[1] < 2:
+        return math.nan  # no frame tracked: Φ(1) is 1 by definition, not by a tracker
     return _mean_phi(expected_overlaps(runs, range(interval[0], interval[1] + 1)))
 
 
@@ -160,6 +165,8 @@ def _eao_with_ci(runs: Sequence[ResetRun], interval: tuple[int, int]) -> tuple[f
     """(the EAO, its percentile bootstrap interval over sequences) with statistics' settings,
     from one pass over the runs; the interval of the resamples that have an EAO (one of
     sequences all shorter than the interval has none)."""
+    if interval[1] < 2:
+        return eao(runs, interval), math.nan, math.nan
     total, count = _run_sums(runs, np.arange(interval[0], interval[1] + 1))
     point = _mean_phi(_phi(total.sum(axis=0), count.sum(axis=0)))
     if len(runs) < 2:
@@ -173,6 +180,7 @@ def _eao_with_ci(runs: Sequence[ResetRun], interval: tuple[int, int]) -> tuple[f
         warnings.simplefilter("ignore", (stats.DegenerateDataWarning, RuntimeWarning))
         found = stats.bootstrap((np.arange(len(runs)),), statistic, confidence_level=statistics.CONFIDENCE,
                                 n_resamples=statistics.RESAMPLES, method="percentile", vectorized=True,
+                                batch=max(1, statistics.BATCH // total.size),  # memory O(runs), not O(resamples runs)
                                 rng=np.random.default_rng(statistics.SEED)).bootstrap_distribution
     found = found[np.isfinite(found)]  # scipy's percentile interval is NaN if one resample is: those are left out
     if not found.size:

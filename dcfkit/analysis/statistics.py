@@ -10,15 +10,15 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import warnings
 from typing import Sequence
 
 import numpy as np
-from scipy import stats
+from scipy import special, stats
 
 CONFIDENCE = 0.95
 RESAMPLES = 10_000
 SEED = 0
+BATCH = 2 ** 21  # indices drawn at a time by the bootstrap (16 MiB): memory O(n), not O(RESAMPLES n)
 METHOD = (f"{CONFIDENCE:.0%} BCa bootstrap confidence intervals over sequences ({RESAMPLES:,} resamples, "
           f"seed {SEED}); paired differences A - B per sequence with the two-sided Wilcoxon signed-rank p "
           f"(zero differences dropped)")
@@ -100,20 +100,43 @@ def _finite(values: Sequence[float]) -> np.ndarray:
 
 
 def _bootstrap(x: np.ndarray) -> tuple[float, float]:
-    """The BCa interval of the mean of ``x``: NaN for one value, the value itself when all are
-    equal (no spread to resample)."""
+    """The BCa interval of the mean of ``x``, as ``scipy.stats.bootstrap(method="BCa")`` gives it
+    with this module's settings, else (BCa undefined) its percentile interval: NaN for one
+    value, the value itself when all are equal (no spread to resample)."""
     if len(x) < 2:
         return math.nan, math.nan
     if np.all(x == x[0]):
         return float(x[0]), float(x[0])
-    with warnings.catch_warnings():  # a few distinct values make BCa's acceleration degenerate: NaN, said below
-        warnings.simplefilter("ignore", stats.DegenerateDataWarning)
-        ci = stats.bootstrap((x,), np.mean, confidence_level=CONFIDENCE, n_resamples=RESAMPLES, method="BCa",
-                             rng=np.random.default_rng(SEED)).confidence_interval
-    if not (np.isfinite(ci.low) and np.isfinite(ci.high)):  # BCa undefined: the percentile interval
-        ci = stats.bootstrap((x,), np.mean, confidence_level=CONFIDENCE, n_resamples=RESAMPLES,
-                             method="percentile", rng=np.random.default_rng(SEED)).confidence_interval
-    return float(ci.low), float(ci.high)
+    means = _bootstrap_means(x)
+    alpha = (1 - CONFIDENCE) / 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ci = stats.quantile(means, np.array(_bca_levels(x, means, alpha)))
+    if not np.all(np.isfinite(ci)):  # BCa undefined: the percentile interval (scipy's draws the same resamples)
+        ci = stats.quantile(means, np.array([alpha, 1 - alpha]))
+    return float(ci[0]), float(ci[1])
+
+
+def _bootstrap_means(x: np.ndarray) -> np.ndarray:
+    """``(RESAMPLES,)`` means of resamples of ``x``: scipy.stats.bootstrap's draws (one
+    ``integers(0, n, (RESAMPLES, n))`` of a generator seeded ``SEED``), drawn in batches of rows
+    so that memory stays O(n) (the draws come out the same, row after row)."""
+    rng, n = np.random.default_rng(SEED), len(x)
+    rows = max(1, BATCH // n)
+    return np.concatenate([np.mean(x[rng.integers(0, n, (min(rows, RESAMPLES - k), n))], axis=-1)
+                           for k in range(0, RESAMPLES, rows)])
+
+
+def _bca_levels(x: np.ndarray, means: np.ndarray, alpha: float) -> tuple[float, float]:
+    """The BCa levels (alpha_1, alpha_2) of Efron & Tibshirani (1993) Eq. (14.10), (14.14)-(14.15),
+    computed as scipy's ``_bca_interval``, with the jackknife means of a mean in closed form:
+    mean + (mean - x_i) / (n - 1), not n resamples of n - 1 values."""
+    n, mean = len(x), np.mean(x)
+    z0 = special.ndtri((np.count_nonzero(means < mean) + np.count_nonzero(means <= mean)) / (2 * len(means)))
+    jackknife = mean + (mean - x) / (n - 1)
+    u = (n - 1) * (np.mean(jackknife) - jackknife)
+    a = 1 / 6 * (np.sum(u ** 3) / n ** 3) / (np.sum(u ** 2) / n ** 2) ** (3 / 2)
+    z = float(special.ndtri(alpha))
+    return tuple(float(special.ndtr(z0 + (z0 + zk) / (1 - a * (z0 + zk)))) for zk in (z, -z))
 
 
 def versus_baseline(per_sequence: Sequence[dict], trackers: Sequence[str], keys: Sequence[str],
@@ -124,8 +147,9 @@ def versus_baseline(per_sequence: Sequence[dict], trackers: Sequence[str], keys:
 
     ``per_sequence`` rows have ``tracker``, ``sequence`` and the scores. Returns plain data:
     ``method``, ``correction``, ``baseline``, ``sequences`` (how many), ``means`` (tracker ->
-    score -> :class:`Interval`) and ``differences`` (tracker -> score -> :class:`Difference`
-    with ``holm_p`` and ``significant``).
+    score -> :class:`Interval`), ``differences`` (tracker -> score -> :class:`Difference`
+    with ``holm_p`` and ``significant``) and ``non_finite`` (tracker -> score -> the sequences
+    left out of its mean and differences for a non-finite score; only those with any).
     """
     baseline = baseline if baseline is not None else trackers[0]
     table: dict[str, dict[str, dict]] = {t: {} for t in trackers}
@@ -140,6 +164,10 @@ def versus_baseline(per_sequence: Sequence[dict], trackers: Sequence[str], keys:
         found = [paired_difference(scores[t][key], scores[baseline][key]) for t in others]
         for t, d, p in zip(others, found, holm([d.wilcoxon_p for d in found])):
             differences[t][key] = {**d.as_record(), "holm_p": p, "significant": bool(p < 0.05)}
+    non_finite = {t: {k: [s for s, bad in zip(shared, ~np.isfinite(np.asarray(scores[t][k], dtype=float))) if bad]
+                      for k in keys} for t in trackers}
     return {"method": METHOD, "correction": HOLM, "baseline": baseline, "sequences": len(shared),
             "means": {t: {k: mean_interval(scores[t][k]).as_record() for k in keys} for t in trackers},
-            "differences": differences}
+            "differences": differences,
+            "non_finite": {t: {k: v for k, v in found.items() if v} for t, found in non_finite.items()
+                           if any(found.values())}}

@@ -110,3 +110,17 @@ def test_the_eao_interval_leaves_out_resamples_without_an_eao():
     scores = score_resets({"t": {"s": short, "l": long}}, {"s": 20, "l": 40}, interval=(25, 30))
     row = scores["overall"][0]
     assert row["eao"] == 1.0 and row["eao_ci_low"] == row["eao_ci_high"] == 1.0
+
+
+def test_one_frame_sequences_have_no_eao():
+    """Nothing is tracked in a one-frame sequence (frame 1 is the start): the interval is Ns = 1
+    alone, whose Φ the VOT2016 toolkit sets to 1 by definition (estimate_expected_overlap.m, "do not
+    calculate for Ns == 1"), and the VOT Python toolkit to 0; neither is a tracker's overlap."""
+    gt = np.array([GT_BOX])
+    nothing = ResetRun(np.full((1, 4), np.nan), gt, (0,), ())
+    scores = score_resets({"t": {"s": nothing, "r": nothing}}, {"s": 1, "r": 1})
+    assert scores["interval"] == [1, 1]
+    row = scores["overall"][0]
+    assert np.isnan(row["eao"]) and np.isnan(row["eao_ci_low"]) and np.isnan(row["eao_ci_high"])
+    assert expected_overlaps([nothing], [1])[0] == 1.0  # the toolkit's Φ(1), kept for longer intervals
+    assert eao([one_failure()], (1, 2)) == pytest.approx((1 + 1) / 2)
