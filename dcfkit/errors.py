@@ -53,6 +53,12 @@ def shown(value: Any) -> str:
     return clip(text)
 
 
+def printable(value: Any) -> str:
+    """``str(value)`` with each character that is not printable (a line break, an escape) as its
+    Python escape: one line, whatever a folder name or environment value holds."""
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode() for c in str(value))
+
+
 def clip(text: str) -> str:
     """``text`` cut to at most :data:`SHOWN_CHARS` characters (a key or path from a config, for a message)."""
     return text if len(text) <= SHOWN_CHARS else text[:SHOWN_CHARS - 3] + "..."

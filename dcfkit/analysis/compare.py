@@ -19,12 +19,16 @@ per-sequence IoUs with equal weights. Sequences found in only one folder, in bot
 in the dataset, or whose dcfkit sidecar says the file is damaged, are listed in ``left_out``.
 ``platforms`` lists each folder's platforms as their sidecars record them
 (:mod:`dcfkit.running.platforms`; "not recorded" for files without one) and ``platform_differences``
-what differs between the two: boxes from different platforms can part where a float decision
-is close (docs/architecture.md).
+what differs between the two files of a sequence, each with its count of sequences unless all have
+it (ten lines at most, then a count of the others): boxes from different platforms can part where a
+float decision is close (docs/architecture.md). A sequence with a non-finite score (no frame
+counted) is named in ``non_finite`` and left out of that score's statistics.
 """
 from __future__ import annotations
 
+import collections
 import logging
+import math
 from pathlib import Path
 from typing import Iterable
 
@@ -121,27 +125,27 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
                          first_divergence(a, b, divergence_px)))
     mean = _row("mean", sum(r["frames"] for r in rows), metrics.average(scores, protocol=proto),
                 metrics.average(scores_ref, protocol=proto), float(np.mean([r["iou"] for r in rows])), None)
-    ours_platforms = _distinct(our_platforms[s.name] for s in both)
-    theirs_platforms = _distinct(their_platforms[s.name] for s in both)
     return {"protocol": proto.name, "divergence_px": float(divergence_px), "results": str(results),
             "reference": str(reference), "rows": rows, "mean": mean, **score_statistics(rows),
             "noise_floor": noise_floor(rows),
             "diverged": sum(r["diverges_at"] is not None for r in rows), "left_out": left_out,
-            "platforms": {"results": sorted({platforms.describe(p) for p in ours_platforms}),
-                          "reference": sorted({platforms.describe(p) for p in theirs_platforms})},
-            "platform_differences": sorted({d for a in ours_platforms for b in theirs_platforms
-                                            for d in platforms.differences(a, b)})}
+            "platforms": {side: _counted((platforms.describe(records[s.name]) for s in both), len(both))
+                          for side, records in (("results", our_platforms), ("reference", their_platforms))},
+            "platform_differences": _counted((d for s in both for d in set(
+                platforms.differences(our_platforms[s.name], their_platforms[s.name]))), len(both))}
 
 
 def score_statistics(rows: list[dict]) -> dict:
-    """Per score (AUC, precision): each folder's mean with its interval, and the paired
-    difference results - reference (:mod:`dcfkit.analysis.statistics`); the AUC's and the
-    precision's difference and Wilcoxon p also at the top level, for scripts."""
+    """Per score (AUC, precision): each folder's mean with its interval, the paired difference
+    results - reference (:mod:`dcfkit.analysis.statistics`) and ``non_finite``, the sequences
+    left out of them for a non-finite score in either folder; the AUC's and the precision's
+    difference and Wilcoxon p also at the top level, for scripts."""
     found = {}
     for score in ("auc", "precision"):
         ours, theirs = [r[score] for r in rows], [r[f"{score}_ref"] for r in rows]
         found[score] = {"results": mean_interval(ours).as_record(), "reference": mean_interval(theirs).as_record(),
-                        "difference": paired_difference(ours, theirs).as_record()}
+                        "difference": paired_difference(ours, theirs).as_record(),
+                        "non_finite": _non_finite(rows, f"d_{score}")}
     pick = lambda d: {k: d[k] for k in ("mean", "ci_low", "ci_high")}  # noqa: E731
     return {"statistics": {"method": METHOD, **found},
             "auc_difference": pick(found["auc"]["difference"]), "wilcoxon_p": found["auc"]["difference"]["wilcoxon_p"],
@@ -152,20 +156,31 @@ def score_statistics(rows: list[dict]) -> dict:
 def noise_floor(rows: list[dict]) -> dict:
     """The measured :data:`PLATFORM_NOISE` beside ``rows``' AUC differences: ``exceeds`` when
     the mean difference is beyond the most the platform moved a single sequence (which bounds
-    what it can do to any mean), and the sequences whose difference is beyond that."""
+    what it can do to any mean; None, no verdict, when no difference is finite), and the
+    sequences whose difference is beyond that. The mean is over the finite differences; the
+    sequences left out are ``non_finite``."""
     floor = PLATFORM_NOISE["auc_sequence"]
-    mean = float(np.mean([r["d_auc"] for r in rows])) if rows else float("nan")
+    finite = [r["d_auc"] for r in rows if math.isfinite(r["d_auc"])]
+    mean = float(np.mean(finite)) if finite else math.nan
     beyond = [r["sequence"] for r in rows if abs(r["d_auc"]) > floor]
-    return {**PLATFORM_NOISE, "mean_auc_difference": mean, "exceeds": bool(abs(mean) > floor),
-            "sequences_beyond": beyond}
+    return {**PLATFORM_NOISE, "mean_auc_difference": mean, "exceeds": bool(abs(mean) > floor) if finite else None,
+            "sequences_beyond": beyond, "non_finite": _non_finite(rows, "d_auc")}
 
 
-def _distinct(records: Iterable) -> list:
-    """The different records, each once (dicts: not hashable)."""
-    out = []
-    for record in records:
-        if record not in out:
-            out.append(record)
+def _non_finite(rows: list[dict], key: str) -> list[str]:
+    """The sequences of ``rows`` whose ``key`` (a difference: non-finite if either score is) is not finite."""
+    return [r["sequence"] for r in rows if not math.isfinite(r[key])]
+
+
+def _counted(lines: Iterable[str], total: int, limit: int = 10) -> list[str]:
+    """The different ``lines`` (each at most once per sequence, of ``total``), most frequent
+    first, each with its count of sequences unless every sequence has it; at most ``limit`` of
+    them and a last line counting the others (one line per sequence would be thousands)."""
+    found = collections.Counter(lines)
+    ranked = sorted(found.items(), key=lambda item: (-item[1], item[0]))
+    out = [line if n == total else f"{line} ({n:,} of {total:,} sequences)" for line, n in ranked[:limit]]
+    if len(ranked) > limit:
+        out.append(f"and {len(ranked) - limit:,} more")
     return out
 
 

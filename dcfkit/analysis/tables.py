@@ -8,7 +8,7 @@ from typing import Mapping
 from typing import Sequence as Seq
 
 from dcfkit.analysis.latex import latex_table
-from dcfkit.errors import shown
+from dcfkit.errors import printable, shown
 from dcfkit.protocols import DEFAULT, Protocol, get_protocol
 
 _TABLES = {  # the columns before and after a protocol's scores (Protocol.score_keys)
@@ -39,7 +39,7 @@ def _cell(key: str, value, full: bool = False) -> str:
     if full:
         return str(value)
     # a sequence or tracker is named by a folder, whose name may hold a line break or a '|'
-    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode() for c in str(value))
+    return printable(value)
 
 
 def format_rows(rows: Seq[Mapping], fmt: str = "table", columns: Seq[str] | None = None) -> str:
@@ -81,6 +81,8 @@ def _is_number(value) -> bool:
 
 
 #: how scores are named in text (a score key of :class:`~dcfkit.protocols.Protocol` -> its name)
+NAMES_SHOWN = 10  # the most sequence names a line lists (a benchmark may have 30,000)
+
 SCORE_LABELS = {"ao": "AO", "sr50": "SR@0.5", "sr75": "SR@0.75", "auc": "AUC", "precision": "precision",
                 "norm_precision": "normalized precision"}
 
@@ -115,7 +117,8 @@ def interval_text(interval: Mapping, signed: bool = False) -> str:
 
 def comparison_lines(statistics: Mapping, names: tuple[str, str] = ("results", "reference")) -> list[str]:
     """One line per score of :func:`dcfkit.analysis.compare.score_statistics`: both means with
-    their intervals, the difference with its interval, the Wilcoxon p and won/lost/tied."""
+    their intervals, the difference with its interval, the Wilcoxon p and won/lost/tied, and
+    the sequences left out for a non-finite score."""
     lines = [f"statistics: {statistics['method']}"]
     for score in ("auc", "precision"):
         s = statistics[score]
@@ -124,29 +127,51 @@ def comparison_lines(statistics: Mapping, names: tuple[str, str] = ("results", "
                      f"{names[1]} {interval_text(s['reference'])}   difference {interval_text(d, signed=True)}   "
                      f"Wilcoxon p {d['wilcoxon_p']:.3g}   won {d['won']}, lost {d['lost']}, tied {d['tied']} "
                      f"of {d['n']}")
+        if s.get("non_finite"):
+            lines.append(f"  {'':<9} left out, {non_finite_text(s['non_finite'], SCORE_LABELS.get(score, score))}")
     return lines
 
 
+def non_finite_text(sequences: Seq[str], score: str) -> str:
+    """``a non-finite AUC (no frame counted) in 2 sequences (a, b)``, ten names at most."""
+    names = ", ".join(printable(name) for name in sequences[:NAMES_SHOWN])
+    more = f", and {len(sequences) - NAMES_SHOWN:,} more" if len(sequences) > NAMES_SHOWN else ""
+    return (f"a non-finite {score} (no frame counted) in {len(sequences):,} "
+            f"sequence{'s' if len(sequences) != 1 else ''} ({names}{more})")
+
+
 def noise_floor_line(floor: Mapping, sequences: int) -> str:
-    """What :func:`dcfkit.analysis.compare.noise_floor` found, in one sentence."""
+    """What :func:`dcfkit.analysis.compare.noise_floor` found, in one sentence (no verdict on a
+    mean that is not a number)."""
+    head = (f"noise floor: a last-bit change in the arithmetic moved one sequence by up to {floor['auc_sequence']:.3f} "
+            f"AUC and a mean of eight by up to {floor['auc_mean_of_8']:.3f} ({floor['source']}); ")
+    left = floor.get("non_finite") or []
+    if floor["exceeds"] is None:
+        return head + f"no verdict: no sequence has a finite AUC difference ({non_finite_text(left, 'AUC')})"
     verdict = "exceeds it" if floor["exceeds"] else "is within it: not a finding"
-    return (f"noise floor: a last-bit change in the arithmetic moved one sequence by up to {floor['auc_sequence']:.3f} "
-            f"AUC and a mean of eight by up to {floor['auc_mean_of_8']:.3f} ({floor['source']}); the mean AUC "
-            f"difference, {floor['mean_auc_difference']:+.3f}, {verdict}; {len(floor['sequences_beyond'])} of "
-            f"{sequences} sequences differ by more than {floor['auc_sequence']:.3f}")
+    kept = sequences - len(left)
+    over = f" over the {kept:,} sequence{'s' if kept != 1 else ''} with one (left out, {non_finite_text(left, 'AUC')})"
+    return (f"{head}the mean AUC difference{over if left else ''}, {floor['mean_auc_difference']:+.3f}, {verdict}; "
+            f"{len(floor['sequences_beyond'])} of {sequences} sequences differ by more than "
+            f"{floor['auc_sequence']:.3f}")
 
 
 def statistics_lines(statistics: Mapping) -> list[str]:
     """The statistics of :func:`dcfkit.analysis.statistics.versus_baseline` as text: each
-    tracker's means with their intervals, then each difference from the baseline ('*': significant)."""
+    tracker's means with their intervals, the sequences left out of them for a non-finite score,
+    then each difference from the baseline ('*': significant)."""
     if not statistics:
         return []
     means, width = statistics["means"], max(len(t) for t in statistics["means"])
     keys = list(next(iter(means.values())))
-    lines = [f"statistics over {statistics['sequences']} sequences: {statistics['method']}; "
-             f"{statistics['correction']}"]
+    left_out = _left_out(statistics, keys)
+    everywhere = left_out.get("every mean and difference", [])
+    over = (f"{statistics['sequences'] - len(everywhere)} of the {statistics['sequences']}" if everywhere
+            else statistics["sequences"])
+    lines = [f"statistics over {over} sequences: {statistics['method']}; {statistics['correction']}"]
     lines += [f"  {t:<{width}}  " + "   ".join(f"{SCORE_LABELS.get(k, k)} {interval_text(m[k])}" for k in keys)
               for t, m in means.items()]
+    lines += [f"  left out of {where}: {non_finite_text(names, 'score')}" for where, names in left_out.items()]
     for tracker, found in statistics["differences"].items():
         for key in keys:
             d = found[key]
@@ -154,3 +179,16 @@ def statistics_lines(statistics: Mapping) -> list[str]:
                          f"{interval_text(d, signed=True)}, Wilcoxon p {d['wilcoxon_p']:.3g} (Holm {d['holm_p']:.3g})"
                          f"{' *' if d['significant'] else ''}, won {d['won']}, lost {d['lost']}, tied {d['tied']}")
     return lines
+
+
+def _left_out(statistics: Mapping, keys: Seq[str]) -> dict[str, list[str]]:
+    """Where -> the sequences left out for a non-finite score: one entry, ``every mean and
+    difference``, when the same sequences are left out of each tracker's every score (a
+    sequence no tracker could be scored on), else one per list of sequences naming its scores."""
+    groups: dict[tuple, list[str]] = {}
+    for tracker, found in statistics.get("non_finite", {}).items():
+        for key, names in found.items():
+            groups.setdefault(tuple(names), []).append(f"{tracker}'s {SCORE_LABELS.get(key, key)}")
+    if len(groups) == 1 and len(next(iter(groups.values()))) == len(statistics["means"]) * len(keys):
+        return {"every mean and difference": list(next(iter(groups)))}
+    return {", ".join(where): list(names) for names, where in groups.items()}

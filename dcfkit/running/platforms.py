@@ -15,6 +15,8 @@ from importlib import metadata
 
 from threadpoolctl import threadpool_info
 
+from dcfkit.errors import printable
+
 try:
     from numpy._core import _multiarray_umath as _umath
 except ImportError:  # numpy 1.x
@@ -60,7 +62,8 @@ def record() -> dict:
 
 
 def describe(rec) -> str:
-    """One line of a :func:`record` (or ``"not recorded"``)."""
+    """One line of a :func:`record` (or ``"not recorded"``); characters that are not printable (a
+    line break in an environment value) escaped."""
     if not isinstance(rec, dict):
         return "not recorded"
     libs = rec.get("libraries") if isinstance(rec.get("libraries"), dict) else {}
@@ -68,22 +71,23 @@ def describe(rec) -> str:
              *(f"{k} {v}" for k, v in libs.items() if v), f"BLAS {rec.get('blas', '?')}", str(rec.get("libc", "?"))]
     switches = rec.get("switches") if isinstance(rec.get("switches"), dict) else {}
     parts += [f"{k}={v}" for k, v in switches.items()]
-    return ", ".join(parts)
+    return printable(", ".join(parts))
 
 
 def differences(a, b) -> list[str]:
     """What differs between two records, one ``"key: a -> b"`` each (libraries and switches
-    key by key); empty when either is missing or they agree."""
+    key by key, each one line as :func:`describe`'s); empty when either is missing or they agree."""
     if not isinstance(a, dict) or not isinstance(b, dict):
         return []
     out = []
     for key in ("arch", "cpu", "simd", "blas", "libc"):
         if a.get(key) != b.get(key):
-            out.append(f"{key}: {a.get(key)} -> {b.get(key)}")
+            out.append(printable(f"{key}: {a.get(key)} -> {b.get(key)}"))
     for group in ("libraries", "switches"):
         ga, gb = a.get(group) or {}, b.get(group) or {}
         if isinstance(ga, dict) and isinstance(gb, dict):
-            out += [f"{k}: {ga.get(k)} -> {gb.get(k)}" for k in sorted(set(ga) | set(gb)) if ga.get(k) != gb.get(k)]
+            out += [printable(f"{k}: {ga.get(k)} -> {gb.get(k)}") for k in sorted(set(ga) | set(gb))
+                    if ga.get(k) != gb.get(k)]
     return out
 
 

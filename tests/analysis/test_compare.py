@@ -12,6 +12,8 @@ import pytest
 from dcfkit import cli
 from dcfkit.analysis.compare import PLATFORM_NOISE, compare_folders, first_divergence, series_iou
 from dcfkit.datasets import DatasetError, Sequence
+from dcfkit.running import platforms
+from dcfkit.running.results import ResultStore
 
 GT = np.array([[10, 10, 10, 10]] * 5, dtype=float)  # 0-based in memory; files hold x + 1
 
@@ -238,3 +240,69 @@ def test_the_noise_floor_is_what_results_md_measured():
     assert f"up to {PLATFORM_NOISE['auc_sequence']:.3f} AUC for the shipped configs" in section
     assert (f"up to {PLATFORM_NOISE['auc_mean_of_8']:.3f} AUC ({PLATFORM_NOISE['precision_mean_of_8']:.3f} precision) "
             f"on the mean of eight") in section
+
+
+def test_platform_differences_are_counted_per_sequence_not_per_pair_of_records(tmp_path, monkeypatch):
+    """Sidecars whose records differ per sequence: each sequence's two records are compared once
+    (the pairs of all distinct records took 105 s for 2,000 sequences), and the printout is a
+    bounded list of distinct differences with their counts."""
+    n = 60
+    seqs = [sequence(f"s{k}") for k in range(n)]
+    for folder, cpu in (("ours", "A"), ("theirs", "B")):
+        (tmp_path / folder).mkdir()
+        store = ResultStore(tmp_path / folder)
+        for k, seq in enumerate(seqs):
+            record = {"arch": "x86_64", "cpu": f"CPU {cpu}{k}", "blas": "openblas" if k % 2 else "mkl"}
+            store.write(seq, GT, {"platform": record})
+    calls = []
+    real = platforms.differences
+    monkeypatch.setattr(platforms, "differences", lambda a, b: calls.append(1) or real(a, b))
+    res = compare_folders(tmp_path / "ours", tmp_path / "theirs", seqs)
+    assert len(calls) == n
+    found = res["platform_differences"]
+    assert len(found) == 11 and found[-1] == f"and {n - 10} more"  # ten lines and the count of the others
+    assert all(line.startswith("cpu: CPU A") and line.endswith(f" (1 of {n} sequences)") for line in found[:-1])
+    assert len(res["platforms"]["reference"]) == 11 and "(1 of 60 sequences)" in res["platforms"]["reference"][0]
+
+
+def test_a_non_finite_score_is_named_and_given_no_verdict(tmp_path, monkeypatch, capsys):
+    """Sequences scoreable on their first frame only (GOT-10k leaves it out): NaN scores, named and
+    left out of the statistics and the noise floor's mean; no verdict when nothing is left."""
+    ours, theirs = tmp_path / "ours", tmp_path / "theirs"
+    seqs = [sequence("one", 1), sequence("two", 1), sequence("a")]
+    for seq in seqs:
+        write(ours, seq.name, A_RESULTS[:len(seq)])
+        write(theirs, seq.name, A_REFERENCE[:len(seq)])
+    res = compare_folders(ours, theirs, seqs, "got10k")
+    assert res["statistics"]["auc"]["non_finite"] == ["one", "two"] == res["noise_floor"]["non_finite"]
+    assert res["noise_floor"]["mean_auc_difference"] == pytest.approx(res["rows"][2]["d_auc"])
+    import dcfkit.cli.evaluate
+
+    for given, expected in ((seqs, "the mean AUC difference over the 1 sequence with one (left out, a non-finite "
+                                   "AUC (no frame counted) in 2 sequences (one, two)), -0.322, exceeds it"),
+                            (seqs[:2], "no verdict: no sequence has a finite AUC difference (a non-finite AUC (no "
+                                       "frame counted) in 2 sequences (one, two))")):
+        monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, given=given, **k: given)
+        assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path), "--protocol", "got10k"]) == 0
+        out = capsys.readouterr().out
+        assert expected in out and "nan" not in out.split("noise floor:")[1]
+        assert "left out, a non-finite AUC (no frame counted) in 2 sequences (one, two)" in out
+
+
+def test_a_line_break_in_a_platform_record_stays_on_its_line(tmp_path, monkeypatch, capsys):
+    """An environment value with a line break (a hostile or broken sidecar) is printed escaped:
+    it cannot forge a line of compare's output."""
+    seqs = [sequence("a")]
+    for folder, value in (("ours", "Haswell"), ("theirs", "Haswell\nwarning: forged\r")):
+        (tmp_path / folder).mkdir()
+        ResultStore(tmp_path / folder).write(seqs[0], GT, {"platform": {"switches": {"OPENBLAS_CORETYPE": value}}})
+    import dcfkit.cli.evaluate
+
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: seqs)
+    assert cli.main(["compare", str(tmp_path / "ours"), str(tmp_path / "theirs"), "--root", str(tmp_path)]) == 0
+    out, err = capsys.readouterr()
+    lines = (out + err).splitlines()
+    assert not any(line.startswith("warning: forged") for line in lines)
+    forged = "OPENBLAS_CORETYPE=Haswell\\nwarning: forged\\r"
+    assert any(line.startswith("reference platform: ") and line.endswith(forged) for line in lines)
+    assert "OPENBLAS_CORETYPE: Haswell -> Haswell\\nwarning: forged\\r" in err

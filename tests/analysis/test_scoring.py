@@ -9,6 +9,7 @@ from scipy import stats
 
 from dcfkit import cli
 from dcfkit.analysis.scoring import evaluate
+from dcfkit.analysis.tables import statistics_lines
 from dcfkit.datasets import DatasetError, Sequence
 
 GT = np.array([[20.0, 20.0, 10.0, 10.0]] * 10)
@@ -175,3 +176,21 @@ def metrics_overlap(box, gt) -> float:
     right, bottom = min(box[0] + box[2] - 1, gt[0] + gt[2] - 1), min(box[1] + box[3] - 1, gt[1] + gt[3] - 1)
     inter = max(0.0, right - left + 1) * max(0.0, bottom - top + 1)
     return inter / (box[2] * box[3] + gt[2] * gt[3] - inter)
+
+
+def test_the_statistics_say_which_sequences_a_non_finite_score_left_out():
+    """Two one-frame sequences score NaN under GOT-10k (frame 1 is left out): the statistics are
+    over the other three and say so, naming the two."""
+    one_frame = [Sequence(name=n, frames=(Path("00000.jpg"),), ground_truth=GT[:1].copy(), attributes={},
+                          dataset="test") for n in ("x", "y")]
+    results = {t: {**r, "x": GT[:1].copy(), "y": GT[:1].copy()} for t, r in RESULTS.items()}
+    st = evaluate(results, SEQUENCES[:3] + one_frame, protocol="got10k").statistics
+    assert st["sequences"] == 5 and st["non_finite"]["far"] == {"ao": ["x", "y"], "precision": ["x", "y"]}
+    assert {m["ao"]["n"] for m in st["means"].values()} == {3}
+    lines = statistics_lines(st)
+    assert lines[0].startswith("statistics over 3 of the 5 sequences: ")
+    assert ("  left out of every mean and difference: a non-finite score (no frame counted) in 2 sequences (x, y)"
+            in lines)
+    st["non_finite"] = {"far": {"ao": ["x"]}}  # one tracker's one score: named as such
+    assert statistics_lines(st)[0].startswith("statistics over 5 sequences: ")
+    assert "  left out of far's AO: a non-finite score (no frame counted) in 1 sequence (x)" in statistics_lines(st)
