@@ -18,6 +18,7 @@ from dcfkit.ablation.published import parse_published
 from dcfkit.config import load_config, shipped_config, shipped_config_dir
 from dcfkit.config.bounded_yaml import read_yaml
 from dcfkit.datasets import DatasetError, canonical_name, load_dataset
+from dcfkit.datasets.base import sequence_names
 from dcfkit.errors import ConfigError, DcfkitError, clip, shown
 from dcfkit.params import closest
 from dcfkit.running.provenance import dcfkit_version, run_key
@@ -332,14 +333,9 @@ def _parse_sequences(path: Path, data: Mapping, sequences) -> tuple | None:
         sequences = data.get("sequences")
     else:
         where = "--sequences (replacing the spec's sequences)"
-    if isinstance(sequences, str):
-        sequences = [s.strip() for s in sequences.split(",") if s.strip()]
     if sequences is None:
         return None
-    if not isinstance(sequences, (list, tuple)) or not sequences or \
-            not all(isinstance(s, str) and s for s in sequences):
-        raise ConfigError(f"{where}: expected a non-empty list of sequence names, got {shown(sequences)}")
-    return tuple(dict.fromkeys(sequences))
+    return tuple(sequence_names(sequences, where, ConfigError))
 
 
 def _parse_variants(path: Path, raw: Any, limit: int) -> dict[str, Variant]:

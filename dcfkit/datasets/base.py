@@ -3,10 +3,12 @@ frames, boxes and attribute flags, and the helpers a loader is built from (frame
 sequence selection). A layout module (or a plugin's) needs nothing else from dcfkit."""
 from __future__ import annotations
 
+import collections
 import dataclasses
 import difflib
 import logging
 import os
+import warnings
 from pathlib import Path
 from typing import Iterable, Mapping
 
@@ -22,13 +24,13 @@ from dcfkit.datasets.annotations import (
     read_text,
 )
 from dcfkit.datasets.images import DatasetWarning, read_frame
-from dcfkit.errors import DatasetError, clip, shown
+from dcfkit.errors import DatasetError, DcfkitError, clip, shown
 
 # a layout's toolkit in one import: the readers are defined beside, in annotations and images
 __all__ = ["ATTRIBUTE_NAMES", "DatasetError", "DatasetWarning", "Sequence", "annotated_frames", "annotation_lines",
            "check_box_count", "count_jpgs", "first_frame_digits", "held_out_sequence", "image_sequence_folders",
            "listed", "numbered_frames", "parse_number", "read_boxes", "read_flags", "read_frame", "read_frame_values",
-           "read_text", "require_root", "scored_sequences", "select_sequences"]
+           "read_text", "require_root", "scored_sequences", "select_sequences", "sequence_names", "unique_names"]
 
 log = logging.getLogger(__name__)
 
@@ -235,30 +237,58 @@ def require_root(root, what: str) -> Path:
 
 def select_sequences(available: list[str], requested: Iterable[str] | str | None, where: str,
                      annotation_of: Mapping[str, Path] | None = None) -> list[str]:
-    """Names to load: all available, or the requested ones (case-insensitive match, each once).
+    """Names to load: all available, or the requested ones (:func:`sequence_names`; a
+    case-insensitive match, each once).
 
-    ``requested`` may be one comma-separated string. ``annotation_of`` maps the benchmark's
-    other sequences (not available) to the annotation file that is missing, for a clearer error.
+    ``annotation_of`` maps the benchmark's other sequences (not available) to the annotation file
+    that is missing, for a clearer error.
     """
     if requested is None:
         return available
-    if isinstance(requested, str):
-        requested = [s for s in requested.split(",") if s.strip()]
-    if not requested:
+    requested = requested if isinstance(requested, str) else list(requested)
+    if not (requested.replace(",", "").strip() if isinstance(requested, str) else requested):
         raise DatasetError(f"no sequence names given for {where}")
+    present = set(available)
     by_lower: dict[str, list[str]] = {}
     for name in available:
         by_lower.setdefault(name.lower(), []).append(name)
     missing = {name.lower(): path for name, path in (annotation_of or {}).items()}
     chosen = []
-    for want in (w.strip() for w in requested):
-        if want in available:
+    for want in sequence_names(requested, f"sequences for {where}"):
+        if want in present:
             chosen.append(want)
         elif len(by_lower.get(want.lower(), [])) == 1:
             chosen.append(by_lower[want.lower()][0])
         else:
             raise _not_found(want, available, where, missing.get(want.lower()))
-    return list(dict.fromkeys(chosen))
+    return unique_names(chosen, f"sequences for {where}")
+
+
+def sequence_names(requested: Iterable[str] | str, where: str, error: type[DcfkitError] = DatasetError) -> list[str]:
+    """The one rule for a list of sequences, from a spec or ``--sequences``: a list of names
+    or one comma-separated string, each name stripped and counted once (:func:`unique_names`).
+    ``error`` (naming ``where``) unless it is a non-empty list of non-blank names."""
+    if isinstance(requested, str):  # "a,,b" as the shell gives it: empty items are no names
+        names = [n.strip() for n in requested.split(",") if n.strip()]
+    elif isinstance(requested, (list, tuple)) and all(isinstance(n, str) for n in requested):
+        names = [n.strip() for n in requested]
+    else:
+        names = []
+    if not names or not all(names):
+        raise error(f"{where}: expected a non-empty list of sequence names, got {shown(requested)}")
+    return unique_names(names, where)
+
+
+def unique_names(names: list[str], where: str) -> list[str]:
+    """``names`` each once, in order: a repeat is dropped with a :class:`DatasetWarning`, since
+    a sequence counted twice weighs twice in every mean and test (and may sit in two folds)."""
+    unique = list(dict.fromkeys(names))
+    if len(unique) < len(names):
+        repeated = [n for n, count in collections.Counter(names).items() if count > 1]
+        warnings.warn(f"{where}: {', '.join(shown(n) for n in repeated[:5])}{' ...' if len(repeated) > 5 else ''} "
+                      f"listed more than once: each sequence counts once ({len(unique)} in all)",
+                      DatasetWarning, stacklevel=2)
+    return unique
 
 
 def _not_found(want: str, available: list[str], where: str, missing_annotation: Path | None) -> DatasetError:
