@@ -28,7 +28,7 @@ from dcfkit.errors import ConfigError, shown
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
 from dcfkit.running.files import ensure_writable, exclusive, make_dir, remove_temporary_files
 from dcfkit.running.provenance import dcfkit_version, json_default, run_key
-from dcfkit.running.results import ResultStore
+from dcfkit.running.results import ResultStore, same_data
 from dcfkit.running.runner import RunTask, execute, warm_up_compiled
 
 __all__ = ["check_one_pass", "experiment_runs", "results_folder", "run_one_pass", "tracker_name"]
@@ -72,8 +72,13 @@ def _say_what_is_recomputed(store: ResultStore, metas: dict, todo: list[Sequence
     replaced = [s.name for s in todo
                 if (metas[s.name] or {}).get("run_key") not in (None, key)
                 and json.dumps(metas[s.name].get("config"), sort_keys=True, default=json_default) != same]
+    other_data = [s.name for s in todo
+                  if (metas[s.name] or {}).get("run_key") == key and not same_data(metas[s.name], s)]
     if damaged:
         log.warning("%s: recomputing %d damaged result(s): %s", store.folder, len(damaged), ", ".join(damaged[:10]))
+    if other_data:
+        log.warning("%s: recomputing %d result(s) made on other data (a sequence of that name whose frames or ground "
+                    "truth differ): %s", store.folder, len(other_data), ", ".join(other_data[:10]))
     if replaced:
         log.warning("%s: replacing the results of another config named %r for %d sequence(s): %s (give this "
                     "config another name to keep both)", store.folder, config["name"], len(replaced),

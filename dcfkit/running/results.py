@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import hashlib
 import json
 import logging
+import os
 import re
 import traceback
 from pathlib import Path
@@ -97,11 +99,11 @@ class ResultStore:
         if read."""
         meta = self.sidecar(seq.name) if meta is None else meta
         if meta is not None and meta.get("run_key") == key:
-            if meta.get("init_box") != [float(v) for v in seq.init_box]:
-                return "missing"  # a corrected annotation: run again
+            if meta.get("init_box") != [float(v) for v in seq.init_box] or not same_data(meta, seq):
+                return "missing"  # a corrected annotation, or another benchmark's sequence of that name: run again
             return "done" if self.problem(seq.name, meta, len(seq)) is None else "damaged"
         error = read_json(self.error_path(seq.name))
-        return "failed" if error is not None and error.get("run_key") == key else "missing"
+        return "failed" if error is not None and error.get("run_key") == key and same_data(error, seq) else "missing"
 
     def is_done(self, seq: Sequence, key: str) -> bool:
         return self.status(seq, key) == "done"
@@ -137,7 +139,7 @@ class ResultStore:
         with contextlib.suppress(FileNotFoundError):
             self.sidecar_path(seq.name).unlink()  # an older sidecar must never describe new boxes
         atomic_write(self.boxes_path(seq.name), text)
-        meta = {**meta, "frames": len(boxes), "sha256": checksum(text.encode())}
+        meta = {**meta, "data_identity": data_identity(seq), "frames": len(boxes), "sha256": checksum(text.encode())}
         for field, path, data, form in (("time_sha256", self.time_path(seq.name), times, format_times),
                                         ("confidence_sha256", self.confidence_path(seq.name), confidence,
                                          format_confidence)):
@@ -155,7 +157,8 @@ class ResultStore:
 
     def write_failure(self, seq: Sequence, record: dict, exc: BaseException) -> None:
         """Store a failed run (removing any results, which another config may have left)."""
-        record = {**record, "sequence": seq.name, "dataset": seq.dataset, "type": type(exc).__name__,
+        record = {**record, "sequence": seq.name, "dataset": seq.dataset, "data_identity": data_identity(seq),
+                  "type": type(exc).__name__,
                   "traceback": "".join(traceback.format_exception(exc)), "time": now()}
         for stale in (self.sidecar_path(seq.name), *self._written(seq.name)):
             with contextlib.suppress(FileNotFoundError):
@@ -189,6 +192,26 @@ class ResultStore:
                 f"results in {self.folder} mix {len(keys)} configurations ({detail}); rerun "
                 f"`dcfkit eval` with one config, or give the other config a different 'name'")
         return results
+
+
+def data_identity(seq: Sequence) -> str:
+    """What identifies a sequence's data, without decoding an image: a digest of its whole ground
+    truth and of its frames' file names and sizes. Two benchmark folders may hold sequences of one
+    name, length and first box; their results must not stand for each other."""
+    digest = hashlib.sha256(np.ascontiguousarray(seq.ground_truth, dtype="<f8").tobytes())
+    for frame in seq.frames:
+        try:
+            size = os.stat(frame).st_size
+        except OSError:  # an unreadable frame: the run fails on it, and says so
+            size = -1
+        digest.update(f"{frame.name}\0{size}\n".encode("utf-8", "surrogateescape"))
+    return digest.hexdigest()[:16]
+
+
+def same_data(record: dict, seq: Sequence) -> bool:
+    """Whether a sidecar or failure ``record`` was made on ``seq``'s data; records of dcfkit
+    <= 0.9.0 have no identity and are trusted, as they were (docs/evaluation.md)."""
+    return "data_identity" not in record or record["data_identity"] == data_identity(seq)
 
 
 _NUMBER = rb"(?:nan|-?\d+\.\d{3})"

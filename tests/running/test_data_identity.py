@@ -1,0 +1,46 @@
+"""A stored run stands for its sequence's data only: another benchmark folder's sequence of the
+same name, length and first box is run again (eval, ablate and search share ResultStore.status)."""
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import cv2
+import numpy as np
+from test_evaluation import CONFIG, Counter, gt_boxes, seqs  # noqa: F401  (seqs: a fixture)
+
+from dcfkit.running import results
+from dcfkit.running.evaluation import run_one_pass
+
+
+def test_a_resume_on_other_data_of_the_same_names_runs_again(tmp_path, seqs, caplog):  # noqa: F811
+    run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    moved = gt_boxes()
+    moved[-1, 0] += 3  # the same name, length and first box; a later box differs
+    other = dataclasses.replace(seqs[0], ground_truth=moved)
+    again = Counter()
+    with caplog.at_level("WARNING"):
+        summary = run_one_pass(CONFIG, [other, *seqs[1:]], tmp_path, make_tracker=again, progress=False)
+    assert summary["done"] == ["a"] and summary["skipped"] == ["b", "c"] and again.made == 1
+    assert "recomputing 1 result(s) made on other data" in caplog.text
+    noise = np.random.default_rng(0).integers(0, 255, (16, 16, 3), np.uint8)
+    cv2.imwrite(str(seqs[1].frames[3]), noise)  # a frame of another size
+    assert run_one_pass(CONFIG, [other, *seqs[1:]], tmp_path, make_tracker=Counter(), progress=False)["done"] == ["b"]
+
+
+def test_the_identity_is_the_data_not_the_folder_and_old_sidecars_are_trusted(tmp_path, seqs):  # noqa: F811
+    copy = tmp_path / "copy"
+    copy.mkdir()
+    frames = [copy / f.name for f in seqs[2].frames]
+    for source, target in zip(seqs[2].frames, frames):
+        target.write_bytes(source.read_bytes())
+    assert results.data_identity(dataclasses.replace(seqs[2], frames=tuple(frames))) == results.data_identity(seqs[2])
+    run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
+    sidecar = tmp_path / "drift" / "a.json"
+    meta = json.loads(sidecar.read_text())
+    del meta["data_identity"]  # as dcfkit <= 0.9.0 wrote it
+    sidecar.write_text(json.dumps(meta))
+    moved = gt_boxes()
+    moved[-1, 0] += 3
+    other = dataclasses.replace(seqs[0], ground_truth=moved)
+    assert run_one_pass(CONFIG, [other], tmp_path, make_tracker=Counter(), progress=False)["skipped"] == ["a"]
