@@ -3,7 +3,9 @@ trackers to beat (docs/search.md). Every choice is resolved against the base whe
 is read, so a wrong key or value fails before anything runs."""
 from __future__ import annotations
 
+import collections
 import dataclasses
+import itertools
 import math
 import os
 from pathlib import Path
@@ -16,12 +18,15 @@ from dcfkit.ablation.spec import as_mapping, check_keys, load_spec_config, parse
 from dcfkit.config import load_config, shipped_config_dir
 from dcfkit.config.bounded_yaml import read_yaml
 from dcfkit.datasets import load_dataset
+from dcfkit.datasets.base import sequence_names
 from dcfkit.errors import ConfigError, DcfkitError, clip, shown
 
 SPEC_KEYS = ("name", "description", "dataset", "sequences", "base", "space", "experiments", "folds",
              "trials", "startup_trials", "seed", "baselines")
 KINDS = ("choice", "float", "int")
 PARAMETER_KEYS = (*KINDS, "log", "when")
+# configs resolved per group of related dimensions when a spec is read (some 4 ms each)
+MAX_STRUCTURES = 1024
 
 
 @dataclasses.dataclass(frozen=True)
@@ -73,19 +78,11 @@ class SearchSpec:
     def load_sequences(self) -> list:
         if self.root is None:
             raise ConfigError(f"{self.path}: no dataset root: give dataset.root in the spec or --root")
-        seqs = load_dataset(self.dataset, self.root)
-        if self.sequences is None:
-            return seqs
-        by_name = {s.name: s for s in seqs}
-        missing = [n for n in self.sequences if n not in by_name]
-        if missing:
-            raise ConfigError(f"{self.path}: sequences: {', '.join(map(clip, missing[:5]))} not under {self.root}")
-        return [by_name[n] for n in self.sequences]
+        return load_dataset(self.dataset, self.root, None if self.sequences is None else list(self.sequences))
 
     def config(self, params: Mapping[str, Any]) -> dict:
         """The base config with the sampled ``params`` (key -> sampled value) applied."""
-        overrides = {p.key: p.value(params[p.key]) for p in self.parameters if p.key in params}
-        return load_config(self.base, overrides)
+        return resolve(self.base, self.parameters, params)
 
 
 def find_search_spec(source: str | os.PathLike) -> Path:
@@ -124,8 +121,8 @@ def load_search_spec(source: str | os.PathLike, root: str | os.PathLike | None =
                  for name, cfg in as_mapping(data.get("baselines"), f"{path}: baselines",
                                              "a mapping {name: config file}").items()}
     sequences = data.get("sequences")
-    if sequences is not None and (not isinstance(sequences, list) or not all(isinstance(s, str) for s in sequences)):
-        raise ConfigError(f"{path}: sequences: expected a list of sequence names, got {shown(sequences)}")
+    if sequences is not None:
+        sequences = sequence_names(sequences, f"{path}: sequences", ConfigError)
     return SearchSpec(
         path=path, name=str(data.get("name") or path.stem), description=str(data.get("description") or ""),
         dataset=dataset, root=root_path, root_origin=origin,
@@ -152,6 +149,8 @@ def _parse_space(path: Path, raw: Any, base: dict) -> tuple:
         params[str(key)] = _parse_parameter(where, str(key), entry, params)
     for p in params.values():
         _check_values(where=f"{path}: space.{clip(p.key)}", base=base, parameter=p, params=params)
+    for group in _groups(tuple(params.values())):
+        _check_structures(path, base, group)
     return tuple(params.values())
 
 
@@ -167,14 +166,18 @@ def _parse_parameter(where: str, key: str, entry: Any, earlier: Mapping[str, Par
         choices = values if isinstance(values, Mapping) else \
             {_label(v): v for v in values} if isinstance(values, list) else None
         if isinstance(values, list) and choices is not None and len(choices) < len(values):
-            raise ConfigError(f"{where}.choice: two values have the label {shown(_repeated(values))}: give a "
-                              f"mapping label -> value")
+            repeated = _repeated([_label(v) for v in values])
+            raise ConfigError(f"{where}.choice: two values have the label {shown(repeated)}: give a mapping "
+                              f"label -> value")
         if not choices or len(choices) < 2:
             raise ConfigError(f"{where}.choice: expected at least two values (a list, or a mapping label -> value), "
                               f"got {shown(values)}")
         if "log" in entry:
             raise ConfigError(f"{where}.log: only for float and int ranges")
-        return Parameter(key, CategoricalDistribution([str(c) for c in choices]),
+        labels = [str(c) for c in choices]
+        if len(set(labels)) < len(labels):  # YAML keys 1 and '1' (or true and 'True') are one label here
+            raise ConfigError(f"{where}.choice: two labels read as {shown(_repeated(labels))}: give distinct labels")
+        return Parameter(key, CategoricalDistribution(labels),
                          {str(c): v for c, v in choices.items()}, when)
     if not (isinstance(values, list) and len(values) == 2
             and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in values)
@@ -201,9 +204,8 @@ def _label(value: Any) -> str:
     return str(value)
 
 
-def _repeated(values: list) -> str:
-    labels = [_label(v) for v in values]
-    return next(label for label in labels if labels.count(label) > 1)
+def _repeated(labels: list[str]) -> str:
+    return next(label for label, count in collections.Counter(labels).items() if count > 1)
 
 
 def _parse_when(where: str, raw: Any, earlier: Mapping[str, Parameter]) -> tuple:
@@ -238,3 +240,76 @@ def _check_values(where: str, base: dict, parameter: Parameter, params: Mapping[
             load_config(base, {**context, parameter.key: value})
         except DcfkitError as exc:
             raise ConfigError(f"{where}: with the value {shown(value)}: {exc}") from None
+
+
+def resolve(base: dict, parameters: tuple, sampled: Mapping[str, Any]) -> dict:
+    """The base config with the ``sampled`` values (key -> sampled value) of ``parameters`` applied."""
+    return load_config(base, {p.key: p.value(sampled[p.key]) for p in parameters if p.key in sampled})
+
+
+def _related(a: Parameter, b: Parameter) -> bool:
+    """Whether one's key lies inside the other's (``label`` and ``label.mu``) or one is sampled
+    only under the other (``when``): then only the two together show a config is valid."""
+    return (a.key.startswith(b.key + ".") or b.key.startswith(a.key + ".")
+            or any(k == b.key for k, _ in a.when) or any(k == a.key for k, _ in b.when))
+
+
+def _groups(parameters: tuple) -> list[list[Parameter]]:
+    """The dimensions in groups of (transitively) related ones, each group in space order."""
+    groups: list[list[Parameter]] = []
+    for p in parameters:
+        linked = [g for g in groups if any(_related(p, q) for q in g)]
+        groups = [g for g in groups if all(g is not h for h in linked)] + [[q for g in linked for q in g] + [p]]
+    order = {p.key: i for i, p in enumerate(parameters)}
+    return [sorted(g, key=lambda p: order[p.key]) for g in groups]
+
+
+def _check_structures(path: Path, base: dict, group: list[Parameter]) -> None:
+    """Resolve the base with every combination of the group's choices, each with the dimensions
+    sampled under it at the :func:`_points` of their ranges: every config the space can make, as
+    far as its structure goes, so a dimension that only some choices take (no ``when``) fails now."""
+    choices = [p for p in group if p.choices]
+    count = math.prod(len(p.choices) for p in choices)
+    if count > MAX_STRUCTURES:
+        raise ConfigError(f"{path}: space: the related choices {clip(', '.join(p.key for p in choices))} make "
+                          f"{count} combinations, more than the {MAX_STRUCTURES} checked when a spec is read")
+    checked = set()
+    for labels in itertools.product(*(p.choices for p in choices)):
+        for point in range(3):
+            sampled = _structure(group, dict(zip((p.key for p in choices), labels)), point)
+            if (mark := repr(sampled)) in checked:
+                continue
+            checked.add(mark)
+            try:
+                resolve(base, tuple(group), sampled)
+            except DcfkitError as exc:
+                raise ConfigError(f"{path}: {_described(sampled)}: {exc}") from None
+
+
+def _structure(group: list[Parameter], labels: Mapping[str, str], point: int) -> dict[str, Any]:
+    """The sampled values of one config of the group: each choice sampled under ``labels`` at
+    its label, each range sampled under them at one of its :func:`_points`."""
+    sampled: dict[str, Any] = {}
+    for p in group:
+        if active(p, sampled):
+            sampled[p.key] = labels[p.key] if p.choices else _points(p.distribution)[point]
+    return sampled
+
+
+def _points(d: BaseDistribution) -> tuple:
+    """A range's ends and a point inside, off any round number: a whole-number key given a
+    float range, ``{float: [1, 3]}``, takes both ends but not 1.76."""
+    if isinstance(d, IntDistribution):
+        return d.low, (d.low + d.high) // 2, d.high
+    inside = d.low * (d.high / d.low) ** 0.382 if d.log else d.low + 0.382 * (d.high - d.low)
+    return d.low, min(max(inside, d.low), d.high), d.high
+
+
+def _described(sampled: Mapping[str, Any]) -> str:
+    """Where a config of the space is wrong: ``space.key: with the value v`` for one dimension,
+    else the values together, with the way out (a dimension only some choices take needs when)."""
+    if len(sampled) == 1:
+        (key, value), = sampled.items()
+        return f"space.{clip(key)}: with the value {shown(value)}"
+    values = clip(", ".join(f"{key}={shown(value)}" for key, value in sampled.items()))
+    return f"space: {values} together give no valid config (a dimension that only some choices take needs when)"

@@ -9,17 +9,23 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 import optuna
+from optuna.trial import TrialState
 
 from dcfkit.autosearch.evaluation import Evaluator
 from dcfkit.autosearch.space import SearchSpec, active
-from dcfkit.autosearch.summary import FINAL, summarize
+from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, summarize
+from dcfkit.datasets import scored_sequences
 from dcfkit.errors import DcfkitError, shown
 from dcfkit.running.files import atomic_write, ensure_writable, exclusive, make_dir, read_json
+from dcfkit.running.results import data_identity
+
+log = logging.getLogger(__name__)
 
 
 def make_folds(names: list[str], k: int, seed: int) -> list[list[str]]:
@@ -39,7 +45,8 @@ def fingerprint(spec: SearchSpec, folds: list[list[str]], evaluator: Evaluator) 
     return {"base": evaluator.key(spec.base), "space": json.loads(json.dumps(space, default=list)),
             "experiments": list(spec.experiments), "folds": folds, "seed": spec.seed,
             "startup_trials": spec.startup_trials, "dataset": spec.dataset,
-            "protocol": evaluator.protocol.name if evaluator.protocol else None}
+            "protocol": evaluator.protocol.name if evaluator.protocol else None,
+            "data": {name: data_identity(seq) for name, seq in evaluator.sequences.items()}}
 
 
 def _trial_seed(seed: int, study: str, number: int) -> int:
@@ -56,8 +63,7 @@ def sample(spec: SearchSpec, study: str, number: int, recorded: list[dict]) -> d
     opt = optuna.create_study(direction="maximize", sampler=sampler)
     dists = {p.key: p.distribution for p in spec.parameters}
     for rec in recorded:
-        opt.add_trial(optuna.trial.create_trial(params=rec["params"], value=rec["value"],
-                                                distributions={k: dists[k] for k in rec["params"]}))
+        opt.add_trial(_frozen(rec, dists))
     trial = opt.ask()
     params: dict[str, Any] = {}
     for p in spec.parameters:
@@ -66,13 +72,35 @@ def sample(spec: SearchSpec, study: str, number: int, recorded: list[dict]) -> d
     return params
 
 
+def _frozen(rec: dict, distributions: dict) -> optuna.trial.FrozenTrial:
+    """A trial record as Optuna's trial; one without a score (None, or the NaN of dcfkit 0.9.0)
+    is a failed trial, which TPE leaves out."""
+    scored = is_score(rec["value"])
+    return optuna.trial.create_trial(params=rec["params"], value=rec["value"] if scored else None,
+                                     state=TrialState.COMPLETE if scored else TrialState.FAIL,
+                                     distributions={k: distributions[k] for k in rec["params"]})
+
+
+def _usable(rec: dict, number: int, distributions: dict) -> bool:
+    """Whether ``rec`` is trial ``number``'s record as :meth:`Search.run_study` writes it."""
+    if not (rec.get("number") == number and isinstance(rec.get("params"), dict) and isinstance(rec.get("key"), str)
+            and isinstance(rec.get("scores"), dict) and isinstance(rec.get("config"), dict)
+            and (rec.get("value") is None or isinstance(rec["value"], (int, float)))):
+        return False
+    try:
+        _frozen(rec, distributions)  # each value one its dimension can take
+    except (KeyError, TypeError, ValueError):
+        return False
+    return True
+
+
 class Search:
     """A search spec run under ``out``: its folds, its studies and their records."""
 
     def __init__(self, spec: SearchSpec, out, evaluator_options: dict | None = None,
                  report: Callable[[str], None] = lambda line: None):
         self.spec, self.out, self.report = spec, Path(out).expanduser().resolve(), report
-        seqs = spec.load_sequences()
+        seqs = scored_sequences(spec.load_sequences())  # a test split's sequence could not score a trial
         self.names = [s.name for s in seqs]
         self.folds = make_folds(self.names, spec.folds, spec.seed)
         self.evaluator = Evaluator(self.out, spec.dataset, seqs, spec.experiments, **(evaluator_options or {}))
@@ -91,19 +119,44 @@ class Search:
         path = self.out / "search.json"
         mine = fingerprint(self.spec, self.folds, self.evaluator)
         recorded = read_json(path)
-        if recorded is not None and recorded.get("fingerprint") != mine:
-            changed = [k for k in mine if (recorded.get("fingerprint") or {}).get(k) != mine[k]]
-            raise DcfkitError(f"{path} records a different search (these differ: {', '.join(changed) or 'the record'}): "
-                              f"give a new --out, or remove {self.out} to start again")
+        if recorded is not None:
+            self._check_fingerprint(path, recorded.get("fingerprint"), mine)
         atomic_write(path, json.dumps({"spec": str(self.spec.path), "name": self.spec.name,
                                        "fingerprint": mine}, indent=1) + "\n")
 
+    def _check_fingerprint(self, path: Path, old: Any, mine: dict) -> None:
+        """Refuse to resume when the recorded fingerprint ``old`` is not ``mine``; one without the
+        data's identity (dcfkit <= 0.9.0) is taken to be on this data."""
+        old = old if isinstance(old, dict) else {}
+        if old and "data" not in old:
+            log.warning("%s was written by dcfkit <= 0.9.0, without what identifies the data: the recorded "
+                        "trials are taken to be on the data under %s", path, self.spec.root)
+            old = {**old, "data": mine["data"]}
+        changed = [k for k in mine if old.get(k) != mine[k]]
+        if changed == ["data"]:
+            was = old["data"] if isinstance(old["data"], dict) else {}
+            differ = [n for n in mine["data"] if was.get(n) != mine["data"][n]]
+            raise DcfkitError(f"{path}: its trials were made on other data: the frames or ground truth of "
+                              f"{', '.join(map(shown, differ[:5]))}{' ...' if len(differ) > 5 else ''} under "
+                              f"{self.spec.root} differ from the recorded ones; give the recorded search's --root, "
+                              f"or a new --out")
+        if changed:
+            raise DcfkitError(f"{path} records a different search (these differ: {', '.join(changed)}): "
+                              f"give a new --out, or remove {self.out} to start again")
+
     def recorded(self, study: str) -> list[dict]:
+        """The study's trial records up to the first missing one; a damaged or edited record is
+        missing (with a warning), and it and those after it are run again, to the same values."""
         folder = self.out / "trials" / study
+        dists = {p.key: p.distribution for p in self.spec.parameters}
         records = []
         for n in range(self.spec.trials):
-            rec = read_json(folder / f"{n:04d}.json")
-            if rec is None or rec.get("number") != n:
+            path = folder / f"{n:04d}.json"
+            rec = read_json(path)
+            if rec is None or not _usable(rec, n, dists):
+                if rec is not None or path.exists():
+                    log.warning("%s is not a trial record as dcfkit writes it: trial %d of %s is run again, "
+                                "and the trials after it", path, n, study)
                 break
             records.append(rec)
         return records
@@ -115,16 +168,19 @@ class Search:
         make_dir(self.out / "trials" / study)
         for n in range(len(records), self.spec.trials):
             params = sample(self.spec, study, n, records)
-            config = self.spec.config(params)
-            scores = self.evaluator.scores(config, names)
-            value = float(np.mean([scores[s]["auc"] for s in names]))
+            try:
+                config = self.spec.config(params)
+            except DcfkitError as exc:  # the spec check resolves every structure; a value inside a range may fail
+                raise DcfkitError(f"{self.spec.path}: {study} trial {n}, {shown(params)}: {exc}") from None
+            scores = finite(self.evaluator.scores(config, names))
+            value = mean_auc(scores, names)
             rec = {"number": n, "params": params, "value": value, "key": self.evaluator.key(config),
                    "scores": scores, "config": config}
             atomic_write(self.out / "trials" / study / f"{n:04d}.json", json.dumps(rec, indent=1) + "\n")
             records.append(rec)
-            best = max(r["value"] for r in records)
-            self.report(f"{study} trial {n} ({n + 1} of {self.spec.trials}): mean AUC {value:.4f} on {len(names)} "
-                        f"sequences (best {best:.4f}) {shown(params)}")
+            best = max((r["value"] for r in records if is_score(r["value"])), default=None)
+            self.report(f"{study} trial {n} ({n + 1} of {self.spec.trials}): mean AUC {_shown_auc(value)} on "
+                        f"{len(names)} sequences (best {_shown_auc(best)}) {shown(params)}")
         return records
 
     def run(self) -> dict:
@@ -135,3 +191,6 @@ class Search:
             studies = {study: self.run_study(study) for study in self.studies()}
             return summarize(self, studies)
 
+
+def _shown_auc(value: float | None) -> str:
+    return "none (no sequence has a scored frame)" if value is None else f"{value:.4f}"

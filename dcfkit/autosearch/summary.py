@@ -3,6 +3,7 @@ sequence with the trackers to beat, and the final study's best config (docs/sear
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import yaml
@@ -14,11 +15,37 @@ from dcfkit.running.files import atomic_write
 FINAL = "all"  # the final study's name: every sequence chooses
 
 
-def best(records: list[dict]) -> dict:
-    """The trial with the highest value (the first of equals)."""
-    if not records:
-        raise DcfkitError("a study without trials has no best")
-    return max(records, key=lambda r: (r["value"], -r["number"]))
+def is_score(value) -> bool:
+    """Whether ``value`` is a score: a finite number (a trial's or sequence's value may be
+    None, or NaN in a record of dcfkit <= 0.9.0, when no frame could be scored)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def mean_auc(scores: dict[str, dict], names: list[str]) -> float | None:
+    """The mean AUC over those of ``names`` that have one; None if none has. A sequence with no
+    frame the protocol scores (a one-frame sequence under ``got10k``) has none, whatever the config."""
+    values = [scores[n]["auc"] for n in names if is_score(scores[n]["auc"])]
+    return float(np.mean(values)) if values else None
+
+
+def finite(value):
+    """``value`` with each non-finite float replaced by None: JSON has no NaN."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite(v) for v in value]
+    return value
+
+
+def best(records: list[dict], study: str) -> dict:
+    """The trial with the highest value (the first of equals); trials without a value never."""
+    scored = [r for r in records if is_score(r["value"])]
+    if not scored:
+        raise DcfkitError(f"study {study}: none of its {len(records)} trials has a score (no sequence it "
+                          f"searches on has a frame the protocol scores)")
+    return max(scored, key=lambda r: (r["value"], -r["number"]))
 
 
 def summarize(search, studies: dict[str, list[dict]]) -> dict:
@@ -27,17 +54,18 @@ def summarize(search, studies: dict[str, list[dict]]) -> dict:
     held_out: dict[str, dict] = {}
     folds = []
     for i, names in enumerate(search.folds):
-        chosen = best(studies[f"fold{i + 1}"])
+        chosen = best(studies[f"fold{i + 1}"], f"fold{i + 1}")
         scores = ev.scores(chosen["config"], names)
         held_out.update(scores)
         folds.append({"fold": i + 1, "held_out": names, "trial": chosen["number"], "params": chosen["params"],
-                      "training_auc": chosen["value"], "held_out_auc": float(np.mean([scores[n]["auc"] for n in names]))})
+                      "training_auc": chosen["value"], "held_out_auc": mean_auc(scores, names)})
     baselines = {name: ev.scores(config, search.names) for name, config in spec.baselines.items()}
     comparisons = _compare(search.names, held_out, baselines)
-    final = best(studies[FINAL])
+    final = best(studies[FINAL], FINAL)
     summary = {"name": spec.name, "spec": str(spec.path), "dataset": spec.dataset,
                "experiments": list(spec.experiments), "trials_per_study": spec.trials,
-               "sequences": search.names, "folds": folds,
+               "sequences": search.names, "unscored": [n for n in search.names if not is_score(held_out[n]["auc"])],
+               "folds": folds,
                "held_out": {"auc": mean_interval([held_out[n]["auc"] for n in search.names]).as_record(),
                             "per_sequence": held_out},
                "baselines": {name: {"auc": mean_interval([s[n]["auc"] for n in search.names]).as_record(),
@@ -46,7 +74,8 @@ def summarize(search, studies: dict[str, list[dict]]) -> dict:
                "beats_every_baseline": bool(comparisons) and all(c["significant"] for c in comparisons.values()),
                "final": {"trial": final["number"], "params": final["params"], "auc": final["value"],
                          "key": final["key"]}}
-    atomic_write(search.out / "summary.json", json.dumps(summary, indent=1) + "\n")
+    summary = finite(summary)  # as summary.json holds it
+    atomic_write(search.out / "summary.json", json.dumps(summary, indent=1, allow_nan=False) + "\n")
     atomic_write(search.out / "summary.md", "\n".join(summary_lines(summary)) + "\n")
     best_config = {"name": f"{spec.name}_best", "description": f"found by dcfkit search {spec.name} "
                    f"(final study, trial {final['number']})", **{k: v for k, v in final["config"].items()
@@ -74,21 +103,27 @@ def summary_lines(summary: dict) -> list[str]:
              f"{' + '.join(summary['experiments'])} (each sequence's runs pooled).", "",
              "| fold | held out | trial | training AUC | held-out AUC | values |", "|---|---|---|---|---|---|"]
     for f in summary["folds"]:
-        lines.append(f"| {f['fold']} | {', '.join(f['held_out'])} | {f['trial']} | {f['training_auc']:.4f} | "
-                     f"{f['held_out_auc']:.4f} | {_values(f['params'])} |")
+        lines.append(f"| {f['fold']} | {', '.join(f['held_out'])} | {f['trial']} | {_n(f['training_auc'], '.4f')} | "
+                     f"{_n(f['held_out_auc'], '.4f')} | {_values(f['params'])} |")
+    unscored = summary.get("unscored") or []  # absent from the summaries of dcfkit <= 0.9.0
+    if unscored:
+        lines += ["", f"Left out of the means and tests, having no frame the protocol scores ({len(unscored)} of "
+                      f"{len(summary['sequences'])}): {', '.join(unscored)}."]
     h = summary["held_out"]["auc"]
-    lines += ["", f"Held-out AUC of the search: {h['mean']:.4f} [{h['ci_low']:.4f}, {h['ci_high']:.4f}]", "",
+    lines += ["", f"Held-out AUC of the search: {_n(h['mean'], '.4f')} "
+                  f"[{_n(h['ci_low'], '.4f')}, {_n(h['ci_high'], '.4f')}]", "",
               "| baseline | AUC | search − baseline | 95% CI | won / lost / tied | Wilcoxon p | Holm p | beaten |",
               "|---|---|---|---|---|---|---|---|"]
     for name, c in summary["comparisons"].items():
         b = summary["baselines"][name]["auc"]
-        lines.append(f"| {name} | {b['mean']:.4f} | {c['mean']:+.4f} | [{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] | "
-                     f"{c['won']} / {c['lost']} / {c['tied']} | {c['wilcoxon_p']:.3f} | {c['holm_p']:.3f} | "
-                     f"{'yes' if c['significant'] else 'no'} |")
+        lines.append(f"| {name} | {_n(b['mean'], '.4f')} | {_n(c['mean'], '+.4f')} | "
+                     f"[{_n(c['ci_low'], '+.4f')}, {_n(c['ci_high'], '+.4f')}] | "
+                     f"{c['won']} / {c['lost']} / {c['tied']} | {_n(c['wilcoxon_p'], '.3f')} | "
+                     f"{_n(c['holm_p'], '.3f')} | {'yes' if c['significant'] else 'no'} |")
     final = summary["final"]
     verdict = ("it beats every baseline on held-out folds" if summary["beats_every_baseline"]
                else "it does not beat every baseline on held-out folds: do not ship it")
-    lines += ["", f"Final study (every sequence): trial {final['trial']}, AUC {final['auc']:.4f}, "
+    lines += ["", f"Final study (every sequence): trial {final['trial']}, AUC {_n(final['auc'], '.4f')}, "
               f"{_values(final['params'])}; best.yaml. The search: {verdict}.", "", summary["method"] + "; "
               + summary["correction"] + " (beaten: significant and the interval above 0)."]
     return lines
@@ -96,3 +131,8 @@ def summary_lines(summary: dict) -> list[str]:
 
 def _values(params: dict) -> str:
     return ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
+
+
+def _n(value, form: str) -> str:
+    """A number as ``form`` gives it; ``n/a`` for None (JSON's NaN)."""
+    return format(value, form) if is_score(value) else "n/a"

@@ -3,7 +3,9 @@
 Datasets are tiny synthetic sequences in the OTB layout (as the ablation tests write them)."""
 from __future__ import annotations
 
+import dataclasses
 import json
+import shutil
 import signal
 import subprocess
 import sys
@@ -15,11 +17,13 @@ import pytest
 from test_ablation import done_sidecars, write_otb
 
 from dcfkit import cli
+from dcfkit.ablation import load_spec
 from dcfkit.analysis.scoring import evaluate
-from dcfkit.autosearch import Search, load_search_spec, make_folds
+from dcfkit.autosearch import Search, SearchSpec, load_search_spec, make_folds
 from dcfkit.autosearch.study import sample
+from dcfkit.autosearch.summary import best
 from dcfkit.config import load_config
-from dcfkit.datasets import load_dataset
+from dcfkit.datasets import DatasetWarning, load_dataset
 from dcfkit.errors import ConfigError, DcfkitError
 from dcfkit.running.results import ResultStore
 
@@ -86,6 +90,10 @@ def test_a_spec_is_resolved_when_read(tmp_path, data):
     ("solver.iterations: {int: [1, 3], log: 2}", r"\.log: expected true or false"),
     ("scale: {choice: [{name: pyramid, n_scales: 5}, {name: pyramid, n_scales: 7}]}",
      r"space\.scale\.choice: two values have the label 'pyramid': give a mapping label -> value"),
+    ("solver.iterations: {float: [1, 3]}", r"space\.solver\.iterations: with the value 1\.764: .*expected an integer"),
+    ("solver.iterations: {choice: {1: 2, '1': 3}}", r"space\.solver\.iterations\.choice: two labels read as '1'"),
+    ("solver.iterations: {choice: {true: 2, 'True': 3}}",
+     r"space\.solver\.iterations\.choice: two labels read as 'True'"),
 ])
 def test_a_wrong_space_entry_names_the_file_and_key(tmp_path, data, change, message):
     path = write(tmp_path / "s.yaml", SPEC.replace("solver.iterations: {int: [1, 3]}", change))
@@ -95,6 +103,92 @@ def test_a_wrong_space_entry_names_the_file_and_key(tmp_path, data, change, mess
     with pytest.raises(ConfigError, match=message) as info:
         load_search_spec(path)
     assert str(path) in str(info.value)
+
+
+def test_a_dimension_of_one_choice_only_needs_when_before_the_first_trial(tmp_path, data):
+    """The base's label takes mu, so each dimension alone resolves; the space also makes
+    label=gaussian with label.mu, which used to fail in the trial that sampled it."""
+    text = SPEC.replace("base: strcf", "base: dr2track").replace(", when: {label: repressed}", "")
+    with pytest.raises(ConfigError, match=r": space: label='gaussian', label\.mu=0\.05 together give no valid config "
+                                          r"\(a dimension that only some choices take needs when\)") as info:
+        load_search_spec(write(tmp_path / "s.yaml", text))
+    assert str(tmp_path / "s.yaml") in str(info.value)
+    load_search_spec(write(tmp_path / "s.yaml", SPEC.replace("base: strcf", "base: dr2track")))  # with its when
+
+
+def test_a_repeated_sequence_counts_once_in_specs_and_on_the_command_line(tmp_path, data):
+    listed = "sequences: [" + ", ".join(["seqA"] * 10) + ", seqB, seqC, seqD]\n"
+    path = write(tmp_path / "s.yaml", SPEC.replace("folds: 2", "folds: 3") + listed)
+    with pytest.warns(DatasetWarning, match=r"s\.yaml: sequences: 'seqA' listed more than once: each sequence counts "
+                                            r"once \(4 in all\)"):
+        spec = load_search_spec(path)
+    search = Search(spec, tmp_path / "out")
+    assert search.names == ["seqA", "seqB", "seqC", "seqD"]
+    assert sorted(n for fold in search.folds for n in fold) == search.names  # held out once each
+    with pytest.warns(DatasetWarning, match=r"'seqA' listed more than once"):  # the ablation's spec: the same rule
+        assert load_spec(write(tmp_path / "a.yaml", listed + "dataset: {name: otb, root: data}\nvariants: {k: kcf}\n")
+                         ).sequences == ("seqA", "seqB", "seqC", "seqD")
+    with pytest.warns(DatasetWarning, match=r"sequences for OTB at .*: 'seqB' listed more than once"):  # --sequences
+        assert [s.name for s in load_dataset("otb", data, "seqB,seqA,seqb")] == ["seqB", "seqA"]
+
+
+def test_a_sequence_without_a_scored_frame_leaves_the_objective_and_the_json_valid(tmp_path):
+    """Under got10k a one-frame sequence has no scored frame (frame 1 never counts): its AUC is
+    NaN for every config. It is left out of the means; a trial with no score at all (as recorded,
+    with a bare NaN, by dcfkit 0.9.0) is a failed trial, and a resume goes on."""
+    data = tmp_path / "data"
+    for i, name in enumerate(("seqA", "seqB", "seqC", "seqD")):
+        write_otb(data, name, seed=i, n_frames=1 if name == "seqD" else 8)
+    spec = write(tmp_path / "s.yaml", SPEC.replace("trials: 3", "trials: 1"))
+    out = tmp_path / "out"
+    strict = {"parse_constant": lambda name: pytest.fail(f"bare {name} in JSON")}
+    assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1", "--protocol", "got10k"]) == 0
+    summary = json.loads((out / "summary.json").read_text(), **strict)
+    assert summary["unscored"] == ["seqD"] and summary["held_out"]["per_sequence"]["seqD"]["auc"] is None
+    assert summary["held_out"]["auc"]["n"] == 3 and summary["comparisons"]["KCF"]["n"] == 3
+    record = json.loads((out / "trials/all/0000.json").read_text(), **strict)
+    assert record["value"] == pytest.approx(np.mean([record["scores"][n]["auc"] for n in ("seqA", "seqB", "seqC")]))
+    # a record without a score, as 0.9.0 wrote it, then a resume with one more trial
+    (out / "trials/all/0000.json").write_text(json.dumps({**record, "value": float("nan")}))
+    assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1", "--protocol", "got10k",
+                     "--trials", "2"]) == 0
+    summary = json.loads((out / "summary.json").read_text(), **strict)
+    assert summary["final"]["trial"] == 1  # a trial without a score is never the best
+    with pytest.raises(DcfkitError, match=r"study fold2: none of its 2 trials has a score"):
+        best([{"number": 0, "value": None}, {"number": 1, "value": float("nan")}], "fold2")
+
+
+def test_a_resume_on_other_data_of_the_same_names_is_refused(tmp_path, data, capsys):
+    spec = write(tmp_path / "s.yaml", SPEC.replace("trials: 3", "trials: 1"))
+    out = tmp_path / "out"
+    assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1"]) == 0
+    other = tmp_path / "other"
+    shutil.copytree(data, other)
+    gt = other / "seqC/groundtruth_rect.txt"  # the same name, length and first box; a later box moved
+    lines = gt.read_text().splitlines()
+    gt.write_text("\n".join([*lines[:-1], "5,5,16,20"]) + "\n")
+    capsys.readouterr()
+    assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1", "--root", str(other)]) != 0
+    err = capsys.readouterr().err
+    assert "search.json: its trials were made on other data: the frames or ground truth of 'seqC' under " in err
+    assert "give the recorded search's --root, or a new --out" in err
+    assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1", "--root", str(shutil.copytree(
+        data, tmp_path / "copy"))]) == 0  # a copy of the same data is the same data
+    record = json.loads((out / "search.json").read_text())  # as dcfkit 0.9.0 wrote it: no identity, trusted
+    del record["fingerprint"]["data"]
+    (out / "search.json").write_text(json.dumps(record))
+    assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1"]) == 0
+    assert "data" in json.loads((out / "search.json").read_text())["fingerprint"]
+
+
+def test_a_sequence_whose_ground_truth_is_withheld_is_left_out_of_the_search(tmp_path, data, monkeypatch, caplog):
+    spec = load_search_spec(write(tmp_path / "s.yaml", SPEC.replace("trials: 3", "trials: 1")))
+    loaded = spec.load_sequences()  # seqC as a test split's: frame 1's box only (it used to be a KeyError)
+    monkeypatch.setattr(SearchSpec, "load_sequences", lambda self: [
+        dataclasses.replace(s, ground_truth_withheld=s.name == "seqC") for s in loaded])
+    with caplog.at_level("WARNING"):
+        summary = Search(spec, tmp_path / "out", {"jobs": 1}).run()
+    assert summary["sequences"] == ["seqA", "seqB", "seqD"] and "withheld after frame 1" in caplog.text
 
 
 @pytest.mark.parametrize("old, new, message", [
@@ -162,6 +256,8 @@ def test_a_rerun_resumes_and_more_trials_extend_the_studies(tmp_path, data, caps
     first = {p.relative_to(out): p.read_bytes() for p in out.glob("trials/*/*.json")}
     assert len(first) == 3 * 2
     (out / "trials/fold2/0001.json").unlink()  # as a kill before the trial was recorded
+    damaged = json.loads((out / "trials/fold1/0001.json").read_text())  # an edited record is run again
+    (out / "trials/fold1/0001.json").write_text(json.dumps({**damaged, "params": {"solver.iterations": 99}}))
     assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1", "--trials", "3"]) == 0
     again = {p.relative_to(out): p.read_bytes() for p in out.glob("trials/*/*.json")}
     assert len(again) == 3 * 3
