@@ -6,24 +6,29 @@ from 20 later starts and from 12 perturbed first boxes (:mod:`dcfkit.experiments
 A run is a :class:`~dcfkit.datasets.Sequence` of its own: its frames from the start, its
 ``start_box``, and a name ``<sequence>_<k>`` (k from 001), so each is stored, resumed and
 scored as a one-pass result is. One-pass results stay in ``OUT/<tracker>/``; the others go to
-``OUT/<tracker>/<experiment>/``.
+``OUT/<tracker>/<experiment>/``. A TRE or SRE run that no tracker can start from is left out
+(:func:`left_out_runs` says why, and a warning when its sequence's runs are made); its
+sequence is scored on the others.
 """
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from typing import Callable, Iterable
 
-from dcfkit.datasets import Sequence
+from dcfkit.datasets import DatasetWarning, Sequence
 from dcfkit.errors import DcfkitError, shown
-from dcfkit.experiments.otb import sre_runs, tre_runs
+from dcfkit.experiments.otb import sre_plan, tre_plan
+from dcfkit.experiments.starts import Plan
 
-__all__ = ["EXPERIMENTS", "Experiment", "get_experiment", "runs_by_sequence"]
+__all__ = ["EXPERIMENTS", "Experiment", "get_experiment", "left_out_runs", "runs_by_sequence"]
 
 
 @dataclasses.dataclass(frozen=True)
 class Experiment:
-    """``runs(sequence)`` gives the runs of one sequence; ``folder`` is the sub-folder of a
-    tracker's results that holds them (``""`` for one-pass results); ``resets`` marks VOT's
+    """``plan(sequence)`` gives the runs of one sequence and those left out (:class:`Plan`),
+    ``runs(sequence)`` the former; ``folder`` is the sub-folder of a tracker's results that
+    holds them (``""`` for one-pass results); ``resets`` marks VOT's
     reset-based runs, which re-initialise the tracker after each failure; ``first_box``
     whether the runs need frame 1's ground truth (TRE and reset-based runs start at the first
     valid one)."""
@@ -31,22 +36,25 @@ class Experiment:
     name: str
     title: str
     source: str
-    runs: Callable[[Sequence], list[Sequence]]
+    plan: Callable[[Sequence], Plan]
     folder: str
     resets: bool = False
     first_box: bool = True
 
+    def runs(self, seq: Sequence) -> list[Sequence]:
+        return self.plan(seq).runs
 
-def _one_run(seq: Sequence) -> list[Sequence]:
-    return [seq]
+
+def _one_run(seq: Sequence) -> Plan:
+    return Plan([seq], {})
 
 
 EXPERIMENTS: dict[str, Experiment] = {e.name: e for e in (
     Experiment("ope", "one-pass evaluation", "Wu et al., TPAMI 2015", _one_run, ""),
     Experiment("tre", "temporal robustness: 20 starts", "Wu et al., TPAMI 2015; OTB toolkit splitSeqTRE.m",
-               tre_runs, "tre", first_box=False),
+               tre_plan, "tre", first_box=False),
     Experiment("sre", "spatial robustness: 8 shifts, 4 scales", "Wu et al., TPAMI 2015; OTB toolkit shiftInitBB.m",
-               sre_runs, "sre"),
+               sre_plan, "sre"),
     Experiment("reset", "reset-based: re-initialised 5 frames after each failure",
                "Kristan et al., TPAMI 2016 (VOT2016); vot-toolkit", _one_run, "reset", resets=True, first_box=False),
 )}
@@ -62,7 +70,25 @@ def get_experiment(experiment: str | Experiment) -> Experiment:
         raise DcfkitError(f"unknown experiment {shown(experiment)}; one of: {', '.join(EXPERIMENTS)}") from None
 
 
+_SAID: set[str] = set()  # the left-out runs warned of
+
+
 def runs_by_sequence(sequences: Iterable[Sequence], experiment: str | Experiment) -> dict[str, list[Sequence]]:
-    """Sequence name -> its runs in ``experiment``."""
-    runs = get_experiment(experiment).runs
-    return {seq.name: runs(seq) for seq in sequences}
+    """Sequence name -> its runs in ``experiment``; a :class:`DatasetWarning` for each run left
+    out (once per process)."""
+    plan = get_experiment(experiment).plan
+    found = {}
+    for seq in sequences:
+        runs, left_out = plan(seq)
+        for why in [w for w in left_out.values() if w not in _SAID]:
+            _SAID.add(why)  # once per process: a command makes a sequence's runs several times
+            warnings.warn(f"{why}; left out, as the toolkit's run would stop at once: sequence {seq.name!r} is "
+                          f"scored on its other {len(runs)} runs", DatasetWarning, stacklevel=2)
+        found[seq.name] = runs
+    return found
+
+
+def left_out_runs(sequences: Iterable[Sequence], experiment: str | Experiment) -> dict[str, str]:
+    """Run name -> why it is left out of ``experiment``: no tracker can start from its first box."""
+    plan = get_experiment(experiment).plan
+    return {name: why for seq in sequences for name, why in plan(seq).left_out.items()}

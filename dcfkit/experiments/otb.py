@@ -12,6 +12,11 @@ of its size (left, right, up, down: ``ceil``; the four corners move that corner 
 opposite one staying: ``round``) or scaled about its centre by 0.8, 0.9, 1.1, 1.2
 (``round``), then kept inside the image. Rounding is MATLAB's (halves away from zero), on
 1-based boxes.
+
+A run whose first box no tracker can start from (a TRE start whose ground truth lies outside
+the image, an SRE box kept inside the image with no width left) is left out with its reason
+(:func:`~dcfkit.experiments.starts.plan_runs`), as the toolkit's run would end before its
+first frame; the others keep their names.
 """
 from __future__ import annotations
 
@@ -21,9 +26,10 @@ import math
 import numpy as np
 
 from dcfkit.datasets import DatasetError, Sequence
+from dcfkit.experiments.starts import Plan, plan_runs
 
-__all__ = ["SRE_SHIFTS", "TRE_MIN_FRAMES", "TRE_SEGMENTS", "run_name", "sre_box", "sre_runs", "tre_runs",
-           "tre_starts"]
+__all__ = ["SRE_SHIFTS", "TRE_MIN_FRAMES", "TRE_SEGMENTS", "run_name", "sre_box", "sre_plan", "sre_runs", "tre_plan",
+           "tre_runs", "tre_starts"]
 
 TRE_SEGMENTS = 20
 TRE_MIN_FRAMES = 20  # a segment's least length (minNum)
@@ -58,14 +64,21 @@ def tre_starts(gt: np.ndarray, segments: int = TRE_SEGMENTS, min_frames: int = T
     return [int(valid[p - 1]) for p in positions]
 
 
-def tre_runs(seq: Sequence) -> list[Sequence]:
-    """One run per TRE segment: the frames from its start to the end, from its ground truth."""
+def tre_plan(seq: Sequence) -> Plan:
+    """One run per TRE segment: the frames from its start to the end, from its ground truth
+    (a start whose ground truth lies outside the image is left out)."""
     try:
         starts = tre_starts(seq.ground_truth)
     except DatasetError as exc:
         raise DatasetError(f"sequence {seq.name!r}: {exc}") from None
-    return [dataclasses.replace(seq, name=run_name(seq, k), frames=seq.frames[s:], ground_truth=seq.ground_truth[s:],
-                                start_box=None) for k, s in enumerate(starts, 1)]
+    runs = [(dataclasses.replace(seq, name=run_name(seq, k), frames=seq.frames[s:], ground_truth=seq.ground_truth[s:],
+                                 start_box=None), f"from frame {s + 1}") for k, s in enumerate(starts, 1)]
+    return plan_runs(seq, runs, "TRE", seq.frame(0).shape[:2])
+
+
+def tre_runs(seq: Sequence) -> list[Sequence]:
+    """The TRE runs of ``seq`` that start (:func:`tre_plan`)."""
+    return tre_plan(seq).runs
 
 
 def _matlab_round(x: float) -> float:
@@ -108,12 +121,17 @@ def sre_box(box, shift: str, image_size: tuple[int, int]) -> np.ndarray:
     return np.array([x - 1, y - 1, w, h], dtype=np.float64)
 
 
-def sre_runs(seq: Sequence) -> list[Sequence]:
-    """One run of the whole sequence per SRE shift of frame 1's box (its image's size read)."""
+def sre_plan(seq: Sequence) -> Plan:
+    """One run of the whole sequence per SRE shift of frame 1's box (its image's size read); a
+    box kept inside the image with no width or height left is left out."""
     first = seq.ground_truth[0]
     if not (np.isfinite(first).all() and (first[2:] > 0).all()):
         raise DatasetError(f"sequence {seq.name!r}: SRE shifts frame 1's ground truth, which is NaN or empty")
-    height, width = seq.frame(0).shape[:2]
-    return [dataclasses.replace(seq, name=run_name(seq, k), start_box=sre_box(seq.ground_truth[0], shift,
-                                                                                (height, width)))
-            for k, shift in enumerate(SRE_SHIFTS, 1)]
+    size = seq.frame(0).shape[:2]
+    return plan_runs(seq, [(dataclasses.replace(seq, name=run_name(seq, k), start_box=sre_box(first, shift, size)),
+                            f"shift {shift}") for k, shift in enumerate(SRE_SHIFTS, 1)], "SRE", size)
+
+
+def sre_runs(seq: Sequence) -> list[Sequence]:
+    """The SRE runs of ``seq`` that start (:func:`sre_plan`)."""
+    return sre_plan(seq).runs

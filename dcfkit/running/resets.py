@@ -1,14 +1,18 @@
 """The frame loop of VOT's reset-based experiment (:mod:`dcfkit.experiments.vot`): track,
 and start a fresh tracker from the ground truth :data:`~dcfkit.experiments.vot.SKIP` frames
-after each failure."""
+after each failure, or from the first frame after that whose ground truth a tracker can start
+from (:func:`~dcfkit.experiments.starts.start_problem`), as vot-toolkit moves a start past
+the frames it must not start on."""
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from typing import Callable
 
 import numpy as np
 
 from dcfkit.datasets import Sequence
+from dcfkit.experiments.starts import start_problem
 from dcfkit.experiments.vot import SKIP, overlap, valid_box
 from dcfkit.running.tracking import Track, TrackerFailure, steps
 
@@ -17,10 +21,20 @@ from dcfkit.running.tracking import Track, TrackerFailure, steps
 class ResetTrack(Track):
     """A :class:`Track` of a reset-based run: frames not tracked (between a failure and the
     next start) have NaN boxes, times and confidences; ``starts`` and ``failures`` are 0-based
-    frame indices."""
+    frame indices; ``moved`` maps a start made later than due (frame 1, or :data:`SKIP`
+    frames after a failure) to the frame it was due."""
 
     starts: list[int] = dataclasses.field(default_factory=list)
     failures: list[int] = dataclasses.field(default_factory=list)
+    moved: dict[int, int] = dataclasses.field(default_factory=dict)
+
+    def record(self) -> dict:
+        """The sidecar's ``resets``: 1-based ``starts`` and ``failures``, as every frame number
+        dcfkit shows, and, if a start was made later than due, ``moved``: ``[due, start]`` of each."""
+        record = {"starts": [i + 1 for i in self.starts], "failures": [i + 1 for i in self.failures]}
+        if self.moved:
+            record["moved"] = [[due + 1, start + 1] for start, due in self.moved.items()]
+        return record
 
     @property
     def fps(self) -> float | None:
@@ -29,10 +43,11 @@ class ResetTrack(Track):
         return int(tracked.sum()) / total if total > 0 else None
 
 
-def next_start(gt: np.ndarray, frame: int) -> int | None:
-    """The first frame from ``frame`` (0-based) with a valid ground truth, or None."""
+def next_start(gt: np.ndarray, frame: int, image_size: tuple[int, int] | None = None) -> int | None:
+    """The first frame from ``frame`` (0-based) with a valid ground truth that, when the
+    ``(height, width)`` is given, a tracker can start from (:func:`start_problem`), or None."""
     for i in range(frame, len(gt)):
-        if valid_box(gt[i]):
+        if valid_box(gt[i]) and (image_size is None or start_problem(gt[i], image_size) is None):
             return i
     return None
 
@@ -41,24 +56,36 @@ def track_with_resets(make_tracker: Callable[[], object], seq: Sequence, frame: 
                       on_frame: Callable[[], None] | None = None) -> ResetTrack:
     """Run fresh trackers from ``make_tracker()`` through ``seq`` (frames read by ``frame(i)``),
     each from the ground truth, the first at frame 1 and the next :data:`SKIP` frames after
-    each failure (a frame whose box does not overlap a valid ground truth)."""
+    each failure (a frame whose box does not overlap a valid ground truth); a start moves on to
+    the next frame whose ground truth is valid and inside the image (:func:`next_start`)."""
     n = len(seq)
     run = ResetTrack(np.full((n, 4), np.nan), np.full(n, np.nan), np.full((n, 2), np.nan))
-    start = next_start(seq.ground_truth, 0)
+    due, size = 0, None  # the image size: unknown until a frame is read
+    start = next_start(seq.ground_truth, due)
     while start is not None:
+        image = frame(start)
+        if size is None:
+            size = image.shape[:2]
+            if start_problem(seq.ground_truth[start], size) is not None:
+                start = next_start(seq.ground_truth, start + 1, size)
+                continue
+        if start != due:
+            run.moved[start] = due
         run.starts.append(start)
-        failed = _segment(make_tracker(), seq, frame, start, run, on_frame)
+        failed = _segment(make_tracker(), seq, frame, start, image, run, on_frame)
         if failed is None:
             break
         run.failures.append(failed)
-        start = next_start(seq.ground_truth, failed + SKIP)
+        due = failed + SKIP
+        start = next_start(seq.ground_truth, due, size)
     return run
 
 
-def _segment(tracker, seq: Sequence, frame: Callable[[int], np.ndarray], start: int, run: ResetTrack,
-             on_frame: Callable[[], None] | None) -> int | None:
-    """Track from ``start`` into ``run`` until a failure (its 0-based frame) or the end (None)."""
-    frames = (frame(i) for i in range(start, len(seq)))
+def _segment(tracker, seq: Sequence, frame: Callable[[int], np.ndarray], start: int, first: np.ndarray,
+             run: ResetTrack, on_frame: Callable[[], None] | None) -> int | None:
+    """Track from ``start`` (its image ``first``, read) into ``run`` until a failure (its 0-based
+    frame) or the end (None)."""
+    frames = itertools.chain([first], (frame(i) for i in range(start + 1, len(seq))))
     try:
         for step in steps(tracker, frames, seq.ground_truth[start].copy()):
             i = start + step.index

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 from scipy import stats
@@ -144,6 +145,7 @@ def test_tre_pools_the_frames_of_a_sequences_runs_as_perfplot_does(tmp_path):
     from dcfkit.experiments.otb import tre_runs
 
     rng = np.random.default_rng(3)
+    cv2.imwrite(str(tmp_path / "0.jpg"), np.zeros((100, 120, 3), np.uint8))  # TRE starts are checked against its size
     seqs = [Sequence(name, tuple(tmp_path / f"{k}.jpg" for k in range(n)),
                      np.column_stack([np.arange(n) + 5.0, np.full(n, 5.0), np.full(n, 20.0), np.full(n, 30.0)]))
             for name, n in (("long", 60), ("short", 30))]

@@ -2,12 +2,20 @@
 splitSeqTRE.m and shiftInitBB.m (Wu et al., TPAMI 2015)."""
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.experiments import EXPERIMENTS, get_experiment, runs_by_sequence
 from dcfkit.experiments.otb import SRE_SHIFTS, sre_box, tre_runs, tre_starts
+
+
+def frames(folder, n: int, size=(60, 80)) -> tuple:
+    """``n`` frame paths in ``folder``, the first written (runs are planned on frame 1's size)."""
+    paths = tuple(folder / f"{k:04d}.jpg" for k in range(n))
+    cv2.imwrite(str(paths[0]), np.zeros((*size, 3), np.uint8))
+    return paths
 
 
 def test_tre_starts_of_a_100_frame_sequence():
@@ -37,7 +45,7 @@ def test_short_sequences_repeat_starts_as_the_toolkit_does():
 
 def test_tre_runs_start_at_their_frame_from_its_ground_truth(tmp_path):
     gt = np.column_stack([np.arange(40.0), np.zeros(40), np.full(40, 5.0), np.full(40, 6.0)])
-    seq = Sequence("walk", tuple(tmp_path / f"{k:04d}.jpg" for k in range(40)), gt, dataset="fake")
+    seq = Sequence("walk", frames(tmp_path, 40), gt, dataset="fake")
     runs = tre_runs(seq)
     starts = tre_starts(gt)
     assert [r.name for r in runs] == [f"walk_{k:03d}" for k in range(1, 21)]
@@ -76,6 +84,6 @@ def test_experiments_by_name(tmp_path):
     assert get_experiment("TRE") is EXPERIMENTS["tre"] and get_experiment(EXPERIMENTS["sre"]) is EXPERIMENTS["sre"]
     with pytest.raises(Exception, match="unknown experiment 'xre'; one of: ope, tre, sre, reset"):
         get_experiment("xre")
-    seq = Sequence("a", tuple(tmp_path / f"{k}.jpg" for k in range(30)), np.ones((30, 4)))
+    seq = Sequence("a", frames(tmp_path, 30), np.ones((30, 4)))
     assert runs_by_sequence([seq], "ope") == {"a": [seq]}
     assert [len(r) for r in runs_by_sequence([seq], "tre")["a"]][-1] == 20
