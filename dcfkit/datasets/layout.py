@@ -3,6 +3,10 @@
 Built-in layouts register here when :mod:`dcfkit.datasets` is imported, as a script does with
 :func:`register_layout`; a plugin's go through ``registry.register_dataset`` (:mod:`dcfkit.registry`),
 which makes them with :func:`new_layout`. Lookups are in :mod:`dcfkit.datasets.catalog`.
+
+Every layout's loader is a :class:`CheckedLoader`: the sequences it returns must have names
+that are one safe file name each (:func:`sequence_name_problem`) and unique, since results,
+exports and reports are files named after them.
 """
 from __future__ import annotations
 
@@ -13,10 +17,11 @@ from pathlib import Path
 from typing import Callable, Iterable, Iterator
 
 from dcfkit.datasets.base import DatasetError, Sequence
-from dcfkit.errors import RegistryError, shown
+from dcfkit.errors import RegistryError, clip, shown
 from dcfkit.protocols import PROTOCOLS
 
 Loader = Callable[..., list[Sequence]]  # (root, sequences=None) -> list[Sequence]
+NAME_BYTES = 200  # the longest sequence name in UTF-8: a result's file name adds 30 bytes, a file name holds 255
 Detector = Callable[[Path], int]  # root -> Evidence (or bool)
 
 
@@ -98,11 +103,82 @@ def new_layout(name: str, load: Loader, description: str, *, detect: Detector | 
                     tuple(dict.fromkeys(layout_key(a) for a in aliases if layout_key(a) != layout_key(name))), provider,
                     str(protocol or ""))
     _check_new_layout(layout)
-    return layout
+    return dataclasses.replace(layout, load=CheckedLoader(load, _where(layout)))
+
+
+def _where(layout: Layout) -> str:
+    return f"dataset layout {layout.name!r}" + (f" (from {layout.provider})" if layout.provider else "")
+
+
+def _escaped(text: str) -> str:
+    """``text`` with the bytes of a name that is not UTF-8 (Python's surrogate escapes) shown as
+    ``\\xff``: printable and writable whatever the terminal's encoding."""
+    return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+
+
+def _shown_name(name) -> str:
+    """``name`` as :func:`shown` shows it, a name that is not UTF-8 as its bytes (``b'seq\\xff'``)."""
+    try:
+        name.encode("utf-8")
+    except (AttributeError, UnicodeEncodeError):
+        return shown(name.encode("utf-8", "surrogateescape") if isinstance(name, str) else name)
+    return shown(name)
+
+
+def sequence_name_problem(name) -> str | None:
+    """Why ``name`` cannot name a sequence, or None: it must be one file name on every system
+    (not empty, no leading ``.``; no ``/``, ``\\`` or ``:``), UTF-8, printable (no line break,
+    tab or NUL), without spaces at either end (list files strip them) and at most
+    :data:`NAME_BYTES` bytes long."""
+    if not isinstance(name, str):
+        return f"is a {type(name).__name__}, not a string"
+    try:
+        size = len(name.encode("utf-8"))
+    except UnicodeEncodeError:
+        return "is not valid UTF-8 (its bytes are shown escaped): rename its folder or files to a UTF-8 name"
+    if name in ("", ".", ".."):
+        return "is not a file name"
+    if any(c in name for c in "/\\:"):
+        return "holds / \\ or :, which would make its result files' path leave the results folder"
+    if name.startswith("."):
+        return "starts with '.', which hides its files and is how dcfkit names files in progress"
+    if not name.isprintable():
+        return "holds a line break, tab, NUL or other unprintable character"
+    if name != name.strip():
+        return "starts or ends with a space, which list files drop"
+    if size > NAME_BYTES:
+        return f"is {size} bytes long in UTF-8; at most {NAME_BYTES} leave room for its result files' endings"
+    return None
+
+
+class CheckedLoader:
+    """A layout's loader as dcfkit calls it: the original, then a check of what it returned, a
+    list of :class:`Sequence` with unique, safe names (:func:`sequence_name_problem`); a
+    :class:`DatasetError` naming the layout and the sequence otherwise."""
+
+    def __init__(self, original: Loader, where: str):
+        self.original, self.where = original, where
+
+    def __call__(self, *args, **kwargs) -> list[Sequence]:
+        loaded = self.original(*args, **kwargs)
+        if not isinstance(loaded, (list, tuple)) or not all(isinstance(s, Sequence) for s in loaded):
+            raise DatasetError(f"{self.where}: load() returned {shown(loaded)}, expected a list of "
+                               f"dcfkit.datasets.Sequence")
+        seen: dict[str, str] = {}
+        for seq in loaded:
+            problem = sequence_name_problem(seq.name)
+            if problem is None and seq.name.casefold() in seen:
+                problem = (f"is also the name of sequence {seen[seq.name.casefold()]!r} (names must differ in "
+                           f"more than case: their result files would be one on a case-insensitive disk)")
+            if problem is not None:
+                found = f" ({clip(_escaped(str(seq.annotation)))})" if seq.annotation else ""
+                raise DatasetError(f"{self.where}: sequence name {_shown_name(seq.name)}{found} {problem}")
+            seen[seq.name.casefold()] = seq.name
+        return list(loaded)
 
 
 def _check_new_layout(layout: Layout) -> None:
-    where = f"dataset layout {layout.name!r}" + (f" (from {layout.provider})" if layout.provider else "")
+    where = _where(layout)
     if not layout.name:
         raise RegistryError(f"dataset layout {shown(layout.description)}: the name is empty")
     if "auto" in (layout.name,) + layout.aliases:
