@@ -248,3 +248,37 @@ def test_a_component_whose_hooks_cannot_be_wrapped_is_refused_by_name():
     with pytest.raises(RegistryError, match=r"scale 'slotted' \(from p\): dcfkit cannot check its update\(\)"):
         checked(NoDict(), "p", {"update": None})
     assert isinstance(checked(Slotted(), "p", {"update": None}).update, Hook)  # a base with a __dict__: wrapped
+
+
+async def _async_start(self, target):
+    self.started = True
+
+
+async def _async_generator_start(self, target):
+    yield target
+
+
+def _generator_start(self, target):
+    self.started = True
+    yield
+
+
+def _generator_make(self, g, detection):
+    yield g
+
+
+@pytest.mark.parametrize("hook, body, said", [
+    ("start", _generator_start, "a generator function (it yields): the tracker's call would return a generator and "
+                                "run none of it"),
+    ("start", _async_start, "an async function: the tracker's call would return a coroutine"),
+    ("start", _async_generator_start, "an async generator function"),
+    ("make", _generator_make, "a generator function"),  # a kind's own hook too
+])
+def test_a_hook_that_would_not_run_when_called_is_refused_at_registration(hook, body, said):
+    from dcfkit.errors import RegistryError
+
+    registry = reg.build_registry(external=False)
+    registry._provider = PROVIDER
+    with pytest.raises(RegistryError, match=re.escape(f"label 'lazy' (from {PROVIDER}): {hook}() is {said}")):
+        registry.register(type("Lazy", (Gaussian,), {"name": "lazy", hook: body}))
+    registry.register(type("Eager", (Gaussian,), {"name": "eager", "start": lambda self, target: None}))

@@ -135,6 +135,23 @@ def _signature_problem(cls: type, method: str, args: tuple[str, ...]) -> str | N
     return None
 
 
+def _body_problem(cls: type, method: str) -> str | None:
+    """Why ``cls``'s ``method`` would not run when called, or None: a generator or async
+    function returns a generator or coroutine without running a line of its body."""
+    try:
+        called, _ = _as_called(cls, method)
+    except (TypeError, AttributeError):  # no instance without __init__, or missing: said elsewhere
+        return None
+    for test, kind in ((inspect.isgeneratorfunction, "a generator function (it yields)"),
+                       (inspect.iscoroutinefunction, "an async function"),
+                       (inspect.isasyncgenfunction, "an async generator function")):
+        if test(called):
+            return (f"{method}() is {kind}: the tracker's call would return a "
+                    f"{'coroutine' if kind == 'an async function' else 'generator'} and run none of it; "
+                    f"make it a plain method")
+    return None
+
+
 def contract_problems(cls: type, base: type) -> list[str]:
     """What ``cls`` lacks of ``base.contract`` (an empty list: it meets it)."""
     contract: Contract = base.__dict__["contract"]
@@ -142,7 +159,7 @@ def contract_problems(cls: type, base: type) -> list[str]:
     for method, args in {**contract.required, **contract.optional, **EVERY_KIND}.items():
         if method in contract.required and getattr(cls, method, None) is getattr(base, method, None):
             problems.append(f"it does not implement {method}({', '.join(args)})")
-        elif problem := _signature_problem(cls, method, args):
+        elif problem := _signature_problem(cls, method, args) or _body_problem(cls, method):
             problems.append(problem)
     hints = typing.get_type_hints(cls.Params)
     for field, (kind, lowest, highest) in contract.params.items():
