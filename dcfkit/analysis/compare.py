@@ -26,15 +26,16 @@ counted) is named in ``non_finite`` and left out of that score's statistics.
 """
 from __future__ import annotations
 
-import collections
 import logging
 import math
+from collections import Counter
 from pathlib import Path
-from typing import Iterable
+from typing import Iterable, Mapping
 
 import numpy as np
 
 from dcfkit.analysis import metrics
+from dcfkit.analysis.report import refuse_reset_runs
 from dcfkit.analysis.statistics import METHOD, mean_interval, paired_difference
 from dcfkit.datasets import DatasetError, Sequence, benchmark_protocol, read_boxes, scored_sequences
 from dcfkit.errors import clip, shown
@@ -42,8 +43,8 @@ from dcfkit.protocols import Protocol, get_protocol
 from dcfkit.running import platforms
 from dcfkit.running.results import ResultStore, result_files
 
-__all__ = ["COLUMNS", "PLATFORM_NOISE", "compare_folders", "first_divergence", "noise_floor", "score_statistics",
-           "series_iou"]
+__all__ = ["COLUMNS", "PLATFORM_NOISE", "compare_folders", "counted_lines", "first_divergence", "noise_floor",
+           "score_statistics", "series_iou"]
 
 COLUMNS = ("sequence", "frames", "precision", "precision_ref", "d_precision", "auc", "auc_ref", "d_auc",
            "iou", "diverges_at")
@@ -93,9 +94,9 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     (``only_in_results``, ``only_in_reference``, ``not_in_dataset``, ``damaged``: sequence names)
     and the statistics of :func:`score_statistics`: ``statistics``, ``auc_difference``,
     ``wilcoxon_p`` (AUC's), ``precision_difference`` and ``precision_wilcoxon_p``.
-    Raises :class:`DatasetError` for a missing folder, a malformed line (naming file and
-    line), two files of one sequence with different line counts, or a line count that is
-    not the sequence's frame count (naming the sequence). Sequences whose ground truth is
+    Raises :class:`DatasetError` for a missing folder, a folder of reset-based runs, a malformed
+    line (naming file and line), two files of one sequence with different line counts, or a line
+    count that is not the sequence's frame count (naming the sequence). Sequences whose ground truth is
     withheld after frame 1 (test splits) are left out, as in :func:`dcfkit.analysis.scoring.evaluate`,
     whose default ``protocol`` (the benchmark's) is this one's too.
     """
@@ -129,9 +130,9 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
             "reference": str(reference), "rows": rows, "mean": mean, **score_statistics(rows),
             "noise_floor": noise_floor(rows),
             "diverged": sum(r["diverges_at"] is not None for r in rows), "left_out": left_out,
-            "platforms": {side: _counted((platforms.describe(records[s.name]) for s in both), len(both))
+            "platforms": {side: counted_lines(Counter(platforms.describe(records[s.name]) for s in both), len(both))
                           for side, records in (("results", our_platforms), ("reference", their_platforms))},
-            "platform_differences": _counted((d for s in both for d in set(
+            "platform_differences": counted_lines(Counter(d for s in both for d in set(
                 platforms.differences(our_platforms[s.name], their_platforms[s.name]))), len(both))}
 
 
@@ -172,12 +173,11 @@ def _non_finite(rows: list[dict], key: str) -> list[str]:
     return [r["sequence"] for r in rows if not math.isfinite(r[key])]
 
 
-def _counted(lines: Iterable[str], total: int, limit: int = 10) -> list[str]:
-    """The different ``lines`` (each at most once per sequence, of ``total``), most frequent
-    first, each with its count of sequences unless every sequence has it; at most ``limit`` of
-    them and a last line counting the others (one line per sequence would be thousands)."""
-    found = collections.Counter(lines)
-    ranked = sorted(found.items(), key=lambda item: (-item[1], item[0]))
+def counted_lines(counts: Mapping[str, int], total: int, limit: int = 10) -> list[str]:
+    """The different lines of ``counts`` (line -> how many of ``total`` sequences have it), most
+    frequent first, each with its count of sequences unless every sequence has it; at most
+    ``limit`` of them and a last line counting the others (one line per sequence would be thousands)."""
+    ranked = sorted(counts.items(), key=lambda item: (-item[1], item[0]))
     out = [line if n == total else f"{line} ({n:,} of {total:,} sequences)" for line, n in ranked[:limit]]
     if len(ranked) > limit:
         out.append(f"and {len(ranked) - limit:,} more")
@@ -187,11 +187,15 @@ def _counted(lines: Iterable[str], total: int, limit: int = 10) -> list[str]:
 def _intact_files(folder) -> tuple[dict[str, Path], list[str], dict[str, dict | None]]:
     """The result files of ``folder``, apart the sequences whose dcfkit sidecar says the file is
     damaged (never compared; each logged), and each file's platform record (None without one).
-    Files without a sidecar are taken as they are."""
+    Files without a sidecar are taken as they are; reset-based runs are refused
+    (:func:`~dcfkit.analysis.report.refuse_reset_runs`)."""
     files, store = result_files(folder), ResultStore(folder)
     damaged, platform_records = [], {}
+    metas = {name: store.sidecar(name) for name in files}
+    refuse_reset_runs(Path(folder), [name for name, meta in metas.items()
+                                     if isinstance(meta, dict) and meta.get("resets") is not None])
     for name in list(files):
-        meta = store.sidecar(name)
+        meta = metas[name]
         record = meta.get("platform") if isinstance(meta, dict) else None
         platform_records[name] = record if isinstance(record, dict) else None
         problem = store.problem(name, meta) if meta is not None else None

@@ -34,9 +34,10 @@ from dcfkit.protocols import Protocol
 from dcfkit.running.files import atomic_write, ensure_writable
 from dcfkit.running.results import import_results, load_results
 
+# the scoring, tables and plots are here too, as the report uses them
 __all__ = ["columns", "default_report_dir", "evaluate", "format_rows", "format_table", "gather_results", "json_ready",
-           "plot_curves", "read_folder", "score_and_write", "score_folders", "score_line", "tracker_folders",
-           "write_files", "write_report"]  # the scoring, tables and plots are here too, as the report uses them
+           "plot_curves", "read_folder", "refuse_reset_runs", "score_and_write", "score_folders", "score_line",
+           "tracker_folders", "write_files", "write_report"]
 
 log = logging.getLogger(__name__)
 
@@ -64,11 +65,24 @@ def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | 
 
 
 def read_folder(folder: Path, sequences: Seq[Sequence]) -> dict:
-    """Sequence name -> result of the tracker in ``folder`` (see :func:`gather_results`)."""
+    """Sequence name -> result of the tracker in ``folder`` (see :func:`gather_results`); a
+    :class:`DatasetError` if it holds reset-based runs (:func:`refuse_reset_runs`)."""
     names = {s.name for s in sequences}
     if any((folder / f"{n}.json").is_file() for n in names):
-        return load_results(folder.parent, folder.name, sequences)
+        results = load_results(folder.parent, folder.name, sequences)
+        refuse_reset_runs(folder, [name for name, result in results.items() if result.resets is not None])
+        return results
     return {k: v for k, v in import_results(folder).items() if k in names}
+
+
+def refuse_reset_runs(folder: Path, names: Seq[str]) -> None:
+    """A :class:`DatasetError` if ``names`` (results in ``folder`` whose sidecar records resets)
+    is not empty: a reset-based run was restarted from the ground truth after each failure, and
+    scored as one pass it would look far better than it is."""
+    if names:
+        more = f" and {len(names) - 1:,} more" if len(names) > 1 else ""
+        raise DatasetError(f"{clip(str(folder))} holds reset-based runs, not one-pass results (the sidecars of "
+                           f"{shown(names[0])}{more} record resets); score them with dcfkit report --experiment reset")
 
 
 def tracker_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,

@@ -2,11 +2,14 @@
 (:mod:`dcfkit.analysis.reset_scores`) and written as tables, statistics and JSON."""
 from __future__ import annotations
 
+import itertools
 import json
 import logging
 from pathlib import Path
 from typing import Iterable
 from typing import Sequence as Seq
+
+import numpy as np
 
 from dcfkit.analysis.report import TABLE_FORMATS, default_report_dir, json_ready, tracker_folders
 from dcfkit.analysis.reset_scores import ResetRun, score_resets
@@ -14,7 +17,9 @@ from dcfkit.analysis.tables import format_rows, statistics_lines
 from dcfkit.datasets import DatasetError, Sequence, scored_sequences
 from dcfkit.errors import clip
 from dcfkit.experiments import EXPERIMENTS
+from dcfkit.experiments.vot import SKIP, overlap
 from dcfkit.running.files import atomic_write, ensure_writable
+from dcfkit.running.resets import next_start
 from dcfkit.running.results import ResultStore
 
 log = logging.getLogger(__name__)
@@ -25,7 +30,9 @@ EXPERIMENT = EXPERIMENTS["reset"]
 
 
 def reset_runs(folder: Path, sequences: Seq[Sequence]) -> dict[str, ResetRun]:
-    """Sequence name -> :class:`ResetRun` of the intact reset-based results in ``folder``."""
+    """Sequence name -> :class:`ResetRun` of the intact reset-based results in ``folder``; a run
+    whose starts and failures are not those its boxes and ground truth give
+    (:func:`resets_problem`) is left out, and said so."""
     runs, by_name = {}, {s.name: s for s in sequences}
     for name, result in ResultStore(folder).load(sequences).items():
         seq = by_name[name]
@@ -34,9 +41,75 @@ def reset_runs(folder: Path, sequences: Seq[Sequence]) -> dict[str, ResetRun]:
                         folder, name)
             continue
         height, width = seq.frame(0).shape[:2]
-        runs[name] = ResetRun(result.boxes, seq.ground_truth, tuple(i - 1 for i in result.resets["starts"]),
-                              tuple(i - 1 for i in result.resets["failures"]), (width, height))
+        run = ResetRun(result.boxes, seq.ground_truth, tuple(i - 1 for i in result.resets["starts"]),
+                       tuple(i - 1 for i in result.resets["failures"]), (width, height))
+        problem = resets_problem(run)
+        if problem is not None:
+            log.warning("%s: sequence %r left out, its sidecar's resets are not its boxes' (%s); run it again to "
+                        "recompute it", folder, name, problem)
+            continue
+        runs[name] = run
     return runs
+
+
+ROUNDING = 1e-3  # the most a result file's %.3f moves a box's edge (x and w each by 0.0005), and a margin
+
+
+def resets_problem(run: ResetRun) -> str | None:
+    """Where (``frame <n>``, 1-based) the ``starts`` and ``failures`` of ``run`` part from those VOT's
+    rule gives from its boxes and ground truth, or None. The rule is the runs' own
+    (:mod:`dcfkit.running.resets`): a failure is the first frame after a start whose box does not
+    overlap the ground truth; the next start is :func:`~dcfkit.running.resets.next_start` from
+    :data:`~dcfkit.experiments.vot.SKIP` frames later (dcfkit <= 0.9.0 did not move a start past a
+    box off the image: that start is taken too). A decision the rounding of the boxes could turn is
+    taken either way; frames no tracker ran must have no box."""
+    gt, size = run.gt, None if run.bounds is None else (run.bounds[1], run.bounds[0])
+    tracked = np.zeros(len(gt), dtype=bool)
+    due = 0
+    for k in itertools.count():
+        expected = {next_start(gt, due), next_start(gt, due, size)}  # None: no start is due
+        start = run.starts[k] if k < len(run.starts) else None
+        if start not in expected:
+            return (f"frame {start + 1}: its sidecar records a start where the rule gives none" if start is not None
+                    else f"frame {min(expected - {None}) + 1}: the rule starts the tracker again, its sidecar "
+                         f"records no start")
+        if start is None:
+            unused = [("failure", i) for i in run.failures[k:]]
+            break
+        failure = run.failures[k] if k < len(run.failures) else None
+        problem = _segment_problem(run, start, failure)
+        if problem is not None:
+            return problem
+        tracked[start:len(gt) if failure is None else failure + 1] = True
+        if failure is None:
+            unused = [("start", i) for i in run.starts[k + 1:]]
+            break
+        due = failure + SKIP
+    if unused:
+        what, frame = unused[0]
+        return f"frame {frame + 1}: its sidecar records a {what} the rule does not give"
+    stray = np.flatnonzero(~tracked & np.isfinite(run.boxes).any(axis=1))
+    return f"frame {stray[0] + 1}: a box where no tracker ran" if stray.size else None
+
+
+def _segment_problem(run: ResetRun, start: int, failure: int | None) -> str | None:
+    """Why the tracking from ``start`` is not one that fails on ``failure`` (None: never), or None."""
+    if failure is not None and failure <= start:
+        return f"frame {failure + 1}: its sidecar records a failure before its start on frame {start + 1}"
+    end = len(run.gt) if failure is None else failure
+    for i in range(start + 1, end):
+        if _fails(run, i, ROUNDING):
+            return f"frame {i + 1}: the box does not overlap the ground truth, a failure its sidecar does not record"
+    if failure is not None and not _fails(run, failure, -ROUNDING):
+        return f"frame {failure + 1}: its sidecar records a failure where the box overlaps the ground truth"
+    return None
+
+
+def _fails(run: ResetRun, i: int, margin: float) -> bool:
+    """Whether frame ``i``'s box, ``margin`` wider on each side, fails (does not overlap the ground
+    truth: :func:`~dcfkit.experiments.vot.overlap`, NaN and never a failure without one)."""
+    x, y, w, h = run.boxes[i]
+    return overlap((x - margin, y - margin, w + 2 * margin, h + 2 * margin), run.gt[i], run.bounds) <= 0
 
 
 def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,
@@ -51,6 +124,10 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
     results = {name: reset_runs(folder, sequences) for name, folder in folders.items()}
     if not results:
         raise DatasetError(f"no reset-based results found under {clip(str(out_dir))} (dcfkit eval --experiment reset)")
+    if not any(all(s.name in runs for runs in results.values()) for s in sequences):
+        raise DatasetError(f"none of the {len(sequences)} sequences has a reset-based result that can be scored "
+                           f"from every tracker (a warning says why a result was left out); run them with dcfkit "
+                           f"eval --experiment reset")
     names = [f"reset_{t}.{ext}" for t in RESET_COLUMNS for _, ext in TABLE_FORMATS if ext != "tex"]
     ensure_writable(report_dir, names + ["statistics.txt", "reset.json"], "the report")
     scores = score_resets(results, {s.name: len(s) for s in sequences}, interval)

@@ -164,14 +164,11 @@ def statistics_lines(statistics: Mapping) -> list[str]:
         return []
     means, width = statistics["means"], max(len(t) for t in statistics["means"])
     keys = list(next(iter(means.values())))
-    left_out = _left_out(statistics, keys)
-    everywhere = left_out.get("every mean and difference", [])
-    over = (f"{statistics['sequences'] - len(everywhere)} of the {statistics['sequences']}" if everywhere
-            else statistics["sequences"])
+    over, left_out = statistics_scope(statistics)
     lines = [f"statistics over {over} sequences: {statistics['method']}; {statistics['correction']}"]
     lines += [f"  {t:<{width}}  " + "   ".join(f"{SCORE_LABELS.get(k, k)} {interval_text(m[k])}" for k in keys)
               for t, m in means.items()]
-    lines += [f"  left out of {where}: {non_finite_text(names, 'score')}" for where, names in left_out.items()]
+    lines += [f"  {line}" for line in left_out]
     for tracker, found in statistics["differences"].items():
         for key in keys:
             d = found[key]
@@ -179,6 +176,17 @@ def statistics_lines(statistics: Mapping) -> list[str]:
                          f"{interval_text(d, signed=True)}, Wilcoxon p {d['wilcoxon_p']:.3g} (Holm {d['holm_p']:.3g})"
                          f"{' *' if d['significant'] else ''}, won {d['won']}, lost {d['lost']}, tied {d['tied']}")
     return lines
+
+
+def statistics_scope(statistics: Mapping) -> tuple[str, list[str]]:
+    """(how many sequences the statistics of :func:`statistics_lines` are over: ``5``, or ``3 of
+    the 5`` when a non-finite score left two out of every one, and ``left out of ...`` phrases
+    naming the sequences a non-finite score left out)."""
+    left_out = _left_out(statistics, list(next(iter(statistics["means"].values()))))
+    everywhere = left_out.get("every mean and difference", [])
+    over = (f"{statistics['sequences'] - len(everywhere)} of the {statistics['sequences']}" if everywhere
+            else f"{statistics['sequences']}")
+    return over, [f"left out of {where}: {non_finite_text(names, 'score')}" for where, names in left_out.items()]
 
 
 def _left_out(statistics: Mapping, keys: Seq[str]) -> dict[str, list[str]]:

@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from dcfkit.analysis.compare import COLUMNS, compare_folders
+from dcfkit.analysis.compare import COLUMNS, compare_folders, counted_lines
 from dcfkit.analysis.report import columns, json_ready, named_folder, score_and_write
 from dcfkit.analysis.report_html import write_html_report
 from dcfkit.analysis.reset_report import RESET_COLUMNS, reset_runs, write_reset_report
@@ -169,9 +169,8 @@ def run_report(args: argparse.Namespace) -> int:
     print(format_table(evaluation.overall, args.format, columns("overall", protocol), protocol,
                        evaluation.statistics), end="")
     if args.format == "table":
-        for tracker, rows in evaluation.platforms.items():
-            lines = [f"{line} ({n} sequences)" if len(rows) > 1 else line for line, n in rows]
-            print(f"{tracker} platform: {'; '.join(lines)}")
+        for tracker, rows in evaluation.platforms.items():  # ten lines at most: records may differ per sequence
+            print(f"{tracker} platform: {'; '.join(counted_lines(dict(rows), sum(n for _, n in rows)))}")
         recorded = {line for rows in evaluation.platforms.values() for line, _ in rows} - {"not recorded"}
         if len(recorded) > 1:
             print(f"warning: these results come from {len(recorded)} platforms; their boxes may part where a float "

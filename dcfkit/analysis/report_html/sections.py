@@ -15,7 +15,7 @@ from typing import Sequence as Seq
 from dcfkit.analysis.plots import PLOT_STYLE
 from dcfkit.analysis.report_html.provenance import folder_provenance
 from dcfkit.analysis.report_html.thumbnails import sequence_thumbnails
-from dcfkit.analysis.tables import SCORE_LABELS
+from dcfkit.analysis.tables import SCORE_LABELS, statistics_scope
 from dcfkit.datasets import ATTRIBUTE_NAMES, Sequence
 
 COLUMN_LABELS = {**SCORE_LABELS, "norm_precision": "norm. precision", "fps": "fps", "sequences": "sequences",
@@ -125,8 +125,9 @@ def statistics_table(statistics: Mapping, trackers: Seq[str], tracker_label: str
                     {"key": f"{key}_holm_p", "label": f"{label} Holm p", "type": "num", "digits": 3}]
         for row, mean, diff in zip(rows, means, diffs):
             row += [_interval(mean), _interval(diff), diff["holm_p"] if diff else None]
-    note = (f"Over the {statistics['sequences']} sequences every tracker ran: {statistics['method']}; "
-            f"{statistics['correction']} (marked *).")
+    over, left_out = statistics_scope(statistics)
+    note = " ".join([f"Over {over} sequences every tracker ran: {statistics['method']}; {statistics['correction']} "
+                     f"(marked *)."] + [f"{line[0].upper()}{line[1:]}." for line in left_out])
     return {"kind": "table", "id": "statistics", "title": "Confidence and significance", "columns": columns,
             "rows": rows, "filter": False, "note": note}
 
