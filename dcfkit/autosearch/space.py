@@ -116,20 +116,42 @@ def load_search_spec(source: str | os.PathLike, root: str | os.PathLike | None =
     if not isinstance(experiments, list) or not experiments:
         raise ConfigError(f"{path}: experiments: expected a list such as [ope, tre], got {shown(experiments)}")
     experiments = check_experiments(experiments, f"{path}: experiments")
-    baselines = {str(name): load_spec_config(path, cfg, {}, f"baselines.{clip(str(name))}",
-                                             f"baselines.{clip(str(name))}")[0]
-                 for name, cfg in as_mapping(data.get("baselines"), f"{path}: baselines",
-                                             "a mapping {name: config file}").items()}
+    baselines = _parse_baselines(path, data.get("baselines"))
     sequences = data.get("sequences")
     if sequences is not None:
         sequences = sequence_names(sequences, f"{path}: sequences", ConfigError)
+    name = _names([data.get("name") or path.stem], f"{path}: name", "name")[0]
     return SearchSpec(
-        path=path, name=str(data.get("name") or path.stem), description=str(data.get("description") or ""),
+        path=path, name=name, description=str(data.get("description") or ""),
         dataset=dataset, root=root_path, root_origin=origin,
         sequences=tuple(sequences) if sequences is not None else None, base=base, base_source=base_source,
         parameters=parameters, experiments=experiments, folds=_whole(path, data, "folds", 4, 2),
         trials=_whole(path, data, "trials", 30, 1), startup_trials=_whole(path, data, "startup_trials", 10, 1),
         seed=_whole(path, data, "seed", 0, 0), baselines=baselines)
+
+
+def _parse_baselines(path: Path, raw: Any) -> dict:
+    """Baseline name -> resolved config; a name is shown in summary.md and keys summary.json."""
+    baselines = as_mapping(raw, f"{path}: baselines", "a mapping {name: config file}")
+    for name in baselines:
+        if name is None or str(name).strip() == "":
+            raise ConfigError(f"{path}: baselines: {shown(name)} is not a name: give each baseline a name")
+    names = _names(list(baselines), f"{path}: baselines", "baseline name")
+    return {name: load_spec_config(path, cfg, {}, f"baselines.{clip(name)}", f"baselines.{clip(name)}")[0]
+            for name, cfg in zip(names, baselines.values())}
+
+
+def _names(keys: list, where: str, what: str) -> list[str]:
+    """``keys`` as the names they stand for (``str``): each one line of printable text (they are
+    written into summary.md), no two that read the same (YAML keys ``1`` and ``'1'``)."""
+    names = [str(k) for k in keys]
+    for name in names:
+        if not name.isprintable():
+            raise ConfigError(f"{where}: the {what} {shown(name)} has a line break or control character: "
+                              f"give one line of printable text")
+    if len(set(names)) < len(names):
+        raise ConfigError(f"{where}: two {what}s read as {shown(_repeated(names))}: give distinct {what}s")
+    return names
 
 
 def _whole(path: Path, data: Mapping, key: str, default: int, least: int) -> int:
@@ -147,9 +169,14 @@ def _parse_space(path: Path, raw: Any, base: dict) -> tuple:
     for key, entry in space.items():
         where = f"{path}: space.{clip(str(key))}"
         params[str(key)] = _parse_parameter(where, str(key), entry, params)
+    groups = _groups(tuple(params.values()))
+    for group in groups:  # first: a parameter's contexts are combinations of its group's choices
+        _check_count(path, group)
+    contexts: dict[str, list[dict]] = {}
     for p in params.values():
-        _check_values(where=f"{path}: space.{clip(p.key)}", base=base, parameter=p, params=params)
-    for group in _groups(tuple(params.values())):
+        contexts[p.key] = _contexts(f"{path}: space.{clip(p.key)}", p, contexts)
+        _check_values(f"{path}: space.{clip(p.key)}", base, p, params, contexts[p.key])
+    for group in groups:
         _check_structures(path, base, group)
     return tuple(params.values())
 
@@ -174,11 +201,8 @@ def _parse_parameter(where: str, key: str, entry: Any, earlier: Mapping[str, Par
                               f"got {shown(values)}")
         if "log" in entry:
             raise ConfigError(f"{where}.log: only for float and int ranges")
-        labels = [str(c) for c in choices]
-        if len(set(labels)) < len(labels):  # YAML keys 1 and '1' (or true and 'True') are one label here
-            raise ConfigError(f"{where}.choice: two labels read as {shown(_repeated(labels))}: give distinct labels")
-        return Parameter(key, CategoricalDistribution(labels),
-                         {str(c): v for c, v in choices.items()}, when)
+        labels = _names(list(choices), f"{where}.choice", "label")  # YAML keys 1 and '1' are one label here
+        return Parameter(key, CategoricalDistribution(labels), dict(zip(labels, choices.values())), when)
     if not (isinstance(values, list) and len(values) == 2
             and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in values)
             and values[0] < values[1]):
@@ -229,17 +253,36 @@ def active(parameter: Parameter, params: Mapping[str, Any]) -> bool:
     return all(params.get(key) in labels for key, labels in parameter.when)
 
 
-def _check_values(where: str, base: dict, parameter: Parameter, params: Mapping[str, Parameter]) -> None:
-    """Resolve the base with each choice (with the choices its ``when`` needs), or with each
-    end of a range, so a wrong key or value is an error now, not in trial 17."""
-    context = {key: params[key].choices[labels[0]] for key, labels in parameter.when}
+def _contexts(where: str, parameter: Parameter, earlier: Mapping[str, list[dict]]) -> list[dict]:
+    """Every way ``parameter``'s ``when`` can hold: choice key -> label for the choices it names
+    and those their own ``when`` names (``earlier``: each earlier parameter's contexts)."""
+    contexts: list[dict] = [{}]
+    for key, labels in parameter.when:
+        contexts = [{**c, **up, key: label} for c in contexts for up in earlier[key] for label in labels
+                    if _agree(c, {**up, key: label})]
+    if not contexts:
+        raise ConfigError(f"{where}.when: never holds (the choices it names are sampled under other labels)")
+    return [dict(t) for t in dict.fromkeys(tuple(c.items()) for c in contexts)]
+
+
+def _agree(a: Mapping, b: Mapping) -> bool:
+    return all(a[k] == v for k, v in b.items() if k in a)
+
+
+def _check_values(where: str, base: dict, parameter: Parameter, params: Mapping[str, Parameter],
+                  contexts: list[dict]) -> None:
+    """Resolve the base with each choice, or each end of a range, under each of its ``contexts``
+    (:func:`_contexts`), so a wrong key or value is an error now, not in trial 17."""
     d = parameter.distribution
     values = list(parameter.choices.values()) if parameter.choices else [d.low, d.high]
-    for value in values:
-        try:
-            load_config(base, {**context, parameter.key: value})
-        except DcfkitError as exc:
-            raise ConfigError(f"{where}: with the value {shown(value)}: {exc}") from None
+    for context in contexts:
+        chosen = {key: params[key].value(context[key]) for key in params if key in context}  # in space order
+        under = f" under {_sampled(context)}" if context else ""
+        for value in values:
+            try:
+                load_config(base, {**chosen, parameter.key: value})
+            except DcfkitError as exc:
+                raise ConfigError(f"{where}: with the value {shown(value)}{under}: {exc}") from None
 
 
 def resolve(base: dict, parameters: tuple, sampled: Mapping[str, Any]) -> dict:
@@ -264,15 +307,20 @@ def _groups(parameters: tuple) -> list[list[Parameter]]:
     return [sorted(g, key=lambda p: order[p.key]) for g in groups]
 
 
-def _check_structures(path: Path, base: dict, group: list[Parameter]) -> None:
-    """Resolve the base with every combination of the group's choices, each with the dimensions
-    sampled under it at the :func:`_points` of their ranges: every config the space can make, as
-    far as its structure goes, so a dimension that only some choices take (no ``when``) fails now."""
+def _check_count(path: Path, group: list[Parameter]) -> None:
+    """Refuse a group with more than :data:`MAX_STRUCTURES` combinations of its choices."""
     choices = [p for p in group if p.choices]
     count = math.prod(len(p.choices) for p in choices)
     if count > MAX_STRUCTURES:
         raise ConfigError(f"{path}: space: the related choices {clip(', '.join(p.key for p in choices))} make "
                           f"{count} combinations, more than the {MAX_STRUCTURES} checked when a spec is read")
+
+
+def _check_structures(path: Path, base: dict, group: list[Parameter]) -> None:
+    """Resolve the base with every combination of the group's choices, each with the dimensions
+    sampled under it at the :func:`_points` of their ranges: every config the space can make, as
+    far as its structure goes, so a dimension that only some choices take (no ``when``) fails now."""
+    choices = [p for p in group if p.choices]
     checked = set()
     for labels in itertools.product(*(p.choices for p in choices)):
         for point in range(3):
@@ -311,5 +359,9 @@ def _described(sampled: Mapping[str, Any]) -> str:
     if len(sampled) == 1:
         (key, value), = sampled.items()
         return f"space.{clip(key)}: with the value {shown(value)}"
-    values = clip(", ".join(f"{key}={shown(value)}" for key, value in sampled.items()))
-    return f"space: {values} together give no valid config (a dimension that only some choices take needs when)"
+    return (f"space: {_sampled(sampled)} together give no valid config (a dimension that only some choices "
+            f"take needs when)")
+
+
+def _sampled(sampled: Mapping[str, Any]) -> str:
+    return clip(", ".join(f"{key}={shown(value)}" for key, value in sampled.items()))

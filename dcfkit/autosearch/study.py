@@ -10,6 +10,7 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import math
 from pathlib import Path
 from typing import Any, Callable
 
@@ -21,7 +22,7 @@ from dcfkit.autosearch.evaluation import Evaluator
 from dcfkit.autosearch.space import SearchSpec, active
 from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, summarize
 from dcfkit.datasets import scored_sequences
-from dcfkit.errors import DcfkitError, shown
+from dcfkit.errors import DcfkitError, clip, shown
 from dcfkit.running.files import atomic_write, ensure_writable, exclusive, make_dir, read_json
 from dcfkit.running.results import data_identity
 
@@ -81,17 +82,55 @@ def _frozen(rec: dict, distributions: dict) -> optuna.trial.FrozenTrial:
                                      distributions={k: distributions[k] for k in rec["params"]})
 
 
-def _usable(rec: dict, number: int, distributions: dict) -> bool:
-    """Whether ``rec`` is trial ``number``'s record as :meth:`Search.run_study` writes it."""
-    if not (rec.get("number") == number and isinstance(rec.get("params"), dict) and isinstance(rec.get("key"), str)
-            and isinstance(rec.get("scores"), dict) and isinstance(rec.get("config"), dict)
-            and (rec.get("value") is None or isinstance(rec["value"], (int, float)))):
+def _params_fault(spec: SearchSpec, params: Any) -> str | None:
+    """What is wrong with a record's ``params`` (None if nothing): they must be the dimensions
+    :func:`sample` samples, each with a value its dimension can take."""
+    if not isinstance(params, dict):
+        return f"params: expected a mapping of the space's keys, got {shown(params)}"
+    dims = {p.key: p for p in spec.parameters}
+    unknown = [k for k in params if k not in dims]
+    if unknown:
+        return f"params: {shown(unknown[0])} is not a key of the space"
+    for key, value in params.items():
+        if not _takes(dims[key].distribution, value):
+            return f"params.{clip(key)}: {shown(value)} is not a value its dimension takes"
+    sampled = [p.key for p in spec.parameters if active(p, params)]
+    if sorted(sampled) != sorted(params):
+        return f"params: expected values for {shown(sampled)} (as sampled under its choices), got {shown(list(params))}"
+    return None
+
+
+def _takes(distribution: optuna.distributions.BaseDistribution, value: Any) -> bool:
+    """Whether :func:`sample` could give ``value``: a label, a whole number or a float, in range."""
+    kind = {optuna.distributions.CategoricalDistribution: str, optuna.distributions.IntDistribution: int}
+    if type(value) is not kind.get(type(distribution), float):  # "0.5" or true would pass Optuna's check
         return False
     try:
-        _frozen(rec, distributions)  # each value one its dimension can take
-    except (KeyError, TypeError, ValueError):
+        optuna.trial.create_trial(params={"v": value}, distributions={"v": distribution}, value=0.0)
+    except (OverflowError, ValueError):  # an int past float's range
         return False
     return True
+
+
+def _scores_fault(rec: dict, names: list[str]) -> str | None:
+    """What is wrong with a record's ``scores`` and ``value`` (None if nothing): the scores must be
+    of the study's training sequences, ``names``, and the value their mean AUC."""
+    scores = rec.get("scores")
+    if not (isinstance(scores, dict) and sorted(scores) == sorted(names)):
+        return f"scores: expected those of this study's training sequences {shown(names)}"
+    if not all(isinstance(s, dict) and all(_number(s.get(k)) for k in ("auc", "precision")) for s in scores.values()):
+        return "scores: expected {auc, precision} numbers or null for each sequence"
+    value = rec.get("value")
+    if isinstance(value, float) and math.isnan(value):  # dcfkit 0.9.0: NaN when a sequence had no score
+        return None if any(not is_score(s["auc"]) for s in scores.values()) else "value: NaN, yet every AUC is scored"
+    if not (_number(value) and value == mean_auc(scores, names)):
+        return f"value: {shown(value)} is not the mean AUC of its scores"
+    return None
+
+
+def _number(value: Any) -> bool:
+    """A score as records hold it: a number, or null (NaN in dcfkit 0.9.0's)."""
+    return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool))
 
 
 class Search:
@@ -118,9 +157,13 @@ class Search:
         """Write ``OUT/search.json``, or refuse to resume a search whose trials would not stand."""
         path = self.out / "search.json"
         mine = fingerprint(self.spec, self.folds, self.evaluator)
-        recorded = read_json(path)
+        recorded = read_json(path)  # None: missing, unreadable or not an object
         if recorded is not None:
             self._check_fingerprint(path, recorded.get("fingerprint"), mine)
+        elif any((self.out / "trials").glob("*/*.json")):
+            state = "not a search record as dcfkit writes it" if path.exists() else "missing"
+            raise DcfkitError(f"{path} is {state}, yet {self.out / 'trials'} holds trial records: nothing shows which "
+                              f"search made them; give a new --out, or remove {self.out / 'trials'} to start again")
         atomic_write(path, json.dumps({"spec": str(self.spec.path), "name": self.spec.name,
                                        "fingerprint": mine}, indent=1) + "\n")
 
@@ -146,20 +189,41 @@ class Search:
 
     def recorded(self, study: str) -> list[dict]:
         """The study's trial records up to the first missing one; a damaged or edited record is
-        missing (with a warning), and it and those after it are run again, to the same values."""
+        missing (with a warning naming what is wrong), and it and those after it are run again,
+        to the same values."""
         folder = self.out / "trials" / study
-        dists = {p.key: p.distribution for p in self.spec.parameters}
         records = []
         for n in range(self.spec.trials):
             path = folder / f"{n:04d}.json"
             rec = read_json(path)
-            if rec is None or not _usable(rec, n, dists):
-                if rec is not None or path.exists():
-                    log.warning("%s is not a trial record as dcfkit writes it: trial %d of %s is run again, "
-                                "and the trials after it", path, n, study)
+            fault = "not a JSON object" if rec is None else self._fault(rec, n, study)
+            if fault:
+                if path.exists():
+                    log.warning("%s is not a trial record as dcfkit writes it (%s): trial %d of %s is run again, "
+                                "and the trials after it", path, fault, n, study)
                 break
             records.append(rec)
         return records
+
+    def _fault(self, rec: dict, number: int, study: str) -> str | None:
+        """What makes ``rec`` not trial ``number`` of ``study`` as :meth:`run_study` records it
+        (None if nothing): its number, values, scores (on the study's training sequences), value,
+        config and run key are checked against each other and against this search."""
+        if rec.get("number") != number:
+            return f"number: expected {number}, got {shown(rec.get('number'))}"
+        fault = _params_fault(self.spec, rec.get("params"))
+        fault = fault or _scores_fault(rec, self.training(study))
+        if fault:
+            return fault
+        try:
+            config = json.loads(json.dumps(self.spec.config(rec["params"])))  # as the record holds it
+        except DcfkitError as exc:
+            return f"params: {exc}"
+        if rec.get("config") != config:
+            return "config: not the config its params make"
+        if rec.get("key") != self.evaluator.key(config):
+            return "key: not its config's run key"
+        return None
 
     def run_study(self, study: str) -> list[dict]:
         """The study's trials, the missing ones run; returns their records."""

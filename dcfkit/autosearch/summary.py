@@ -9,7 +9,7 @@ import numpy as np
 import yaml
 
 from dcfkit.analysis.statistics import HOLM, METHOD, holm, mean_interval, paired_difference
-from dcfkit.errors import DcfkitError
+from dcfkit.errors import DcfkitError, printable
 from dcfkit.running.files import atomic_write
 
 FINAL = "all"  # the final study's name: every sequence chooses
@@ -97,18 +97,19 @@ def _compare(names: list[str], held_out: dict, baselines: dict) -> dict:
 
 def summary_lines(summary: dict) -> list[str]:
     """``summary.md``: the folds, the held-out score against each baseline, the final choice."""
-    lines = [f"# Search {summary['name']}", "",
+    lines = [f"# Search {printable(summary['name'])}", "",
              f"{len(summary['sequences'])} sequences, {len(summary['folds'])} folds, "
              f"{summary['trials_per_study']} trials a study; objective: mean AUC over "
              f"{' + '.join(summary['experiments'])} (each sequence's runs pooled).", "",
              "| fold | held out | trial | training AUC | held-out AUC | values |", "|---|---|---|---|---|---|"]
     for f in summary["folds"]:
-        lines.append(f"| {f['fold']} | {', '.join(f['held_out'])} | {f['trial']} | {_n(f['training_auc'], '.4f')} | "
-                     f"{_n(f['held_out_auc'], '.4f')} | {_values(f['params'])} |")
+        lines.append(f"| {f['fold']} | {_cell(', '.join(f['held_out']))} | {f['trial']} | "
+                     f"{_n(f['training_auc'], '.4f')} | {_n(f['held_out_auc'], '.4f')} | "
+                     f"{_cell(_values(f['params']))} |")
     unscored = summary.get("unscored") or []  # absent from the summaries of dcfkit <= 0.9.0
     if unscored:
         lines += ["", f"Left out of the means and tests, having no frame the protocol scores ({len(unscored)} of "
-                      f"{len(summary['sequences'])}): {', '.join(unscored)}."]
+                      f"{len(summary['sequences'])}): {printable(', '.join(unscored))}."]
     h = summary["held_out"]["auc"]
     lines += ["", f"Held-out AUC of the search: {_n(h['mean'], '.4f')} "
                   f"[{_n(h['ci_low'], '.4f')}, {_n(h['ci_high'], '.4f')}]", "",
@@ -116,7 +117,7 @@ def summary_lines(summary: dict) -> list[str]:
               "|---|---|---|---|---|---|---|---|"]
     for name, c in summary["comparisons"].items():
         b = summary["baselines"][name]["auc"]
-        lines.append(f"| {name} | {_n(b['mean'], '.4f')} | {_n(c['mean'], '+.4f')} | "
+        lines.append(f"| {_cell(name)} | {_n(b['mean'], '.4f')} | {_n(c['mean'], '+.4f')} | "
                      f"[{_n(c['ci_low'], '+.4f')}, {_n(c['ci_high'], '+.4f')}] | "
                      f"{c['won']} / {c['lost']} / {c['tied']} | {_n(c['wilcoxon_p'], '.3f')} | "
                      f"{_n(c['holm_p'], '.3f')} | {'yes' if c['significant'] else 'no'} |")
@@ -124,13 +125,18 @@ def summary_lines(summary: dict) -> list[str]:
     verdict = ("it beats every baseline on held-out folds" if summary["beats_every_baseline"]
                else "it does not beat every baseline on held-out folds: do not ship it")
     lines += ["", f"Final study (every sequence): trial {final['trial']}, AUC {_n(final['auc'], '.4f')}, "
-              f"{_values(final['params'])}; best.yaml. The search: {verdict}.", "", summary["method"] + "; "
+              f"{printable(_values(final['params']))}; best.yaml. The search: {verdict}.", "", summary["method"] + "; "
               + summary["correction"] + " (beaten: significant and the interval above 0)."]
     return lines
 
 
 def _values(params: dict) -> str:
     return ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
+
+
+def _cell(text: str) -> str:
+    """``text`` as one markdown table cell: one line, its ``|`` escaped (names come from specs and folders)."""
+    return printable(text).replace("|", "\\|")
 
 
 def _n(value, form: str) -> str:
