@@ -10,9 +10,8 @@ from dcfkit.ablation import expand, load_spec, run_ablation, summary_columns, va
 from dcfkit.ablation.experiment import ABLATION_EXPERIMENTS, runs_dir
 from dcfkit.ablation.spec import MAX_VARIANTS, job_dir
 from dcfkit.analysis.tables import format_table, statistics_lines
-from dcfkit.cli.common import add_max_frames_argument, add_protocol_argument, variant_count
+from dcfkit.cli.common import add_max_frames_argument, add_protocol_argument, executor_choice, variant_count
 from dcfkit.config import shipped_config_dir
-from dcfkit.errors import DcfkitError
 from dcfkit.experiments import runs_by_sequence
 from dcfkit.running.results import ResultStore
 
@@ -66,9 +65,7 @@ def _dry_run(spec, out: Path) -> int:
 
 def run(args: argparse.Namespace) -> int:
     """Run a spec, print the summary table; exit status 1 if a job failed."""
-    executor = args.executor or ("dask" if args.scheduler else "local")
-    if args.scheduler and executor != "dask":
-        raise DcfkitError("--scheduler needs --executor dask")
+    executor = executor_choice(args)
     spec = load_spec(args.spec, root=args.root, sequences=args.sequences, max_variants=args.max_variants)
     spec = dataclasses.replace(spec, max_frames=args.max_frames, experiment=args.experiment or spec.experiment)
     if args.dry_run:

@@ -6,6 +6,7 @@ from pathlib import Path
 
 from dcfkit.errors import DcfkitError, shown
 from dcfkit.protocols import DEFAULT, PROTOCOLS
+from dcfkit.running.scheduler import check_address
 
 
 def parse_box(text: str) -> tuple[float, ...]:
@@ -85,3 +86,14 @@ def add_experiment_argument(parser: argparse.ArgumentParser) -> None:
                         help="ope: one pass from frame 1 (default); tre: 20 later starts; sre: 12 shifted or scaled "
                              "first boxes (OTB, Wu et al. 2015); reset: VOT's re-initialisation 5 frames after each "
                              "failure (accuracy, failures, EAO). Results other than ope go to OUT/<tracker>/<experiment>/")
+
+
+def executor_choice(args: argparse.Namespace) -> str:
+    """``--executor``, dask by default with ``--scheduler``, whose address is checked (scheme,
+    HOST:PORT) before anything runs; connecting is left to the run."""
+    executor = args.executor or ("dask" if args.scheduler else "local")
+    if args.scheduler and executor != "dask":
+        raise DcfkitError("--scheduler needs --executor dask")
+    if args.scheduler:
+        check_address(args.scheduler)
+    return executor

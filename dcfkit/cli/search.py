@@ -6,7 +6,7 @@ import dataclasses
 import sys
 from pathlib import Path
 
-from dcfkit.cli.common import add_protocol_argument
+from dcfkit.cli.common import add_protocol_argument, executor_choice
 from dcfkit.config import shipped_config_dir
 from dcfkit.errors import DcfkitError
 from dcfkit.running.runner import usable_cores
@@ -45,9 +45,7 @@ def run(args: argparse.Namespace) -> int:
     from dcfkit.autosearch.space import check_experiments  # lazy: as dcfkit.autosearch
     from dcfkit.autosearch.summary import summary_lines  # lazy: as dcfkit.autosearch
 
-    executor = args.executor or ("dask" if args.scheduler else "local")
-    if args.scheduler and executor != "dask":
-        raise DcfkitError("--scheduler needs --executor dask")
+    executor = executor_choice(args)
     jobs = args.jobs if args.jobs is not None else usable_cores()
     if jobs < 1:
         raise DcfkitError(f"--jobs must be >= 1, got {jobs}")

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import logging
 import multiprocessing
 import os
 import signal
@@ -32,7 +33,10 @@ from dcfkit.running.files import StoreError
 from dcfkit.running.provenance import dcfkit_version, invocation, machine, now, plugin_versions, run_key, sources
 from dcfkit.running.resets import ResetTrack, track_with_resets
 from dcfkit.running.results import ResultStore
+from dcfkit.running.scheduler import connect as connect_scheduler, import_distributed
 from dcfkit.running.tracking import TrackerFailure, track
+
+log = logging.getLogger(__name__)
 
 _THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS",
                 "NUMEXPR_NUM_THREADS", "VECLIB_MAXIMUM_THREADS")
@@ -129,8 +133,8 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
             "time": now(), **(origin or invocation()), "machine": machine(), "platform": platforms.record(),
             "config": task.config,
             "times": run.times.tolist()}
-    if isinstance(run, ResetTrack):  # 1-based, as every frame number dcfkit shows
-        meta["resets"] = {"starts": [i + 1 for i in run.starts], "failures": [i + 1 for i in run.failures]}
+    if isinstance(run, ResetTrack):
+        meta["resets"] = run.record()
     store.write(seq, run.boxes, meta, run.times, run.confidence)
     return {"sequence": seq.name, "status": "done", "fps": run.fps, "frames": len(seq)}
 
@@ -229,13 +233,15 @@ def crash_message(seq: Sequence, exc: BaseException) -> str:
 def run_pool(calls: Mapping[Any, tuple], jobs: int, on_result: Callable[[Any, Any], None],
              on_crash: Callable[[Any, BaseException], Any]) -> None:
     """Run ``fn(*args)`` for every ``key: (fn, *args)`` of ``calls`` in ``jobs`` spawned,
-    single-threaded worker processes; ``on_result(key, result)`` as each finishes.
+    single-threaded worker processes (at most one a usable core: :func:`worker_count`);
+    ``on_result(key, result)`` as each finishes.
 
     A call whose worker raised outside ``fn``'s own handling, or died (killed, out of memory:
     the pool then fails every call not yet finished), gets ``on_crash(key, exc)`` as its
     result. Ctrl-C or any error in the caller terminates the workers at once."""
     with single_threaded_env():  # workers are spawned on submit and inherit it
-        pool = ProcessPoolExecutor(max_workers=min(jobs, len(calls)), mp_context=multiprocessing.get_context("spawn"),
+        pool = ProcessPoolExecutor(max_workers=worker_count(jobs, len(calls)),
+                                   mp_context=multiprocessing.get_context("spawn"),
                                    initializer=worker_init, initargs=(os.getpid(),))
         try:
             futures = {pool.submit(*call): key for key, call in calls.items()}
@@ -262,25 +268,21 @@ def _deliver(finished: Iterable, key_of: Callable, on_result: Callable, on_crash
 
 def _run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: str, origin: Mapping, on_result,
               on_crash) -> None:
-    try:
-        from distributed import Client, LocalCluster  # optional: dcfkit[dask]
-        from distributed import as_completed as dask_completed  # optional, as above
-    except ImportError:
-        raise DcfkitError("--executor dask needs dask.distributed: pip install 'dcfkit[dask]'") from None
+    distributed = import_distributed()
     with contextlib.ExitStack() as stack:
         if scheduler:
-            client = stack.enter_context(Client(scheduler))
+            client = stack.enter_context(connect_scheduler(scheduler))
         else:
             with single_threaded_env():  # inherited by the worker processes
-                cluster = stack.enter_context(LocalCluster(
-                    n_workers=max(1, min(jobs, len(tasks))), threads_per_worker=1, processes=True,
+                cluster = stack.enter_context(distributed.LocalCluster(
+                    n_workers=worker_count(jobs, len(tasks)), threads_per_worker=1, processes=True,
                     dashboard_address=None))
-            client = stack.enter_context(Client(cluster))
+            client = stack.enter_context(distributed.Client(cluster))
         futures = [client.submit(run_in_worker, t, version, origin, pure=False,
                                  key=f"dcfkit-{t.key}-{t.seq.dataset}-{t.seq.name}") for t in tasks]
         by_key = {f.key: t for f, t in zip(futures, tasks)}
         try:
-            _deliver(dask_completed(futures), lambda future: by_key[future.key], on_result, on_crash)
+            _deliver(distributed.as_completed(futures), lambda future: by_key[future.key], on_result, on_crash)
         except BaseException:
             client.cancel(futures)
             raise
@@ -292,15 +294,27 @@ def usable_cores() -> int:
     return max(1, os.cpu_count() or 1)
 
 
+def worker_count(jobs: int, tasks: int) -> int:
+    """Local worker processes for ``tasks`` tasks at ``jobs``: at most one a task and one a usable
+    core (more would only share the cores and multiply the memory: said in a warning)."""
+    wanted, cores = max(1, min(jobs, tasks)), usable_cores()
+    if wanted > cores:
+        log.warning("--jobs %d: running %d worker processes, one per usable core (more would only share them "
+                    "and multiply the memory)", jobs, cores)
+    return min(wanted, cores)
+
+
 def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None], jobs: int = 1,
             executor: str = "local", scheduler: str | None = None, version: str | None = None,
             on_frame: Callable[[], None] | None = None) -> None:
     """Run every task, calling ``on_result(task, summary)`` as each finishes (in this process).
 
     ``executor="local"``: in this process when ``jobs == 1`` or there is one task (then
-    ``on_frame()`` is called after every frame), else in ``jobs`` spawned worker processes
-    (tasks and their ``make_tracker`` must be picklable). ``"dask"``: ``Client(scheduler)``,
-    or a ``LocalCluster`` of ``jobs`` single-threaded workers when ``scheduler`` is None."""
+    ``on_frame()`` is called after every frame), else in ``jobs`` spawned worker processes, at
+    most one a usable core (tasks and their ``make_tracker`` must be picklable). ``"dask"``: the scheduler at
+    ``scheduler`` (:func:`dcfkit.running.scheduler.connect`: a bad address, or one that is not a
+    Dask scheduler, is one line in bounded time), or a ``LocalCluster`` of ``jobs``
+    single-threaded workers when ``scheduler`` is None."""
     tasks = list(tasks)
     version = version if version is not None else dcfkit_version()
     origin = invocation()  # the client's command, whichever process or machine runs a task
