@@ -11,11 +11,12 @@ a process runs a throw-away copy of the tracker on the first frame, untimed, so 
 loading of compiled code is not counted).
 
 On rerun a run is skipped when its results are intact and from the same run key
-(:func:`dcfkit.running.provenance.run_key`); damaged and failed runs are run again.
+(:func:`dcfkit.running.provenance.run_key`); damaged and failed runs are run again. A run
+never replaces an intact one of more frames (``--max-frames``), and two evaluations never
+write the same run (:mod:`dcfkit.running.claims`).
 """
 from __future__ import annotations
 
-import contextlib
 import json
 import logging
 from pathlib import Path
@@ -26,7 +27,8 @@ import numpy as np
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.errors import ConfigError, shown
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
-from dcfkit.running.files import ensure_writable, exclusive, make_dir, remove_temporary_files
+from dcfkit.running.claims import claimed
+from dcfkit.running.files import ensure_writable, make_dir, remove_temporary_files
 from dcfkit.running.provenance import dcfkit_version, json_default, run_key
 from dcfkit.running.results import ResultStore, same_data
 from dcfkit.running.runner import RunTask, execute, warm_up_compiled
@@ -72,10 +74,14 @@ def _say_what_is_recomputed(store: ResultStore, metas: dict, todo: list[Sequence
     replaced = [s.name for s in todo
                 if (metas[s.name] or {}).get("run_key") not in (None, key)
                 and json.dumps(metas[s.name].get("config"), sort_keys=True, default=json_default) != same]
-    other_data = [s.name for s in todo
-                  if (metas[s.name] or {}).get("run_key") == key and not same_data(metas[s.name], s)]
+    shorter = [s.name for s in todo if (_other_length(store, s, metas[s.name]) or len(s)) < len(s)]
+    other_data = [s.name for s in todo if (metas[s.name] or {}).get("run_key") == key
+                  and not same_data(metas[s.name], s) and s.name not in shorter]
     if damaged:
         log.warning("%s: recomputing %d damaged result(s): %s", store.folder, len(damaged), ", ".join(damaged[:10]))
+    if shorter:
+        log.warning("%s: replacing %d result(s) of fewer frames (an eval --max-frames smoke run's): %s", store.folder,
+                    len(shorter), ", ".join(shorter[:10]))
     if other_data:
         log.warning("%s: recomputing %d result(s) made on other data (a sequence of that name whose frames or ground "
                     "truth differ): %s", store.folder, len(other_data), ", ".join(other_data[:10]))
@@ -83,6 +89,25 @@ def _say_what_is_recomputed(store: ResultStore, metas: dict, todo: list[Sequence
         log.warning("%s: replacing the results of another config named %r for %d sequence(s): %s (give this "
                     "config another name to keep both)", store.folder, config["name"], len(replaced),
                     ", ".join(replaced[:10]))
+
+
+def _other_length(store: ResultStore, run: Sequence, meta: dict | None) -> int | None:
+    """The frame count of ``run``'s intact stored result (sidecar ``meta``) if it is not ``run``'s, else None."""
+    if meta is None or meta.get("frames") == len(run) or store.problem(run.name, meta) is not None:
+        return None
+    return meta["frames"]
+
+
+def _check_nothing_longer(store: ResultStore, metas: dict, todo: list[Sequence]) -> None:
+    """A run never replaces an intact one of more frames (a smoke run's cut sequences, an
+    ``eval --max-frames``, must not cost the full results): refused, before anything runs."""
+    for run in todo:
+        frames = _other_length(store, run, metas[run.name]) or 0
+        if frames > len(run):
+            raise DatasetError(
+                f"{store.boxes_path(run.name)} holds an intact run of {frames} frames and this run of {run.name!r} has "
+                f"{len(run)} (--max-frames?): it is not replaced; write this run to another --out, or remove those "
+                f"results to replace them")
 
 
 def results_folder(out_dir, config: Mapping, experiment: str | Experiment = "ope") -> Path:
@@ -100,8 +125,8 @@ def experiment_runs(sequences: Iterable[Sequence], experiment: str | Experiment 
 def _plan(config: dict, sequences: list[Sequence], runs: list[Sequence], out_dir, experiment: Experiment
           ) -> tuple[ResultStore, str, list[Sequence], dict]:
     """(store, run key, runs to do, every run's sidecar), after every check that needs no
-    tracking: the first boxes, the benchmark of the results there, and (when anything is to
-    run) that the folder takes the result files."""
+    tracking: the first boxes, the benchmark of the results there, that no run replaces one of
+    more frames, and (when anything is to run) that the folder takes the result files."""
     if experiment.first_box:
         _check_first_boxes(sequences)
     key = run_key(config)
@@ -109,6 +134,7 @@ def _plan(config: dict, sequences: list[Sequence], runs: list[Sequence], out_dir
     metas = {s.name: store.sidecar(s.name) for s in runs}  # each read once
     todo = [s for s in runs if store.status(s, key, metas[s.name]) != "done"]
     _check_same_dataset(store, metas, todo)
+    _check_nothing_longer(store, metas, todo)
     if todo:
         ensure_writable(store.folder, [f for s in todo for f in store.file_names(s.name)],
                         f"{tracker_name(config)}'s results")
@@ -142,13 +168,9 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     if not folder.is_dir():
         make_dir(folder)  # a first run: the locks need the folder
     runs = experiment_runs(sequences, experiment)
-    with contextlib.ExitStack() as locks:  # a run on other sequences of this folder may go on alongside
-        with contextlib.suppress(OSError):  # e.g. read-only results to score: exclusive() warns and goes on
-            (folder / ".locks").mkdir(exist_ok=True)
-        for run in runs:
-            what = f"{'sequence' if experiment.name == 'ope' else 'run'} {run.name!r}"
-            locks.enter_context(exclusive(folder / ".locks" / f"{run.name}.lock", "dcfkit eval",
-                                          f"{tracker_name(config)}'s results of {what} to {folder}"))
+    kind = "sequence" if experiment.name == "ope" else "run"
+    with claimed(folder, [run.name for run in runs], "dcfkit eval",  # other runs of this folder may go on alongside
+                 lambda name: f"{tracker_name(config)}'s results of {kind} {name!r} to {folder}"):
         store, key, todo, metas = _plan(config, sequences, runs, out_dir, experiment)
         _say_what_is_recomputed(store, metas, todo, config, key)
         remove_temporary_files(store.folder, [f for s in todo for f in store.file_names(s.name)])

@@ -93,17 +93,31 @@ class ResultStore:
         return read_json(self.sidecar_path(name))
 
     def status(self, seq: Sequence, key: str, meta: dict | None = None) -> str:
-        """``done`` (complete, intact, from run ``key`` started at ``seq``'s current first
-        box), ``damaged`` (its sidecar is ``key``'s but the sidecar or the boxes file is not
-        what was written), ``failed`` (``key`` raised) or ``missing``. ``meta``: the sidecar,
-        if read."""
+        """``done`` (complete, intact, from run ``key`` on ``seq``'s current data: :meth:`stale`),
+        ``damaged`` (its sidecar is ``key``'s but the sidecar or the boxes file is not what was
+        written), ``failed`` (``key`` raised) or ``missing`` (an intact run of another length, a
+        ``--max-frames`` smoke run's or a full one's, is missing too). ``meta``: the sidecar, if read."""
         meta = self.sidecar(seq.name) if meta is None else meta
         if meta is not None and meta.get("run_key") == key:
-            if meta.get("init_box") != [float(v) for v in seq.init_box] or not same_data(meta, seq):
+            if "init_box" not in meta or self.stale(seq.name, meta, seq) is not None:
                 return "missing"  # a corrected annotation, or another benchmark's sequence of that name: run again
-            return "done" if self.problem(seq.name, meta, len(seq)) is None else "damaged"
+            if self.problem(seq.name, meta) is not None:
+                return "damaged"
+            return "done" if meta["frames"] == len(seq) else "missing"
         error = read_json(self.error_path(seq.name))
         return "failed" if error is not None and error.get("run_key") == key and same_data(error, seq) else "missing"
+
+    def stale(self, name: str, meta: dict, seq: Sequence) -> str | None:
+        """Why the intact stored run of ``name`` does not stand for ``seq`` as it is now (it
+        started from another first box, or ran on other data), or None; sidecars without the
+        field (older dcfkit) are trusted."""
+        if "init_box" in meta and not _same_box(meta["init_box"], seq.init_box):
+            return (f"{self.sidecar_path(name)}: its run started from the box {meta['init_box']!r:.80}, and the "
+                    f"sequence now starts from {[float(v) for v in seq.init_box]} (a corrected annotation)")
+        if not same_data(meta, seq):
+            return (f"{self.sidecar_path(name)}: its run was made on other data (the sequence's ground truth or "
+                    f"frames have changed since)")
+        return None
 
     def is_done(self, seq: Sequence, key: str) -> bool:
         return self.status(seq, key) == "done"
@@ -121,15 +135,17 @@ class ResultStore:
             data = path.read_bytes()
         except OSError as exc:
             return f"cannot read {path} ({exc.strerror})"
-        frames = meta["frames"] if frames is None else frames
         if "sha256" in meta:
-            if meta["sha256"] == checksum(data) and meta["frames"] == frames:
-                return None
-            return f"{path} is not the file its run wrote (cut short or edited)"
-        lines = data.splitlines(keepends=True)
-        if len(lines) == frames and all(_RESULT_LINE.fullmatch(line) for line in lines):
-            return None
-        return f"{path} (written by dcfkit < 0.4, without a checksum) is not as its run wrote it"
+            if meta["sha256"] != checksum(data) or data.count(b"\n") != meta["frames"]:
+                return f"{path} is not the file its run wrote (cut short or edited)"
+        else:
+            lines = data.splitlines(keepends=True)
+            if len(lines) != meta["frames"] or not all(_RESULT_LINE.fullmatch(line) for line in lines):
+                return f"{path} (written by dcfkit < 0.4, without a checksum) is not as its run wrote it"
+        if frames is not None and meta["frames"] != frames:
+            return (f"{path} holds a run of {meta['frames']} frames and the sequence has {frames} (the results of "
+                    f"an eval --max-frames N are scored with the same --max-frames)")
+        return None
 
     def write(self, seq: Sequence, boxes: np.ndarray, meta: dict, times: np.ndarray | None = None,
               confidence: np.ndarray | None = None) -> None:
@@ -168,7 +184,8 @@ class ResultStore:
 
     def load(self, sequences: Iterable[Sequence | str]) -> dict[str, SequenceResult]:
         """Intact results for ``sequences`` (names or :class:`Sequence`); others (not run,
-        failed, damaged, malformed: each of the last two is logged) are left out. A
+        failed, damaged, malformed, and for a :class:`Sequence` of another length, or
+        :meth:`stale`: each but the first two logged) are left out. A
         :class:`DatasetError` if the intact results come from different configs."""
         results, keys = {}, {}
         for seq in sequences:
@@ -177,6 +194,8 @@ class ResultStore:
             if meta is None or not self.boxes_path(name).is_file():
                 continue
             problem = self.problem(name, meta, None if isinstance(seq, str) else len(seq))
+            if problem is None and not isinstance(seq, str):
+                problem = self.stale(name, meta, seq)
             if problem is not None:
                 log.warning("%s: left out; run it again to recompute %r", problem, name)
                 continue
@@ -206,6 +225,14 @@ def data_identity(seq: Sequence) -> str:
             size = -1
         digest.update(f"{frame.name}\0{size}\n".encode("utf-8", "surrogateescape"))
     return digest.hexdigest()[:16]
+
+
+def _same_box(stored, box: np.ndarray) -> bool:
+    """Whether a sidecar's ``init_box`` is ``box`` (NaN for NaN: a reset-based run's frame 1 may have none)."""
+    try:
+        return np.array_equal(np.asarray(stored, dtype=np.float64), box, equal_nan=True)
+    except (TypeError, ValueError):
+        return False
 
 
 def same_data(record: dict, seq: Sequence) -> bool:

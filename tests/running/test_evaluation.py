@@ -206,21 +206,6 @@ def test_a_sidecar_with_wrong_types_is_named_left_out_and_recomputed(tmp_path, s
     assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["done"] == ["b"]
 
 
-def test_a_second_eval_of_the_same_sequences_is_refused_and_of_others_not(tmp_path, seqs):
-    fcntl = pytest.importorskip("fcntl", reason="POSIX file locks")
-    (tmp_path / "drift" / ".locks").mkdir(parents=True)
-    with open(tmp_path / "drift" / ".locks" / "b.lock", "a+") as held:  # as a running eval of b holds it
-        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        with pytest.raises(DcfkitError, match=r"another `dcfkit eval` is writing drift's results of "
-                                                         r"sequence 'b' to .*drift"):
-            run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
-        assert files(tmp_path / "drift") == set()  # nothing was run
-        # another subset of the benchmark may run alongside
-        assert run_one_pass(CONFIG, [seqs[0], seqs[2]], tmp_path, make_tracker=Counter(),
-                            progress=False)["done"] == ["a", "c"]
-    assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["done"] == ["b"]
-
-
 def test_workers_leave_plugin_warnings_to_the_parent(monkeypatch):
     for var in runner._THREAD_VARS:
         monkeypatch.setenv(var, os.environ.get(var, "1"))  # restored after the test
