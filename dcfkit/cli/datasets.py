@@ -10,7 +10,7 @@ from pathlib import Path
 
 from dcfkit.cli.common import add_dataset_arguments
 from dcfkit.datasets import layouts, load_dataset
-from dcfkit.integrations.vot import export_sequences
+from dcfkit.integrations.vot import DEFAULT_FPS, export_sequences, frame_rate
 from dcfkit.protocols import DEFAULT
 from dcfkit.registry import PluginWarning, get_registry
 
@@ -56,9 +56,13 @@ def add_export_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_export(args: argparse.Namespace) -> int:
-    """Write the sequences of a dataset in another toolkit's layout."""
+    """Add the sequences of a dataset to a workspace in another toolkit's layout."""
     sequences = load_dataset(args.dataset, args.root, args.sequences)
-    names = export_sequences(sequences, args.out, copy=args.copy)
-    print(f"{len(names)} sequences written to {args.out / 'sequences'} (list.txt, <sequence>/sequence, "
-          f"groundtruth.txt, color/)")
+    done = export_sequences(sequences, args.out, copy=args.copy)
+    already = f", {len(done['skipped'])} already there" if done["skipped"] else ""
+    print(f"{len(done['written'])} sequences written to {args.out / 'sequences'}{already} (list.txt lists "
+          f"{len(done['listed'])}; <sequence>/sequence, groundtruth.txt, color/)")
+    for dataset in sorted({s.dataset for s in sequences if frame_rate(s) is None}):
+        print(f"note: fps={DEFAULT_FPS} written for {dataset!r}, the VOT toolkit's default: dcfkit does not know "
+              f"its frame rate")
     return 0
