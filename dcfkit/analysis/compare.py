@@ -104,8 +104,9 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     proto = get_protocol(protocol or benchmark_protocol(sequences))
     if not divergence_px >= 0:
         raise DatasetError(f"divergence_px must be a number >= 0, got {shown(divergence_px)}")
-    (ours, damaged, our_platforms), (theirs, damaged_ref, their_platforms) = (_intact_files(results),
-                                                                              _intact_files(reference))
+    by_name = {s.name: s for s in sequences}
+    (ours, damaged, our_platforms), (theirs, damaged_ref, their_platforms) = (_intact_files(results, by_name),
+                                                                              _intact_files(reference, by_name))
     sequences = scored_sequences(sequences)
     known = {s.name for s in sequences}
     both = [s for s in sequences if s.name in ours and s.name in theirs]
@@ -184,9 +185,12 @@ def counted_lines(counts: Mapping[str, int], total: int, limit: int = 10) -> lis
     return out
 
 
-def _intact_files(folder) -> tuple[dict[str, Path], list[str], dict[str, dict | None]]:
+def _intact_files(folder, sequences: Mapping[str, Sequence]
+                  ) -> tuple[dict[str, Path], list[str], dict[str, dict | None]]:
     """The result files of ``folder``, apart the sequences whose dcfkit sidecar says the file is
-    damaged (never compared; each logged), and each file's platform record (None without one).
+    damaged or stale (:meth:`~dcfkit.running.results.ResultStore.stale`: made from another first
+    box or on other data than ``sequences`` now hold; never compared, each logged), and each
+    file's platform record (None without one).
     Files without a sidecar are taken as they are; reset-based runs are refused
     (:func:`~dcfkit.analysis.report.refuse_reset_runs`)."""
     files, store = result_files(folder), ResultStore(folder)
@@ -199,6 +203,8 @@ def _intact_files(folder) -> tuple[dict[str, Path], list[str], dict[str, dict | 
         record = meta.get("platform") if isinstance(meta, dict) else None
         platform_records[name] = record if isinstance(record, dict) else None
         problem = store.problem(name, meta) if meta is not None else None
+        if problem is None and meta is not None and name in sequences:
+            problem = store.stale(name, meta, sequences[name])
         if problem is not None:
             log.warning("%s: left out of the comparison", problem)
             damaged.append(files.pop(name))

@@ -89,3 +89,15 @@ def test_a_reset_run_without_frame_1_ground_truth_resumes_and_is_scored(tmp_path
     again = run_one_pass(CONFIG, [late], tmp_path, make_tracker=Counter(), progress=False, experiment="reset")
     assert again["skipped"] == ["a"] and again["done"] == []
     assert list(load_results(tmp_path / "drift", "reset", [late])) == ["a"] and "left out" not in caplog.text
+
+
+def test_compare_leaves_out_a_result_made_before_the_ground_truth_changed(tmp_path, seqs, caplog):  # noqa: F811
+    from dcfkit.analysis.compare import compare_folders
+
+    for out in ("ours", "theirs"):
+        run_one_pass(CONFIG, seqs, tmp_path / out, make_tracker=Counter(), progress=False)
+    corrected = [moved(seqs[0], 5, dx=1.0), seqs[1]]
+    with caplog.at_level("WARNING"):
+        found = compare_folders(tmp_path / "ours" / "drift", tmp_path / "theirs" / "drift", corrected)
+    assert [row["sequence"] for row in found["rows"]] == ["b"] and found["left_out"]["damaged"] == ["a"]
+    assert "a.json: its run was made on other data" in caplog.text
