@@ -53,6 +53,8 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
         _prepare(out, tasks.values(), job_list, version)
         todo = sorted((t for t in tasks.values() if not ResultStore(t.folder).is_done(t.seq, t.key)),
                       key=lambda t: -len(t.seq))  # longest first: the workers end together
+        for task in todo:
+            ResultStore(task.folder).refuse_to_shorten(task.seq)
         result = {"jobs": job_list, "runs": len(tasks), "done": [],
                   "skipped": [k for k, t in tasks.items() if t not in todo], "failed": {}}
         _run(spec, result, todo, len(tasks), variant_names(job_list), jobs, executor, scheduler, progress, version)

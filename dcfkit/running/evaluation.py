@@ -74,7 +74,7 @@ def _say_what_is_recomputed(store: ResultStore, metas: dict, todo: list[Sequence
     replaced = [s.name for s in todo
                 if (metas[s.name] or {}).get("run_key") not in (None, key)
                 and json.dumps(metas[s.name].get("config"), sort_keys=True, default=json_default) != same]
-    shorter = [s.name for s in todo if (_other_length(store, s, metas[s.name]) or len(s)) < len(s)]
+    shorter = [s.name for s in todo if (store.other_length(s, metas[s.name]) or len(s)) < len(s)]
     other_data = [s.name for s in todo if (metas[s.name] or {}).get("run_key") == key
                   and not same_data(metas[s.name], s) and s.name not in shorter]
     if damaged:
@@ -89,25 +89,6 @@ def _say_what_is_recomputed(store: ResultStore, metas: dict, todo: list[Sequence
         log.warning("%s: replacing the results of another config named %r for %d sequence(s): %s (give this "
                     "config another name to keep both)", store.folder, config["name"], len(replaced),
                     ", ".join(replaced[:10]))
-
-
-def _other_length(store: ResultStore, run: Sequence, meta: dict | None) -> int | None:
-    """The frame count of ``run``'s intact stored result (sidecar ``meta``) if it is not ``run``'s, else None."""
-    if meta is None or meta.get("frames") == len(run) or store.problem(run.name, meta) is not None:
-        return None
-    return meta["frames"]
-
-
-def _check_nothing_longer(store: ResultStore, metas: dict, todo: list[Sequence]) -> None:
-    """A run never replaces an intact one of more frames (a smoke run's cut sequences, an
-    ``eval --max-frames``, must not cost the full results): refused, before anything runs."""
-    for run in todo:
-        frames = _other_length(store, run, metas[run.name]) or 0
-        if frames > len(run):
-            raise DatasetError(
-                f"{store.boxes_path(run.name)} holds an intact run of {frames} frames and this run of {run.name!r} has "
-                f"{len(run)} (--max-frames?): it is not replaced; write this run to another --out, or remove those "
-                f"results to replace them")
 
 
 def results_folder(out_dir, config: Mapping, experiment: str | Experiment = "ope") -> Path:
@@ -134,7 +115,8 @@ def _plan(config: dict, sequences: list[Sequence], runs: list[Sequence], out_dir
     metas = {s.name: store.sidecar(s.name) for s in runs}  # each read once
     todo = [s for s in runs if store.status(s, key, metas[s.name]) != "done"]
     _check_same_dataset(store, metas, todo)
-    _check_nothing_longer(store, metas, todo)
+    for run in todo:
+        store.refuse_to_shorten(run, metas[run.name])
     if todo:
         ensure_writable(store.folder, [f for s in todo for f in store.file_names(s.name)],
                         f"{tracker_name(config)}'s results")

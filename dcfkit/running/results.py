@@ -119,6 +119,22 @@ class ResultStore:
                     f"frames have changed since)")
         return None
 
+    def other_length(self, run: Sequence, meta: dict | None) -> int | None:
+        """The frame count of ``run``'s intact stored result (sidecar ``meta``) if it is not ``run``'s, else None."""
+        if meta is None or meta.get("frames") == len(run) or self.problem(run.name, meta) is not None:
+            return None
+        return meta["frames"]
+
+    def refuse_to_shorten(self, run: Sequence, meta: dict | None = None) -> None:
+        """A :class:`DatasetError` if an intact stored run of ``run`` has more frames: a smoke run's
+        cut sequences (``--max-frames``) must never cost the full results."""
+        frames = self.other_length(run, self.sidecar(run.name) if meta is None else meta) or 0
+        if frames > len(run):
+            raise DatasetError(
+                f"{self.boxes_path(run.name)} holds an intact run of {frames} frames and this run of {run.name!r} has "
+                f"{len(run)} (--max-frames?): it is not replaced; write this run to another --out, or remove those "
+                f"results to replace them")
+
     def is_done(self, seq: Sequence, key: str) -> bool:
         return self.status(seq, key) == "done"
 

@@ -522,3 +522,16 @@ def test_an_unwritable_job_folder_is_refused_before_tracking(tmp_path, data, mon
     monkeypatch.setattr("dcfkit.running.runner.track", lambda *a, **k: pytest.fail("tracked before the check"))
     with pytest.raises(DcfkitError, match=r"cannot write the ablation's results to .*: Permission denied"):
         run_ablation(spec, tmp_path / "out", jobs=1, progress=False)
+
+
+def test_a_smoke_ablation_never_replaces_the_full_results(tmp_path, data, capsys):
+    spec = str(write_spec(tmp_path / "spec.yaml", "dataset: {name: otb, root: data}\nvariants: {k: {config: kcf}}\n"))
+    base = ["ablate", spec, "--out", str(tmp_path / "out"), "--sequences", "seqA", "--jobs", "1", "--no-progress"]
+    assert cli.main(base) == 0
+    (full,) = (tmp_path / "out" / "jobs").glob("*/*/seqA.txt")
+    before = full.read_bytes()
+    capsys.readouterr()
+    assert cli.main(base + ["--max-frames", "5"]) != 0
+    err = capsys.readouterr().err.strip()
+    assert f"holds an intact run of {N_FRAMES} frames and this run of 'seqA' has 5" in err and "\n" not in err
+    assert full.read_bytes() == before
