@@ -42,7 +42,8 @@ def claimed(folder: Path, names: Iterable[str], command: str, what: Callable[[st
     try:
         with contextlib.suppress(FileExistsError):
             locks.mkdir()
-        with open(locks / ".guard", "a+") as guard:
+        # read-only: flock needs no write access, so another user's guard serves too
+        with open(os.open(locks / ".guard", os.O_RDONLY | os.O_CREAT, 0o666)) as guard:
             fcntl.flock(guard, fcntl.LOCK_EX)  # brief: held by others only while they claim
             _check_claims(locks, names, command, what)
             held = open(mine.with_suffix(LOCK), "a+")
@@ -51,7 +52,8 @@ def claimed(folder: Path, names: Iterable[str], command: str, what: Callable[[st
     except OSError as exc:
         if held is not None:
             held.close()
-        log.warning("cannot create the lock %s (%s): running without it", mine.with_suffix(LOCK), exc.strerror)
+        log.warning("cannot create the lock %s (%s): running without it", exc.filename or mine.with_suffix(LOCK),
+                    exc.strerror)
         yield
         return
     try:
@@ -64,22 +66,37 @@ def claimed(folder: Path, names: Iterable[str], command: str, what: Callable[[st
 
 
 def _check_claims(locks: Path, names: set[str], command: str, what: Callable[[str], str]) -> None:
-    """Raise if a live owner in ``locks`` claims one of ``names``; remove the claims of dead ones."""
+    """Raise if an owner in ``locks`` that is alive, or whose lock cannot be read (another
+    user's, or something else in its place), claims one of ``names``; remove dead ones' claims."""
     for claims in locks.glob(f"*{CLAIMS}"):
-        lock = claims.with_suffix(LOCK)
+        lock, unreadable = claims.with_suffix(LOCK), None
         try:
-            with open(lock, "a+") as owner:
+            with open(os.open(lock, os.O_RDONLY)) as owner:  # flock needs no write access
                 fcntl.flock(owner, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            for stale in (claims, lock):  # its owner was killed, or is removing them as it ends
-                with contextlib.suppress(FileNotFoundError):
-                    stale.unlink()
-            continue
         except BlockingIOError:
-            pass
+            pass  # alive
+        except OSError as exc:
+            if isinstance(exc, FileNotFoundError):  # no lock: its owner ended, or was killed before it locked
+                _remove(claims)
+                continue
+            unreadable = exc.strerror  # cannot tell whether its owner runs: it may
+        else:
+            _remove(claims, lock)  # its owner was killed, or is removing them as it ends
+            continue
         try:
             taken = names.intersection(json.loads(claims.read_text(encoding="utf-8")))
         except (OSError, ValueError, TypeError):
-            continue  # removed as it ended
+            continue  # removed as it ended, or not a list of runs
+        if taken and unreadable:
+            raise DcfkitError(f"{claims} claims {what(min(taken))}, and its lock {lock} cannot be read "
+                              f"({unreadable}): if no `{command}` writes there, remove both")
         if taken:
             raise DcfkitError(f"another `{command}` is writing {what(min(taken))} (it holds {lock}); "
                               f"wait for it or write elsewhere")
+
+
+def _remove(*paths: Path) -> None:
+    """Unlink ``paths`` as far as possible (one in the way, a folder say, stays and is read as such)."""
+    for path in paths:
+        with contextlib.suppress(OSError):
+            path.unlink()

@@ -60,3 +60,22 @@ def test_a_live_claim_refuses_the_same_runs_and_a_killed_one_lapses(tmp_path, se
     assert len(list((folder / ".locks").glob("*.claims"))) == 1  # left by the killed run
     assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["done"] == ["b", "c"]
     assert sorted(p.name for p in (folder / ".locks").iterdir()) == [".guard"]  # nothing left once it ended
+
+
+def test_a_stray_entry_in_the_locks_never_turns_claims_off(tmp_path, caplog):
+    """A folder where an owner's lock goes (or a lock that cannot be read) made every evaluation run
+    unclaimed, with a warning naming its own lock: two evaluations then wrote the same runs."""
+    locks = tmp_path / ".locks"
+    (locks / "stray.lock").mkdir(parents=True)
+    (locks / "stray.claims").write_text('["a"]')
+    with caplog.at_level("WARNING"):
+        with claimed(tmp_path, ["b"], "dcfkit eval", str):  # claims nothing of it: runs, claimed
+            assert len(list(locks.glob("*.claims"))) == 2
+            with pytest.raises(DcfkitError, match="another `dcfkit eval` is writing b"):
+                with claimed(tmp_path, ["b"], "dcfkit eval", str):
+                    pass
+        with pytest.raises(DcfkitError, match=r"stray\.claims claims a, and its lock .*stray\.lock cannot be read "
+                                              r"\(Is a directory\): if no `dcfkit eval` writes there, remove both"):
+            with claimed(tmp_path, ["a"], "dcfkit eval", str):
+                pass
+    assert "running without it" not in caplog.text
