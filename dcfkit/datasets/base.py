@@ -74,7 +74,9 @@ class Sequence:
     is True for a test split that publishes frame 1's box only (GOT-10k, TrackingNet): rows
     2..N are NaN, so the sequence can be tracked but not scored (:func:`scored_sequences`).
     ``start_box`` is the 0-based box the tracker starts from when it is not frame 1's ground
-    truth (a run of a robustness experiment, :mod:`dcfkit.experiments`).
+    truth (a run of a robustness experiment, :mod:`dcfkit.experiments`). ``cut`` is True for the
+    first frames of a longer sequence (:meth:`head`: a smoke run), whose results must never
+    replace the whole sequence's.
     """
 
     name: str
@@ -85,6 +87,7 @@ class Sequence:
     annotation: Path | None = None
     ground_truth_withheld: bool = False
     start_box: np.ndarray | None = None
+    cut: bool = False
 
     def __post_init__(self):
         gt = np.array(self.ground_truth, dtype=np.float64, copy=True).reshape(-1, 4)
@@ -110,7 +113,7 @@ class Sequence:
             return self
         if n < 1:
             raise DatasetError(f"a sequence needs at least 1 frame, got a limit of {n}")
-        return dataclasses.replace(self, frames=self.frames[:n], ground_truth=self.ground_truth[:n])
+        return dataclasses.replace(self, frames=self.frames[:n], ground_truth=self.ground_truth[:n], cut=True)
 
     def __repr__(self) -> str:
         flags = ",".join(k for k, v in self.attributes.items() if v)

@@ -80,8 +80,8 @@ def _say_what_is_recomputed(store: ResultStore, metas: dict, todo: list[Sequence
     if damaged:
         log.warning("%s: recomputing %d damaged result(s): %s", store.folder, len(damaged), ", ".join(damaged[:10]))
     if shorter:
-        log.warning("%s: replacing %d result(s) of fewer frames (an eval --max-frames smoke run's): %s", store.folder,
-                    len(shorter), ", ".join(shorter[:10]))
+        log.warning("%s: replacing %d result(s) of fewer frames (a --max-frames smoke run's, or the sequence has "
+                    "grown): %s", store.folder, len(shorter), ", ".join(shorter[:10]))
     if other_data:
         log.warning("%s: recomputing %d result(s) made on other data (a sequence of that name whose frames or ground "
                     "truth differ): %s", store.folder, len(other_data), ", ".join(other_data[:10]))

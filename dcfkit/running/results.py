@@ -126,13 +126,16 @@ class ResultStore:
         return meta["frames"]
 
     def refuse_to_shorten(self, run: Sequence, meta: dict | None = None) -> None:
-        """A :class:`DatasetError` if an intact stored run of ``run`` has more frames: a smoke run's
-        cut sequences (``--max-frames``) must never cost the full results."""
+        """A :class:`DatasetError` if ``run`` is cut (:meth:`Sequence.head`) and an intact stored
+        run of it has more frames: a smoke run (``--max-frames``) must never cost the full
+        results. A sequence shortened or corrected in its folder is recomputed, as other data is."""
+        if not run.cut:
+            return
         frames = self.other_length(run, self.sidecar(run.name) if meta is None else meta) or 0
         if frames > len(run):
             raise DatasetError(
                 f"{self.boxes_path(run.name)} holds an intact run of {frames} frames and this run of {run.name!r} has "
-                f"{len(run)} (--max-frames?): it is not replaced; write this run to another --out, or remove those "
+                f"{len(run)} (--max-frames): it is not replaced; write this run to another --out, or remove those "
                 f"results to replace them")
 
     def is_done(self, seq: Sequence, key: str) -> bool:
@@ -232,8 +235,10 @@ class ResultStore:
 def data_identity(seq: Sequence) -> str:
     """What identifies a sequence's data, without decoding an image: a digest of its whole ground
     truth and of its frames' file names and sizes. Two benchmark folders may hold sequences of one
-    name, length and first box; their results must not stand for each other."""
-    digest = hashlib.sha256(np.ascontiguousarray(seq.ground_truth, dtype="<f8").tobytes())
+    name, length and first box; their results must not stand for each other. The ground truth is
+    rounded to 1e-6 px: a box a layout computes (vot_area's polygon norms) may differ in its last
+    bit between BLAS builds, and must not make one machine's results another data's."""
+    digest = hashlib.sha256(np.ascontiguousarray(np.round(seq.ground_truth, 6) + 0.0, dtype="<f8").tobytes())
     for frame in seq.frames:
         try:
             size = os.stat(frame).st_size

@@ -44,3 +44,17 @@ def test_the_identity_is_the_data_not_the_folder_and_old_sidecars_are_trusted(tm
     moved[-1, 0] += 3
     other = dataclasses.replace(seqs[0], ground_truth=moved)
     assert run_one_pass(CONFIG, [other], tmp_path, make_tracker=Counter(), progress=False)["skipped"] == ["a"]
+
+
+def test_the_identity_ignores_a_last_bit_of_the_ground_truth():
+    """vot_area's boxes come from np.linalg.norm, whose last bit may differ between BLAS builds:
+    one machine's results must not read as other data on another."""
+    from dcfkit.datasets import Sequence
+
+    gt = np.array([[10.1, 20.2, 30.3, 40.4], [11.1, 21.2, 31.3, 41.4]])
+    nudged = np.nextafter(gt, np.inf)
+    moved = gt.copy()
+    moved[1, 0] += 0.01  # a correction
+    same, other, corrected = (Sequence("s", ("0.jpg", "1.jpg"), g) for g in (gt, nudged, moved))
+    assert not np.array_equal(gt, nudged)
+    assert results.data_identity(same) == results.data_identity(other) != results.data_identity(corrected)

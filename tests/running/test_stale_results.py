@@ -53,7 +53,7 @@ def test_a_smoke_run_never_replaces_longer_results(tmp_path, seqs, experiment, c
     before = {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file()}
     cut = [s.head(22) for s in seqs]
     with pytest.raises(DatasetError, match=r"_?\w*\.txt holds an intact run of \d+ frames and this run of '\w+' has "
-                                           r"\d+ \(--max-frames\?\): it is not replaced; write this run to another"):
+                                           r"\d+ \(--max-frames\): it is not replaced; write this run to another"):
         run_one_pass(CONFIG, cut, tmp_path, make_tracker=Counter(), progress=False, experiment=experiment)
     assert {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file()} == before
     assert "damaged" not in caplog.text
@@ -63,7 +63,8 @@ def test_a_full_run_replaces_a_smoke_runs_results_and_says_why(tmp_path, seqs, c
     run_one_pass(CONFIG, [s.head(5) for s in seqs], tmp_path, make_tracker=Counter(), progress=False)
     with caplog.at_level("WARNING"):
         assert run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)["done"] == ["a", "b"]
-    assert "replacing 2 result(s) of fewer frames (an eval --max-frames smoke run's): a, b" in caplog.text
+    assert ("replacing 2 result(s) of fewer frames (a --max-frames smoke run's, or the sequence has grown): a, b"
+            in caplog.text)
     assert "damaged" not in caplog.text and "other data" not in caplog.text
 
 
@@ -101,3 +102,14 @@ def test_compare_leaves_out_a_result_made_before_the_ground_truth_changed(tmp_pa
         found = compare_folders(tmp_path / "ours" / "drift", tmp_path / "theirs" / "drift", corrected)
     assert [row["sequence"] for row in found["rows"]] == ["b"] and found["left_out"]["damaged"] == ["a"]
     assert "a.json: its run was made on other data" in caplog.text
+
+
+@pytest.mark.parametrize("experiment", ["ope", "tre"])
+def test_a_sequence_shortened_or_corrected_in_its_folder_runs_again(tmp_path, seqs, experiment):  # noqa: F811
+    """Only a smoke run's cut sequence is refused: one shortened in its folder (or a TRE run that a
+    corrected row made shorter) is other data, recomputed."""
+    run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False, experiment=experiment)
+    short = dataclasses.replace(seqs[0], frames=seqs[0].frames[:22], ground_truth=seqs[0].ground_truth[:22])
+    again = run_one_pass(CONFIG, [short, seqs[1]], tmp_path, make_tracker=Counter(), progress=False,
+                         experiment=experiment)
+    assert again["done"] == [r.name for r in experiment_runs([short], experiment)]
