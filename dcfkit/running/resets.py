@@ -11,7 +11,7 @@ from typing import Callable
 
 import numpy as np
 
-from dcfkit.datasets import Sequence
+from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.experiments.starts import start_problem
 from dcfkit.experiments.vot import SKIP, overlap, valid_box
 from dcfkit.running.tracking import Track, TrackerFailure, steps
@@ -78,6 +78,9 @@ def track_with_resets(make_tracker: Callable[[], object], seq: Sequence, frame: 
         run.failures.append(failed)
         due = failed + SKIP
         start = next_start(seq.ground_truth, due, size)
+    if not run.starts:  # else scored as a run without a failure
+        raise DatasetError(f"sequence {seq.name!r}: no frame's ground truth is valid and inside the image, so no "
+                           f"reset-based run can start")
     return run
 
 

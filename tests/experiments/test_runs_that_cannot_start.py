@@ -124,3 +124,12 @@ def test_a_reset_due_on_a_box_outside_the_image_starts_at_the_next_frame_inside(
     assert summary["done"] == ["gap"] and not summary["failed"]
     meta = json.loads((tmp_path / "out" / "still" / "reset" / "gap.json").read_text())
     assert meta["resets"] == {"starts": [2, 17], "failures": [11], "moved": [[1, 2], [16, 17]]}
+
+
+def test_a_reset_based_run_that_can_start_nowhere_fails_and_is_not_scored_as_perfect(tmp_path):
+    gone = sequence(tmp_path, "gone", np.array([[WIDTH + 3, 6, 8, 9]] * N))  # off the image on every frame
+    with pytest.raises(DatasetError, match=r"sequence 'gone': no frame's ground truth is valid and inside the image"):
+        track_with_resets(Still, gone, gone.frame)
+    summary = run_one_pass(CONFIG, [gone, sequence(tmp_path, "here", walking())], tmp_path / "out",
+                           make_tracker=Still, progress=False, experiment="reset")
+    assert summary["done"] == ["here"] and list(summary["failed"]) == ["gone"]
