@@ -116,11 +116,14 @@ def _present(target: Path, files: dict[str, str], frames: int) -> bool:
                            f"exist): nothing is overwritten; remove it or export into another workspace")
     try:
         differs = [name for name, text in files.items() if (target / name).read_text(encoding="utf-8") != text]
-        count = sum(1 for _ in (target / "color").iterdir())
+        entries = list((target / "color").iterdir())
+        count, broken = len(entries), sum(1 for e in entries if not e.exists())
     except (OSError, UnicodeDecodeError):
-        differs, count = list(files), None
+        differs, count, broken = list(files), None, 0
     if count != frames:
         differs.append(f"color/ ({count if count is not None else 'no'} frames, not {frames})")
+    if broken:  # links to frames moved since: the toolkit could read none of them
+        differs.append(f"color/ ({broken} of its frames lead nowhere)")
     if differs:
         raise DatasetError(f"{clip(str(target))} exists and is not this export ({', '.join(differs)} differ): "
                            f"nothing is overwritten; remove it or export into another workspace")

@@ -167,3 +167,17 @@ def test_a_dangling_link_where_a_sequence_goes_is_named(tmp_path):
     with pytest.raises(DcfkitError, match=r"ws/sequences/b is a symbolic link \(to .*gone, which does not exist\)"):
         export_sequences([otb_like(tmp_path, "b")], tmp_path / "ws")
     assert os.path.islink(tmp_path / "ws" / "sequences" / "b")
+
+
+def test_a_rerun_never_skips_a_sequence_whose_frame_links_lead_nowhere(tmp_path):
+    """An export linked to frames that moved since was "already there" on a rerun from the new
+    place: the workspace held links the toolkit could not read."""
+    a = otb_like(tmp_path, "a")
+    export_sequences([a], tmp_path / "ws")
+    moved = tmp_path / "moved"
+    (tmp_path / "src").rename(moved)
+    a2 = Sequence("a", tuple(moved / Path(f).relative_to(tmp_path / "src") for f in a.frames), a.ground_truth, {},
+                  a.dataset)
+    with pytest.raises(DatasetError, match=r"ws/sequences/a exists and is not this export \(color/ \(5 of its "
+                                           r"frames lead nowhere\) differ\): nothing is overwritten"):
+        export_sequences([a2], tmp_path / "ws")
