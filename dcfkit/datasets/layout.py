@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import enum
+import unicodedata
 from pathlib import Path
 from typing import Callable, Iterable, Iterator
 
@@ -21,6 +22,10 @@ from dcfkit.errors import RegistryError, clip, shown
 from dcfkit.protocols import PROTOCOLS
 
 Loader = Callable[..., list[Sequence]]  # (root, sequences=None) -> list[Sequence]
+#: Unicode categories no name may hold: controls (line breaks, tab, NUL), format characters,
+#: line and paragraph separators, surrogates (bytes that were not UTF-8), unassigned code points;
+#: a no-break or ideographic space is a name's own (str.isprintable refuses those too)
+UNPRINTABLE = frozenset({"Cc", "Cf", "Zl", "Zp", "Cs", "Cn"})
 NAME_BYTES = 200  # the longest sequence name in UTF-8: a result's file name adds 30 bytes, a file name holds 255
 Detector = Callable[[Path], int]  # root -> Evidence (or bool)
 
@@ -142,7 +147,7 @@ def sequence_name_problem(name) -> str | None:
         return "holds / \\ or :, which would make its result files' path leave the results folder"
     if name.startswith("."):
         return "starts with '.', which hides its files and is how dcfkit names files in progress"
-    if not name.isprintable():
+    if any(unicodedata.category(c) in UNPRINTABLE for c in name):  # isprintable() refuses a no-break space too
         return "holds a line break, tab, NUL or other unprintable character"
     if name != name.strip():
         return "starts or ends with a space, which list files drop"
@@ -167,13 +172,13 @@ class CheckedLoader:
         seen: dict[str, str] = {}
         for seq in loaded:
             problem = sequence_name_problem(seq.name)
-            if problem is None and seq.name.casefold() in seen:
-                problem = (f"is also the name of sequence {seen[seq.name.casefold()]!r} (names must differ in "
+            if problem is None and seq.name.lower() in seen:
+                problem = (f"is also the name of sequence {seen[seq.name.lower()]!r} (names must differ in "
                            f"more than case: their result files would be one on a case-insensitive disk)")
             if problem is not None:
                 found = f" ({clip(_escaped(str(seq.annotation)))})" if seq.annotation else ""
                 raise DatasetError(f"{self.where}: sequence name {_shown_name(seq.name)}{found} {problem}")
-            seen[seq.name.casefold()] = seq.name
+            seen[seq.name.lower()] = seq.name
         return list(loaded)
 
 

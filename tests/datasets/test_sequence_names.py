@@ -40,8 +40,14 @@ def test_a_layout_returning_an_unsafe_name_is_refused_naming_the_layout_and_the_
 
 
 def test_names_that_real_benchmarks_use_are_taken():
-    for name in ("Jogging.1", "car1_s", "airplane-1", "GOT-10k_Val_000001", "bike 3", "名前", "x" * NAME_BYTES):
+    for name in ("Jogging.1", "car1_s", "airplane-1", "GOT-10k_Val_000001", "bike 3", "名前", "x" * NAME_BYTES,
+                 "zebra\u00a0x", "東京\u3000駅", "straße"):  # str.isprintable refused the no-break and ideographic spaces
         assert sequence_name_problem(name) is None, name
+
+
+def test_names_that_only_casefold_alike_are_two(tmp_path):
+    with registered_layout("german", lambda root, sequences=None: toys("straße", "strasse"), "ROOT/<seq>"):
+        assert [s.name for s in load_dataset("german", tmp_path)] == ["straße", "strasse"]  # no disk takes them as one
 
 
 def test_names_must_be_unique_even_in_case(tmp_path):
