@@ -14,6 +14,7 @@ import pytest
 from dcfkit import datasets
 from dcfkit.datasets import (
     DatasetError,
+    DatasetWarning,
     Evidence,
     Sequence,
     canonical_name,
@@ -161,9 +162,10 @@ def test_uav_listing_only_present_sequences_and_not_found(tmp_path):
     msg = str(e.value)
     assert "'wakeboard'" in msg and "Did you mean 'wakeboard7'" in msg and "truck4_1" in msg
     assert [s.name for s in load_dataset("uav123_10fps", root, "WAKEBOARD7")] == ["wakeboard7"]
-    # each sequence once, however often it is named
-    assert [s.name for s in load_dataset("uav123_10fps", root, "wakeboard7,truck4_1,Wakeboard7")] == \
-        ["wakeboard7", "truck4_1"]
+    # each sequence once, however often it is named, and the repeat said
+    with pytest.warns(DatasetWarning, match="'wakeboard7' listed more than once: each sequence counts once"):
+        assert [s.name for s in load_dataset("uav123_10fps", root, "wakeboard7,truck4_1,Wakeboard7")] == \
+            ["wakeboard7", "truck4_1"]
     # a sequence of the benchmark whose annotation file is missing: that file is named
     # and the sequences that are there are listed
     with pytest.raises(DatasetError, match=r"sequence 'boat1' .*annotation file not found: .*boat1\.txt\. "
