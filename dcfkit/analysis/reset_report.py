@@ -17,7 +17,7 @@ from dcfkit.analysis.tables import format_rows, statistics_lines
 from dcfkit.datasets import DatasetError, Sequence, scored_sequences
 from dcfkit.errors import clip
 from dcfkit.experiments import EXPERIMENTS
-from dcfkit.experiments.vot import SKIP, overlap
+from dcfkit.experiments.vot import SKIP, failed
 from dcfkit.running.files import atomic_write, ensure_writable
 from dcfkit.running.resets import next_start
 from dcfkit.running.results import ResultStore
@@ -107,9 +107,9 @@ def _segment_problem(run: ResetRun, start: int, failure: int | None) -> str | No
 
 def _fails(run: ResetRun, i: int, margin: float) -> bool:
     """Whether frame ``i``'s box, ``margin`` wider on each side, fails (does not overlap the ground
-    truth: :func:`~dcfkit.experiments.vot.overlap`, NaN and never a failure without one)."""
+    truth: :func:`~dcfkit.experiments.vot.failed`)."""
     x, y, w, h = run.boxes[i]
-    return overlap((x - margin, y - margin, w + 2 * margin, h + 2 * margin), run.gt[i], run.bounds) <= 0
+    return failed((x - margin, y - margin, w + 2 * margin, h + 2 * margin), run.gt[i], run.bounds)
 
 
 def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["BURN_IN", "SKIP", "overlap", "valid_box"]
+__all__ = ["BURN_IN", "SKIP", "failed", "overlap", "valid_box"]
 
 SKIP = 5  # frames from a failure to the next start (vot-toolkit's skip_initialize)
 BURN_IN = 10  # frames from each start left out of accuracy, the start included
@@ -45,3 +45,9 @@ def overlap(box, gt, bounds: tuple[float, float] | None = None) -> float:
     inter = max(0.0, min(ar, br) - max(al, bl)) * max(0.0, min(ab, bb) - max(at, bt))
     union = (ar - al) * (ab - at) + (br - bl) * (bb - bt) - inter
     return float(inter / union) if union > 0 else 0.0
+
+
+def failed(box, gt, bounds: tuple[float, float] | None = None) -> bool:
+    """VOT's failure: ``box`` does not overlap ``gt`` (:func:`overlap` <= 0; never on a frame
+    without ground truth). The rule the runs apply and the reset report replays."""
+    return overlap(box, gt, bounds) <= 0

@@ -13,7 +13,7 @@ import numpy as np
 
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.experiments.starts import start_problem
-from dcfkit.experiments.vot import SKIP, overlap, valid_box
+from dcfkit.experiments.vot import SKIP, failed, valid_box
 from dcfkit.running.tracking import Track, TrackerFailure, steps
 
 
@@ -72,11 +72,11 @@ def track_with_resets(make_tracker: Callable[[], object], seq: Sequence, frame: 
         if start != due:
             run.moved[start] = due
         run.starts.append(start)
-        failed = _segment(make_tracker(), seq, frame, start, image, run, on_frame)
-        if failed is None:
+        failure = _segment(make_tracker(), seq, frame, start, image, run, on_frame)
+        if failure is None:
             break
-        run.failures.append(failed)
-        due = failed + SKIP
+        run.failures.append(failure)
+        due = failure + SKIP
         start = next_start(seq.ground_truth, due, size)
     if not run.starts:  # else scored as a run without a failure
         raise DatasetError(f"sequence {seq.name!r}: no frame's ground truth is valid and inside the image, so no "
@@ -96,7 +96,7 @@ def _segment(tracker, seq: Sequence, frame: Callable[[int], np.ndarray], start: 
             if on_frame is not None:
                 on_frame()
             bounds = (step.image.shape[1], step.image.shape[0])
-            if step.index > 0 and overlap(step.box, seq.ground_truth[i], bounds) <= 0:
+            if step.index > 0 and failed(step.box, seq.ground_truth[i], bounds):
                 return i
     except TrackerFailure as exc:  # steps numbers the frames from this start
         raise TrackerFailure(start + exc.frame, exc.detail) from exc.__cause__
