@@ -24,6 +24,7 @@ import numpy as np
 from dcfkit import __version__
 from dcfkit.config.slots import components
 from dcfkit.registry import get_registry
+from dcfkit.running.code_state import box_code, built_source
 from dcfkit.running.platforms import cpu_model
 
 _COMMAND: contextvars.ContextVar[list | None] = contextvars.ContextVar("dcfkit_command", default=None)
@@ -56,13 +57,16 @@ def plugin_versions(config: Mapping) -> list[str]:
     return get_registry().plugin_versions(used) if used else []  # e.g. an OpenCV baseline: no registry
 
 
-def run_key(config: Mapping, version: str | None = None) -> str:
+def run_key(config: Mapping, version: str | None = None, code: str | None = None) -> str:
     """The identity of a run: 16 hex digits of SHA-256 over the canonical JSON (sorted keys)
     of ``config`` without its ``name`` and ``description`` (they change no box), the dcfkit
-    version and the versions of the plugins whose components the config uses (a plugin's
-    new release gives new results; configs of built-ins only keep their keys)."""
+    version, the digest of dcfkit's box code (``code``, default
+    :func:`~dcfkit.running.code_state.box_code`: an edited tracker gives new results at the
+    same version) and the versions of the plugins whose components the config uses (a
+    plugin's new release gives new results; configs of built-ins only keep their keys)."""
     payload = {"config": {k: v for k, v in config.items() if k not in LABEL_KEYS},
-               "dcfkit": version if version is not None else dcfkit_version()}
+               "dcfkit": version if version is not None else dcfkit_version(),
+               "code": code if code is not None else box_code()}
     plugins = plugin_versions(config)
     if plugins:
         payload["plugins"] = plugins
@@ -135,10 +139,13 @@ def git_state(folder: str) -> dict | None:
 @functools.lru_cache(maxsize=None)
 def package_source(distribution: str, package_dir: str | None = None) -> dict | None:
     """Where an installed package's code came from: the git state of the work tree it runs from
-    (``package_dir``'s parent holds ``.git``: a checkout, an editable install), else the commit
-    pip recorded for a VCS install or the git state of the folder of an editable one (PEP 610
-    ``direct_url.json``); None when nothing says (a release from an index)."""
+    (``package_dir``'s parent holds ``.git``: a checkout, an editable install), else the state
+    its build recorded (``pip install .`` of a checkout: :func:`~dcfkit.running.code_state.built_source`),
+    else the commit pip recorded for a VCS install or the git state of the folder of an
+    editable one (PEP 610 ``direct_url.json``); None when nothing says (a release from an index)."""
     if package_dir is not None and (found := git_state(os.path.dirname(os.path.abspath(package_dir)))):
+        return found
+    if package_dir is not None and (found := built_source(Path(package_dir))):
         return found
     try:
         direct = json.loads(importlib.metadata.distribution(distribution).read_text("direct_url.json") or "null")
@@ -155,9 +162,11 @@ def package_source(distribution: str, package_dir: str | None = None) -> dict | 
 
 
 def sources(plugins: list[str]) -> dict:
-    """:func:`package_source` of dcfkit and of each of ``plugins`` (``"name version"``, as
-    :func:`plugin_versions` lists them), by distribution name (results sidecars record it)."""
-    found = {"dcfkit": package_source("dcfkit", str(Path(__file__).resolve().parents[1]))}
+    """:func:`package_source` of dcfkit, with ``code`` (:func:`~dcfkit.running.code_state.box_code`),
+    and of each of ``plugins`` (``"name version"``, as :func:`plugin_versions` lists them), by
+    distribution name (results sidecars record it)."""
+    found = {"dcfkit": {**(package_source("dcfkit", str(Path(__file__).resolve().parents[1])) or {}),
+                        "code": box_code()}}
     for plugin in plugins:
         name = plugin.rsplit(" ", 1)[0]
         found[name] = package_source(name)

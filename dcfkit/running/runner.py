@@ -30,6 +30,7 @@ from dcfkit.errors import DcfkitError, shown
 from dcfkit.registry import PluginWarning
 from dcfkit.running import platforms
 from dcfkit.running.files import StoreError
+from dcfkit.running.code_state import box_code
 from dcfkit.running.provenance import dcfkit_version, invocation, machine, now, plugin_versions, run_key, sources
 from dcfkit.running.resets import ResetTrack, track_with_resets
 from dcfkit.running.results import ResultStore
@@ -216,8 +217,9 @@ def run_in_worker(task: RunTask, version: str, origin: Mapping | None = None) ->
         raise DcfkitError(f"this worker runs dcfkit {dcfkit_version()}, the client {version}; "
                           f"install the same version on every worker")
     if task.make_tracker is None and run_key(task.config, version) != task.key:
-        raise DcfkitError(f"this worker's plugins ({', '.join(plugin_versions(task.config)) or 'none'}) are not "
-                          f"the client's: install the same plugin versions on every worker")
+        plugins = ", ".join(plugin_versions(task.config)) or "none"
+        raise DcfkitError(f"this worker's dcfkit code ({box_code()}) or plugins ({plugins}) are not the client's: "
+                          f"install the same dcfkit source and plugin versions on every worker")
     return run_sequence(task, version, origin=origin)
 
 

@@ -44,15 +44,18 @@ def _command(meta: Mapping) -> str:
 
 
 def describe_sources(record) -> str:
-    """A sidecar's ``source`` as ``dcfkit 1a2b3c4d5e6f (uncommitted changes); plugin ...``."""
+    """A sidecar's ``source`` as ``dcfkit 1a2b3c4d5e6f with uncommitted changes, code 0123abcd...;
+    plugin ...`` (``code``: the digest of dcfkit's box code, recorded since it enters the run key)."""
     if not isinstance(record, dict):
         return NOT_RECORDED
     parts = []
     for name, found in record.items():
-        if not isinstance(found, dict) or not found.get("commit"):
-            parts.append(f"{name}: no git commit recorded (a release)")
+        found = found if isinstance(found, dict) else {}
+        if not found.get("commit"):
+            part = f"{name}: no git commit recorded (a release)"
         else:
-            parts.append(f"{name} {str(found['commit'])[:12]}" + (" with uncommitted changes" if found.get("dirty") else ""))
+            part = f"{name} {str(found['commit'])[:12]}" + (" with uncommitted changes" if found.get("dirty") else "")
+        parts.append(part + (f", code {found['code']}" if isinstance(found.get("code"), str) else ""))
     return "; ".join(parts)
 
 
