@@ -11,6 +11,7 @@ import importlib.metadata
 import json
 import os
 import platform
+import re
 import shlex
 import subprocess
 import sys
@@ -89,8 +90,16 @@ def running_command(argv: list[str]):
         _COMMAND.reset(token)
 
 
+def without_home(text: str) -> str:
+    """``text`` with the user's home folder written ``~``: what dcfkit writes to files that are
+    shared (sidecars, reports) names no user (docs/evaluation.md, "What is recorded")."""
+    home = str(Path.home()).rstrip("/\\")
+    return re.sub(re.escape(home) + r"(?![\w.-])", "~", text) if len(home) > 1 else text  # not /home/al of /home/alice
+
+
 def invocation() -> dict:
-    """How this command was given: ``{"command": argv, "cwd": working directory}``. The
+    """How this command was given: ``{"command": argv}``, the home folder written ``~``
+    (:func:`without_home`; the working directory and the host are not recorded). The
     process's ``sys.argv`` (with ``python -m PACKAGE`` as the first words when it was run so:
     ``sys.argv[0]`` is then the path of ``__main__.py``, which does not run alone) unless
     :func:`running_command` says otherwise. Result sidecars record the client's."""
@@ -102,7 +111,7 @@ def invocation() -> dict:
             argv[:1] = ["python", "-m", spec.name.removesuffix(".__main__")]
         elif argv:
             argv[0] = os.path.basename(argv[0]) or argv[0]
-    return {"command": argv, "cwd": os.getcwd()}
+    return {"command": [without_home(a) for a in argv]}
 
 
 def command_line(record: Mapping) -> str | None:
@@ -115,8 +124,9 @@ def command_line(record: Mapping) -> str | None:
 
 @functools.lru_cache(maxsize=1)
 def machine() -> dict:
-    """The machine this process runs on: host name, OS, CPU model, cores, Python version."""
-    return {"host": platform.node(), "system": platform.platform(terse=True), "cpu": cpu_model(),
+    """The machine this process runs on: OS, CPU model, cores, Python version (not its host
+    name: sidecars are shared with the results)."""
+    return {"system": platform.platform(terse=True), "cpu": cpu_model(),
             "cores": os.cpu_count(), "python": platform.python_version()}
 
 

@@ -31,7 +31,16 @@ from dcfkit.registry import PluginWarning
 from dcfkit.running import platforms
 from dcfkit.running.files import StoreError
 from dcfkit.running.code_state import box_code
-from dcfkit.running.provenance import dcfkit_version, invocation, machine, now, plugin_versions, run_key, sources
+from dcfkit.running.provenance import (
+    dcfkit_version,
+    invocation,
+    machine,
+    now,
+    plugin_versions,
+    run_key,
+    sources,
+    without_home,
+)
 from dcfkit.running.resets import ResetTrack, track_with_resets
 from dcfkit.running.results import ResultStore
 from dcfkit.running.scheduler import connect as connect_scheduler, import_distributed
@@ -156,8 +165,8 @@ def record_failure(task: RunTask, version: str, message: str, exc: BaseException
     cause = exc.__cause__ if isinstance(exc, TrackerFailure) and exc.__cause__ else exc
     ResultStore(task.folder).write_failure(task.seq, {
         "tracker": task.config.get("name"), "frame": frame,
-        "frame_file": str(task.seq.frames[frame - 1]) if frame else None,
-        "error": message, "run_key": task.key, "dcfkit_version": version}, cause)
+        "frame_file": without_home(str(task.seq.frames[frame - 1])) if frame else None,
+        "error": without_home(message), "run_key": task.key, "dcfkit_version": version}, cause)
     return {"sequence": task.seq.name, "status": "failed", "error": message, "frames": len(task.seq)}
 
 
