@@ -8,8 +8,8 @@ from typing import Any, Mapping
 from dcfkit.ablation.sensitivity import METRICS, sensitivity
 from dcfkit.ablation.spec import AblationSpec, format_value, job_dir
 from dcfkit.analysis.report_html import evaluation_sections, sections
-from dcfkit.analysis.report_html.provenance import shared_path, this_process
-from dcfkit.running.provenance import LABEL_KEYS
+from dcfkit.analysis.report_html.provenance import this_process
+from dcfkit.running.provenance import LABEL_KEYS, shared_path
 
 
 def flatten(config: Any, prefix: str = "") -> dict[str, Any]:

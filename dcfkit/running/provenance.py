@@ -97,6 +97,15 @@ def without_home(text: str) -> str:
     return re.sub(re.escape(home) + r"(?![\w.-])", "~", text) if len(home) > 1 else text  # not /home/al of /home/alice
 
 
+def shared_path(path, base) -> str:
+    """``path`` as a file in folder ``base`` names it: relative to ``base`` (``../results/kcf``),
+    :func:`without_home` if it cannot be (another drive) or ``base`` is None."""
+    if base is not None:
+        with contextlib.suppress(ValueError):
+            return Path(os.path.relpath(Path(path).resolve(), Path(base).resolve())).as_posix()
+    return without_home(str(path))
+
+
 def invocation() -> dict:
     """How this command was given: ``{"command": argv}``, the home folder written ``~``
     (:func:`without_home`; the working directory and the host are not recorded). The

@@ -228,7 +228,8 @@ class ResultStore:
             detail = "; ".join(f"{k}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}" for k, v in keys.items())
             raise DatasetError(
                 f"results in {self.folder} mix {len(keys)} configurations ({detail}); rerun "
-                f"`dcfkit eval` with one config, or give the other config a different 'name'")
+                f"`dcfkit eval` with one config, or give the other config a different 'name' (a key also "
+                f"changes with dcfkit's version and box code: rerunning the eval recomputes the older runs)")
         return results
 
 

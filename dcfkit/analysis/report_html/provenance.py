@@ -9,13 +9,20 @@ relative to the page's folder and the home folder as ``~``.
 """
 from __future__ import annotations
 
-import os
 from collections import Counter
 from pathlib import Path
 from typing import Iterable, Mapping
 
 from dcfkit.running import platforms
-from dcfkit.running.provenance import command_line, dcfkit_version, invocation, machine, now, without_home
+from dcfkit.running.provenance import (
+    command_line,
+    dcfkit_version,
+    invocation,
+    machine,
+    now,
+    shared_path,
+    without_home,
+)
 from dcfkit.running.results import ResultStore
 
 NOT_RECORDED = "not recorded"
@@ -46,17 +53,6 @@ def _command(meta: Mapping) -> str:
     return NOT_RECORDED if line is None else without_home(line)
 
 
-def shared_path(path, base: Path | None) -> str:
-    """``path`` as a page in ``base`` shows it: relative to ``base`` (``../results/kcf``), the
-    home folder as ``~`` if it cannot be (another drive), as given when ``base`` is None."""
-    if base is None:
-        return without_home(str(path))
-    try:
-        return Path(os.path.relpath(Path(path).resolve(), Path(base).resolve())).as_posix()
-    except ValueError:
-        return without_home(str(path))
-
-
 def describe_sources(record) -> str:
     """A sidecar's ``source`` as ``dcfkit 1a2b3c4d5e6f with uncommitted changes, code 0123abcd...;
     plugin ...`` (``code``: the digest of dcfkit's box code, recorded since it enters the run key)."""
@@ -75,7 +71,7 @@ def describe_sources(record) -> str:
 
 def folder_provenance(folder: Path, names: Iterable[str], base: Path | None = None) -> dict:
     """What the sidecars of sequences ``names`` in ``folder`` record: ``folder`` (relative to
-    ``base``, the page's folder: :func:`shared_path`),
+    ``base``, the page's folder: :func:`~dcfkit.running.provenance.shared_path`),
     ``sequences`` (sidecars read), ``run_keys``, ``versions``, ``plugins``, ``sources`` (git
     commits), ``commands``,
     ``machines``, ``platforms`` (each ``[[value, sequences], ...]``), ``times`` (first, last) and
