@@ -64,16 +64,20 @@ def local_build_backend() -> bool:
 
 @pytest.fixture(scope="session")
 def pip_install_copy(tmp_path_factory):
-    """``install(source) -> site``: pip-install (no deps) a copy of a project folder into a fresh
-    folder, as a user's ``pip install`` would, and return that folder (for PYTHONPATH)."""
+    """``install(source, git=False) -> site``: pip-install (no deps) a copy of a project folder
+    into a fresh folder, as a user's ``pip install`` would, and return that folder (for
+    PYTHONPATH). ``git``: the copy, ``site/../source``, is a git checkout of one commit, as a
+    user's clone is."""
 
-    def install(project: Path) -> Path:
+    def install(project: Path, git: bool = False) -> Path:
         if importlib.util.find_spec("pip") is None:
             pytest.skip("pip is not installed in this environment")
         tmp = tmp_path_factory.mktemp(project.name)
         source = tmp / "source"  # pip builds in the source tree: build a copy, leave the checkout clean
         shutil.copytree(project, source, ignore=shutil.ignore_patterns(
             "build", "*.egg-info", "__pycache__", ".git", ".ci-venv", "plugins", "tests", ".pytest_cache"))
+        if git:
+            _commit_all(source)
         target = tmp / "site"
         isolated = not local_build_backend()  # then pip fetches setuptools + wheel (a local index or PyPI)
         cmd = [sys.executable, "-m", "pip", "install", "--no-deps", "--no-input", "--disable-pip-version-check",
@@ -91,6 +95,13 @@ def pip_install_copy(tmp_path_factory):
         return target
 
     return install
+
+
+def _commit_all(folder: Path) -> None:
+    """Make ``folder`` a git checkout of one commit of all its files."""
+    ident = ["-c", "user.name=dcfkit tests", "-c", "user.email=tests@dcfkit.invalid", "-c", "commit.gpgsign=false"]
+    for args in (["init", "-q"], ["add", "-A"], ["commit", "-qm", "a user's clone"]):
+        subprocess.run(["git", "-C", str(folder), *ident, *args], check=True, capture_output=True, timeout=60)
 
 
 @pytest.fixture

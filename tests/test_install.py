@@ -1,14 +1,20 @@
-"""dcfkit as a user installs it (not this checkout): shipped configs found, the README's demo runs."""
+"""dcfkit as a user installs it (not this checkout): shipped configs found, the README's demo runs,
+and the commit it was built from recorded."""
+import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
+
+from dcfkit.running.code_state import code_digest
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_installed_package_finds_its_configs_and_runs_the_demo(pip_install_copy, tmp_path):
-    site = pip_install_copy(ROOT)
+    git = shutil.which("git") is not None  # then the copy is a clone: `pip install .` of a checkout
+    site = pip_install_copy(ROOT, git=git)
     assert (site / "dcfkit" / "configs" / "dr2track.yaml").is_file()
     assert (site / "dcfkit" / "configs" / "ablations" / "table3.yaml").is_file()
     assert (site / "dcfkit" / "data" / "uav123_sequences.tsv").is_file()
@@ -24,3 +30,12 @@ def test_installed_package_finds_its_configs_and_runs_the_demo(pip_install_copy,
                           cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
     assert demo.returncode == 0, demo.stderr
     assert "strcf" in demo.stdout and "dr2track" in demo.stdout
+    if git:  # the source state: recorded at build time, and the installed files' digest
+        commit = subprocess.run(["git", "-C", str(site.parent / "source"), "rev-parse", "HEAD"], capture_output=True,
+                                text=True, check=True).stdout.strip()
+        state = subprocess.run([sys.executable, "-c", "import json; from dcfkit.running.provenance import sources; "
+                                "print(json.dumps(sources([])))"], cwd=tmp_path, env=env, capture_output=True,
+                               text=True, timeout=120)
+        assert state.returncode == 0, state.stderr
+        assert json.loads(state.stdout) == {"dcfkit": {"commit": commit, "dirty": False,
+                                                       "code": code_digest(ROOT / "dcfkit")}}

@@ -329,7 +329,8 @@ def test_result_hashes_change_with_the_version_of_a_plugin_the_config_uses(monke
     registry_with("0.2.0")
     assert run_key(flat) != old_key
     monkeypatch.setattr("dcfkit.running.runner._worker_ready", True)  # no worker set-up in the test process
-    with pytest.raises(DcfkitError, match=r"worker's plugins \(dcfkit-test-versioned 0.2.0\) are not the client's"):
+    with pytest.raises(DcfkitError, match=r"worker's dcfkit code \(\w+\) or plugins \(dcfkit-test-versioned 0.2.0\) "
+                       r"are not the client's"):
         run_in_worker(RunTask(flat, None, "unused", old_key), dcfkit_version())
     monkeypatch.setattr(reg, "_REGISTRY", None)
 

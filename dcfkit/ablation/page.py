@@ -9,7 +9,7 @@ from dcfkit.ablation.sensitivity import METRICS, sensitivity
 from dcfkit.ablation.spec import AblationSpec, format_value, job_dir
 from dcfkit.analysis.report_html import evaluation_sections, sections
 from dcfkit.analysis.report_html.provenance import this_process
-from dcfkit.running.provenance import LABEL_KEYS
+from dcfkit.running.provenance import LABEL_KEYS, shared_path
 
 
 def flatten(config: Any, prefix: str = "") -> dict[str, Any]:
@@ -101,11 +101,13 @@ def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[s
     if spec.grid is not None:
         head.append(sensitivity_charts(spec, info["overall"]))
     folders = {**{v: job_dir(out, spec.dataset, k) for v, k in keys.items()}, **dict(spec.published)}
-    extra = [("spec", str(spec.path)), ("dataset", f"{spec.dataset} at {spec.root}")]
+    root = shared_path(spec.root, out) if spec.root is not None else "no root"
+    extra = [("spec", shared_path(spec.path, out)), ("dataset", f"{spec.dataset} at {root}")]
     return {"title": f"dcfkit ablation {spec.name}: {sections.count(len(trackers), 'variant')} on {spec.dataset}",
             "protocol": scores.protocol.describe(),
             "subtitle": f"{spec.description + ' · ' if spec.description else ''}"
                         f"{sections.count(len(sequences), 'sequence')}, {sum(len(s) for s in sequences)} frames",
             "trackers": trackers,
             "sections": [*head, *evaluation_sections(scores, sequences, results, trackers),
-                         sections.provenance(folders, [s.name for s in sequences], trackers, this_process(), extra)]}
+                         sections.provenance(folders, [s.name for s in sequences], trackers, this_process(), extra,
+                                             base=out)]}

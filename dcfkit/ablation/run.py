@@ -89,7 +89,7 @@ def _run(spec, result, todo, total, variants, jobs, executor, scheduler, progres
 
     warm_up_compiled(todo)  # numba compiles here, not in the first jobs the bar times
     bar = tqdm(total=total, initial=total - len(todo), unit="job", desc=spec.name,
-               disable=not progress or not todo, dynamic_ncols=True)
+               disable=None if progress and todo else True, dynamic_ncols=True)  # None: on a terminal only
 
     def on_result(task: RunTask, res: dict) -> None:
         if res["status"] == "done":

@@ -21,6 +21,7 @@ from dcfkit.datasets import Sequence
 from dcfkit.experiments import runs_by_sequence
 from dcfkit.protocols import DEFAULT, get_protocol
 from dcfkit.running.files import atomic_write, read_json
+from dcfkit.running.provenance import shared_path
 from dcfkit.running.results import ResultStore
 
 SUMMARY_COLUMNS = ("variant", "precision", "auc", "fps", "sequences", "failed")
@@ -85,9 +86,9 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     statistics = versus_baseline(scores.per_sequence, variants, (protocol.rank_key, "precision"), baseline)
     job_rows = [{"variant": j.variant, "sequence": j.sequence, "key": j.key,
                  "status": status[j.key, j.sequence][0], "error": status[j.key, j.sequence][1]} for j in jobs]
-    info = {"spec": str(spec.path), "name": spec.name, "description": spec.description,
+    info = {"spec": shared_path(spec.path, out), "name": spec.name, "description": spec.description,
             "protocol": protocol_record(scores.protocol), "experiment": spec.experiment,
-            "dataset": spec.dataset, "root": str(spec.root), "sequences": [s.name for s in sequences],
+            "dataset": spec.dataset, "root": None if spec.root is None else shared_path(spec.root, out), "sequences": [s.name for s in sequences],
             "overall": overall, "per_sequence": per_sequence, "statistics": statistics, "jobs": job_rows,
             "grid": ({"base": spec.grid.base, "mode": spec.grid.mode,
                       "parameters": {k: {"label": lab, "values": vals}

@@ -24,6 +24,7 @@ from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, summari
 from dcfkit.datasets import scored_sequences
 from dcfkit.errors import DcfkitError, clip, shown
 from dcfkit.running.files import atomic_write, ensure_writable, exclusive, make_dir, read_json
+from dcfkit.running.provenance import shared_path
 from dcfkit.running.results import data_identity
 
 log = logging.getLogger(__name__)
@@ -164,7 +165,7 @@ class Search:
             state = "not a search record as dcfkit writes it" if path.exists() else "missing"
             raise DcfkitError(f"{path} is {state}, yet {self.out / 'trials'} holds trial records: nothing shows which "
                               f"search made them; give a new --out, or remove {self.out / 'trials'} to start again")
-        atomic_write(path, json.dumps({"spec": str(self.spec.path), "name": self.spec.name,
+        atomic_write(path, json.dumps({"spec": shared_path(self.spec.path, self.out), "name": self.spec.name,
                                        "fingerprint": mine}, indent=1) + "\n")
 
     def _check_fingerprint(self, path: Path, old: Any, mine: dict) -> None:

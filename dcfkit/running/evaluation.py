@@ -171,7 +171,7 @@ def _run(summary: dict, tasks: list[RunTask], jobs: int, progress: bool, version
 
     warm_up_compiled(tasks)  # numba compiles here, not in the first runs the bar times
     bar = tqdm(total=sum(len(t.seq) for t in tasks), unit="frame", desc=summary["tracker"],
-               disable=not progress or not tasks, dynamic_ncols=True)
+               disable=None if progress and tasks else True, dynamic_ncols=True)  # None: on a terminal only
     done_frames = [0]
 
     def on_result(task: RunTask, result: dict) -> None:

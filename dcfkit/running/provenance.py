@@ -11,6 +11,7 @@ import importlib.metadata
 import json
 import os
 import platform
+import re
 import shlex
 import subprocess
 import sys
@@ -24,6 +25,7 @@ import numpy as np
 from dcfkit import __version__
 from dcfkit.config.slots import components
 from dcfkit.registry import get_registry
+from dcfkit.running.code_state import box_code, built_source
 from dcfkit.running.platforms import cpu_model
 
 _COMMAND: contextvars.ContextVar[list | None] = contextvars.ContextVar("dcfkit_command", default=None)
@@ -56,13 +58,16 @@ def plugin_versions(config: Mapping) -> list[str]:
     return get_registry().plugin_versions(used) if used else []  # e.g. an OpenCV baseline: no registry
 
 
-def run_key(config: Mapping, version: str | None = None) -> str:
+def run_key(config: Mapping, version: str | None = None, code: str | None = None) -> str:
     """The identity of a run: 16 hex digits of SHA-256 over the canonical JSON (sorted keys)
     of ``config`` without its ``name`` and ``description`` (they change no box), the dcfkit
-    version and the versions of the plugins whose components the config uses (a plugin's
-    new release gives new results; configs of built-ins only keep their keys)."""
+    version, the digest of dcfkit's box code (``code``, default
+    :func:`~dcfkit.running.code_state.box_code`: an edited tracker gives new results at the
+    same version) and the versions of the plugins whose components the config uses (a
+    plugin's new release gives new results; configs of built-ins only keep their keys)."""
     payload = {"config": {k: v for k, v in config.items() if k not in LABEL_KEYS},
-               "dcfkit": version if version is not None else dcfkit_version()}
+               "dcfkit": version if version is not None else dcfkit_version(),
+               "code": code if code is not None else box_code()}
     plugins = plugin_versions(config)
     if plugins:
         payload["plugins"] = plugins
@@ -85,8 +90,25 @@ def running_command(argv: list[str]):
         _COMMAND.reset(token)
 
 
+def without_home(text: str) -> str:
+    """``text`` with the user's home folder written ``~``: what dcfkit writes to files that are
+    shared (sidecars, reports) names no user (docs/evaluation.md, "What is recorded")."""
+    home = str(Path.home()).rstrip("/\\")
+    return re.sub(re.escape(home) + r"(?![\w.-])", "~", text) if len(home) > 1 else text  # not /home/al of /home/alice
+
+
+def shared_path(path, base) -> str:
+    """``path`` as a file in folder ``base`` names it: relative to ``base`` (``../results/kcf``),
+    :func:`without_home` if it cannot be (another drive) or ``base`` is None."""
+    if base is not None:
+        with contextlib.suppress(ValueError):
+            return Path(os.path.relpath(Path(path).resolve(), Path(base).resolve())).as_posix()
+    return without_home(str(path))
+
+
 def invocation() -> dict:
-    """How this command was given: ``{"command": argv, "cwd": working directory}``. The
+    """How this command was given: ``{"command": argv}``, the home folder written ``~``
+    (:func:`without_home`; the working directory and the host are not recorded). The
     process's ``sys.argv`` (with ``python -m PACKAGE`` as the first words when it was run so:
     ``sys.argv[0]`` is then the path of ``__main__.py``, which does not run alone) unless
     :func:`running_command` says otherwise. Result sidecars record the client's."""
@@ -98,7 +120,7 @@ def invocation() -> dict:
             argv[:1] = ["python", "-m", spec.name.removesuffix(".__main__")]
         elif argv:
             argv[0] = os.path.basename(argv[0]) or argv[0]
-    return {"command": argv, "cwd": os.getcwd()}
+    return {"command": [without_home(a) for a in argv]}
 
 
 def command_line(record: Mapping) -> str | None:
@@ -111,8 +133,9 @@ def command_line(record: Mapping) -> str | None:
 
 @functools.lru_cache(maxsize=1)
 def machine() -> dict:
-    """The machine this process runs on: host name, OS, CPU model, cores, Python version."""
-    return {"host": platform.node(), "system": platform.platform(terse=True), "cpu": cpu_model(),
+    """The machine this process runs on: OS, CPU model, cores, Python version (not its host
+    name: sidecars are shared with the results)."""
+    return {"system": platform.platform(terse=True), "cpu": cpu_model(),
             "cores": os.cpu_count(), "python": platform.python_version()}
 
 
@@ -135,10 +158,13 @@ def git_state(folder: str) -> dict | None:
 @functools.lru_cache(maxsize=None)
 def package_source(distribution: str, package_dir: str | None = None) -> dict | None:
     """Where an installed package's code came from: the git state of the work tree it runs from
-    (``package_dir``'s parent holds ``.git``: a checkout, an editable install), else the commit
-    pip recorded for a VCS install or the git state of the folder of an editable one (PEP 610
-    ``direct_url.json``); None when nothing says (a release from an index)."""
+    (``package_dir``'s parent holds ``.git``: a checkout, an editable install), else the state
+    its build recorded (``pip install .`` of a checkout: :func:`~dcfkit.running.code_state.built_source`),
+    else the commit pip recorded for a VCS install or the git state of the folder of an
+    editable one (PEP 610 ``direct_url.json``); None when nothing says (a release from an index)."""
     if package_dir is not None and (found := git_state(os.path.dirname(os.path.abspath(package_dir)))):
+        return found
+    if package_dir is not None and (found := built_source(Path(package_dir))):
         return found
     try:
         direct = json.loads(importlib.metadata.distribution(distribution).read_text("direct_url.json") or "null")
@@ -155,9 +181,11 @@ def package_source(distribution: str, package_dir: str | None = None) -> dict | 
 
 
 def sources(plugins: list[str]) -> dict:
-    """:func:`package_source` of dcfkit and of each of ``plugins`` (``"name version"``, as
-    :func:`plugin_versions` lists them), by distribution name (results sidecars record it)."""
-    found = {"dcfkit": package_source("dcfkit", str(Path(__file__).resolve().parents[1]))}
+    """:func:`package_source` of dcfkit, with ``code`` (:func:`~dcfkit.running.code_state.box_code`),
+    and of each of ``plugins`` (``"name version"``, as :func:`plugin_versions` lists them), by
+    distribution name (results sidecars record it)."""
+    found = {"dcfkit": {**(package_source("dcfkit", str(Path(__file__).resolve().parents[1])) or {}),
+                        "code": box_code()}}
     for plugin in plugins:
         name = plugin.rsplit(" ", 1)[0]
         found[name] = package_source(name)

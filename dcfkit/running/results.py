@@ -33,7 +33,7 @@ from dcfkit.running.files import (
     make_dir,
     read_json,
 )
-from dcfkit.running.provenance import json_default, now
+from dcfkit.running.provenance import json_default, now, without_home
 
 log = logging.getLogger(__name__)
 
@@ -194,7 +194,7 @@ class ResultStore:
         """Store a failed run (removing any results, which another config may have left)."""
         record = {**record, "sequence": seq.name, "dataset": seq.dataset, "data_identity": data_identity(seq),
                   "type": type(exc).__name__,
-                  "traceback": "".join(traceback.format_exception(exc)), "time": now()}
+                  "traceback": without_home("".join(traceback.format_exception(exc))), "time": now()}
         for stale in (self.sidecar_path(seq.name), *self._written(seq.name)):
             with contextlib.suppress(FileNotFoundError):
                 stale.unlink()
@@ -228,7 +228,8 @@ class ResultStore:
             detail = "; ".join(f"{k}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}" for k, v in keys.items())
             raise DatasetError(
                 f"results in {self.folder} mix {len(keys)} configurations ({detail}); rerun "
-                f"`dcfkit eval` with one config, or give the other config a different 'name'")
+                f"`dcfkit eval` with one config, or give the other config a different 'name' (a key also "
+                f"changes with dcfkit's version and box code: rerunning the eval recomputes the older runs)")
         return results
 
 

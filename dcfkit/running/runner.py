@@ -30,7 +30,17 @@ from dcfkit.errors import DcfkitError, shown
 from dcfkit.registry import PluginWarning
 from dcfkit.running import platforms
 from dcfkit.running.files import StoreError
-from dcfkit.running.provenance import dcfkit_version, invocation, machine, now, plugin_versions, run_key, sources
+from dcfkit.running.code_state import box_code
+from dcfkit.running.provenance import (
+    dcfkit_version,
+    invocation,
+    machine,
+    now,
+    plugin_versions,
+    run_key,
+    sources,
+    without_home,
+)
 from dcfkit.running.resets import ResetTrack, track_with_resets
 from dcfkit.running.results import ResultStore
 from dcfkit.running.scheduler import connect as connect_scheduler, import_distributed
@@ -155,8 +165,8 @@ def record_failure(task: RunTask, version: str, message: str, exc: BaseException
     cause = exc.__cause__ if isinstance(exc, TrackerFailure) and exc.__cause__ else exc
     ResultStore(task.folder).write_failure(task.seq, {
         "tracker": task.config.get("name"), "frame": frame,
-        "frame_file": str(task.seq.frames[frame - 1]) if frame else None,
-        "error": message, "run_key": task.key, "dcfkit_version": version}, cause)
+        "frame_file": without_home(str(task.seq.frames[frame - 1])) if frame else None,
+        "error": without_home(message), "run_key": task.key, "dcfkit_version": version}, cause)
     return {"sequence": task.seq.name, "status": "failed", "error": message, "frames": len(task.seq)}
 
 
@@ -216,8 +226,9 @@ def run_in_worker(task: RunTask, version: str, origin: Mapping | None = None) ->
         raise DcfkitError(f"this worker runs dcfkit {dcfkit_version()}, the client {version}; "
                           f"install the same version on every worker")
     if task.make_tracker is None and run_key(task.config, version) != task.key:
-        raise DcfkitError(f"this worker's plugins ({', '.join(plugin_versions(task.config)) or 'none'}) are not "
-                          f"the client's: install the same plugin versions on every worker")
+        plugins = ", ".join(plugin_versions(task.config)) or "none"
+        raise DcfkitError(f"this worker's dcfkit code ({box_code()}) or plugins ({plugins}) are not the client's: "
+                          f"install the same dcfkit source and plugin versions on every worker")
     return run_sequence(task, version, origin=origin)
 
 

@@ -10,7 +10,6 @@ import hashlib
 import json
 import math
 import os
-import platform
 import re
 import shutil
 from pathlib import Path
@@ -151,12 +150,14 @@ def test_provenance_of_old_and_new_sidecars(tmp_path):
         "frames": 3, "run_key": "k1", "dcfkit_version": "0.4.0", "command": ["dcfkit", "eval", "my config.yaml"],
         "cwd": "/w", "machine": {"host": "h", "cpu": "C", "cores": 8, "system": "Linux", "python": "3.11"},
         "time": "2026-01-02T00:00:00+00:00", "config": {"name": "t"}}))
-    prov = folder_provenance(folder, ["a", "b", "c"])
+    prov = folder_provenance(folder, ["a", "b", "c"], base=tmp_path / "t_report")
     assert prov["sequences"] == 2 and prov["run_keys"] == [["k1", 2]]
-    assert sorted(prov["commands"]) == [["cd /w && dcfkit eval 'my config.yaml'", 1], ["not recorded", 1]]
-    assert ["h: C, 8 cores, Linux, Python 3.11", 1] in prov["machines"]
+    # older sidecars recorded the working directory and the host: read, and not shown on a shared page
+    assert sorted(prov["commands"]) == [["dcfkit eval 'my config.yaml'", 1], ["not recorded", 1]]
+    assert ["C, 8 cores, Linux, Python 3.11", 1] in prov["machines"]
     assert prov["platforms"] == [["not recorded", 2]]  # sidecars older than 0.6.0 hold none
-    assert folder_provenance(tmp_path, ["a"]) == {"folder": str(tmp_path), "sequences": 0}
+    assert prov["folder"] == "../t"  # relative to the page's folder
+    assert folder_provenance(tmp_path, ["a"], base=tmp_path) == {"folder": ".", "sequences": 0}
 
 
 # --------------------------------------------------------------------------- in Chromium
@@ -309,8 +310,8 @@ def test_report_page_of_a_synthetic_run_in_chromium(tmp_path, browser, capsys):
     path = run_report(tmp_path, root, "otb", ["seqA", "seqB"], [("kcf", {}), ("strcf", {"name": f"'{HOSTILE_NAME}'"})])
     check_report(browser, path, load_dataset("otb", root))
     sidecar = json.loads((tmp_path / "out" / "kcf" / "seqA.json").read_text())  # what the provenance reads
-    assert sidecar["command"][:3] == ["dcfkit", "eval", "kcf"] and sidecar["cwd"] == os.getcwd()
-    assert sidecar["machine"]["cores"] == os.cpu_count() and sidecar["machine"]["host"] == platform.node()
+    assert sidecar["command"][:3] == ["dcfkit", "eval", "kcf"] and "cwd" not in sidecar
+    assert sidecar["machine"]["cores"] == os.cpu_count() and "host" not in sidecar["machine"]
     page, problems = open_page(browser, path)
     assert HOSTILE_NAME in page.locator("#overall-table").inner_text() and not problems
     assert page.locator("#provenance").inner_text().count(dcfkit_platforms.describe(sidecar["platform"])) >= 2

@@ -14,7 +14,7 @@ from dcfkit.analysis.report_html.provenance import describe_sources
 from dcfkit.config import load_config
 from dcfkit.datasets import Sequence
 from dcfkit.datasets.synthetic import make_sequence
-from dcfkit.running import provenance
+from dcfkit.running import code_state, provenance
 from dcfkit.running.evaluation import run_one_pass
 from dcfkit.running.provenance import git_state, package_source
 
@@ -52,7 +52,7 @@ def test_dcfkit_records_the_commit_it_runs_from_or_none(tmp_path):
     found = provenance.sources([])
     assert set(found) == {"dcfkit"}
     if expected is not None:
-        assert found["dcfkit"] == expected
+        assert found["dcfkit"] == {**expected, "code": code_state.box_code()}
     assert describe_sources(found).startswith("dcfkit ")
 
 

@@ -31,9 +31,9 @@ def evaluation_sections(evaluation: Mapping, sequences: Seq[Sequence], results: 
 
 
 def report_page(evaluation: Mapping, sequences: Seq[Sequence], results: Mapping[str, Mapping],
-                folders: Mapping[str, Path]) -> dict:
+                folders: Mapping[str, Path], report_dir: Path | None = None) -> dict:
     """The page of a report on ``sequences``: ``results`` (tracker -> sequence -> result) read
-    from ``folders`` (tracker -> folder) and scored as ``evaluation``."""
+    from ``folders`` (tracker -> folder, shown relative to ``report_dir``) and scored as ``evaluation``."""
     protocol = evaluation.protocol
     trackers = [r["tracker"] for r in evaluation.overall]
     datasets = sorted({s.dataset for s in sequences if s.dataset})
@@ -47,7 +47,8 @@ def report_page(evaluation: Mapping, sequences: Seq[Sequence], results: Mapping[
             "trackers": trackers,
             "sections": [overall, *([statistics] if statistics else []),
                          *evaluation_sections(evaluation, sequences, results, trackers),
-                         sections.provenance(folders, [s.name for s in sequences], trackers, this_process())]}
+                         sections.provenance(folders, [s.name for s in sequences], trackers, this_process(),
+                                             base=report_dir)]}
 
 
 def write_html_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None, report_dir=None,
@@ -61,5 +62,5 @@ def write_html_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str]
     folders, results, evaluation = score_folders(out_dir, sequences, trackers, report_dir, include_first,
                                                  weighting, protocol, missing=missing)
     paths = write_files(evaluation, report_dir)
-    page = report_page(evaluation, sequences, results, folders)
+    page = report_page(evaluation, sequences, results, folders, report_dir)
     return evaluation, paths + [write_page(page, report_dir / PAGE)]

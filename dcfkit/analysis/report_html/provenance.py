@@ -3,7 +3,9 @@ commands, dcfkit and plugin versions, run keys (config hashes), machines, platfo
 (:mod:`dcfkit.running.platforms`), times, config.
 
 Sidecars written before dcfkit recorded the command and the machine lack them; they are
-then "not recorded", and imported result files (no sidecars) have nothing recorded.
+then "not recorded", and imported result files (no sidecars) have nothing recorded. A page is
+shared: it shows no host name or working directory (older sidecars recorded them), paths
+relative to the page's folder and the home folder as ``~``.
 """
 from __future__ import annotations
 
@@ -12,14 +14,23 @@ from pathlib import Path
 from typing import Iterable, Mapping
 
 from dcfkit.running import platforms
-from dcfkit.running.provenance import command_line, dcfkit_version, invocation, machine, now
+from dcfkit.running.provenance import (
+    command_line,
+    dcfkit_version,
+    invocation,
+    machine,
+    now,
+    shared_path,
+    without_home,
+)
 from dcfkit.running.results import ResultStore
 
 NOT_RECORDED = "not recorded"
 
 
 def describe_machine(record) -> str:
-    """``host: CPU, N cores, OS, Python x.y`` of a :func:`dcfkit.running.provenance.machine` record."""
+    """``CPU, N cores, OS, Python x.y`` of a :func:`dcfkit.running.provenance.machine` record
+    (an older record's ``host`` left out)."""
     if not isinstance(record, Mapping):
         return NOT_RECORDED
     parts = [str(record[k]) for k in ("cpu",) if record.get(k)]
@@ -28,7 +39,7 @@ def describe_machine(record) -> str:
     parts += [str(record[k]) for k in ("system",) if record.get(k)]
     if record.get("python"):
         parts.append(f"Python {record['python']}")
-    return f"{record.get('host') or '?'}: {', '.join(parts)}"
+    return ", ".join(parts) or NOT_RECORDED
 
 
 def _counted(values: Iterable) -> list[list]:
@@ -37,27 +48,30 @@ def _counted(values: Iterable) -> list[list]:
 
 
 def _command(meta: Mapping) -> str:
+    """The command as one shell line, the home folder as ``~`` (an older sidecar's ``cwd`` left out)."""
     line = command_line(meta)
-    if line is None:
-        return NOT_RECORDED
-    return f"cd {meta['cwd']} && {line}" if isinstance(meta.get("cwd"), str) else line
+    return NOT_RECORDED if line is None else without_home(line)
 
 
 def describe_sources(record) -> str:
-    """A sidecar's ``source`` as ``dcfkit 1a2b3c4d5e6f (uncommitted changes); plugin ...``."""
+    """A sidecar's ``source`` as ``dcfkit 1a2b3c4d5e6f with uncommitted changes, code 0123abcd...;
+    plugin ...`` (``code``: the digest of dcfkit's box code, recorded since it enters the run key)."""
     if not isinstance(record, dict):
         return NOT_RECORDED
     parts = []
     for name, found in record.items():
-        if not isinstance(found, dict) or not found.get("commit"):
-            parts.append(f"{name}: no git commit recorded (a release)")
+        found = found if isinstance(found, dict) else {}
+        if not found.get("commit"):
+            part = f"{name}: no git commit recorded (a release)"
         else:
-            parts.append(f"{name} {str(found['commit'])[:12]}" + (" with uncommitted changes" if found.get("dirty") else ""))
+            part = f"{name} {str(found['commit'])[:12]}" + (" with uncommitted changes" if found.get("dirty") else "")
+        parts.append(part + (f", code {found['code']}" if isinstance(found.get("code"), str) else ""))
     return "; ".join(parts)
 
 
-def folder_provenance(folder: Path, names: Iterable[str]) -> dict:
-    """What the sidecars of sequences ``names`` in ``folder`` record: ``folder``,
+def folder_provenance(folder: Path, names: Iterable[str], base: Path | None = None) -> dict:
+    """What the sidecars of sequences ``names`` in ``folder`` record: ``folder`` (relative to
+    ``base``, the page's folder: :func:`~dcfkit.running.provenance.shared_path`),
     ``sequences`` (sidecars read), ``run_keys``, ``versions``, ``plugins``, ``sources`` (git
     commits), ``commands``,
     ``machines``, ``platforms`` (each ``[[value, sequences], ...]``), ``times`` (first, last) and
@@ -65,10 +79,10 @@ def folder_provenance(folder: Path, names: Iterable[str]) -> dict:
     store = ResultStore(folder)
     metas = [m for m in (store.sidecar(n) for n in names) if m is not None]
     if not metas:
-        return {"folder": str(folder), "sequences": 0}
+        return {"folder": shared_path(folder, base), "sequences": 0}
     times = sorted(str(m["time"]) for m in metas if m.get("time"))
     return {
-        "folder": str(folder),
+        "folder": shared_path(folder, base),
         "sequences": len(metas),
         "run_keys": _counted(str(m.get("run_key", m.get("config_hash", NOT_RECORDED))) for m in metas),
         "versions": _counted(str(m.get("dcfkit_version", NOT_RECORDED)) for m in metas),

@@ -98,10 +98,11 @@ def gallery(sequences: Seq[Sequence], results: Mapping[str, Mapping], trackers: 
 
 
 def provenance(folders: Mapping[str, Path], names: Iterable[str], trackers: Seq[str], this_run: Mapping,
-               extra: Seq[tuple[str, str]] = ()) -> dict:
-    """What produced the results of each tracker (its folder's sidecars) and this page."""
+               extra: Seq[tuple[str, str]] = (), base: Path | None = None) -> dict:
+    """What produced the results of each tracker (its folder's sidecars, paths relative to
+    ``base``, the page's folder) and this page."""
     names = list(names)
-    entries = [{"t": trackers.index(t), **folder_provenance(folder, names)} for t, folder in folders.items()]
+    entries = [{"t": trackers.index(t), **folder_provenance(folder, names, base)} for t, folder in folders.items()]
     return {"kind": "provenance", "id": "provenance", "title": "Provenance", "report": dict(this_run),
             "extra": [list(e) for e in extra], "trackers": entries}
 
