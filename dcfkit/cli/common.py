@@ -4,7 +4,6 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from dcfkit.datasets import load_datasets
 from dcfkit.errors import DcfkitError, shown
 from dcfkit.protocols import DEFAULT, PROTOCOLS
 from dcfkit.running.scheduler import check_address
@@ -65,11 +64,6 @@ def add_dataset_arguments(parser: argparse.ArgumentParser, root_help: str = "ben
                              f"(sequence names must differ; docs/evaluation.md, 'Pooling datasets')")
     parser.add_argument("--sequences", default=None,
                         help="comma-separated sequence names, from any --root (default: all)")
-
-
-def load_sequences(args: argparse.Namespace) -> list:
-    """The sequences of ``--dataset``/``--root``/``--sequences``, pooled over every ``--root``."""
-    return load_datasets(args.dataset, args.root, args.sequences)
 
 
 def frame_limit(text: str) -> int:
