@@ -33,7 +33,7 @@ from dcfkit.cli.common import (
 )
 from dcfkit.config import load_config
 from dcfkit.config.overrides import parse_overrides
-from dcfkit.datasets import load_datasets, scored_sequences
+from dcfkit.datasets import benchmark_protocol, load_datasets, scored_sequences
 from dcfkit.errors import ConfigError, shown
 from dcfkit.experiments import runs_by_sequence
 from dcfkit.integrations.opencv import opencv_tracker
@@ -85,6 +85,8 @@ def distinct_names(specs: list[str], resolved: list[tuple[dict, Callable | None]
 def run_eval(args: argparse.Namespace) -> int:
     """Run each config on the dataset and print its scores; exit status 1 if a sequence failed."""
     sequences = [s.head(args.max_frames) for s in load_datasets(args.dataset, args.root, args.sequences)]
+    if args.protocol is None:  # pooled benchmarks scored by different rules: refused before any run
+        benchmark_protocol(sequences)
     overrides = parse_overrides(args.overrides)
     resolved = distinct_names(args.configs, [_resolve_config(spec, overrides) for spec in args.configs])
     for config, _ in resolved:  # every config's folder and results checked before the first runs

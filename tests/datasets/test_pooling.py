@@ -104,8 +104,12 @@ def test_dataset_names_must_be_one_for_all_or_one_per_root(roots, tmp_path, caps
     assert "3 --dataset for 2 --root" in capsys.readouterr().err
 
 
-def test_benchmarks_scored_by_different_rules_need_a_protocol(tmp_path, jpg):  # noqa: F811
+def test_benchmarks_scored_by_different_rules_need_a_protocol(tmp_path, jpg, capsys):  # noqa: F811
     lasot, dtb = lasot_root(tmp_path, jpg), dtb_root(tmp_path)[0]
+    out = tmp_path / "out"
+    assert cli.main(["eval", "kcf", "--root", str(lasot), "--root", str(dtb), "--out", str(out), "--no-progress"]) != 0
+    assert "name the protocol that scores them all (--protocol" in capsys.readouterr().err
+    assert not out.exists()  # refused before anything ran
     pooled = load_datasets(None, [lasot, dtb])
     results = {"t": {s.name: s.ground_truth for s in pooled}}
     with pytest.raises(DatasetError, match=r"scored by different rules \(lasot: lasot; dtb70: otb\): name the "
