@@ -7,6 +7,7 @@ from typing import Any, Mapping
 
 from dcfkit.ablation.sensitivity import METRICS, sensitivity
 from dcfkit.ablation.spec import AblationSpec, format_value, job_dir
+from dcfkit.ablation.spec_keys import data_text
 from dcfkit.analysis.report_html import evaluation_sections, sections
 from dcfkit.analysis.report_html.provenance import this_process
 from dcfkit.running.provenance import LABEL_KEYS, shared_path
@@ -101,8 +102,7 @@ def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[s
     if spec.grid is not None:
         head.append(sensitivity_charts(spec, info["overall"]))
     folders = {**{v: job_dir(out, spec.dataset, k) for v, k in keys.items()}, **dict(spec.published)}
-    root = shared_path(spec.root, out) if spec.root is not None else "no root"
-    extra = [("spec", shared_path(spec.path, out)), ("dataset", f"{spec.dataset} at {root}")]
+    extra = [("spec", shared_path(spec.path, out)), ("dataset", data_text(spec, out))]
     return {"title": f"dcfkit ablation {spec.name}: {sections.count(len(trackers), 'variant')} on {spec.dataset}",
             "protocol": scores.protocol.describe(),
             "subtitle": f"{spec.description + ' · ' if spec.description else ''}"

@@ -9,6 +9,7 @@ from pathlib import Path
 from dcfkit.ablation.experiment import runs_dir
 from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir, variant_names
 from dcfkit.ablation.summary import output_names, summarize
+from dcfkit.datasets import benchmark_protocol
 from dcfkit.errors import DcfkitError, shown
 from dcfkit.experiments import runs_by_sequence
 from dcfkit.running.files import atomic_write, ensure_writable, exclusive, read_json
@@ -41,6 +42,8 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
         raise DcfkitError(f"executor must be 'local' or 'dask', got {shown(executor)}")
     out = Path(out).expanduser().resolve()
     seqs = spec.load_sequences()
+    if protocol is None:  # pooled benchmarks scored by different rules: refused before any run
+        benchmark_protocol(seqs)
     version = dcfkit_version()
     job_list = expand(spec, seqs, version)
     runs = runs_by_sequence(seqs, spec.experiment)

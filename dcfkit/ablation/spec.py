@@ -15,12 +15,12 @@ import yaml
 from dcfkit import limits
 from dcfkit.ablation.experiment import check_experiment
 from dcfkit.ablation.published import parse_published
+from dcfkit.ablation.spec_keys import as_mapping, check_keys, check_root, parse_datasets, pooled_sequences
 from dcfkit.config import load_config, shipped_config, shipped_config_dir
 from dcfkit.config.bounded_yaml import read_yaml
-from dcfkit.datasets import DatasetError, canonical_name, load_dataset
+from dcfkit.datasets import load_dataset
 from dcfkit.datasets.base import sequence_names
 from dcfkit.errors import ConfigError, DcfkitError, clip, shown
-from dcfkit.params import closest
 from dcfkit.running.provenance import dcfkit_version, run_key
 
 SPEC_KEYS = ("name", "description", "dataset", "sequences", "experiment", "variants", "grid", "published")
@@ -72,16 +72,13 @@ class AblationSpec:
     max_frames: int | None = None  # a smoke run: each sequence's first frames only
     experiment: str = "ope"  # the runs of each sequence: one of ABLATION_EXPERIMENTS
     published: tuple = ()  # (name, folder) of result files scored beside the variants, never run
+    pool: tuple = ()  # pooled datasets: (name, root, origin) of each, ``dataset`` their names joined by "+"
 
     def load_sequences(self) -> list:
         """The :class:`dcfkit.datasets.Sequence` objects to run: the spec's subset, else all under root."""
-        if self.root is None:
-            raise ConfigError(f"{self.path}: dataset.root is not given; pass --root DIR "
-                              f"(the {self.dataset} benchmark folder)")
-        if not os.path.isdir(self.root):
-            hint = "" if self.root_origin == "--root" else f"; pass --root DIR (the {self.dataset} benchmark folder)"
-            raise ConfigError(f"{self.path}: dataset root {clip(str(self.root))} ({self.root_origin}) "
-                              f"is not a folder{hint}")
+        if self.pool:
+            return [s.head(self.max_frames) for s in pooled_sequences(self)]
+        check_root(self.path, self.dataset, self.root, self.root_origin)
         found = load_dataset(self.dataset, self.root, list(self.sequences) if self.sequences is not None else None)
         return [s.head(self.max_frames) for s in found]
 
@@ -124,20 +121,6 @@ def _is_spec_file(path: Path) -> bool:
         data = read_yaml(path)
         return "variants" in data or "grid" in data
     return False
-
-
-def as_mapping(value: Any, where: str, what: str) -> dict:
-    if value is None:
-        return {}
-    if not isinstance(value, Mapping):
-        raise ConfigError(f"{where}: expected {what}, got {type(value).__name__} {shown(value)}")
-    return dict(value)
-
-
-def check_keys(data: Mapping, valid: tuple, where: str) -> None:
-    for key in data:
-        if key not in valid:
-            raise ConfigError(f"{where}: unknown key {shown(key)}{closest(key, valid)}; valid keys: {', '.join(valid)}")
 
 
 def _overrides(value: Any, where: str) -> dict:
@@ -266,11 +249,12 @@ def variant_limit(given: int | None = None) -> int:
     return given
 
 
-def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
+def load_spec(source: str | os.PathLike, root=None,
               sequences: Iterable[str] | str | None = None, max_variants: int | None = None) -> AblationSpec:
     """Read and validate an ablation spec (a path, or a shipped name such as ``table3``).
 
-    ``root`` replaces the spec's ``dataset.root`` (relative to the working directory);
+    ``root`` (a folder, or a list of them to pool) replaces the spec's ``dataset.root``
+    (relative to the working directory; :func:`~dcfkit.ablation.spec_keys.parse_datasets`);
     the spec's own root is relative to the spec file. ``sequences`` (names, or one
     comma-separated string) replaces the spec's subset. Every variant's config is resolved
     here, so a wrong key or value fails before anything runs; errors name the spec file
@@ -284,7 +268,7 @@ def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
     for key in ("name", "description"):
         if data.get(key) is not None and not isinstance(data[key], str):
             raise ConfigError(f"{path}: {key}: expected a string, got {shown(data[key])}")
-    dataset_name, root_path, origin = parse_dataset(path, data.get("dataset"), root)
+    dataset_name, root_path, origin, pool = parse_datasets(path, data.get("dataset"), root)
     named = _parse_variants(path, data.get("variants"), limit)
     grid, grid_variants = None, []
     if data.get("grid") is not None:
@@ -301,29 +285,8 @@ def load_spec(source: str | os.PathLike, root: str | os.PathLike | None = None,
                         variants=tuple(named.values()) + tuple(grid_variants), grid=grid,
                         experiment=(experiment := check_experiment(data.get("experiment", "ope"), f"{path}: experiment")),
                         published=parse_published(path, data.get("published"), [*named, *(v.name for v in grid_variants)],
-                                                  experiment))
-
-
-def parse_dataset(path: Path, dataset: Any, root) -> tuple[str, Path | None, str]:
-    """(canonical dataset name, absolute root or None, where the root came from)."""
-    if isinstance(dataset, str):
-        dataset = {"name": dataset}
-    dataset = as_mapping(dataset, f"{path}: dataset", "a mapping {name: uav123_10fps, root: path}")
-    check_keys(dataset, ("name", "root"), f"{path}: dataset")
-    if not dataset.get("name"):
-        raise ConfigError(f"{path}: dataset.name: missing (e.g. uav123_10fps, dtb70, uavdt, otb)")
-    if not isinstance(dataset["name"], str):
-        raise ConfigError(f"{path}: dataset.name: expected a name such as uav123_10fps, got {shown(dataset['name'])}")
-    try:
-        name = canonical_name(dataset["name"])
-    except DatasetError as exc:
-        raise ConfigError(f"{path}: dataset.name: {exc}") from None
-    if root is not None:
-        return name, Path(root).expanduser().resolve(), "--root"
-    if dataset.get("root"):
-        return (name, (path.parent / Path(str(dataset["root"])).expanduser()).resolve(),
-                f"dataset.root {shown(dataset['root'])} relative to the spec")
-    return name, None, "not given"
+                                                  experiment),
+                        pool=pool)
 
 
 def _parse_sequences(path: Path, data: Mapping, sequences) -> tuple | None:

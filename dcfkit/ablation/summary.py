@@ -11,6 +11,7 @@ from dcfkit.ablation.page import ablation_page
 from dcfkit.ablation.published import STATUS, read_published
 from dcfkit.ablation.sensitivity import plot_sensitivity, sensitivity_file
 from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir
+from dcfkit.ablation.spec_keys import data_record
 from dcfkit.analysis.plots import plot_curves
 from dcfkit.analysis.report import json_ready
 from dcfkit.analysis.report_html import PAGE, write_page
@@ -88,7 +89,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
                  "status": status[j.key, j.sequence][0], "error": status[j.key, j.sequence][1]} for j in jobs]
     info = {"spec": shared_path(spec.path, out), "name": spec.name, "description": spec.description,
             "protocol": protocol_record(scores.protocol), "experiment": spec.experiment,
-            "dataset": spec.dataset, "root": None if spec.root is None else shared_path(spec.root, out), "sequences": [s.name for s in sequences],
+            **data_record(spec, out), "sequences": [s.name for s in sequences],
             "overall": overall, "per_sequence": per_sequence, "statistics": statistics, "jobs": job_rows,
             "grid": ({"base": spec.grid.base, "mode": spec.grid.mode,
                       "parameters": {k: {"label": lab, "values": vals}

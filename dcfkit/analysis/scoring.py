@@ -40,7 +40,8 @@ class Evaluation:
     ``overall``, ``per_sequence`` and ``per_attribute`` are row lists (trackers best first by
     the protocol's ranking score); ``curves`` maps tracker -> averaged curves,
     ``attribute_curves`` attribute -> tracker -> curves, ``attributes`` attribute -> number of
-    sequences; ``platforms`` tracker -> ``[[platform, sequences], ...]``; ``statistics`` each
+    sequences; ``settings`` how they were scored, with ``datasets`` (dataset -> sequences scored:
+    several when roots were pooled); ``platforms`` tracker -> ``[[platform, sequences], ...]``; ``statistics`` each
     tracker's ranking score and precision with confidence intervals and its paired difference
     from the best (:func:`dcfkit.analysis.statistics.versus_baseline`).
     """
@@ -128,7 +129,8 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
         attributes={a: len(n) for a, n in attributes.items()}, thresholds=proto.thresholds,
         settings={"protocol": proto.name, "experiment": experiment.name, "include_first": include_first,
                   "weighting": weighting,
-                  "missing": "skip" if left_out is not None else "fail", "left_out": left_out or {}},
+                  "missing": "skip" if left_out is not None else "fail", "left_out": left_out or {},
+                  "datasets": dict(Counter(s.dataset or "unnamed" for s in sequences))},
         platforms={t: _platforms(res.values()) for t, res in results.items()},
         statistics=versus_baseline(per_sequence, ranked, (proto.rank_key, "precision")) if ranked else {})
 

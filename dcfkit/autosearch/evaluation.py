@@ -9,7 +9,7 @@ from typing import Iterable, Mapping
 from dcfkit.ablation.experiment import runs_dir
 from dcfkit.ablation.spec import job_dir
 from dcfkit.analysis.scoring import evaluate
-from dcfkit.datasets import Sequence
+from dcfkit.datasets import Sequence, benchmark_protocol
 from dcfkit.experiments import runs_by_sequence
 from dcfkit.protocols import get_protocol
 from dcfkit.running.files import ensure_writable
@@ -34,6 +34,8 @@ class Evaluator:
         self.experiments = tuple(experiments)
         self.runs = {e: runs_by_sequence(sequences, e) for e in self.experiments}
         self.protocol = get_protocol(protocol) if protocol else None
+        if protocol is None:  # pooled benchmarks scored by different rules: refused before the first trial
+            benchmark_protocol(sequences)
         self.version = dcfkit_version()
 
     def key(self, config: Mapping) -> str:

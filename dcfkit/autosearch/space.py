@@ -14,7 +14,8 @@ from typing import Any, Mapping
 from optuna.distributions import BaseDistribution, CategoricalDistribution, FloatDistribution, IntDistribution
 
 from dcfkit.ablation.experiment import check_experiment
-from dcfkit.ablation.spec import as_mapping, check_keys, load_spec_config, parse_dataset
+from dcfkit.ablation.spec import load_spec_config
+from dcfkit.ablation.spec_keys import as_mapping, check_keys, parse_datasets, pooled_sequences
 from dcfkit.config import load_config, shipped_config_dir
 from dcfkit.config.bounded_yaml import read_yaml
 from dcfkit.datasets import load_dataset
@@ -74,8 +75,11 @@ class SearchSpec:
     startup_trials: int
     seed: int
     baselines: dict  # name -> resolved config
+    pool: tuple = ()  # pooled datasets: (name, root, origin) of each, ``dataset`` their names joined by "+"
 
     def load_sequences(self) -> list:
+        if self.pool:
+            return pooled_sequences(self)
         if self.root is None:
             raise ConfigError(f"{self.path}: no dataset root: give dataset.root in the spec or --root")
         return load_dataset(self.dataset, self.root, None if self.sequences is None else list(self.sequences))
@@ -99,13 +103,14 @@ def find_search_spec(source: str | os.PathLike) -> Path:
                       + (f"; shipped: {', '.join(shipped)}" if shipped else ""))
 
 
-def load_search_spec(source: str | os.PathLike, root: str | os.PathLike | None = None) -> SearchSpec:
-    """Read and validate a search spec; ``root`` replaces its ``dataset.root``. Errors name the
-    file and the key."""
+def load_search_spec(source: str | os.PathLike, root=None) -> SearchSpec:
+    """Read and validate a search spec; ``root`` (a folder, or a list of them to pool) replaces
+    its dataset roots (:func:`~dcfkit.ablation.spec_keys.parse_datasets`). Errors name the file
+    and the key."""
     path = find_search_spec(source)
     data = read_yaml(path)
     check_keys(data, SPEC_KEYS, str(path))
-    dataset, root_path, origin = parse_dataset(path, data.get("dataset"), root)
+    dataset, root_path, origin, pool = parse_datasets(path, data.get("dataset"), root)
     if "base" not in data:
         raise ConfigError(f"{path}: base: missing (the config every trial changes, e.g. ../dr2track.yaml)")
     base, base_source = load_spec_config(path, data["base"], {}, "base", "base")
@@ -127,7 +132,7 @@ def load_search_spec(source: str | os.PathLike, root: str | os.PathLike | None =
         sequences=tuple(sequences) if sequences is not None else None, base=base, base_source=base_source,
         parameters=parameters, experiments=experiments, folds=_whole(path, data, "folds", 4, 2),
         trials=_whole(path, data, "trials", 30, 1), startup_trials=_whole(path, data, "startup_trials", 10, 1),
-        seed=_whole(path, data, "seed", 0, 0), baselines=baselines)
+        seed=_whole(path, data, "seed", 0, 0), baselines=baselines, pool=pool)
 
 
 def _parse_baselines(path: Path, raw: Any) -> dict:

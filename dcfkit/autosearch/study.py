@@ -18,6 +18,7 @@ import numpy as np
 import optuna
 from optuna.trial import TrialState
 
+from dcfkit.ablation.spec_keys import data_record, roots_text
 from dcfkit.autosearch.evaluation import Evaluator
 from dcfkit.autosearch.space import SearchSpec, active
 from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, summarize
@@ -46,7 +47,7 @@ def fingerprint(spec: SearchSpec, folds: list[list[str]], evaluator: Evaluator) 
              for p in spec.parameters}
     return {"base": evaluator.key(spec.base), "space": json.loads(json.dumps(space, default=list)),
             "experiments": list(spec.experiments), "folds": folds, "seed": spec.seed,
-            "startup_trials": spec.startup_trials, "dataset": spec.dataset,
+            "startup_trials": spec.startup_trials, "dataset": data_record(spec)["dataset"],
             "protocol": evaluator.protocol.name if evaluator.protocol else None,
             "data": {name: data_identity(seq) for name, seq in evaluator.sequences.items()}}
 
@@ -174,7 +175,7 @@ class Search:
         old = old if isinstance(old, dict) else {}
         if old and "data" not in old:
             log.warning("%s was written by dcfkit <= 0.9.0, without what identifies the data: the recorded "
-                        "trials are taken to be on the data under %s", path, self.spec.root)
+                        "trials are taken to be on the data under %s", path, roots_text(self.spec))
             old = {**old, "data": mine["data"]}
         changed = [k for k in mine if old.get(k) != mine[k]]
         if changed == ["data"]:
@@ -182,7 +183,7 @@ class Search:
             differ = [n for n in mine["data"] if was.get(n) != mine["data"][n]]
             raise DcfkitError(f"{path}: its trials were made on other data: the frames or ground truth of "
                               f"{', '.join(map(shown, differ[:5]))}{' ...' if len(differ) > 5 else ''} under "
-                              f"{self.spec.root} differ from the recorded ones; give the recorded search's --root, "
+                              f"{roots_text(self.spec)} differ from the recorded ones; give the recorded search's --root, "
                               f"or a new --out")
         if changed:
             raise DcfkitError(f"{path} records a different search (these differ: {', '.join(changed)}): "

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import yaml
 
+from dcfkit.ablation.spec_keys import data_record
 from dcfkit.analysis.statistics import HOLM, METHOD, holm, mean_interval, paired_difference
 from dcfkit.errors import DcfkitError, printable
 from dcfkit.running.files import atomic_write
@@ -63,7 +64,7 @@ def summarize(search, studies: dict[str, list[dict]]) -> dict:
     baselines = {name: ev.scores(config, search.names) for name, config in spec.baselines.items()}
     comparisons = _compare(search.names, held_out, baselines)
     final = best(studies[FINAL], FINAL)
-    summary = {"name": spec.name, "spec": shared_path(spec.path, search.out), "dataset": spec.dataset,
+    summary = {"name": spec.name, "spec": shared_path(spec.path, search.out), "dataset": data_record(spec)["dataset"],
                "experiments": list(spec.experiments), "trials_per_study": spec.trials,
                "sequences": search.names, "unscored": [n for n in search.names if not is_score(held_out[n]["auc"])],
                "folds": folds,

@@ -30,8 +30,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="local process pool (default) or dask.distributed (default with --scheduler)")
     parser.add_argument("--scheduler", default=None, metavar="ADDR",
                         help="dask scheduler address, e.g. tcp://10.0.0.5:8786 (default: a LocalCluster)")
-    parser.add_argument("--root", type=Path, default=None,
-                        help="benchmark root folder (default: the spec's dataset.root, relative to the spec)")
+    parser.add_argument("--root", type=Path, action="append", default=None,
+                        help="benchmark root folder (default: the spec's dataset.root, relative to the spec); "
+                             "repeat it to pool several: one per dataset the spec lists, or any for one")
     parser.add_argument("--sequences", default=None,
                         help="comma-separated sequence names (default: the spec's, else all)")
     parser.add_argument("--max-variants", type=variant_count, default=None, metavar="N",

@@ -55,11 +55,15 @@ def add_protocol_argument(parser: argparse.ArgumentParser) -> None:
 
 
 def add_dataset_arguments(parser: argparse.ArgumentParser, root_help: str = "benchmark root folder") -> None:
-    """``--dataset``, ``--root`` and ``--sequences``."""
-    parser.add_argument("--dataset", default="auto",
-                        help="dataset name, as `dcfkit datasets` lists them (default: detect from --root)")
-    parser.add_argument("--root", required=True, type=Path, help=root_help)
-    parser.add_argument("--sequences", default=None, help="comma-separated sequence names (default: all)")
+    """``--dataset``, ``--root`` and ``--sequences``; ``--root`` repeats to pool datasets."""
+    parser.add_argument("--dataset", action="append", default=None,
+                        help="dataset name, as `dcfkit datasets` lists them (default: detect from --root); with "
+                             "several --root, one for all or one per --root in order")
+    parser.add_argument("--root", action="append", required=True, type=Path,
+                        help=f"{root_help}; repeat it to pool the sequences of several roots into one evaluation "
+                             f"(sequence names must differ; docs/evaluation.md, 'Pooling datasets')")
+    parser.add_argument("--sequences", default=None,
+                        help="comma-separated sequence names, from any --root (default: all)")
 
 
 def frame_limit(text: str) -> int:

@@ -9,7 +9,7 @@ import warnings
 from pathlib import Path
 
 from dcfkit.cli.common import add_dataset_arguments
-from dcfkit.datasets import layouts, load_dataset
+from dcfkit.datasets import layouts, load_datasets
 from dcfkit.integrations.vot import DEFAULT_FPS, export_sequences, frame_rate
 from dcfkit.protocols import DEFAULT
 from dcfkit.registry import PluginWarning, get_registry
@@ -57,7 +57,7 @@ def add_export_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run_export(args: argparse.Namespace) -> int:
     """Add the sequences of a dataset to a workspace in another toolkit's layout."""
-    sequences = load_dataset(args.dataset, args.root, args.sequences)
+    sequences = load_datasets(args.dataset, args.root, args.sequences)
     done = export_sequences(sequences, args.out, copy=args.copy)
     already = f", {len(done['skipped'])} already there" if done["skipped"] else ""
     print(f"{len(done['written'])} sequences written to {args.out / 'sequences'}{already} (list.txt lists "

@@ -33,7 +33,7 @@ from dcfkit.cli.common import (
 )
 from dcfkit.config import load_config
 from dcfkit.config.overrides import parse_overrides
-from dcfkit.datasets import load_dataset, scored_sequences
+from dcfkit.datasets import benchmark_protocol, load_datasets, scored_sequences
 from dcfkit.errors import ConfigError, shown
 from dcfkit.experiments import runs_by_sequence
 from dcfkit.integrations.opencv import opencv_tracker
@@ -84,7 +84,9 @@ def distinct_names(specs: list[str], resolved: list[tuple[dict, Callable | None]
 
 def run_eval(args: argparse.Namespace) -> int:
     """Run each config on the dataset and print its scores; exit status 1 if a sequence failed."""
-    sequences = [s.head(args.max_frames) for s in load_dataset(args.dataset, args.root, args.sequences)]
+    sequences = [s.head(args.max_frames) for s in load_datasets(args.dataset, args.root, args.sequences)]
+    if args.protocol is None:  # pooled benchmarks scored by different rules: refused before any run
+        benchmark_protocol(sequences)
     overrides = parse_overrides(args.overrides)
     resolved = distinct_names(args.configs, [_resolve_config(spec, overrides) for spec in args.configs])
     for config, _ in resolved:  # every config's folder and results checked before the first runs
@@ -153,7 +155,7 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run_report(args: argparse.Namespace) -> int:
     """Print the overall table and write the report files."""
-    sequences = [s.head(args.max_frames) for s in load_dataset(args.dataset, args.root, args.sequences)]
+    sequences = [s.head(args.max_frames) for s in load_datasets(args.dataset, args.root, args.sequences)]
     trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
     if args.experiment != "ope" and args.html:
         raise ConfigError("--html shows one-pass results; leave it out for --experiment " + args.experiment)
@@ -221,7 +223,7 @@ def _named(folder: str) -> tuple[str | None, Path]:
 
 def run_compare(args: argparse.Namespace) -> int:
     """Print the per-sequence comparison."""
-    sequences = load_dataset(args.dataset, args.root, args.sequences)
+    sequences = load_datasets(args.dataset, args.root, args.sequences)
     (name, results), (name_ref, reference) = _named(args.results), _named(args.reference)
     res = compare_folders(results, reference, sequences, args.protocol, args.divergence_px)
     res["names"] = [name or "results", name_ref or "reference"]

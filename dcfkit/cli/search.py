@@ -19,8 +19,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", required=True, type=Path,
                         help="search folder (OUT/trials/..., OUT/jobs/..., OUT/summary.md, OUT/best.yaml); "
                              "reruns resume, with more --trials if given")
-    parser.add_argument("--root", type=Path, default=None,
-                        help="benchmark root folder (default: the spec's dataset.root, relative to the spec)")
+    parser.add_argument("--root", type=Path, action="append", default=None,
+                        help="benchmark root folder (default: the spec's dataset.root, relative to the spec); "
+                             "repeat it to pool several: one per dataset the spec lists, or any for one")
     parser.add_argument("--trials", type=int, default=None,
                         help="trials per study (default: the spec's 'trials'); a rerun with more adds trials")
     parser.add_argument("--experiments", default=None, metavar="LIST",

@@ -14,7 +14,8 @@ Conventions
   only has NaN rows after it and ``ground_truth_withheld`` set (:func:`scored_sequences`).
 * Images are decoded by OpenCV (:func:`read_frame`): ``(H, W, 3) uint8``, **BGR** channel order.
 
-Only sequences present on disk are listed. Each layout lives in its own module and registers
+Only sequences present on disk are listed. :func:`load_datasets` pools the sequences of several
+roots into one set. Each layout lives in its own module and registers
 itself in :mod:`~dcfkit.datasets.layout` (name, aliases, loader, detection, description);
 another benchmark is added with :func:`register_layout`. See ``docs/evaluation.md`` for the
 layouts.
@@ -32,6 +33,7 @@ from dcfkit.datasets.catalog import (
 )
 from dcfkit.datasets.images import DatasetWarning, read_frame
 from dcfkit.datasets.layout import Evidence, Layout, register_layout, registered_layout, unregister_layout
+from dcfkit.datasets.pooling import load_datasets, pair_roots
 
 # Importing a layout module registers it; the import order is the order of the names in
 # messages ("valid names: uav123, uav123_10fps, ..."), so it is not alphabetical.
@@ -66,7 +68,9 @@ __all__ = [
     "lasot_test",
     "layouts",
     "load_dataset",
+    "load_datasets",
     "otb",
+    "pair_roots",
     "read_boxes",
     "read_frame",
     "register_layout",

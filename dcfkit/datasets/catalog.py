@@ -132,10 +132,15 @@ def _evidence(layout: Layout, root: Path) -> Evidence:
 def benchmark_protocol(sequences: Iterable[Sequence]) -> str:
     """The protocol that scored the published tables of the benchmark ``sequences`` come from:
     their layout's ``protocol`` (LaSOT's toolkit for LaSOT, GOT-10k's for GOT-10k), else the
-    OTB toolkit's (:data:`dcfkit.protocols.DEFAULT`), also for sequences of several benchmarks
-    that disagree."""
-    found = set()
-    for name in {s.dataset for s in sequences}:
+    OTB toolkit's (:data:`dcfkit.protocols.DEFAULT`). Sequences of benchmarks scored by
+    different rules (pooled roots) are a :class:`DatasetError`: the protocol must be named."""
+    found: dict[str, list[str]] = {}
+    for name in dict.fromkeys(s.dataset for s in sequences):
         layout = _find(name) if name else None
-        found.add(layout.protocol if layout is not None and layout.protocol else DEFAULT)
-    return found.pop() if len(found) == 1 else DEFAULT
+        found.setdefault(layout.protocol if layout is not None and layout.protocol else DEFAULT, []).append(
+            name or "unnamed")
+    if len(found) > 1:
+        rules = "; ".join(f"{', '.join(names)}: {protocol}" for protocol, names in found.items())
+        raise DatasetError(f"the sequences come from benchmarks whose tables are scored by different rules ({rules}): "
+                           f"name the protocol that scores them all (--protocol, or protocol= in Python)")
+    return next(iter(found), DEFAULT)

@@ -93,7 +93,7 @@ def test_cli_formats(folders, tmp_path, capsys, monkeypatch):
     ours, theirs = folders
     import dcfkit.cli.evaluate
 
-    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: [sequence("a"), sequence("b")])
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: [sequence("a"), sequence("b")])
     base = ["compare", str(ours), str(theirs), "--root", str(tmp_path)]
     assert cli.main(base) == 0
     out = capsys.readouterr().out
@@ -139,7 +139,7 @@ def test_bad_input_is_one_line_naming_what(folders, tmp_path, capsys, monkeypatc
         compare_folders(ours, theirs, seqs)
     import dcfkit.cli.evaluate
 
-    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: seqs)
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: seqs)
     assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("dcfkit compare: error: ") and "Traceback" not in err and len(err.splitlines()) == 1
@@ -204,7 +204,7 @@ def test_the_comparison_carries_its_uncertainty(folders, tmp_path, capsys, monke
     assert "bootstrap" in res["statistics"]["method"]
     import dcfkit.cli.evaluate
 
-    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: seqs)
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: seqs)
     assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "statistics: 95% BCa bootstrap" in out
@@ -227,7 +227,7 @@ def test_compare_says_whether_a_difference_exceeds_the_measured_platform_noise(f
     assert not near["exceeds"] and near["sequences_beyond"] == []
     import dcfkit.cli.evaluate
 
-    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: [sequence("b")])
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: [sequence("b")])
     assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path)]) == 0
     assert "the mean AUC difference, +0.000, is within it: not a finding; 0 of 1 sequences" in capsys.readouterr().out
 
@@ -282,7 +282,7 @@ def test_a_non_finite_score_is_named_and_given_no_verdict(tmp_path, monkeypatch,
                                    "AUC (no frame counted) in 2 sequences (one, two)), -0.322, exceeds it"),
                             (seqs[:2], "no verdict: no sequence has a finite AUC difference (a non-finite AUC (no "
                                        "frame counted) in 2 sequences (one, two))")):
-        monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, given=given, **k: given)
+        monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, given=given, **k: given)
         assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path), "--protocol", "got10k"]) == 0
         out = capsys.readouterr().out
         assert expected in out and "nan" not in out.split("noise floor:")[1]
@@ -298,7 +298,7 @@ def test_a_line_break_in_a_platform_record_stays_on_its_line(tmp_path, monkeypat
         ResultStore(tmp_path / folder).write(seqs[0], GT, {"platform": {"switches": {"OPENBLAS_CORETYPE": value}}})
     import dcfkit.cli.evaluate
 
-    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: seqs)
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: seqs)
     assert cli.main(["compare", str(tmp_path / "ours"), str(tmp_path / "theirs"), "--root", str(tmp_path)]) == 0
     out, err = capsys.readouterr()
     lines = (out + err).splitlines()

@@ -32,7 +32,7 @@ def test_the_platform_line_of_report_lists_ten_records_and_counts_the_others(tmp
         store.write(seq, GT, {"run_key": "k", "platform": {"arch": "x86_64", "cpu": f"CPU {k:02d}"}})
     import dcfkit.cli.evaluate
 
-    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: seqs)
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: seqs)
     assert cli.main(["report", str(tmp_path / "out"), "--root", str(tmp_path), "--report-dir",
                      str(tmp_path / "report")]) == 0
     lines = [line for line in capsys.readouterr().out.splitlines() if line.startswith("kcf platform: ")]

@@ -63,7 +63,7 @@ def test_report_prints_and_writes_the_statistics(tmp_path, monkeypatch, capsys):
         for name, boxes in by_sequence.items():
             (folder / f"{name}.txt").write_text("".join(f"{x + 1:.3f},{y + 1:.3f},{w:.3f},{h:.3f}\n"
                                                         for x, y, w, h in boxes))
-    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: SEQUENCES)
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: SEQUENCES)
     assert cli.main(["report", str(tmp_path / "out"), "--root", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "statistics over 5 sequences: 95% BCa bootstrap" in out and "far - " in out and "(Holm " in out
@@ -104,7 +104,7 @@ def test_report_names_what_it_left_out(tmp_path, monkeypatch, capsys):
             if not (tracker == "far" and name == "c"):
                 (folder / f"{name}.txt").write_text("".join(f"{x + 1:.3f},{y + 1:.3f},{w:.3f},{h:.3f}\n"
                                                             for x, y, w, h in boxes))
-    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: SEQUENCES)
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: SEQUENCES)
     assert cli.main(["report", str(tmp_path / "out"), "--root", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "left out: c (no result from far; --missing fail scores it as a failure)" in out
@@ -123,7 +123,7 @@ def test_published_results_join_a_report_under_a_name_of_their_own(tmp_path, mon
         for name, boxes in by_sequence.items():
             (folder / f"{name}.txt").write_text("".join(f"{x + 1:.3f},{y + 1:.3f},{w:.3f},{h:.3f}\n"
                                                         for x, y, w, h in boxes))
-    monkeypatch.setattr(dcfkit.cli.evaluate, "load_dataset", lambda *a, **k: SEQUENCES)
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: SEQUENCES)
     named = f"Far (paper)={tmp_path / 'published' / 'far'}"
     assert cli.main(["report", str(tmp_path), "--root", str(tmp_path), "--trackers", f"near,{named}",
                      "--report-dir", str(tmp_path / "rep")]) == 0
