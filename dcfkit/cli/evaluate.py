@@ -127,14 +127,17 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--trackers", default=None,
                         help="comma-separated tracker folders (names in OUT or paths; default: all)")
     parser.add_argument("--format", choices=("table", "markdown", "csv", "latex"), default="table",
-                        help="format of the table printed to stdout (latex: booktabs, best per score bold, second "
-                             "underlined, confidence intervals in brackets)")
+                        help="format of the table printed to stdout; every format names the experiment, the protocol "
+                             "and a --max-frames cut (latex: a booktabs table a paper can take: each tracker's "
+                             "scores with confidence intervals, its difference from the best with its interval, "
+                             "Wilcoxon p and sequences won/tied/lost)")
     parser.add_argument("--report-dir", type=Path, default=None,
                         help="default: OUT_report beside OUT (OUT_report/<experiment> but for ope): out of the folder "
                              "whose sub-folders are trackers")
     parser.add_argument("--html", action="store_true",
                         help="also write report.html: one self-contained page with sortable tables, interactive "
-                             "plots, each sequence's frames with every tracker's box, and the provenance")
+                             "plots, each sequence's frames with every tracker's box, and the provenance (ope, tre, "
+                             "sre)")
     add_protocol_argument(parser)
     parser.add_argument("--skip-first", action="store_true",
                         help="do not score frame 1 (default: as the protocol; otb scores it with the ground "
@@ -198,8 +201,10 @@ def _reset_report(args: argparse.Namespace, sequences: list, trackers: list[str]
 def add_compare_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("results", metavar="RESULTS",
                    help="folder of <sequence>.txt result files (1-based x,y,w,h), e.g. OUT/<tracker>; NAME=FOLDER "
-                        "names it")
-    p.add_argument("reference", metavar="REFERENCE", help="folder of result files to compare with (or NAME=FOLDER)")
+                        "names it (the output calls each side by its NAME, else its folder's name)")
+    p.add_argument("reference", metavar="REFERENCE",
+                   help="folder of result files to compare with (or NAME=FOLDER); differences are RESULTS minus "
+                        "REFERENCE")
     add_dataset_arguments(p, "benchmark root folder (the ground truth)")
     add_protocol_argument(p)
     p.add_argument("--divergence-px", type=pixels, default=2.0,
