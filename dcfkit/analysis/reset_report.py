@@ -126,7 +126,7 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
     report_dir = default_report_dir(out_dir, report_dir, EXPERIMENT)
     folders = tracker_folders(out_dir, sequences, trackers, exclude=[report_dir], sub=EXPERIMENT.folder)
     found = folders if folders or trackers is not None else other_folders(out_dir, EXPERIMENT.folder)
-    check_results_fit(out_dir, found, sequences, "fail", cut_length(sequences))
+    check_results_fit(out_dir, found, sequences, "skip", cut_length(sequences))
     results = {name: reset_runs(folder, sequences) for name, folder in folders.items()}
     if not results:
         raise DatasetError(f"no reset-based results found under {clip(str(out_dir))} (dcfkit eval --experiment reset)")

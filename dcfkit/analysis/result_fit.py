@@ -65,9 +65,10 @@ def _other_sequences(out_dir, folders: Mapping[str, Path], unmatched: list[str],
     wanted = _names((r.name for r in runs), len(runs))
     whose = (f"the results in {clip(str(out_dir))}" if len(unmatched) == len(folders)
              else f"the results of {_names(unmatched)}")
-    found = f"they are of {_names(held)}" if held else "there are none"
-    return (f"{whose} are of other sequences than the {len(runs):,} scored here ({wanted}): {found}; report them "
-            f"on the dataset they were run on (--dataset, --root, --sequences)"
+    if not held:
+        return f"{whose}: no result file (<sequence>.txt) in {_names(str(folders[t]) for t in unmatched)}"
+    return (f"{whose} are of other sequences than the {len(runs):,} scored here ({wanted}): they are of "
+            f"{_names(held)}; report them on the dataset they were run on (--dataset, --root, --sequences)"
             + ("" if len(unmatched) == len(folders) else ", or leave those trackers out (--trackers)"))
 
 
@@ -75,11 +76,15 @@ def _other_lengths(folder: Path, matched: list[Sequence], cut: int | None) -> tu
     """(the ``--max-frames`` they were made with, None for whole runs; their names) when every
     stored run of ``matched`` in ``folder`` that has a sidecar has another frame count than its
     run and all were made with one ``--max-frames`` (or none) that is not ``cut``; else None."""
-    store = ResultStore(folder)
-    metas = {run.name: store.sidecar(run.name) for run in matched}
-    metas = {name: m for name, m in metas.items() if isinstance(m, dict) and isinstance(m.get("frames"), int)}
-    other = [run for run in matched if run.name in metas and metas[run.name]["frames"] != len(run)]
-    if not other or len(other) < len(metas):
+    store, metas = ResultStore(folder), {}
+    for run in matched:  # the first run that fits ends the search: a report reads one sidecar a tracker
+        meta = store.sidecar(run.name)
+        if isinstance(meta, dict) and isinstance(meta.get("frames"), int):
+            if meta["frames"] == len(run):
+                return None
+            metas[run.name] = meta
+    other = [run for run in matched if run.name in metas]
+    if not other:
         return None
     made = {_max_frames(metas[run.name]) for run in other}
     if made == {UNKNOWN}:  # no command recorded: a smoke run of N leaves N frames of every longer run
