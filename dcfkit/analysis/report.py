@@ -4,8 +4,10 @@
 tracker and sequence (``per_sequence``) and per tracker and attribute
 (``per_attribute``), plus the averaged curves for plotting. Scores follow a named scoring
 protocol of :mod:`dcfkit.protocols` (default ``otb``, the OTB / UAV123 MATLAB toolkit),
-and every output names it: a first line of the text and Markdown tables, a ``protocol``
-column of the CSV tables, ``protocol`` in ``report.json`` and the plot titles. Averages
+and every output names it, with the experiment and any ``--max-frames`` cut
+(:mod:`dcfkit.analysis.setting`): first lines of the text and Markdown tables and of
+``statistics.txt``, last columns of the CSV tables, ``report.json``, the plot titles and the
+LaTeX captions (``overall.tex``: :func:`dcfkit.analysis.latex.comparison_table`). Averages
 weigh sequences as the protocol does unless ``weighting`` says otherwise. A tracker's
 ``fps`` is the mean over sequences of the per-sequence fps (frames / tracker time in that
 sequence), not total frames / total time. A sequence missing from a tracker's results is
@@ -215,10 +217,10 @@ def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | No
     :func:`evaluate`) and write tables and plots to ``report_dir``.
 
     ``report_dir`` defaults to :func:`default_report_dir`. Writes ``overall``, ``per_sequence``
-    and (when sequences have attributes) ``per_attribute`` tables as ``.txt``, ``.md`` and
-    ``.csv``; ``report.json`` with all rows and curves; ``precision`` and ``success`` plots
+    and (when sequences have attributes) ``per_attribute`` tables as ``.txt``, ``.md``, ``.csv``
+    and ``.tex``; ``statistics.txt``; ``report.json`` with all rows and curves; ``precision`` and ``success`` plots
     and ``precision_<ATTR>`` and ``success_<ATTR>`` plots per attribute, each as PNG and SVG. Every file names
-    the protocol. ``missing`` is :func:`evaluate`'s: by default the sequences every tracker
+    the experiment, the protocol and any ``--max-frames`` cut. ``missing`` is :func:`evaluate`'s: by default the sequences every tracker
     has a result for are scored, the others named. ``experiment`` ``tre`` or ``sre`` scores
     each tracker's runs of it (``<tracker>/<experiment>/``), pooled per sequence. Returns the paths.
     """
