@@ -12,10 +12,12 @@ from dcfkit.ablation.published import STATUS, read_published
 from dcfkit.ablation.sensitivity import plot_sensitivity, sensitivity_file
 from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir
 from dcfkit.ablation.spec_keys import data_record
+from dcfkit.analysis.latex import comparison_table
 from dcfkit.analysis.plots import plot_curves
 from dcfkit.analysis.report import json_ready
 from dcfkit.analysis.report_html import PAGE, write_page
 from dcfkit.analysis.scoring import evaluate, protocol_record
+from dcfkit.analysis.setting import experiment_line
 from dcfkit.analysis.statistics import versus_baseline
 from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.datasets import Sequence
@@ -96,6 +98,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
                                      for k, (lab, vals) in spec.grid.parameters.items()}}
                      if spec.grid else None)}
     files = _write_files(spec, out, info, scores.curves, protocol)
+    files.append(_write_latex(spec, out, info["statistics"], protocol, scores.settings.get("max_frames")))
     page = ablation_page(spec, out, info, summary_columns("summary", protocol), scores, sequences,
                          {**results, **published}, keys)
     files.append(write_page(page, out / PAGE))
@@ -162,6 +165,15 @@ def _write_files(spec: AblationSpec, out: Path, info: dict, curves: dict, protoc
     return files
 
 
+def _write_latex(spec: AblationSpec, out: Path, statistics: dict, protocol, max_frames: int | None) -> Path:
+    """``summary.tex``: the variants compared with the baseline as a LaTeX table
+    (:func:`~dcfkit.analysis.latex.comparison_table`), the experiment and protocol in its caption."""
+    path = out / "summary.tex"
+    setting = [f"ablation {spec.name}", experiment_line(spec.experiment, max_frames), get_protocol(protocol).describe()]
+    atomic_write(path, comparison_table(statistics, setting, name="Variant"))
+    return path
+
+
 @contextlib.contextmanager
 def _quiet(logger: logging.Logger):
     level = logger.level
@@ -177,6 +189,6 @@ def output_names(spec: AblationSpec) -> list[str]:
     plots = ([sensitivity_file(key) for key in spec.grid.parameters] if spec.grid is not None else
              [f"{kind}.{ext}" for kind in ("precision", "success") for ext in ("png", "svg")])
     tables = [f"{stem}.{ext}" for stem in ("summary", "per_sequence") for ext in ("md", "csv")]
-    return tables + ["summary.json", PAGE] + plots
+    return tables + ["summary.tex", "summary.json", PAGE] + plots
 
 

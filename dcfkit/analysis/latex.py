@@ -1,6 +1,9 @@
-"""Score tables as LaTeX for papers (booktabs): in each score column the best value is bold and
-the second underlined; the caption names the protocol and, where intervals are shown, how they
-were computed (:mod:`dcfkit.analysis.statistics`)."""
+"""Score tables as LaTeX for papers (booktabs): :func:`latex_table` marks in each score column
+the best value bold and the second underlined; :func:`comparison_table` gives each tracker's
+scores with their confidence intervals and its paired difference from a baseline with its
+interval, Wilcoxon p and the sequences won, tied and lost (:mod:`dcfkit.analysis.statistics`).
+Each caption names the experiment, the protocol and the sequences; the tables need
+``\\usepackage{booktabs}`` only."""
 from __future__ import annotations
 
 import math
@@ -10,46 +13,117 @@ from typing import Sequence as Seq
 from dcfkit.protocols import Protocol, get_protocol
 
 _ESCAPES = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{",
-            "}": r"\}", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}"}
+            "}": r"\}", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}",
+            "<": r"\textless{}", ">": r"\textgreater{}", "\u2212": "-"}
 _HEADERS = {"ao": "AO", "sr50": "SR$_{0.5}$", "sr75": "SR$_{0.75}$", "auc": "AUC", "precision": "Precision",
             "norm_precision": "Norm. prec.", "fps": "FPS", "tracker": "Tracker", "sequence": "Sequence",
             "attribute": "Attribute", "name": "Attribute name", "sequences": "Seq.", "missing": "Missing",
-            "frames": "Frames", "variant": "Variant"}
+            "frames": "Frames", "variant": "Variant", "accuracy": "Accuracy", "failures": "Failures",
+            "eao": "EAO"}
+LOWER_IS_BETTER = frozenset({"failures"})  # scores whose won and lost sequences are those with fewer
 
 
 def escape(text) -> str:
-    """``text`` with LaTeX's special characters escaped."""
-    return "".join(_ESCAPES.get(c, c) for c in str(text))
+    """``text`` with LaTeX's special characters escaped (``--`` stays two hyphens: ``--max-frames``)."""
+    return "".join(_ESCAPES.get(c, c) for c in str(text)).replace("--", "-{}-")
 
 
-def latex_table(rows: Seq[Mapping], columns: Seq[str], protocol: str | Protocol,
-                statistics: Mapping | None = None, name_key: str = "tracker") -> str:
-    """``rows`` in ``columns`` as a booktabs ``table``. The protocol's score columns mark their
-    best and second values; with ``statistics`` (:func:`~dcfkit.analysis.statistics.versus_baseline`)
-    a row's mean scores carry their confidence intervals."""
+def latex_table(rows: Seq[Mapping], columns: Seq[str], protocol: str | Protocol, setting: Seq[str] = ()) -> str:
+    """``rows`` in ``columns`` as a booktabs ``table``, its caption ``setting`` (sentences naming
+    the experiment and the sequences) and the protocol; the protocol's score columns mark their
+    best and second values."""
     proto = get_protocol(protocol)
     places = {c: _places([r.get(c) for r in rows]) for c in columns if c in proto.score_keys}
-    means = (statistics or {}).get("means", {})
     body = []
     for row in rows:
         cells = []
         for c in columns:
             text = _number(c, row.get(c))
-            interval = means.get(row.get(name_key), {}).get(c)
             if c in places and row.get(c) is not None:
                 mark = {1: r"\textbf{%s}", 2: r"\underline{%s}"}.get(places[c].get(row[c]))
                 text = mark % text if mark else text
-            if interval and math.isfinite(interval["ci_low"]):
-                text += rf" {{\scriptsize [{interval['ci_low']:.3f}, {interval['ci_high']:.3f}]}}"
             cells.append(text)
         body.append(" & ".join(cells) + r" \\")
-    caption = f"{escape(proto.describe())}. Best in bold, second underlined."
-    if means:
-        caption += f" In brackets: {escape(statistics['method'])}."
+    caption = _sentences([*setting, proto.describe()]) + " Best in bold, second underlined."
     align = "".join("l" if any(isinstance(r.get(c), str) for r in rows) else "r" for c in columns)
     head = " & ".join(escape(_HEADERS.get(c, c)) for c in columns) + r" \\"
+    return _table(caption, align, [head], body)
+
+
+def comparison_table(statistics: Mapping, setting: Seq[str], name: str = "Tracker",
+                     lead: Seq[tuple[str, Mapping[str, str]]] = ()) -> str:
+    """The statistics of :func:`~dcfkit.analysis.statistics.versus_baseline` as a booktabs
+    ``table`` a paper can take: per tracker and score its mean with the confidence interval,
+    then its paired difference from the baseline (Delta) with the interval, the Wilcoxon p
+    (``*``: significant after Holm's correction) and the sequences won/tied/lost (fewer
+    failures win). ``setting``: the caption's first sentences (experiment, protocol); ``lead``:
+    columns before the scores, (header, tracker -> LaTeX cell)."""
+    means, baseline = statistics["means"], statistics["baseline"]
+    keys = list(next(iter(means.values())))
+    head = [" & " * (1 + len(lead)) + " & ".join(rf"\multicolumn{{4}}{{c}}{{{escape(_HEADERS.get(k, k))}}}"
+                                           for k in keys) + r" \\",
+            "".join(rf"\cmidrule(lr){{{2 + len(lead) + 4 * i}-{5 + len(lead) + 4 * i}}}" for i in range(len(keys))),
+            " & ".join([escape(name), *(escape(h) for h, _ in lead)]
+                       + [r"Mean [CI] & $\Delta$ [CI] & $p$ & W/T/L"] * len(keys)) + r" \\"]
+    body = []
+    for tracker, found in means.items():
+        cells = [escape(tracker), *(cells.get(tracker, "--") for _, cells in lead)]
+        for key in keys:
+            cells.append(interval_cell(found[key]))
+            cells += _difference_cells(key, statistics["differences"].get(tracker, {}).get(key))
+        body.append(" & ".join(cells) + r" \\")
+    caption = _sentences([*setting, f"Means over the {statistics['sequences']} sequences every {name.lower()} ran",
+                          statistics["method"]])
+    caption += (rf" $\Delta$: the paired difference from {escape(baseline)} (--: {escape(baseline)} itself); "
+                rf"$p$: its Wilcoxon p, $^{{*}}$ where significant after Holm's correction across the "
+                rf"comparisons of a score (corrected $p < 0.05$); W/T/L: the sequences it scored better, "
+                rf"the same, worse on.")
+    return _table(caption, "l" * (1 + len(lead)) + "rrrr" * len(keys), head, body)
+
+
+def interval_cell(interval: Mapping | None, signed: bool = False) -> str:
+    r"""``0.452 {\scriptsize [0.401, 0.498]}`` (signed: in math mode, with real minus signs)."""
+    if not interval or not _finite(interval.get("mean")):
+        return "--"
+    text = _signed(interval["mean"]) if signed else f"{interval['mean']:.3f}"
+    if _finite(interval.get("ci_low")) and _finite(interval.get("ci_high")):
+        low, high = ((_signed(interval[k]) if signed else f"{interval[k]:.3f}") for k in ("ci_low", "ci_high"))
+        text += rf" {{\scriptsize [{low}, {high}]}}"
+    return text
+
+
+def _difference_cells(key: str, d: Mapping | None) -> list[str]:
+    """Delta [CI], p, W/T/L of one difference (the baseline's: dashes)."""
+    if not d:
+        return ["--"] * 3
+    p = d["wilcoxon_p"]
+    p_text = "--" if not _finite(p) else "$<$0.001" if p < 0.001 else f"{p:.3f}"
+    if d.get("significant") and _finite(p):
+        p_text += "$^{*}$"
+    won, lost = (d["lost"], d["won"]) if key in LOWER_IS_BETTER else (d["won"], d["lost"])
+    return [interval_cell(d, signed=True), p_text, f"{won}/{d['tied']}/{lost}"]
+
+
+def _signed(value: float) -> str:
+    return f"${value:+.3f}$"
+
+
+def _finite(value) -> bool:
+    return isinstance(value, (int, float)) and math.isfinite(value)
+
+
+def _sentences(parts: Seq[str]) -> str:
+    """``parts`` escaped, each a sentence (capitalised, a full stop)."""
+    out = []
+    for part in parts:
+        text = escape(part.rstrip(". "))
+        out.append(text[:1].upper() + text[1:] + ".")
+    return " ".join(out)
+
+
+def _table(caption: str, align: str, head: Seq[str], body: Seq[str]) -> str:
     return "\n".join([r"\begin{table}", r"\centering", rf"\caption{{{caption}}}", rf"\begin{{tabular}}{{{align}}}",
-                      r"\toprule", head, r"\midrule", *body, r"\bottomrule", r"\end{tabular}", r"\end{table}"]) + "\n"
+                      r"\toprule", *head, r"\midrule", *body, r"\bottomrule", r"\end{tabular}", r"\end{table}"]) + "\n"
 
 
 def _places(values: Seq) -> dict:

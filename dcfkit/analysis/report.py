@@ -4,8 +4,10 @@
 tracker and sequence (``per_sequence``) and per tracker and attribute
 (``per_attribute``), plus the averaged curves for plotting. Scores follow a named scoring
 protocol of :mod:`dcfkit.protocols` (default ``otb``, the OTB / UAV123 MATLAB toolkit),
-and every output names it: a first line of the text and Markdown tables, a ``protocol``
-column of the CSV tables, ``protocol`` in ``report.json`` and the plot titles. Averages
+and every output names it, with the experiment and any ``--max-frames`` cut
+(:mod:`dcfkit.analysis.setting`): first lines of the text and Markdown tables and of
+``statistics.txt``, last columns of the CSV tables, ``report.json``, the plot titles and the
+LaTeX captions (``overall.tex``: :func:`dcfkit.analysis.latex.comparison_table`). Averages
 weigh sequences as the protocol does unless ``weighting`` says otherwise. A tracker's
 ``fps`` is the mean over sequences of the per-sequence fps (frames / tracker time in that
 sequence), not total frames / total time. A sequence missing from a tracker's results is
@@ -26,6 +28,8 @@ import numpy as np
 
 from dcfkit.analysis.plots import plot_curves
 from dcfkit.analysis.scoring import Evaluation, evaluate
+from dcfkit.analysis.result_fit import check_results_fit, other_folders
+from dcfkit.analysis.setting import cut_length, experiment_line
 from dcfkit.analysis.tables import columns, format_rows, format_table, score_line, statistics_lines
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
 from dcfkit.errors import clip, shown
@@ -173,9 +177,11 @@ def report_file_names(sequences: Seq[Sequence]) -> list[str]:
 
 
 def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
-    """The tables, ``report.json`` and plots of :func:`write_report` from ``evaluation``."""
+    """The tables, ``statistics.txt``, ``report.json`` and plots of :func:`write_report` from
+    ``evaluation``, each naming the experiment, the protocol and any ``--max-frames`` cut."""
     paths = []
     protocol = evaluation.protocol.name
+    experiment, cut = evaluation.settings.get("experiment", "ope"), evaluation.settings.get("max_frames")
 
     def text(name, content):
         path = report_dir / name
@@ -186,10 +192,12 @@ def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
     for stem in tables:
         for fmt, ext in TABLE_FORMATS:
             text(f"{stem}.{ext}", format_table(getattr(evaluation, stem), fmt, columns(stem, protocol), protocol,
-                                               evaluation.statistics if stem == "overall" else None))
-    text("statistics.txt", "\n".join(statistics_lines(evaluation.statistics)) + "\n")
+                                               evaluation.statistics if stem == "overall" else None,
+                                               experiment=experiment, max_frames=cut))
+    head = [experiment_line(experiment, cut), evaluation.protocol.describe(), ""]
+    text("statistics.txt", "\n".join(head + statistics_lines(evaluation.statistics)) + "\n")
     text("report.json", json.dumps(json_ready(evaluation.as_record()), indent=1) + "\n")
-    run = evaluation.settings.get("experiment", "ope").upper()
+    run = experiment.upper() + (f", first {cut} frames" if cut is not None else "")
     for kind in ("precision", "success"):
         paths += plot_curves(evaluation.curves, kind, report_dir / kind, title=f"{kind.capitalize()} plots of {run}",
                              protocol=protocol)
@@ -209,10 +217,10 @@ def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | No
     :func:`evaluate`) and write tables and plots to ``report_dir``.
 
     ``report_dir`` defaults to :func:`default_report_dir`. Writes ``overall``, ``per_sequence``
-    and (when sequences have attributes) ``per_attribute`` tables as ``.txt``, ``.md`` and
-    ``.csv``; ``report.json`` with all rows and curves; ``precision`` and ``success`` plots
+    and (when sequences have attributes) ``per_attribute`` tables as ``.txt``, ``.md``, ``.csv``
+    and ``.tex``; ``statistics.txt``; ``report.json`` with all rows and curves; ``precision`` and ``success`` plots
     and ``precision_<ATTR>`` and ``success_<ATTR>`` plots per attribute, each as PNG and SVG. Every file names
-    the protocol. ``missing`` is :func:`evaluate`'s: by default the sequences every tracker
+    the experiment, the protocol and any ``--max-frames`` cut. ``missing`` is :func:`evaluate`'s: by default the sequences every tracker
     has a result for are scored, the others named. ``experiment`` ``tre`` or ``sre`` scores
     each tracker's runs of it (``<tracker>/<experiment>/``), pooled per sequence. Returns the paths.
     """
@@ -260,6 +268,9 @@ def score_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | N
     by_sequence = runs_by_sequence(sequences, experiment)
     runs = [run for found in by_sequence.values() for run in found]
     folders = tracker_folders(out_dir, runs, trackers, exclude=[report_dir], sub=experiment.folder)
+    if not folders and trackers is None:  # sub-folders of results, none of these sequences': whose?
+        folders = other_folders(out_dir, experiment.folder)
+    check_results_fit(out_dir, folders, runs, missing, cut_length(sequences))
     results = {name: read_folder(folder, runs) for name, folder in folders.items()}
     if not results:
         raise DatasetError(f"no tracker results{' of experiment ' + experiment.name if experiment.folder else ''} "

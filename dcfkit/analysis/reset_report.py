@@ -11,8 +11,11 @@ from typing import Sequence as Seq
 
 import numpy as np
 
+from dcfkit.analysis.latex import comparison_table, interval_cell
 from dcfkit.analysis.report import TABLE_FORMATS, default_report_dir, json_ready, tracker_folders
+from dcfkit.analysis.result_fit import check_results_fit, other_folders
 from dcfkit.analysis.reset_scores import ResetRun, score_resets
+from dcfkit.analysis.setting import cut_length, experiment_line, experiment_record
 from dcfkit.analysis.tables import format_rows, statistics_lines
 from dcfkit.datasets import DatasetError, Sequence, scored_sequences
 from dcfkit.errors import clip
@@ -116,11 +119,14 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
                        report_dir=None, interval: tuple[int, int] | None = None) -> tuple[dict, list[Path]]:
     """Score the reset-based runs (``<tracker>/reset/``) of every tracker in ``out_dir`` on the
     sequences all of them ran, and write ``reset_overall`` and ``reset_per_sequence`` tables
-    (``.txt``, ``.md``, ``.csv``), ``statistics.txt`` and ``reset.json`` to ``report_dir``
-    (default ``<out_dir>_report/reset``). Returns (the scores, the paths)."""
+    (``.txt``, ``.md``, ``.csv``; ``reset_overall.tex``: :func:`reset_latex`), ``statistics.txt``
+    and ``reset.json`` to ``report_dir`` (default ``<out_dir>_report/reset``), each naming the
+    experiment and any ``--max-frames`` cut. Returns (the scores, the paths)."""
     sequences = scored_sequences(sequences)
     report_dir = default_report_dir(out_dir, report_dir, EXPERIMENT)
     folders = tracker_folders(out_dir, sequences, trackers, exclude=[report_dir], sub=EXPERIMENT.folder)
+    found = folders if folders or trackers is not None else other_folders(out_dir, EXPERIMENT.folder)
+    check_results_fit(out_dir, found, sequences, "skip", cut_length(sequences))
     results = {name: reset_runs(folder, sequences) for name, folder in folders.items()}
     if not results:
         raise DatasetError(f"no reset-based results found under {clip(str(out_dir))} (dcfkit eval --experiment reset)")
@@ -129,17 +135,48 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
                            f"from every tracker (a warning says why a result was left out); run them with dcfkit "
                            f"eval --experiment reset")
     names = [f"reset_{t}.{ext}" for t in RESET_COLUMNS for _, ext in TABLE_FORMATS if ext != "tex"]
-    ensure_writable(report_dir, names + ["statistics.txt", "reset.json"], "the report")
+    ensure_writable(report_dir, names + ["reset_overall.tex", "statistics.txt", "reset.json"], "the report")
     scores = score_resets(results, {s.name: len(s) for s in sequences}, interval)
-    scores["experiment"] = {"name": EXPERIMENT.name, "title": EXPERIMENT.title, "source": EXPERIMENT.source}
+    scores["experiment"] = experiment_record(EXPERIMENT)
+    scores["max_frames"] = cut_length(sequences)
     paths = []
     for table, columns in RESET_COLUMNS.items():
         for fmt, ext in TABLE_FORMATS:
             if ext != "tex":
-                paths.append(_write(report_dir / f"reset_{table}.{ext}", format_rows(scores[table], fmt, columns)))
-    paths.append(_write(report_dir / "statistics.txt", "\n".join(statistics_lines(scores["statistics"])) + "\n"))
+                paths.append(_write(report_dir / f"reset_{table}.{ext}", reset_table(scores, table, fmt)))
+    paths.append(_write(report_dir / "reset_overall.tex", reset_latex(scores)))
+    head = [experiment_line(EXPERIMENT, scores["max_frames"]), _eao_line(scores), ""]
+    paths.append(_write(report_dir / "statistics.txt", "\n".join(head + statistics_lines(scores["statistics"])) + "\n"))
     paths.append(_write(report_dir / "reset.json", json.dumps(json_ready(scores), indent=1) + "\n"))
     return scores, paths
+
+
+def _eao_line(scores: dict) -> str:
+    low, high = scores["interval"]
+    return (f"EAO over sequence lengths {low}..{high} (VOT2016), its interval a percentile bootstrap over "
+            f"sequences")
+
+
+def reset_table(scores: dict, table: str, fmt: str) -> str:
+    """The ``overall`` or ``per_sequence`` rows of :func:`score_resets` as :func:`format_rows`
+    ``fmt``, naming the experiment and any cut: first lines, or last CSV columns."""
+    rows, columns, cut = scores[table], RESET_COLUMNS[table], scores.get("max_frames")
+    if fmt == "csv":
+        extra = {"experiment": EXPERIMENT.name, **({} if cut is None else {"max_frames": cut})}
+        return format_rows([{**r, **extra} for r in rows], fmt, (*columns, *extra))
+    return f"{experiment_line(EXPERIMENT, cut)}\n{_eao_line(scores)}\n\n" + format_rows(rows, fmt, columns)
+
+
+def reset_latex(scores: dict) -> str:
+    """The overall scores of :func:`score_resets` as a LaTeX comparison table
+    (:func:`~dcfkit.analysis.latex.comparison_table`): each tracker's EAO with its interval, then
+    its accuracy and failures with their intervals and paired differences from the best."""
+    eao = {r["tracker"]: interval_cell({"mean": r["eao"], "ci_low": r["eao_ci_low"], "ci_high": r["eao_ci_high"]})
+           for r in scores["overall"]}
+    if not scores["statistics"]:
+        raise DatasetError("no tracker's reset-based runs to tabulate")
+    return comparison_table(scores["statistics"], [experiment_line(EXPERIMENT, scores.get("max_frames")),
+                                                   _eao_line(scores)], lead=[("EAO [CI]", eao)])
 
 
 def _write(path: Path, text: str) -> Path:

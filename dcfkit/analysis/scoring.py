@@ -10,6 +10,7 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from dcfkit.analysis import metrics
+from dcfkit.analysis.setting import cut_length, experiment_record
 from dcfkit.analysis.statistics import versus_baseline
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, benchmark_protocol, scored_sequences
 from dcfkit.errors import shown
@@ -59,9 +60,12 @@ class Evaluation:
     statistics: dict
 
     def as_record(self) -> dict:
-        """The scores as plain data (``report.json``): the protocol as its name, title and source."""
+        """The scores as plain data (``report.json``): the protocol and the experiment as their
+        name, title and source; ``settings`` name the experiment and the ``--max-frames`` cut
+        (``max_frames``, None for whole sequences)."""
         record = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         record["protocol"] = protocol_record(self.protocol)
+        record["experiment"] = experiment_record(self.settings["experiment"])
         return record
 
 
@@ -127,8 +131,8 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
         protocol=proto, overall=overall, per_sequence=per_sequence, per_attribute=per_attribute,
         curves=curves, attribute_curves=attribute_curves,
         attributes={a: len(n) for a, n in attributes.items()}, thresholds=proto.thresholds,
-        settings={"protocol": proto.name, "experiment": experiment.name, "include_first": include_first,
-                  "weighting": weighting,
+        settings={"protocol": proto.name, "experiment": experiment.name, "max_frames": cut_length(sequences),
+                  "include_first": include_first, "weighting": weighting,
                   "missing": "skip" if left_out is not None else "fail", "left_out": left_out or {},
                   "datasets": dict(Counter(s.dataset or "unnamed" for s in sequences))},
         platforms={t: _platforms(res.values()) for t, res in results.items()},

@@ -7,8 +7,10 @@ import math
 from typing import Mapping
 from typing import Sequence as Seq
 
-from dcfkit.analysis.latex import latex_table
+from dcfkit.analysis.latex import comparison_table, latex_table
+from dcfkit.analysis.setting import experiment_line
 from dcfkit.errors import printable, shown
+from dcfkit.experiments import Experiment, get_experiment
 from dcfkit.protocols import DEFAULT, Protocol, get_protocol
 
 _TABLES = {  # the columns before and after a protocol's scores (Protocol.score_keys)
@@ -95,16 +97,27 @@ def score_line(row: Mapping, protocol: str | Protocol = DEFAULT) -> str:
 
 
 def format_table(rows: Seq[Mapping], fmt: str, columns: Seq[str], protocol: str | Protocol = DEFAULT,
-                 statistics: Mapping | None = None) -> str:
-    """:func:`format_rows` naming the scoring protocol: a first line (``table``,
-    ``markdown``), a last ``protocol`` column (``csv``, so the file stays one table), or the
-    caption of a LaTeX table (``latex``, with the intervals of ``statistics`` if given)."""
+                 statistics: Mapping | None = None, *, experiment: str | Experiment | None = None,
+                 max_frames: int | None = None) -> str:
+    """:func:`format_rows` naming the scoring protocol and, if given, the ``experiment`` and the
+    ``--max-frames`` cut (:mod:`dcfkit.analysis.setting`): first lines (``table``, ``markdown``),
+    last columns ``protocol``, ``experiment`` and ``max_frames`` (``csv``, so the file stays one
+    table), or the caption of a LaTeX table (``latex``: with ``statistics``, the comparison
+    table of :func:`~dcfkit.analysis.latex.comparison_table`)."""
     proto = get_protocol(protocol)
+    setting = {} if experiment is None else {"experiment": get_experiment(experiment).name}
+    if max_frames is not None:
+        setting["max_frames"] = max_frames
     if fmt == "latex":
-        return latex_table(rows, columns, proto, statistics)
+        lines = [experiment_line(experiment, max_frames)] if experiment is not None else []
+        if statistics:
+            return comparison_table(statistics, [*lines, proto.describe()])
+        return latex_table(rows, columns, proto, lines)
     if fmt == "csv":
-        return format_rows([{**r, "protocol": proto.name} for r in rows], fmt, (*columns, "protocol"))
-    return f"{proto.describe()}\n\n" + format_rows(rows, fmt, columns)
+        return format_rows([{**r, "protocol": proto.name, **setting} for r in rows], fmt,
+                           (*columns, "protocol", *setting))
+    head = f"{experiment_line(experiment, max_frames)}\n" if experiment is not None else ""
+    return f"{head}{proto.describe()}\n\n" + format_rows(rows, fmt, columns)
 
 
 def interval_text(interval: Mapping, signed: bool = False) -> str:
@@ -124,7 +137,7 @@ def comparison_lines(statistics: Mapping, names: tuple[str, str] = ("results", "
         s = statistics[score]
         d = s["difference"]
         lines.append(f"  {SCORE_LABELS.get(score, score):<9} {names[0]} {interval_text(s['results'])}   "
-                     f"{names[1]} {interval_text(s['reference'])}   difference {interval_text(d, signed=True)}   "
+                     f"{names[1]} {interval_text(s['reference'])}   {names[0]} - {names[1]} {interval_text(d, signed=True)}   "
                      f"Wilcoxon p {d['wilcoxon_p']:.3g}   won {d['won']}, lost {d['lost']}, tied {d['tied']} "
                      f"of {d['n']}")
         if s.get("non_finite"):

@@ -13,12 +13,11 @@ from typing import Any, Callable, Mapping
 from dcfkit.analysis.compare import COLUMNS, compare_folders, counted_lines
 from dcfkit.analysis.report import columns, json_ready, named_folder, score_and_write
 from dcfkit.analysis.report_html import write_html_report
-from dcfkit.analysis.reset_report import RESET_COLUMNS, reset_runs, write_reset_report
+from dcfkit.analysis.reset_report import reset_latex, reset_runs, reset_table, write_reset_report
 from dcfkit.analysis.reset_scores import score_resets
 from dcfkit.analysis.scoring import MISSING, evaluate
 from dcfkit.analysis.tables import (
     comparison_lines,
-    format_rows,
     format_table,
     noise_floor_line,
     score_line,
@@ -34,7 +33,7 @@ from dcfkit.cli.common import (
 from dcfkit.config import load_config
 from dcfkit.config.overrides import parse_overrides
 from dcfkit.datasets import benchmark_protocol, load_datasets, scored_sequences
-from dcfkit.errors import ConfigError, shown
+from dcfkit.errors import ConfigError, printable, shown
 from dcfkit.experiments import runs_by_sequence
 from dcfkit.integrations.opencv import opencv_tracker
 from dcfkit.running.evaluation import check_one_pass, results_folder, run_one_pass, tracker_name
@@ -130,14 +129,17 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--trackers", default=None,
                         help="comma-separated tracker folders (names in OUT or paths; default: all)")
     parser.add_argument("--format", choices=("table", "markdown", "csv", "latex"), default="table",
-                        help="format of the table printed to stdout (latex: booktabs, best per score bold, second "
-                             "underlined, confidence intervals in brackets)")
+                        help="format of the table printed to stdout; every format names the experiment, the protocol "
+                             "and a --max-frames cut (latex: a booktabs table a paper can take: each tracker's "
+                             "scores with confidence intervals, its difference from the best with its interval, "
+                             "Wilcoxon p and sequences won/tied/lost)")
     parser.add_argument("--report-dir", type=Path, default=None,
                         help="default: OUT_report beside OUT (OUT_report/<experiment> but for ope): out of the folder "
                              "whose sub-folders are trackers")
     parser.add_argument("--html", action="store_true",
                         help="also write report.html: one self-contained page with sortable tables, interactive "
-                             "plots, each sequence's frames with every tracker's box, and the provenance")
+                             "plots, each sequence's frames with every tracker's box, and the provenance (ope, tre, "
+                             "sre)")
     add_protocol_argument(parser)
     parser.add_argument("--skip-first", action="store_true",
                         help="do not score frame 1 (default: as the protocol; otb scores it with the ground "
@@ -157,19 +159,19 @@ def run_report(args: argparse.Namespace) -> int:
     """Print the overall table and write the report files."""
     sequences = [s.head(args.max_frames) for s in load_datasets(args.dataset, args.root, args.sequences)]
     trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
-    if args.experiment != "ope" and args.html:
-        raise ConfigError("--html shows one-pass results; leave it out for --experiment " + args.experiment)
     if args.experiment == "reset":
+        if args.html:
+            raise ConfigError("--html: reset-based runs have no report page (their tables, statistics.txt and "
+                              "reset.json are written without it); leave --html out for --experiment reset")
         return _reset_report(args, sequences, trackers)
-    write = write_html_report if args.html else functools.partial(score_and_write, experiment=args.experiment)
+    write = functools.partial(write_html_report if args.html else score_and_write, experiment=args.experiment)
     evaluation, paths = write(args.out, sequences, trackers, args.report_dir, include_first=not args.skip_first,
                               weighting="frame" if args.frame_weighted else None, protocol=args.protocol,
                               missing=args.missing)
-    if args.format == "table" and args.experiment != "ope":
-        print(f"experiment {args.experiment}: each sequence's runs pooled, as the OTB toolkit's perfPlot.m")
     protocol = evaluation.protocol.name  # --protocol, else the benchmark's
     print(format_table(evaluation.overall, args.format, columns("overall", protocol), protocol,
-                       evaluation.statistics), end="")
+                       evaluation.statistics, experiment=args.experiment,
+                       max_frames=evaluation.settings["max_frames"]), end="")
     if args.format == "table":
         for tracker, rows in evaluation.platforms.items():  # ten lines at most: records may differ per sequence
             print(f"{tracker} platform: {'; '.join(counted_lines(dict(rows), sum(n for _, n in rows)))}")
@@ -188,12 +190,8 @@ def run_report(args: argparse.Namespace) -> int:
 
 def _reset_report(args: argparse.Namespace, sequences: list, trackers: list[str] | None) -> int:
     """``report --experiment reset``: the accuracy, failures and EAO table and the statistics."""
-    if args.format == "latex":
-        raise ConfigError("--format latex: the reset-based table has no LaTeX form; use table, markdown or csv")
     scores, paths = write_reset_report(args.out, sequences, trackers, args.report_dir)
-    low, high = scores["interval"]
-    print(f"reset-based experiment (VOT2016), EAO over sequence lengths {low}..{high}\n")
-    print(format_rows(scores["overall"], args.format, RESET_COLUMNS["overall"]), end="")
+    print(reset_latex(scores) if args.format == "latex" else reset_table(scores, "overall", args.format), end="")
     if args.format == "table":
         for name, without in scores["left_out"].items():
             print(f"left out: {name} (no result from {', '.join(without)})")
@@ -205,8 +203,10 @@ def _reset_report(args: argparse.Namespace, sequences: list, trackers: list[str]
 def add_compare_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("results", metavar="RESULTS",
                    help="folder of <sequence>.txt result files (1-based x,y,w,h), e.g. OUT/<tracker>; NAME=FOLDER "
-                        "names it")
-    p.add_argument("reference", metavar="REFERENCE", help="folder of result files to compare with (or NAME=FOLDER)")
+                        "names it (the output calls each side by its NAME, else its folder's name)")
+    p.add_argument("reference", metavar="REFERENCE",
+                   help="folder of result files to compare with (or NAME=FOLDER); differences are RESULTS minus "
+                        "REFERENCE")
     add_dataset_arguments(p, "benchmark root folder (the ground truth)")
     add_protocol_argument(p)
     p.add_argument("--divergence-px", type=pixels, default=2.0,
@@ -221,28 +221,39 @@ def _named(folder: str) -> tuple[str | None, Path]:
     return named_folder(Path.cwd(), folder) if "=" in folder and not os.path.isdir(folder) else (None, Path(folder))
 
 
+def side_names(named: tuple[tuple[str | None, Path], tuple[str | None, Path]]) -> list[str]:
+    """What ``compare`` calls its two sides: each one's NAME, else its folder's name (with its
+    parent's where both share it; ``RESULTS`` and ``REFERENCE`` for one folder given twice)."""
+    (a, folder_a), (b, folder_b) = named
+    names = [a or folder_a.resolve().name, b or folder_b.resolve().name]
+    if names[0] == names[1] and not (a and b):
+        names = [n or f"{f.resolve().parent.name}/{f.resolve().name}" for n, f in named]
+    return [printable(n) for n in names] if names[0] != names[1] else ["RESULTS", "REFERENCE"]
+
+
 def run_compare(args: argparse.Namespace) -> int:
-    """Print the per-sequence comparison."""
+    """Print the per-sequence comparison, each side named (:func:`side_names`)."""
     sequences = load_datasets(args.dataset, args.root, args.sequences)
-    (name, results), (name_ref, reference) = _named(args.results), _named(args.reference)
-    res = compare_folders(results, reference, sequences, args.protocol, args.divergence_px)
-    res["names"] = [name or "results", name_ref or "reference"]
+    named = _named(args.results), _named(args.reference)
+    res = compare_folders(named[0][1], named[1][1], sequences, args.protocol, args.divergence_px)
+    res["names"] = ours, theirs = side_names(named)
     if args.format == "json":
         print(json.dumps(json_ready(res), indent=1))
         return 0
     print(format_table(res["rows"] + [res["mean"]], args.format, COLUMNS, res["protocol"]), end="")
-    left = "; ".join(f"{k.replace('_', ' ')}: {', '.join(v)}" for k, v in res["left_out"].items() if v)
-    print(f"\nresults: {res['results']}\nreference: {res['reference']}\n"
+    notes = sys.stderr if args.format == "csv" else sys.stdout
+    sides = {"results": ours, "reference": theirs}
+    labels = {"only_in_results": f"only in {ours}", "only_in_reference": f"only in {theirs}"}
+    left = "; ".join(f"{labels.get(k, k.replace('_', ' '))}: {', '.join(v)}" for k, v in res["left_out"].items() if v)
+    print(f"\n{ours} (RESULTS): {res['results']}\n{theirs} (REFERENCE): {res['reference']}\n"
           f"{res['diverged']} of {len(res['rows'])} sequences diverge (centres more than "
-          f"{args.divergence_px:g} px apart); d_ = results minus reference\n"
-          f"left out: {left or 'none'}", file=sys.stderr if args.format == "csv" else sys.stdout)
-    for side in ("results", "reference"):
-        print(f"{side} platform: {'; '.join(res['platforms'][side])}",
-              file=sys.stderr if args.format == "csv" else sys.stdout)
-    print("\n".join(comparison_lines(res["statistics"], tuple(res["names"]))),
-          file=sys.stderr if args.format == "csv" else sys.stdout)
-    print(noise_floor_line(res["noise_floor"], len(res["rows"])), file=sys.stderr if args.format == "csv" else sys.stdout)
+          f"{args.divergence_px:g} px apart); precision, auc: {ours}; precision_ref, auc_ref: {theirs}; "
+          f"d_ = {ours} minus {theirs}\nleft out: {left or 'none'}", file=notes)
+    for side, name in sides.items():
+        print(f"{name} platform: {'; '.join(res['platforms'][side])}", file=notes)
+    print("\n".join(comparison_lines(res["statistics"], (ours, theirs))), file=notes)
+    print(noise_floor_line(res["noise_floor"], len(res["rows"])), file=notes)
     if res["platform_differences"]:
-        print(f"warning: the two folders come from different platforms ({'; '.join(res['platform_differences'])}); "
+        print(f"warning: {ours} and {theirs} come from different platforms ({'; '.join(res['platform_differences'])}); "
               f"their boxes may part where a float decision is close (docs/architecture.md)", file=sys.stderr)
     return 0

@@ -99,10 +99,13 @@ def test_cli_formats(folders, tmp_path, capsys, monkeypatch):
     out = capsys.readouterr().out
     assert out.startswith("protocol otb: OTB / UAV123 MATLAB toolkit")
     assert "1 of 2 sequences diverge (centres more than 2 px apart)" in out
-    assert "left out: only in results: only_ours; only in reference: only_theirs; not in dataset: c" in out
+    assert "left out: only in ours: only_ours; only in theirs: only_theirs; not in dataset: c" in out
+    # each side by its folder's name (dcfkit <= 0.9: 'results' and 'reference')
+    assert f"\nours (RESULTS): {ours}\ntheirs (REFERENCE): {theirs}\n" in out
+    assert "precision, auc: ours; precision_ref, auc_ref: theirs; d_ = ours minus theirs" in out
     assert cli.main(base + ["--format", "csv", "--protocol", "pysot", "--divergence-px", "4"]) == 0
     captured = capsys.readouterr()
-    assert "left out: only in results: only_ours;" in captured.err  # notes beside the CSV, not in it
+    assert "left out: only in ours: only_ours;" in captured.err  # notes beside the CSV, not in it
     lines = captured.out.splitlines()
     assert len(lines) == 4 and lines[0] == ("sequence,frames,precision,precision_ref,d_precision,auc,auc_ref,d_auc,iou,"
                         "diverges_at,protocol")
@@ -208,7 +211,7 @@ def test_the_comparison_carries_its_uncertainty(folders, tmp_path, capsys, monke
     assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "statistics: 95% BCa bootstrap" in out
-    assert f"AUC       results {auc['results']['mean']:.3f} [" in out and "won 0, lost 1, tied 1 of 2" in out
+    assert f"AUC       ours {auc['results']['mean']:.3f} [" in out and "won 0, lost 1, tied 1 of 2" in out
     assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path), "--format", "json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["auc_difference"] == pytest.approx(res["auc_difference"]) and data["wilcoxon_p"] == 1.0
@@ -304,5 +307,16 @@ def test_a_line_break_in_a_platform_record_stays_on_its_line(tmp_path, monkeypat
     lines = (out + err).splitlines()
     assert not any(line.startswith("warning: forged") for line in lines)
     forged = "OPENBLAS_CORETYPE=Haswell\\nwarning: forged\\r"
-    assert any(line.startswith("reference platform: ") and line.endswith(forged) for line in lines)
+    assert any(line.startswith("theirs platform: ") and line.endswith(forged) for line in lines)
     assert "OPENBLAS_CORETYPE: Haswell -> Haswell\\nwarning: forged\\r" in err
+
+
+def test_each_side_is_named_by_its_name_or_folder(tmp_path):
+    from dcfkit.cli.evaluate import side_names
+
+    a, b = tmp_path / "run1" / "kcf", tmp_path / "run2" / "kcf"
+    assert side_names(((None, a), (None, tmp_path / "dsst"))) == ["kcf", "dsst"]
+    assert side_names(((None, a), (None, b))) == ["run1/kcf", "run2/kcf"]  # one folder name: with the parents
+    assert side_names((("mine", a), (None, b))) == ["mine", "kcf"]
+    assert side_names(((None, a), (None, a))) == ["RESULTS", "REFERENCE"]  # a folder with itself
+    assert side_names((("x\ny", a), (None, b))) == ["x\\ny", "kcf"]  # a name cannot forge a line

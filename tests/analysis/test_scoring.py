@@ -68,7 +68,8 @@ def test_report_prints_and_writes_the_statistics(tmp_path, monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "statistics over 5 sequences: 95% BCa bootstrap" in out and "far - " in out and "(Holm " in out
     written = (tmp_path / "out_report" / "statistics.txt").read_text()
-    assert written.splitlines()[0] == out.split("\n\n")[-2].splitlines()[0]
+    assert written.splitlines()[3] == out.split("\n\n")[-2].splitlines()[0]
+    assert written.startswith("experiment OPE (one-pass evaluation") and written.splitlines()[1].startswith("protocol ")
 
 
 def test_a_missing_result_is_left_out_and_named_unless_asked_to_fail():

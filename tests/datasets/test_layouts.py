@@ -449,7 +449,7 @@ def test_eval_and_report_on_lasot_give_per_attribute_tables(tmp_path, jpg, capsy
     assert cli.main(["report", str(out), "--dataset", "lasot", "--root", str(root), "--protocol", "lasot"]) == 0
     table = (out.parent / "out_report" / "per_attribute.txt").read_text()
     assert "Illumination Variation" in table and "Aspect Ratio Change" in table
-    assert table.splitlines()[0].startswith("protocol lasot: LaSOT toolkit")
+    assert table.splitlines()[1].startswith("protocol lasot: LaSOT toolkit")
     rows = [r for r in json.loads((out.parent / "out_report" / "report.json").read_text())["per_attribute"]]
     assert {(r["attribute"], r["sequences"]) for r in rows} == {("IV", 3), ("ARC", 1)}
     assert (out.parent / "out_report" / "success_IV.png").is_file()

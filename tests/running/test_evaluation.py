@@ -558,13 +558,14 @@ def test_cli_eval_and_report(tmp_path, seqs, monkeypatch, capsys):
                               "--sequences", "a,c", "--format", "markdown"])
     assert cli_evaluate.run_report(args) == 0
     out = capsys.readouterr().out
-    assert out.startswith("protocol otb: ") and "\n\n| tracker | auc |" in out and "| fast |" in out
+    assert out.startswith("experiment OPE (one-pass evaluation; Wu et al., TPAMI 2015)\nprotocol otb: ")
+    assert "\n\n| tracker | auc |" in out and "| fast |" in out
     assert (tmp_path / "out_report" / "success.png").is_file()
     args = parser.parse_args([str(tmp_path / "out"), "--root", str(root), "--dataset", "dtb70",
                               "--sequences", "a,c", "--format", "csv", "--protocol", "got10k"])
     assert cli_evaluate.run_report(args) == 0
     assert capsys.readouterr().out.splitlines()[0] == (
-        "tracker,ao,sr50,sr75,auc,precision,norm_precision,fps,sequences,missing,protocol")
+        "tracker,ao,sr50,sr75,auc,precision,norm_precision,fps,sequences,missing,protocol,experiment")
     assert json.loads((tmp_path / "out_report" / "report.json").read_text())["protocol"]["name"] == "got10k"
 
 

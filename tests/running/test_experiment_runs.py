@@ -80,6 +80,7 @@ def test_reset_runs_record_their_starts_and_failures(tmp_path, seqs):
 
 
 def test_eval_and_report_of_each_experiment(tmp_path, capsys):
+    """Every table and file names its experiment; TRE and SRE get their page, LaTeX the reset table."""
     root = tmp_path / "data"
     for i, name in enumerate(("seqA", "seqB")):
         write_otb(root, name, seed=i, n_frames=N)
@@ -89,21 +90,41 @@ def test_eval_and_report_of_each_experiment(tmp_path, capsys):
                          "--experiment", experiment, "--no-progress"]) == 0
         said = capsys.readouterr().out
         assert f"-> {out / 'kcf' / experiment}" in said
-        assert cli.main(["report", str(out), "--dataset", "otb", "--root", str(root), "--experiment", experiment,
-                         "--report-dir", str(report_dir / experiment)]) == 0
+        report = ["report", str(out), "--dataset", "otb", "--root", str(root), "--experiment", experiment,
+                  "--report-dir", str(report_dir / experiment)]
+        assert cli.main(report) == 0
         printed = capsys.readouterr().out
+        named = f"experiment {experiment.upper()} ("
+        folder = report_dir / experiment
+        assert printed.startswith(named)
         if experiment == "reset":
-            scores = json.loads((report_dir / "reset" / "reset.json").read_text())
+            scores = json.loads((folder / "reset.json").read_text())
             assert scores["overall"][0]["tracker"] == "kcf" and scores["overall"][0]["sequences"] == 2
             assert "EAO over sequence lengths" in printed and scores["interval"] == [N, N]
+            assert scores["experiment"]["name"] == "reset" and scores["max_frames"] is None
+            texts = ["reset_overall.txt", "reset_per_sequence.md", "statistics.txt"]
+            assert (folder / "reset_overall.csv").read_text().splitlines()[1].endswith(",reset")
+            assert cli.main(report + ["--format", "latex"]) == 0
+            latex = capsys.readouterr().out
+            assert latex == (folder / "reset_overall.tex").read_text()
+            assert r"\caption{Experiment RESET (" in latex and "EAO [CI]" in latex and r"kcf & " in latex
         else:
-            record = json.loads((report_dir / experiment / "report.json").read_text())
+            record = json.loads((folder / "report.json").read_text())
             assert record["settings"]["experiment"] == experiment and record["overall"][0]["sequences"] == 2
-            assert f"experiment {experiment}: each sequence's runs pooled" in printed
-            assert (report_dir / experiment / "success.png").is_file()
-    assert cli.main(["report", str(out), "--dataset", "otb", "--root", str(root), "--experiment", "tre",
+            assert record["experiment"]["name"] == experiment and record["settings"]["max_frames"] is None
+            assert f"{named}" in printed and "each sequence's runs pooled" in printed
+            assert (folder / "success.png").is_file()
+            texts = ["overall.txt", "overall.md", "per_sequence.txt", "statistics.txt"]
+            assert (folder / "overall.csv").read_text().splitlines()[0].endswith(",protocol,experiment")
+            assert rf"\caption{{Experiment {experiment.upper()} (" in (folder / "overall.tex").read_text()
+            assert cli.main(report + ["--html"]) == 0  # dcfkit < 0.10 refused --html but for one pass
+            page = (folder / "report.html").read_text()
+            assert f"dcfkit report ({experiment.upper()}): 1 tracker on otb" in page
+        for name in texts:
+            assert (folder / name).read_text().startswith(named), name
+    assert cli.main(["report", str(out), "--dataset", "otb", "--root", str(root), "--experiment", "reset",
                      "--html"]) != 0
-    assert "--html shows one-pass results; leave it out for --experiment tre" in capsys.readouterr().err
+    assert "--html: reset-based runs have no report page" in capsys.readouterr().err
 
 
 def test_an_ablation_runs_and_pools_an_experiment(tmp_path, capsys):
@@ -124,6 +145,9 @@ variants:
     assert f"2 jobs ({2 * runs} distinct runs)" in printed
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["experiment"] == "tre" and all(r["failed"] == 0 for r in summary["overall"])
+    latex = (tmp_path / "out" / "summary.tex").read_text()  # the variants compared, as a paper's table
+    assert latex.startswith("\\begin{table}") and r"\caption{Ablation tre. Experiment TRE (" in latex
+    assert "Variant & Mean [CI] & $\\Delta$ [CI] & $p$ & W/T/L" in latex and "difference from kcf" in latex
     assert len(list((tmp_path / "out" / "jobs").glob(f"otb/*/tre/seqA_{runs:03d}.json"))) == 2
     bad = write_spec(tmp_path / "bad.yaml", "name: x\ndataset: otb\nexperiment: reset\nvariants: {k: kcf}\n")
     with pytest.raises(ConfigError, match=r"bad.yaml: experiment: expected one of ope, tre, sre, got 'reset' "

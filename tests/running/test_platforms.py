@@ -108,8 +108,8 @@ def test_compare_command_warns_about_different_platforms(tmp_path, seqs, capsys)
     if cli.main(args) != 0:
         pytest.fail(capsys.readouterr().err)
     out, err = capsys.readouterr()
-    assert "reference platform: " + platforms.describe(RECORD) in out
-    assert "warning: the two folders come from different platforms (" in err and "cpu: " in err
+    assert "there/drift platform: " + platforms.describe(RECORD) in out  # one folder name: with its parent
+    assert "warning: here/drift and there/drift come from different platforms (" in err and "cpu: " in err
 
     _with_platform(tmp_path / "there" / "drift", platforms.record())
     assert cli.main(args) == 0

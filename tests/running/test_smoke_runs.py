@@ -58,3 +58,45 @@ def test_head_keeps_a_sequence_whole_or_cuts_it():
     with pytest.raises(DatasetError, match="at least 1 frame"):
         seq.head(0)
 
+
+
+def test_a_smoke_run_reported_without_its_cut_says_so_once(data, tmp_path, capsys):
+    """dcfkit <= 0.9 warned once per result file, then said to report fewer trackers."""
+    base = ["--dataset", "otb", "--root", str(data), "--no-progress"]
+    assert cli.main(["eval", "kcf", "dsst", "--out", str(tmp_path / "out"), "--max-frames", "4", *base]) == 0
+    capsys.readouterr()
+    report = ["report", str(tmp_path / "out"), "--dataset", "otb", "--root", str(data)]
+    for flag, said in (([], "no --max-frames"), (["--max-frames", "3"], "--max-frames 3")):
+        assert cli.main(report + flag) == 2
+        err = capsys.readouterr().err
+        assert err.strip().splitlines() == [
+            f"dcfkit report: error: the results of dsst, kcf in {tmp_path / 'out'} were cut by --max-frames 4 (their "
+            f"runs of seqA, seqB hold at most 4 frames) and this report has {said}: report them with --max-frames 4"]
+    assert cli.main(report + ["--max-frames", "4", "--format", "csv"]) == 0
+    assert capsys.readouterr().out.splitlines()[0].endswith(",protocol,experiment,max_frames")
+    record = json.loads((tmp_path / "out_report" / "report.json").read_text())
+    assert record["settings"]["max_frames"] == 4
+    cut = "a smoke run: each sequence cut to its first 4 frames (--max-frames 4)"
+    for name in ("overall.txt", "overall.md", "statistics.txt", "per_sequence.txt"):
+        assert cut in (tmp_path / "out_report" / name).read_text().splitlines()[0], name
+    assert "(-{}-max-frames 4)" in (tmp_path / "out_report" / "overall.tex").read_text()
+    assert (tmp_path / "out_report" / "per_sequence.csv").read_text().splitlines()[1].endswith(",ope,4")
+
+
+def test_whole_runs_reported_with_a_cut_and_results_of_another_dataset_are_named(data, tmp_path, capsys):
+    base = ["--dataset", "otb", "--no-progress"]
+    assert cli.main(["eval", "kcf", "--out", str(tmp_path / "out"), "--root", str(data), *base]) == 0
+    capsys.readouterr()
+    assert cli.main(["report", str(tmp_path / "out"), "--root", str(data), "--max-frames", "4", *base[:2]]) == 2
+    assert ("dcfkit report: error: the results of kcf in " in (err := capsys.readouterr().err)
+            and "are whole runs (seqA, seqB: longer than this report's --max-frames 4 leaves): report them "
+                "without --max-frames" in err)
+    other = tmp_path / "other"
+    write_otb(other, "seqX", seed=5)
+    for trackers in ([], ["--trackers", "kcf"]):
+        assert cli.main(["report", str(tmp_path / "out"), "--root", str(other), *base[:2], *trackers]) == 2
+        err = capsys.readouterr().err
+        assert err.strip().splitlines() == [
+            f"dcfkit report: error: the results in {tmp_path / 'out'} are of other sequences than the 1 scored here "
+            f"(seqX): they are of seqA, seqB; report them on the dataset they were run on (--dataset, --root, "
+            f"--sequences)"]
