@@ -15,9 +15,9 @@ from dcfkit.analysis.report import TABLE_FORMATS, default_report_dir, json_ready
 from dcfkit.analysis.reset_scores import ResetRun, score_resets
 from dcfkit.analysis.tables import format_rows, statistics_lines
 from dcfkit.datasets import DatasetError, Sequence, scored_sequences
-from dcfkit.errors import clip
+from dcfkit.errors import ConfigError, clip
 from dcfkit.experiments import EXPERIMENTS
-from dcfkit.experiments.vot import SKIP, failed
+from dcfkit.experiments.vot import RULES, SKIP, get_rule
 from dcfkit.running.files import atomic_write, ensure_writable
 from dcfkit.running.resets import next_start
 from dcfkit.running.results import ResultStore
@@ -30,9 +30,10 @@ EXPERIMENT = EXPERIMENTS["reset"]
 
 
 def reset_runs(folder: Path, sequences: Seq[Sequence]) -> dict[str, ResetRun]:
-    """Sequence name -> :class:`ResetRun` of the intact reset-based results in ``folder``; a run
-    whose starts and failures are not those its boxes and ground truth give
-    (:func:`resets_problem`) is left out, and said so."""
+    """Sequence name -> :class:`ResetRun` of the intact reset-based results in ``folder``, each
+    with the rule that made it; a run of no known rule (dcfkit <= 0.9.0's continuous overlap), or
+    whose starts and failures are not those its boxes and ground truth give (:func:`resets_problem`),
+    is left out, and said so."""
     runs, by_name = {}, {s.name: s for s in sequences}
     for name, result in ResultStore(folder).load(sequences).items():
         seq = by_name[name]
@@ -40,9 +41,16 @@ def reset_runs(folder: Path, sequences: Seq[Sequence]) -> dict[str, ResetRun]:
             log.warning("%s: the result of %r is not a reset-based run (no 'resets' in its sidecar): left out",
                         folder, name)
             continue
+        rule = result.resets.get("rule")
+        if rule not in RULES:
+            log.warning("%s: sequence %r left out, its failures were decided by %s, not a toolkit's rule (%s); run "
+                        "dcfkit eval --experiment reset again to recompute it", folder, name,
+                        "dcfkit <= 0.9.0's continuous overlap" if rule is None else f"rule {rule!r}",
+                        ", ".join(RULES))
+            continue
         height, width = seq.frame(0).shape[:2]
         run = ResetRun(result.boxes, seq.ground_truth, tuple(i - 1 for i in result.resets["starts"]),
-                       tuple(i - 1 for i in result.resets["failures"]), (width, height))
+                       tuple(i - 1 for i in result.resets["failures"]), (width, height), rule)
         problem = resets_problem(run)
         if problem is not None:
             log.warning("%s: sequence %r left out, its sidecar's resets are not its boxes' (%s); run it again to "
@@ -56,8 +64,8 @@ ROUNDING = 1e-3  # the most a result file's %.3f moves a box's edge (x and w eac
 
 
 def resets_problem(run: ResetRun) -> str | None:
-    """Where (``frame <n>``, 1-based) the ``starts`` and ``failures`` of ``run`` part from those VOT's
-    rule gives from its boxes and ground truth, or None. The rule is the runs' own
+    """Where (``frame <n>``, 1-based) the ``starts`` and ``failures`` of ``run`` part from those its
+    rule (:class:`~dcfkit.experiments.vot.ResetRule`) gives from its boxes and ground truth, or None. The rule is the runs' own
     (:mod:`dcfkit.running.resets`): a failure is the first frame after a start whose box does not
     overlap the ground truth; the next start is :func:`~dcfkit.running.resets.next_start` from
     :data:`~dcfkit.experiments.vot.SKIP` frames later (dcfkit <= 0.9.0 did not move a start past a
@@ -107,15 +115,17 @@ def _segment_problem(run: ResetRun, start: int, failure: int | None) -> str | No
 
 def _fails(run: ResetRun, i: int, margin: float) -> bool:
     """Whether frame ``i``'s box, ``margin`` wider on each side, fails (does not overlap the ground
-    truth: :func:`~dcfkit.experiments.vot.failed`)."""
+    truth by the run's rule: :meth:`~dcfkit.experiments.vot.ResetRule.failed`)."""
     x, y, w, h = run.boxes[i]
-    return failed((x - margin, y - margin, w + 2 * margin, h + 2 * margin), run.gt[i], run.bounds)
+    return get_rule(run.rule).failed((x - margin, y - margin, w + 2 * margin, h + 2 * margin), run.gt[i], run.bounds)
 
 
 def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,
-                       report_dir=None, interval: tuple[int, int] | None = None) -> tuple[dict, list[Path]]:
+                       report_dir=None, interval: tuple[int, int] | None = None, protocol: str | None = None
+                       ) -> tuple[dict, list[Path]]:
     """Score the reset-based runs (``<tracker>/reset/``) of every tracker in ``out_dir`` on the
-    sequences all of them ran, and write ``reset_overall`` and ``reset_per_sequence`` tables
+    sequences all of them ran, with the rule they were made with (``protocol``, if given, must be
+    it: a :class:`ConfigError` if not, or if the runs were made with several), and write ``reset_overall`` and ``reset_per_sequence`` tables
     (``.txt``, ``.md``, ``.csv``), ``statistics.txt`` and ``reset.json`` to ``report_dir``
     (default ``<out_dir>_report/reset``). Returns (the scores, the paths)."""
     sequences = scored_sequences(sequences)
@@ -128,10 +138,12 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
         raise DatasetError(f"none of the {len(sequences)} sequences has a reset-based result that can be scored "
                            f"from every tracker (a warning says why a result was left out); run them with dcfkit "
                            f"eval --experiment reset")
+    rule = _one_rule(results, protocol)
     names = [f"reset_{t}.{ext}" for t in RESET_COLUMNS for _, ext in TABLE_FORMATS if ext != "tex"]
     ensure_writable(report_dir, names + ["statistics.txt", "reset.json"], "the report")
     scores = score_resets(results, {s.name: len(s) for s in sequences}, interval)
     scores["experiment"] = {"name": EXPERIMENT.name, "title": EXPERIMENT.title, "source": EXPERIMENT.source}
+    scores["rule"] = {"name": rule.name, "title": rule.title, "tables": rule.tables}
     paths = []
     for table, columns in RESET_COLUMNS.items():
         for fmt, ext in TABLE_FORMATS:
@@ -140,6 +152,24 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
     paths.append(_write(report_dir / "statistics.txt", "\n".join(statistics_lines(scores["statistics"])) + "\n"))
     paths.append(_write(report_dir / "reset.json", json.dumps(json_ready(scores), indent=1) + "\n"))
     return scores, paths
+
+
+def _one_rule(results: dict[str, dict[str, ResetRun]], protocol: str | None):
+    """The :class:`~dcfkit.experiments.vot.ResetRule` every run of ``results`` was made with."""
+    made = {}
+    for tracker, runs in results.items():
+        for run in runs.values():
+            made.setdefault(run.rule, tracker)
+    if len(made) > 1:
+        raise ConfigError("the reset-based runs were made with different failure rules (" + "; ".join(
+            f"{rule}: {tracker}'s" for rule, tracker in made.items()) + "); their scores do not compare: run them "
+            "again with one --protocol, or report them apart with --trackers")
+    rule = get_rule(next(iter(made), protocol))
+    if protocol is not None and made and protocol != rule.name:
+        raise ConfigError(f"--protocol {protocol}: these reset-based runs were made with the {rule.name} rule, whose "
+                          f"failures restarted them; leave --protocol out or give {rule.name} (dcfkit eval --experiment "
+                          f"reset --protocol {protocol} makes runs of the other rule)")
+    return rule
 
 
 def _write(path: Path, text: str) -> Path:
