@@ -42,7 +42,7 @@ def reset_runs(folder: Path, sequences: Seq[Sequence]) -> dict[str, ResetRun]:
                         folder, name)
             continue
         rule = result.resets.get("rule")
-        if rule not in RULES:
+        if not isinstance(rule, str) or rule not in RULES:
             log.warning("%s: sequence %r left out, its failures were decided by %s, not a toolkit's rule (%s); run "
                         "dcfkit eval --experiment reset again to recompute it", folder, name,
                         "dcfkit <= 0.9.0's continuous overlap" if rule is None else f"rule {rule!r}",
@@ -65,12 +65,13 @@ ROUNDING = 1e-3  # the most a result file's %.3f moves a box's edge (x and w eac
 
 def resets_problem(run: ResetRun) -> str | None:
     """Where (``frame <n>``, 1-based) the ``starts`` and ``failures`` of ``run`` part from those its
-    rule (:class:`~dcfkit.experiments.vot.ResetRule`) gives from its boxes and ground truth, or None. The rule is the runs' own
-    (:mod:`dcfkit.running.resets`): a failure is the first frame after a start whose box does not
-    overlap the ground truth; the next start is :func:`~dcfkit.running.resets.next_start` from
-    :data:`~dcfkit.experiments.vot.SKIP` frames later (dcfkit <= 0.9.0 did not move a start past a
-    box off the image: that start is taken too). A decision the rounding of the boxes could turn is
-    taken either way; frames no tracker ran must have no box."""
+    rule (:class:`~dcfkit.experiments.vot.ResetRule`) gives from its boxes and ground truth, or
+    None. The loop is the runs' own (:mod:`dcfkit.running.resets`): a failure is the first frame
+    after a start whose box does not overlap the ground truth; the next start is
+    :func:`~dcfkit.running.resets.next_start` from :data:`~dcfkit.experiments.vot.SKIP` frames
+    later (dcfkit <= 0.9.0 did not move a start past a box off the image: that start is taken
+    too). A decision the rounding of the boxes could turn is taken either way; frames no tracker
+    ran must have no box."""
     gt, size = run.gt, None if run.bounds is None else (run.bounds[1], run.bounds[0])
     tracked = np.zeros(len(gt), dtype=bool)
     due = 0
@@ -125,9 +126,10 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
                        ) -> tuple[dict, list[Path]]:
     """Score the reset-based runs (``<tracker>/reset/``) of every tracker in ``out_dir`` on the
     sequences all of them ran, with the rule they were made with (``protocol``, if given, must be
-    it: a :class:`ConfigError` if not, or if the runs were made with several), and write ``reset_overall`` and ``reset_per_sequence`` tables
-    (``.txt``, ``.md``, ``.csv``), ``statistics.txt`` and ``reset.json`` to ``report_dir``
-    (default ``<out_dir>_report/reset``). Returns (the scores, the paths)."""
+    it: a :class:`ConfigError` if not, or if the runs were made with several), and write
+    ``reset_overall`` and ``reset_per_sequence`` tables (``.txt``, ``.md``, ``.csv``),
+    ``statistics.txt`` and ``reset.json`` to ``report_dir`` (default ``<out_dir>_report/reset``).
+    Returns (the scores, the paths)."""
     sequences = scored_sequences(sequences)
     report_dir = default_report_dir(out_dir, report_dir, EXPERIMENT)
     folders = tracker_folders(out_dir, sequences, trackers, exclude=[report_dir], sub=EXPERIMENT.folder)
@@ -166,9 +168,9 @@ def _one_rule(results: dict[str, dict[str, ResetRun]], protocol: str | None):
             "again with one --protocol, or report them apart with --trackers")
     rule = get_rule(next(iter(made), protocol))
     if protocol is not None and made and protocol != rule.name:
-        raise ConfigError(f"--protocol {protocol}: these reset-based runs were made with the {rule.name} rule, whose "
-                          f"failures restarted them; leave --protocol out or give {rule.name} (dcfkit eval --experiment "
-                          f"reset --protocol {protocol} makes runs of the other rule)")
+        raise ConfigError(f"--protocol {protocol}: these reset-based runs were made with the {rule.name} rule, "
+                          f"whose failures restarted them; leave --protocol out or give {rule.name} (dcfkit eval "
+                          f"--experiment reset --protocol {protocol} makes runs of the other rule)")
     return rule
 
 

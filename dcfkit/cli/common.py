@@ -62,7 +62,7 @@ def add_protocol_argument(parser: argparse.ArgumentParser, reset: bool = False) 
 def check_protocol(args: argparse.Namespace) -> None:
     """A :class:`ConfigError` if ``--protocol`` does not fit ``--experiment``: the reset-based
     experiment takes one of its rules, the others a scoring protocol."""
-    from dcfkit.experiments.vot import RULES
+    from dcfkit.experiments.vot import RULES  # lazy: as add_protocol_argument
 
     if args.protocol is None:
         return

@@ -87,9 +87,11 @@ def trax2016_overlap(boxes, gts, bounds=NO_BOUNDS, inclusive: bool = False) -> n
 def vottoolkit_overlap(boxes, gts, size: tuple[int, int]) -> np.ndarray:
     """Overlaps ``(N,)`` float64 of ``boxes`` and ``gts`` as vot-toolkit 0.9's
     ``calculate_overlap`` of two rectangles inside an image ``size`` ``(width, height)`` (its
-    experiments and analyses bound every overlap so): pixels ``x .. x + w - 1`` of the boxes stored in float32 and rounded; 1 when the union of their bounds is
-    at most one pixel wide or high, 0 when its part inside the image is."""
-    a, b = (np.round(np.asarray(v, dtype=np.float64).reshape(-1, 4).astype(_F)).astype(np.float64) for v in (boxes, gts))
+    experiments and analyses bound every overlap so): pixels ``x .. x + w - 1`` of the boxes stored
+    in float32 and rounded (half to even); 1 when the union of their bounds is at most one pixel
+    wide or high, 0 when its part inside the image is."""
+    a, b = (np.round(np.asarray(v, dtype=np.float64).reshape(-1, 4).astype(_F)).astype(np.float64)
+            for v in (boxes, gts))
     ends_a, ends_b = a[:, :2] + a[:, 2:] - 1, b[:, :2] + b[:, 2:] - 1
     low, high = np.minimum(a[:, :2], b[:, :2]), np.maximum(ends_a, ends_b)
     one = (low >= high).any(axis=1)
