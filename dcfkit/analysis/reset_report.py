@@ -18,9 +18,9 @@ from dcfkit.analysis.reset_scores import ResetRun, score_resets
 from dcfkit.analysis.setting import cut_length, experiment_line, experiment_record
 from dcfkit.analysis.tables import format_rows, statistics_lines
 from dcfkit.datasets import DatasetError, Sequence, scored_sequences
-from dcfkit.errors import clip
+from dcfkit.errors import ConfigError, clip
 from dcfkit.experiments import EXPERIMENTS
-from dcfkit.experiments.vot import SKIP, failed
+from dcfkit.experiments.vot import RULES, SKIP, get_rule
 from dcfkit.running.files import atomic_write, ensure_writable
 from dcfkit.running.resets import next_start
 from dcfkit.running.results import ResultStore
@@ -33,9 +33,10 @@ EXPERIMENT = EXPERIMENTS["reset"]
 
 
 def reset_runs(folder: Path, sequences: Seq[Sequence]) -> dict[str, ResetRun]:
-    """Sequence name -> :class:`ResetRun` of the intact reset-based results in ``folder``; a run
-    whose starts and failures are not those its boxes and ground truth give
-    (:func:`resets_problem`) is left out, and said so."""
+    """Sequence name -> :class:`ResetRun` of the intact reset-based results in ``folder``, each
+    with the rule that made it; a run of no known rule (dcfkit <= 0.9.0's continuous overlap), or
+    whose starts and failures are not those its boxes and ground truth give (:func:`resets_problem`),
+    is left out, and said so."""
     runs, by_name = {}, {s.name: s for s in sequences}
     for name, result in ResultStore(folder).load(sequences).items():
         seq = by_name[name]
@@ -43,9 +44,16 @@ def reset_runs(folder: Path, sequences: Seq[Sequence]) -> dict[str, ResetRun]:
             log.warning("%s: the result of %r is not a reset-based run (no 'resets' in its sidecar): left out",
                         folder, name)
             continue
+        rule = result.resets.get("rule")
+        if not isinstance(rule, str) or rule not in RULES:
+            log.warning("%s: sequence %r left out, its failures were decided by %s, not a toolkit's rule (%s); run "
+                        "dcfkit eval --experiment reset again to recompute it", folder, name,
+                        "dcfkit <= 0.9.0's continuous overlap" if rule is None else f"rule {rule!r}",
+                        ", ".join(RULES))
+            continue
         height, width = seq.frame(0).shape[:2]
         run = ResetRun(result.boxes, seq.ground_truth, tuple(i - 1 for i in result.resets["starts"]),
-                       tuple(i - 1 for i in result.resets["failures"]), (width, height))
+                       tuple(i - 1 for i in result.resets["failures"]), (width, height), rule)
         problem = resets_problem(run)
         if problem is not None:
             log.warning("%s: sequence %r left out, its sidecar's resets are not its boxes' (%s); run it again to "
@@ -59,13 +67,14 @@ ROUNDING = 1e-3  # the most a result file's %.3f moves a box's edge (x and w eac
 
 
 def resets_problem(run: ResetRun) -> str | None:
-    """Where (``frame <n>``, 1-based) the ``starts`` and ``failures`` of ``run`` part from those VOT's
-    rule gives from its boxes and ground truth, or None. The rule is the runs' own
-    (:mod:`dcfkit.running.resets`): a failure is the first frame after a start whose box does not
-    overlap the ground truth; the next start is :func:`~dcfkit.running.resets.next_start` from
-    :data:`~dcfkit.experiments.vot.SKIP` frames later (dcfkit <= 0.9.0 did not move a start past a
-    box off the image: that start is taken too). A decision the rounding of the boxes could turn is
-    taken either way; frames no tracker ran must have no box."""
+    """Where (``frame <n>``, 1-based) the ``starts`` and ``failures`` of ``run`` part from those its
+    rule (:class:`~dcfkit.experiments.vot.ResetRule`) gives from its boxes and ground truth, or
+    None. The loop is the runs' own (:mod:`dcfkit.running.resets`): a failure is the first frame
+    after a start whose box does not overlap the ground truth; the next start is
+    :func:`~dcfkit.running.resets.next_start` from :data:`~dcfkit.experiments.vot.SKIP` frames
+    later (dcfkit <= 0.9.0 did not move a start past a box off the image: that start is taken
+    too). A decision the rounding of the boxes could turn is taken either way; frames no tracker
+    ran must have no box."""
     gt, size = run.gt, None if run.bounds is None else (run.bounds[1], run.bounds[0])
     tracked = np.zeros(len(gt), dtype=bool)
     due = 0
@@ -110,18 +119,21 @@ def _segment_problem(run: ResetRun, start: int, failure: int | None) -> str | No
 
 def _fails(run: ResetRun, i: int, margin: float) -> bool:
     """Whether frame ``i``'s box, ``margin`` wider on each side, fails (does not overlap the ground
-    truth: :func:`~dcfkit.experiments.vot.failed`)."""
+    truth by the run's rule: :meth:`~dcfkit.experiments.vot.ResetRule.failed`)."""
     x, y, w, h = run.boxes[i]
-    return failed((x - margin, y - margin, w + 2 * margin, h + 2 * margin), run.gt[i], run.bounds)
+    return get_rule(run.rule).failed((x - margin, y - margin, w + 2 * margin, h + 2 * margin), run.gt[i], run.bounds)
 
 
 def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,
-                       report_dir=None, interval: tuple[int, int] | None = None) -> tuple[dict, list[Path]]:
+                       report_dir=None, interval: tuple[int, int] | None = None, protocol: str | None = None
+                       ) -> tuple[dict, list[Path]]:
     """Score the reset-based runs (``<tracker>/reset/``) of every tracker in ``out_dir`` on the
-    sequences all of them ran, and write ``reset_overall`` and ``reset_per_sequence`` tables
-    (``.txt``, ``.md``, ``.csv``; ``reset_overall.tex``: :func:`reset_latex`), ``statistics.txt``
-    and ``reset.json`` to ``report_dir`` (default ``<out_dir>_report/reset``), each naming the
-    experiment and any ``--max-frames`` cut. Returns (the scores, the paths)."""
+    sequences all of them ran, with the rule they were made with (``protocol``, if given, must be
+    it: a :class:`ConfigError` if not, or if the runs were made with several), and write
+    ``reset_overall`` and ``reset_per_sequence`` tables (``.txt``, ``.md``, ``.csv``;
+    ``reset_overall.tex``: :func:`reset_latex`), ``statistics.txt`` and ``reset.json`` to
+    ``report_dir`` (default ``<out_dir>_report/reset``), each naming the experiment, the rule
+    and any ``--max-frames`` cut. Returns (the scores, the paths)."""
     sequences = scored_sequences(sequences)
     report_dir = default_report_dir(out_dir, report_dir, EXPERIMENT)
     folders = tracker_folders(out_dir, sequences, trackers, exclude=[report_dir], sub=EXPERIMENT.folder)
@@ -134,11 +146,13 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
         raise DatasetError(f"none of the {len(sequences)} sequences has a reset-based result that can be scored "
                            f"from every tracker (a warning says why a result was left out); run them with dcfkit "
                            f"eval --experiment reset")
+    rule = _one_rule(results, protocol)
     names = [f"reset_{t}.{ext}" for t in RESET_COLUMNS for _, ext in TABLE_FORMATS if ext != "tex"]
     ensure_writable(report_dir, names + ["reset_overall.tex", "statistics.txt", "reset.json"], "the report")
     scores = score_resets(results, {s.name: len(s) for s in sequences}, interval)
     scores["experiment"] = experiment_record(EXPERIMENT)
     scores["max_frames"] = cut_length(sequences)
+    scores["rule"] = {"name": rule.name, "title": rule.title, "tables": rule.tables}
     paths = []
     for table, columns in RESET_COLUMNS.items():
         for fmt, ext in TABLE_FORMATS:
@@ -153,8 +167,9 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
 
 def _eao_line(scores: dict) -> str:
     low, high = scores["interval"]
-    return (f"EAO over sequence lengths {low}..{high} (VOT2016), its interval a percentile bootstrap over "
-            f"sequences")
+    rule = scores["rule"]
+    return (f"overlaps and failures: {rule['name']} ({rule['title']}); EAO over sequence lengths {low}..{high} "
+            f"(VOT2016), its interval a percentile bootstrap over sequences")
 
 
 def reset_table(scores: dict, table: str, fmt: str) -> str:
@@ -177,6 +192,24 @@ def reset_latex(scores: dict) -> str:
         raise DatasetError("no tracker's reset-based runs to tabulate")
     return comparison_table(scores["statistics"], [experiment_line(EXPERIMENT, scores.get("max_frames")),
                                                    _eao_line(scores)], lead=[("EAO [CI]", eao)])
+
+
+def _one_rule(results: dict[str, dict[str, ResetRun]], protocol: str | None):
+    """The :class:`~dcfkit.experiments.vot.ResetRule` every run of ``results`` was made with."""
+    made = {}
+    for tracker, runs in results.items():
+        for run in runs.values():
+            made.setdefault(run.rule, tracker)
+    if len(made) > 1:
+        raise ConfigError("the reset-based runs were made with different failure rules (" + "; ".join(
+            f"{rule}: {tracker}'s" for rule, tracker in made.items()) + "); their scores do not compare: run them "
+            "again with one --protocol, or report them apart with --trackers")
+    rule = get_rule(next(iter(made), protocol))
+    if protocol is not None and made and protocol != rule.name:
+        raise ConfigError(f"--protocol {protocol}: these reset-based runs were made with the {rule.name} rule, "
+                          f"whose failures restarted them; leave --protocol out or give {rule.name} (dcfkit eval "
+                          f"--experiment reset --protocol {protocol} makes runs of the other rule)")
+    return rule
 
 
 def _write(path: Path, text: str) -> Path:

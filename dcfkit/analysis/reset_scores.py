@@ -2,8 +2,10 @@
 robustness and the expected average overlap (EAO), as VOT2016 defines them (Kristan et al.,
 TPAMI 2016; docs/evaluation.md, "Reset-based experiment").
 
-Overlaps are those of :func:`dcfkit.experiments.vot.overlap`, inside the image. As the
-VOT2016 (MATLAB) toolkit computes them (``estimate_accuracy.m``,
+Overlaps are those of the run's :class:`~dcfkit.experiments.vot.ResetRule` (the rule that
+decided its failures): VOT2016's averages unbounded overlaps in the accuracy and overlaps
+inside the image in the EAO, vot-toolkit's the same in both. As the VOT2016 (MATLAB) toolkit
+computes them (``estimate_accuracy.m``,
 ``estimate_expected_overlap.m``, ``analyze_average_expected_overlap.m``):
 
 * **Accuracy**: the mean overlap of the tracked frames, leaving out the
@@ -32,7 +34,7 @@ import numpy as np
 from scipy import stats
 
 from dcfkit.analysis import statistics
-from dcfkit.experiments.vot import BURN_IN, overlap
+from dcfkit.experiments.vot import BURN_IN, DEFAULT_RULE, get_rule
 
 __all__ = ["ResetRun", "eao", "eao_interval", "expected_overlaps", "fragments", "pooled_accuracy", "score_resets",
            "sequence_scores"]
@@ -41,29 +43,38 @@ __all__ = ["ResetRun", "eao", "eao_interval", "expected_overlaps", "fragments", 
 @dataclasses.dataclass(frozen=True)
 class ResetRun:
     """One reset-based run: ``boxes`` ``(N, 4)`` 0-based (NaN where not tracked), the ground
-    truth ``gt``, the 0-based ``starts`` and ``failures``, and the image ``bounds``
-    ``(width, height)`` (None: not cut)."""
+    truth ``gt``, the 0-based ``starts`` and ``failures``, the image ``bounds``
+    ``(width, height)`` (None: not cut) and the name of the ``rule`` that decided its failures."""
 
     boxes: np.ndarray
     gt: np.ndarray
     starts: tuple[int, ...]
     failures: tuple[int, ...]
     bounds: tuple[float, float] | None = None
+    rule: str = DEFAULT_RULE
+
+    def _overlaps(self, overlap) -> np.ndarray:
+        """Each frame's ``overlap`` with the ground truth (NaN where either is missing)."""
+        out = np.full(len(self.gt), np.nan)
+        tracked = np.isfinite(self.boxes).all(axis=1)
+        if tracked.any():
+            out[tracked] = overlap(self.boxes[tracked], self.gt[tracked], self.bounds)
+        return out
 
     @functools.cached_property
     def overlaps(self) -> np.ndarray:
-        """Each frame's overlap with the ground truth (NaN where either is missing); computed
-        once, read by the accuracy, the fragments and the EAO."""
-        out = np.full(len(self.gt), np.nan)
-        for i, (box, gt) in enumerate(zip(self.boxes, self.gt)):
-            if np.isfinite(box).all():
-                out[i] = overlap(box, gt, self.bounds)
-        return out
+        """Each frame's overlap as the rule's EAO takes it; computed once, read by the fragments."""
+        return self._overlaps(get_rule(self.rule).eao)
+
+    @functools.cached_property
+    def accuracy_overlaps(self) -> np.ndarray:
+        """Each frame's overlap as the rule's accuracy takes it."""
+        return self._overlaps(get_rule(self.rule).accuracy)
 
 
 def _accuracy_frames(run: ResetRun) -> tuple[np.ndarray, np.ndarray]:
     """(each frame's overlap, whether it counts in the accuracy)."""
-    o = run.overlaps
+    o = run.accuracy_overlaps
     counted = np.isfinite(o)
     for start in run.starts:
         counted[start:start + BURN_IN] = False

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from dcfkit.errors import DcfkitError, shown
+from dcfkit.errors import ConfigError, DcfkitError, shown
 from dcfkit.protocols import DEFAULT, PROTOCOLS
 from dcfkit.running.scheduler import check_address
 
@@ -44,14 +44,34 @@ seed = _argument_type(int, lambda v: v >= 0, "a whole number >= 0")  # numpy ref
 variant_count = _argument_type(int, lambda v: v >= 1, "a whole number of variants >= 1")
 
 
-def add_protocol_argument(parser: argparse.ArgumentParser) -> None:
-    """``--protocol``, for the commands that print scores."""
-    parser.add_argument("--protocol", choices=tuple(PROTOCOLS), default=None,
+def add_protocol_argument(parser: argparse.ArgumentParser, reset: bool = False) -> None:
+    """``--protocol``, for the commands that print scores; ``reset``: also the rules of the
+    reset-based experiment (:func:`check_protocol` matches them to ``--experiment``)."""
+    from dcfkit.experiments.vot import DEFAULT_RULE, RULES  # lazy: the parser is built before any command runs
+
+    extra = (f"; with --experiment reset: {DEFAULT_RULE} (default: the VOT2016 toolkit's overlap, failures and "
+             f"scores) or vot-toolkit (vot-toolkit 0.9's)") if reset else ""
+    parser.add_argument("--protocol", choices=tuple(PROTOCOLS) + (tuple(RULES) if reset else ()), default=None,
                         help="scoring rules: otb (the OTB / UAV123 MATLAB toolkit, which computed the published "
                              "UAV123 tables), pysot, got10k or lasot (the LaSOT toolkit: absent frames fail); "
                              "default: the rules of the benchmark's published tables (lasot for LaSOT, got10k "
-                             f"for GOT-10k, {DEFAULT} for the others, `dcfkit datasets` says which); "
+                             f"for GOT-10k, {DEFAULT} for the others, `dcfkit datasets` says which){extra}; "
                              "docs/evaluation.md lists the differences")
+
+
+def check_protocol(args: argparse.Namespace) -> None:
+    """A :class:`ConfigError` if ``--protocol`` does not fit ``--experiment``: the reset-based
+    experiment takes one of its rules, the others a scoring protocol."""
+    from dcfkit.experiments.vot import RULES  # lazy: as add_protocol_argument
+
+    if args.protocol is None:
+        return
+    if args.experiment == "reset" and args.protocol not in RULES:
+        raise ConfigError(f"--protocol {args.protocol} scores one-pass runs; --experiment reset takes "
+                          f"{' or '.join(RULES)} (the toolkit whose overlap decides failures and scores)")
+    if args.experiment != "reset" and args.protocol in RULES:
+        raise ConfigError(f"--protocol {args.protocol} is a rule of the reset-based experiment; give --experiment "
+                          f"reset, or for --experiment {args.experiment} one of {', '.join(PROTOCOLS)}")
 
 
 def add_dataset_arguments(parser: argparse.ArgumentParser, root_help: str = "benchmark root folder") -> None:

@@ -28,6 +28,7 @@ from dcfkit.cli.common import (
     add_experiment_argument,
     add_max_frames_argument,
     add_protocol_argument,
+    check_protocol,
     pixels,
 )
 from dcfkit.config import load_config
@@ -35,6 +36,7 @@ from dcfkit.config.overrides import parse_overrides
 from dcfkit.datasets import benchmark_protocol, load_datasets, scored_sequences
 from dcfkit.errors import ConfigError, printable, shown
 from dcfkit.experiments import runs_by_sequence
+from dcfkit.experiments.vot import get_rule
 from dcfkit.integrations.opencv import opencv_tracker
 from dcfkit.running.evaluation import check_one_pass, results_folder, run_one_pass, tracker_name
 from dcfkit.running.results import load_results
@@ -51,7 +53,7 @@ def add_eval_arguments(parser: argparse.ArgumentParser) -> None:
                         help="override a config value (repeatable), e.g. --set solver.iterations=3")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_max_frames_argument(parser)
-    add_protocol_argument(parser)
+    add_protocol_argument(parser, reset=True)
     add_experiment_argument(parser)
 
 
@@ -83,17 +85,20 @@ def distinct_names(specs: list[str], resolved: list[tuple[dict, Callable | None]
 
 def run_eval(args: argparse.Namespace) -> int:
     """Run each config on the dataset and print its scores; exit status 1 if a sequence failed."""
+    check_protocol(args)
+    rule = args.protocol if args.experiment == "reset" else None
     sequences = [s.head(args.max_frames) for s in load_datasets(args.dataset, args.root, args.sequences)]
-    if args.protocol is None:  # pooled benchmarks scored by different rules: refused before any run
+    if args.protocol is None and args.experiment != "reset":  # pooled benchmarks of different rules: refused
         benchmark_protocol(sequences)
     overrides = parse_overrides(args.overrides)
     resolved = distinct_names(args.configs, [_resolve_config(spec, overrides) for spec in args.configs])
     for config, _ in resolved:  # every config's folder and results checked before the first runs
-        check_one_pass(config, sequences, args.out, args.experiment)
+        check_one_pass(config, sequences, args.out, args.experiment, rule)
     status = 0
     for config, factory in resolved:
         summary = run_one_pass(config, sequences, args.out, make_tracker=factory,
-                               jobs=args.jobs, progress=not args.no_progress, experiment=args.experiment)
+                               jobs=args.jobs, progress=not args.no_progress, experiment=args.experiment,
+                               reset_rule=rule)
         print(f"{summary['tracker']}: {len(summary['done'])} run, {len(summary['skipped'])} "
               f"already done, {len(summary['failed'])} failed -> {summary['dir']}")
         print(f"  {_scores(args, summary['tracker'], sequences)}")
@@ -114,7 +119,7 @@ def _scores(args: argparse.Namespace, tracker: str, sequences: list) -> str:
         scored = scored_sequences(sequences)
         row = score_resets({tracker: reset_runs(folder, scored)}, {s.name: len(s) for s in scored})["overall"][0]
         return (f"EAO {row['eao']:.3f}, accuracy {row['accuracy']:.3f}, {row['failures']} failures on "
-                f"{row['sequences']} sequences (reset-based, VOT2016)")
+                f"{row['sequences']} sequences (reset-based, {get_rule(args.protocol).title})")
     by_sequence = runs_by_sequence(scored_sequences(sequences), args.experiment)
     runs = [run for found in by_sequence.values() for run in found]
     scores = evaluate({tracker: load_results(folder.parent, folder.name, runs)}, sequences, protocol=args.protocol,
@@ -140,7 +145,7 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
                         help="also write report.html: one self-contained page with sortable tables, interactive "
                              "plots, each sequence's frames with every tracker's box, and the provenance (ope, tre, "
                              "sre)")
-    add_protocol_argument(parser)
+    add_protocol_argument(parser, reset=True)
     parser.add_argument("--skip-first", action="store_true",
                         help="do not score frame 1 (default: as the protocol; otb scores it with the ground "
                              "truth as the prediction, pysot as the file has it, got10k never)")
@@ -157,6 +162,7 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run_report(args: argparse.Namespace) -> int:
     """Print the overall table and write the report files."""
+    check_protocol(args)
     sequences = [s.head(args.max_frames) for s in load_datasets(args.dataset, args.root, args.sequences)]
     trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
     if args.experiment == "reset":
@@ -190,7 +196,7 @@ def run_report(args: argparse.Namespace) -> int:
 
 def _reset_report(args: argparse.Namespace, sequences: list, trackers: list[str] | None) -> int:
     """``report --experiment reset``: the accuracy, failures and EAO table and the statistics."""
-    scores, paths = write_reset_report(args.out, sequences, trackers, args.report_dir)
+    scores, paths = write_reset_report(args.out, sequences, trackers, args.report_dir, protocol=args.protocol)
     print(reset_latex(scores) if args.format == "latex" else reset_table(scores, "overall", args.format), end="")
     if args.format == "table":
         for name, without in scores["left_out"].items():

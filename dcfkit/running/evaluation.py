@@ -27,6 +27,7 @@ import numpy as np
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.errors import ConfigError, shown
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
+from dcfkit.experiments.vot import get_rule
 from dcfkit.running.claims import claimed
 from dcfkit.running.files import ensure_writable, make_dir, remove_temporary_files
 from dcfkit.running.provenance import dcfkit_version, json_default, run_key
@@ -91,6 +92,22 @@ def _say_what_is_recomputed(store: ResultStore, metas: dict, todo: list[Sequence
                     ", ".join(replaced[:10]))
 
 
+def _reset_rule_of(meta: dict | None) -> str | None:
+    """The rule a reset-based run's sidecar records (None: none, as dcfkit <= 0.9.0 wrote them)."""
+    resets = (meta or {}).get("resets")
+    return resets.get("rule") if isinstance(resets, dict) else None
+
+
+def _say_other_rule(store: ResultStore, metas: dict, todo: list[Sequence], rule: str) -> None:
+    """Say so when reset-based results are recomputed because another failure rule made them."""
+    other = {s.name: _reset_rule_of(metas[s.name]) or "dcfkit <= 0.9.0's continuous overlap" for s in todo
+             if isinstance((metas[s.name] or {}).get("resets"), dict) and _reset_rule_of(metas[s.name]) != rule}
+    if other:
+        log.warning("%s: recomputing %d reset-based result(s) whose failures another rule decided (%s), with %s's: "
+                    "%s", store.folder, len(other), ", ".join(sorted(set(other.values()))), rule,
+                    ", ".join(list(other)[:10]))
+
+
 def results_folder(out_dir, config: Mapping, experiment: str | Experiment = "ope") -> Path:
     """Where ``config``'s results of ``experiment`` go: ``OUT/<name>/`` or ``OUT/<name>/<experiment>/``."""
     folder = Path(out_dir) / tracker_name(config)
@@ -103,17 +120,19 @@ def experiment_runs(sequences: Iterable[Sequence], experiment: str | Experiment 
     return [run for runs in runs_by_sequence(sequences, experiment).values() for run in runs]
 
 
-def _plan(config: dict, sequences: list[Sequence], runs: list[Sequence], out_dir, experiment: Experiment
-          ) -> tuple[ResultStore, str, list[Sequence], dict]:
+def _plan(config: dict, sequences: list[Sequence], runs: list[Sequence], out_dir, experiment: Experiment,
+          rule: str | None = None) -> tuple[ResultStore, str, list[Sequence], dict]:
     """(store, run key, runs to do, every run's sidecar), after every check that needs no
     tracking: the first boxes, the benchmark of the results there, that no run replaces one of
-    more frames, and (when anything is to run) that the folder takes the result files."""
+    more frames, and (when anything is to run) that the folder takes the result files. ``rule``:
+    a reset-based run's failure rule, part of its key."""
     if experiment.first_box:
         _check_first_boxes(sequences)
-    key = run_key(config)
+    key = run_key(config, reset_rule=rule if experiment.resets else None)
     store = ResultStore(results_folder(out_dir, config, experiment))
     metas = {s.name: store.sidecar(s.name) for s in runs}  # each read once
-    todo = [s for s in runs if store.status(s, key, metas[s.name]) != "done"]
+    todo = [s for s in runs if store.status(s, key, metas[s.name]) != "done"
+            or (experiment.resets and _reset_rule_of(metas[s.name]) != rule)]
     _check_same_dataset(store, metas, todo)
     for run in todo:
         store.refuse_to_shorten(run, metas[run.name])
@@ -123,17 +142,21 @@ def _plan(config: dict, sequences: list[Sequence], runs: list[Sequence], out_dir
     return store, key, todo, metas
 
 
-def check_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, experiment: str = "ope") -> None:
+def check_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, experiment: str = "ope",
+                   reset_rule: str | None = None) -> None:
     """Raise now what :func:`run_one_pass` would raise before tracking (``dcfkit eval`` checks
     every config this way before it runs the first)."""
     sequences = list(sequences)
-    _plan(dict(config), sequences, experiment_runs(sequences, experiment), out_dir, get_experiment(experiment))
+    _plan(dict(config), sequences, experiment_runs(sequences, experiment), out_dir, get_experiment(experiment),
+          get_rule(reset_rule).name)
 
 
 def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_tracker=None,
-                 jobs: int = 1, progress: bool = True, experiment: str | Experiment = "ope") -> dict:
+                 jobs: int = 1, progress: bool = True, experiment: str | Experiment = "ope",
+                 reset_rule: str | None = None) -> dict:
     """Evaluate the tracker described by ``config`` on ``sequences`` in ``experiment``
-    (default one pass: each sequence once, from frame 1's ground truth).
+    (default one pass: each sequence once, from frame 1's ground truth); a reset-based run's
+    failures are ``reset_rule``'s (:data:`~dcfkit.experiments.vot.RULES`, default VOT2016's).
 
     Each run starts from a fresh tracker; results go to :func:`results_folder`. Runs with
     intact results of the same run key are skipped; before anything is tracked, the folder is
@@ -146,6 +169,7 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     :mod:`dcfkit.experiments` names them (one pass: the sequences' names).
     """
     config, sequences, experiment = dict(config), list(sequences), get_experiment(experiment)
+    rule = get_rule(reset_rule).name
     folder = results_folder(out_dir, config, experiment)
     if not folder.is_dir():
         make_dir(folder)  # a first run: the locks need the folder
@@ -153,12 +177,15 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     kind = "sequence" if experiment.name == "ope" else "run"
     with claimed(folder, [run.name for run in runs], "dcfkit eval",  # other runs of this folder may go on alongside
                  lambda name: f"{tracker_name(config)}'s results of {kind} {name!r} to {folder}"):
-        store, key, todo, metas = _plan(config, sequences, runs, out_dir, experiment)
+        store, key, todo, metas = _plan(config, sequences, runs, out_dir, experiment, rule)
         _say_what_is_recomputed(store, metas, todo, config, key)
+        if experiment.resets:
+            _say_other_rule(store, metas, todo, rule)
         remove_temporary_files(store.folder, [f for s in todo for f in store.file_names(s.name)])
         summary = {"tracker": tracker_name(config), "dir": store.folder, "run_key": key,
                    "done": [], "skipped": [s.name for s in runs if s not in todo], "failed": {}}
-        _run(summary, [RunTask(config, s, store.folder, key, make_tracker, experiment.resets) for s in todo],
+        _run(summary, [RunTask(config, s, store.folder, key, make_tracker, experiment.resets, rule)
+                       for s in todo],
              jobs, progress, dcfkit_version())
     order = {s.name: i for i, s in enumerate(runs)}
     summary["done"].sort(key=order.get)

@@ -13,7 +13,7 @@ import numpy as np
 
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.experiments.starts import start_problem
-from dcfkit.experiments.vot import SKIP, failed, valid_box
+from dcfkit.experiments.vot import DEFAULT_RULE, SKIP, ResetRule, get_rule, valid_box
 from dcfkit.running.tracking import Track, TrackerFailure, steps
 
 
@@ -22,16 +22,19 @@ class ResetTrack(Track):
     """A :class:`Track` of a reset-based run: frames not tracked (between a failure and the
     next start) have NaN boxes, times and confidences; ``starts`` and ``failures`` are 0-based
     frame indices; ``moved`` maps a start made later than due (frame 1, or :data:`SKIP`
-    frames after a failure) to the frame it was due."""
+    frames after a failure) to the frame it was due; ``rule`` names the
+    :class:`~dcfkit.experiments.vot.ResetRule` that decided the failures."""
 
+    rule: str = DEFAULT_RULE
     starts: list[int] = dataclasses.field(default_factory=list)
     failures: list[int] = dataclasses.field(default_factory=list)
     moved: dict[int, int] = dataclasses.field(default_factory=dict)
 
     def record(self) -> dict:
-        """The sidecar's ``resets``: 1-based ``starts`` and ``failures``, as every frame number
-        dcfkit shows, and, if a start was made later than due, ``moved``: ``[due, start]`` of each."""
-        record = {"starts": [i + 1 for i in self.starts], "failures": [i + 1 for i in self.failures]}
+        """The sidecar's ``resets``: the ``rule``, 1-based ``starts`` and ``failures``, as every frame
+        number dcfkit shows, and, if a start was made later than due, ``moved``: ``[due, start]`` of each."""
+        record = {"rule": self.rule, "starts": [i + 1 for i in self.starts],
+                  "failures": [i + 1 for i in self.failures]}
         if self.moved:
             record["moved"] = [[due + 1, start + 1] for start, due in self.moved.items()]
         return record
@@ -53,13 +56,14 @@ def next_start(gt: np.ndarray, frame: int, image_size: tuple[int, int] | None = 
 
 
 def track_with_resets(make_tracker: Callable[[], object], seq: Sequence, frame: Callable[[int], np.ndarray],
-                      on_frame: Callable[[], None] | None = None) -> ResetTrack:
+                      on_frame: Callable[[], None] | None = None, rule: str = DEFAULT_RULE) -> ResetTrack:
     """Run fresh trackers from ``make_tracker()`` through ``seq`` (frames read by ``frame(i)``),
     each from the ground truth, the first at frame 1 and the next :data:`SKIP` frames after
-    each failure (a frame whose box does not overlap a valid ground truth); a start moves on to
-    the next frame whose ground truth is valid and inside the image (:func:`next_start`)."""
-    n = len(seq)
-    run = ResetTrack(np.full((n, 4), np.nan), np.full(n, np.nan), np.full((n, 2), np.nan))
+    each failure (a frame whose box does not overlap a valid ground truth by ``rule``'s
+    overlap); a start moves on to the next frame whose ground truth is valid and inside the
+    image (:func:`next_start`)."""
+    n, found = len(seq), get_rule(rule)
+    run = ResetTrack(np.full((n, 4), np.nan), np.full(n, np.nan), np.full((n, 2), np.nan), rule=found.name)
     due, size = 0, None  # the image size: unknown until a frame is read
     start = next_start(seq.ground_truth, due)
     while start is not None:
@@ -72,7 +76,7 @@ def track_with_resets(make_tracker: Callable[[], object], seq: Sequence, frame: 
         if start != due:
             run.moved[start] = due
         run.starts.append(start)
-        failure = _segment(make_tracker(), seq, frame, start, image, run, on_frame)
+        failure = _segment(make_tracker(), seq, frame, start, image, run, on_frame, found)
         if failure is None:
             break
         run.failures.append(failure)
@@ -85,7 +89,7 @@ def track_with_resets(make_tracker: Callable[[], object], seq: Sequence, frame: 
 
 
 def _segment(tracker, seq: Sequence, frame: Callable[[int], np.ndarray], start: int, first: np.ndarray,
-             run: ResetTrack, on_frame: Callable[[], None] | None) -> int | None:
+             run: ResetTrack, on_frame: Callable[[], None] | None, rule: ResetRule) -> int | None:
     """Track from ``start`` (its image ``first``, read) into ``run`` until a failure (its 0-based
     frame) or the end (None)."""
     frames = itertools.chain([first], (frame(i) for i in range(start + 1, len(seq))))
@@ -96,7 +100,7 @@ def _segment(tracker, seq: Sequence, frame: Callable[[int], np.ndarray], start: 
             if on_frame is not None:
                 on_frame()
             bounds = (step.image.shape[1], step.image.shape[0])
-            if step.index > 0 and failed(step.box, seq.ground_truth[i], bounds):
+            if step.index > 0 and rule.failed(step.box, seq.ground_truth[i], bounds):
                 return i
     except TrackerFailure as exc:  # steps numbers the frames from this start
         raise TrackerFailure(start + exc.frame, exc.detail) from exc.__cause__

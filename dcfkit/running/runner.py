@@ -26,6 +26,7 @@ import cv2
 import numpy as np
 
 from dcfkit.datasets import Sequence
+from dcfkit.experiments.vot import DEFAULT_RULE
 from dcfkit.errors import DcfkitError, shown
 from dcfkit.registry import PluginWarning
 from dcfkit.running import platforms
@@ -56,7 +57,8 @@ _THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS",
 class RunTask:
     """One run to do: ``config`` on ``seq`` into the store at ``folder`` under ``key``.
     ``make_tracker(config)`` builds the tracker (None: :func:`dcfkit.load_tracker`);
-    ``resets``: VOT's reset-based run (:mod:`dcfkit.running.resets`)."""
+    ``resets``: VOT's reset-based run (:mod:`dcfkit.running.resets`), its failures decided by
+    the :class:`~dcfkit.experiments.vot.ResetRule` named ``rule``."""
 
     config: dict
     seq: Sequence
@@ -64,6 +66,7 @@ class RunTask:
     key: str
     make_tracker: Callable | None = None
     resets: bool = False
+    rule: str = DEFAULT_RULE
 
 
 # --------------------------------------------------------------------------- one run
@@ -129,7 +132,7 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
         tracker = make()
         if task.resets:
             first = [tracker]  # the tracker made above starts the run; each restart gets a fresh one
-            run = track_with_resets(lambda: first.pop() if first else make(), seq, read, tick)
+            run = track_with_resets(lambda: first.pop() if first else make(), seq, read, tick, task.rule)
         else:
             run = track(tracker, (read(i) for i in range(len(seq))), seq.init_box, tick)
     except Exception as exc:
@@ -225,7 +228,7 @@ def run_in_worker(task: RunTask, version: str, origin: Mapping | None = None) ->
     if dcfkit_version() != version:
         raise DcfkitError(f"this worker runs dcfkit {dcfkit_version()}, the client {version}; "
                           f"install the same version on every worker")
-    if task.make_tracker is None and run_key(task.config, version) != task.key:
+    if task.make_tracker is None and run_key(task.config, version, task.rule if task.resets else None) != task.key:
         plugins = ", ".join(plugin_versions(task.config)) or "none"
         raise DcfkitError(f"this worker's dcfkit code ({box_code()}) or plugins ({plugins}) are not the client's: "
                           f"install the same dcfkit source and plugin versions on every worker")

@@ -19,7 +19,7 @@ from dcfkit import cli
 from dcfkit.analysis.reset_report import resets_problem
 from dcfkit.analysis.reset_scores import ResetRun
 from dcfkit.datasets import Sequence, load_dataset
-from dcfkit.experiments.vot import overlap
+from dcfkit.experiments.vot import get_rule
 from dcfkit.running.evaluation import run_one_pass
 from dcfkit.running.files import format_boxes
 from dcfkit.running.resets import track_with_resets
@@ -101,8 +101,8 @@ NOT_RECORDED = "the box does not overlap the ground truth, a failure its sidecar
 
 
 @pytest.mark.parametrize("change", [
-    lambda r: ({"starts": [1, 18], "failures": []}, f"frame {r['failures'][0]}: {NOT_RECORDED}"),  # an IndexError
-    lambda r: ({"starts": [1], "failures": []}, f"frame {r['failures'][0]}: {NOT_RECORDED}"),  # failures hidden
+    lambda r: ({**r, "starts": [1, 18], "failures": []}, f"frame {r['failures'][0]}: {NOT_RECORDED}"),  # an IndexError
+    lambda r: ({**r, "starts": [1], "failures": []}, f"frame {r['failures'][0]}: {NOT_RECORDED}"),  # failures hidden
     lambda r: ({**r, "failures": r["failures"][1:]}, f"frame {r['failures'][0]}: {NOT_RECORDED}"),
     lambda r: ({**r, "starts": [1, r["starts"][1] + 1, *r["starts"][2:]]},
                f"frame {r['starts'][1] + 1}: its sidecar records a start where the rule gives none"),
@@ -188,23 +188,18 @@ def test_a_start_moved_past_a_box_off_the_image_and_one_not_moved_both_pass():
     assert resets_problem(ResetRun(boxes, gt, (0, 19), (12,), BOUNDS)) is not None
 
 
-@pytest.mark.parametrize("box, gt_x", [
-    ([10.0004, 10.0, 9.9998, 10.0], 20.0),  # overlaps by 0.0002; the file's 10.000 + 10.000 only touches
-    ([10.0006, 10.0, 9.9996, 10.0], 20.0003),  # 0.0001 short of it; the file's 10.001 + 10.000 overlaps
-])
-def test_a_decision_the_rounding_of_the_file_could_turn_is_taken_either_way(box, gt_x):
-    """The run decided on the exact box; the check sees it as the %.3f result file holds it."""
+def test_a_decision_the_rounding_of_the_file_could_turn_is_taken_either_way():
+    """The run decided on the exact box; the check sees it as the %.3f result file holds it. The
+    box's window (its corners floored and ceiled) starts at 18, inside the ground truth's
+    10..19, and its first pixel, 18.9996 rounded, is 19: an overlap; the file's 19.000 starts the
+    window at 19, where the ground truth's ends: no overlap (trax's windows must overlap)."""
+    box, rule = [18.9996, 10.0, 5.0, 10.0], get_rule("vot2016")
     gt = np.tile(GT_BOX, (N, 1))
-    gt[12] = [gt_x, 10.0, 10.0, 10.0]
     boxes = gt.copy()
     boxes[12] = box
-    failed = overlap(box, gt[12], BOUNDS) <= 0
-    if failed:
-        boxes[13:17] = np.nan
     stored = read_boxes_of(boxes)
-    assert failed != (overlap(stored[12], gt[12], BOUNDS) <= 0)  # the rounding turns the decision
-    run = ResetRun(stored, gt, (0, 17) if failed else (0,), (12,) if failed else (), BOUNDS)
-    assert resets_problem(run) is None
+    assert not rule.failed(box, gt[12], BOUNDS) and rule.failed(stored[12], gt[12], BOUNDS)
+    assert resets_problem(ResetRun(stored, gt, (0,), (), BOUNDS)) is None
 
 
 def read_boxes_of(boxes: np.ndarray) -> np.ndarray:

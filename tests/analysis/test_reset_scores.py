@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from dcfkit.analysis import reset_scores
 from dcfkit.analysis.reset_scores import (
-    ResetRun,
     eao,
     eao_interval,
     expected_overlaps,
@@ -17,6 +17,14 @@ from dcfkit.analysis.reset_scores import (
     score_resets,
     sequence_scores,
 )
+
+
+
+def ResetRun(*args) -> reset_scores.ResetRun:  # noqa: N802
+    """A run of whole-pixel boxes inside a 640x480 image under vot-toolkit's rule, whose overlap of
+    such boxes is their continuous one: the cases' overlaps stay as worked out by hand."""
+    return reset_scores.ResetRun(*args, bounds=(640, 480), rule="vot-toolkit")
+
 
 GT_BOX = [10.0, 10.0, 10.0, 10.0]
 HALF = [10.0, 10.0, 10.0, 5.0]  # overlap 0.5 with GT_BOX
@@ -124,3 +132,17 @@ def test_one_frame_sequences_have_no_eao():
     assert np.isnan(row["eao"]) and np.isnan(row["eao_ci_low"]) and np.isnan(row["eao_ci_high"])
     assert expected_overlaps([nothing], [1])[0] == 1.0  # the toolkit's Φ(1), kept for longer intervals
     assert eao([one_failure()], (1, 2)) == pytest.approx((1 + 1) / 2)
+
+
+def test_vot2016_s_accuracy_is_unbounded_and_its_eao_inside_the_image():
+    """The VOT2016 toolkit's accuracy ranking passes no image to its overlap, its EAO the image's
+    [0, W - 1] x [0, H - 1]: a box and ground truth [5, 0, 10, 10] in a 12 px wide image overlap
+    by 1 in the accuracy and by the 7 x 11 pixels of columns 5..11 over 11 x 11 in the EAO."""
+    box = [5.0, 0.0, 10.0, 10.0]
+    run = reset_scores.ResetRun(np.tile(box, (3, 1)), np.tile([0.0, 0.0, 10.0, 10.0], (3, 1)), (0,), (), (12, 20))
+    boxes = np.tile(box, (3, 1))
+    same = reset_scores.ResetRun(boxes, boxes.copy(), (0,), (), (12, 20), "vot2016")
+    np.testing.assert_allclose(same.accuracy_overlaps, 1.0)
+    np.testing.assert_allclose(same.overlaps, 1.0)
+    np.testing.assert_allclose(run.accuracy_overlaps, 66 / 176)  # columns 0..10 and 5..15, 11 rows, unbounded
+    np.testing.assert_allclose(run.overlaps, 66 / 132)  # 0..10 and 5..11 in columns 0..11

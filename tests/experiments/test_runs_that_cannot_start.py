@@ -118,12 +118,12 @@ def test_a_reset_due_on_a_box_outside_the_image_starts_at_the_next_frame_inside(
     seq = sequence(tmp_path, "gap", gt)
     run = track_with_resets(Still, seq, seq.frame)
     assert run.starts == [1, 16] and run.failures == [10] and 10 + SKIP == 15
-    assert run.record() == {"starts": [2, 17], "failures": [11], "moved": [[1, 2], [16, 17]]}
+    assert run.record() == {"rule": "vot2016", "starts": [2, 17], "failures": [11], "moved": [[1, 2], [16, 17]]}
     assert np.isnan(run.boxes[11:16]).all() and np.isfinite(run.boxes[16:]).all()
     summary = run_one_pass(CONFIG, [seq], tmp_path / "out", make_tracker=Still, progress=False, experiment="reset")
     assert summary["done"] == ["gap"] and not summary["failed"]
     meta = json.loads((tmp_path / "out" / "still" / "reset" / "gap.json").read_text())
-    assert meta["resets"] == {"starts": [2, 17], "failures": [11], "moved": [[1, 2], [16, 17]]}
+    assert meta["resets"] == {"rule": "vot2016", "starts": [2, 17], "failures": [11], "moved": [[1, 2], [16, 17]]}
 
 
 def test_a_reset_based_run_that_can_start_nowhere_fails_and_is_not_scored_as_perfect(tmp_path):

@@ -74,9 +74,56 @@ def test_reset_runs_record_their_starts_and_failures(tmp_path, seqs):
     meta = json.loads((tmp_path / "out" / "fast" / "reset" / "a.json").read_text())
     # drifting 3 px a frame from the target: no overlap on the 2nd frame after a start (3 px: 3 of 6
     # wide still overlap; 6 px: none); a start on frame 1, restarts 5 frames after each failure
-    assert meta["resets"] == {"starts": [1, 8, 15, 22], "failures": [3, 10, 17, 24]}
+    assert meta["resets"] == {"rule": "vot2016", "starts": [1, 8, 15, 22], "failures": [3, 10, 17, 24]}
     boxes = read_boxes(tmp_path / "out" / "fast" / "reset" / "a.txt")
     assert np.isnan(boxes[3:7]).all() and np.isfinite(boxes[7]).all()
+
+
+def eval_reset(seqs_root, out, *extra) -> int:
+    return cli.main(["eval", "kcf", "--dataset", "otb", "--root", str(seqs_root), "--out", str(out), "--experiment",
+                     "reset", "--no-progress", *extra])
+
+
+def test_the_reset_rule_is_part_of_a_run_and_of_its_report(tmp_path, capsys, caplog):
+    """A run's failures are its rule's: the rule is recorded in its sidecar and its key, a run of
+    one rule is never read as the other's, and the report scores each with its own."""
+    root, out = tmp_path / "data", tmp_path / "out"
+    write_otb(root, "seqA", seed=0, n_frames=N)
+    sidecar = out / "kcf" / "reset" / "seqA.json"
+    assert eval_reset(root, out) == 0
+    assert "(reset-based, VOT2016 MATLAB toolkit, trax 2016 region overlap)" in capsys.readouterr().out
+    first = json.loads(sidecar.read_text())
+    assert first["resets"]["rule"] == "vot2016"
+    assert eval_reset(root, out, "--protocol", "vot-toolkit") == 0
+    second = json.loads(sidecar.read_text())
+    assert second["resets"]["rule"] == "vot-toolkit" and second["run_key"] != first["run_key"]
+    assert "1 run, 0 already done" in capsys.readouterr().out
+    report = ["report", str(out), "--dataset", "otb", "--root", str(root), "--experiment", "reset"]
+    assert cli.main(report + ["--report-dir", str(tmp_path / "r")]) == 0
+    assert "reset-based experiment (vot-toolkit: vot-toolkit 0.9" in capsys.readouterr().out
+    assert json.loads((tmp_path / "r" / "reset.json").read_text())["rule"]["name"] == "vot-toolkit"
+    assert cli.main(report + ["--protocol", "vot2016"]) != 0
+    assert ("--protocol vot2016: these reset-based runs were made with the vot-toolkit rule"
+            in capsys.readouterr().err)
+    del second["resets"]["rule"]  # as dcfkit 0.9.0 wrote it: its failures a continuous overlap's
+    sidecar.write_text(json.dumps(second))
+    assert cli.main(report) != 0
+    assert "left out, its failures were decided by dcfkit <= 0.9.0's continuous overlap" in caplog.text
+    assert eval_reset(root, out, "--protocol", "vot-toolkit") == 0  # recomputed, never reused
+    assert "1 run, 0 already done" in capsys.readouterr().out
+    assert "whose failures another rule decided (dcfkit <= 0.9.0's continuous overlap)" in caplog.text
+
+
+@pytest.mark.parametrize("experiment, protocol, said", [
+    ("reset", "otb", "--protocol otb scores one-pass runs; --experiment reset takes vot2016 or vot-toolkit"),
+    ("ope", "vot2016", "--protocol vot2016 is a rule of the reset-based experiment; give --experiment reset"),
+])
+def test_a_protocol_of_another_experiment_is_an_error(tmp_path, capsys, experiment, protocol, said):
+    for command in ("eval", "report"):
+        args = ["kcf", "--out", str(tmp_path / "out")] if command == "eval" else [str(tmp_path / "out")]
+        assert cli.main([command, *args, "--dataset", "otb", "--root", str(tmp_path), "--experiment", experiment,
+                         "--protocol", protocol]) != 0
+        assert said in capsys.readouterr().err
 
 
 def test_eval_and_report_of_each_experiment(tmp_path, capsys):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from dcfkit.datasets import Sequence
-from dcfkit.experiments.vot import SKIP, overlap, valid_box
+from dcfkit.experiments.vot import SKIP, valid_box
 from dcfkit.running.resets import next_start, track_with_resets
 from dcfkit.running.tracking import TrackerFailure
 
@@ -85,10 +85,22 @@ def test_an_exception_names_the_frame_of_the_whole_sequence():
     assert info.value.frame == 16
 
 
-def test_overlap_is_cut_to_the_image_and_missing_boxes_are_said():
-    assert overlap([0, 0, 10, 10], [5, 0, 10, 10]) == pytest.approx(50 / 150)
-    # cut to a 12-wide image: [0, 10) and [5, 12): intersection 5 x 10, union 100 + 70 - 50
-    assert overlap([0, 0, 10, 10], [5, 0, 10, 10], bounds=(12, 20)) == pytest.approx(50 / 120)
-    assert overlap([20, 20, 5, 5], [0, 0, 5, 5]) == 0.0
-    assert overlap([np.nan] * 4, [0, 0, 5, 5]) == 0.0 and np.isnan(overlap([0, 0, 5, 5], [0, 0, 0, 5]))
+def test_valid_boxes():
     assert valid_box([0, 0, 1, 1]) and not valid_box([0, 0, -1, 1]) and not valid_box([np.inf, 0, 1, 1])
+
+
+class Sliver(Scripted):
+    """On frame 7, a box 1 px wide over the ground truth's last 0.4 px (a continuous overlap of
+    0.4 x 6 / 50.6 > 0, which dcfkit <= 0.9.0 kept tracking)."""
+
+    def update(self, image):
+        box = np.array(super().update(image), dtype=float)
+        return np.array([box[0] + 7.6, box[1], 1.0, box[3]]) if self.frame == 7 else box
+
+
+@pytest.mark.parametrize("rule", ["vot2016", "vot-toolkit"])
+def test_the_rule_decides_the_failures_and_is_recorded(rule):
+    gt = ground_truth()
+    found = track_with_resets(lambda: Sliver(gt), sequence(gt), lambda i: IMAGE, rule=rule)
+    assert found.failures == [7] and found.starts == [0, 7 + SKIP]
+    assert found.record() == {"rule": rule, "starts": [1, 13], "failures": [8]}
