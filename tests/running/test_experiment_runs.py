@@ -100,7 +100,7 @@ def test_the_reset_rule_is_part_of_a_run_and_of_its_report(tmp_path, capsys, cap
     assert "1 run, 0 already done" in capsys.readouterr().out
     report = ["report", str(out), "--dataset", "otb", "--root", str(root), "--experiment", "reset"]
     assert cli.main(report + ["--report-dir", str(tmp_path / "r")]) == 0
-    assert "reset-based experiment (vot-toolkit: vot-toolkit 0.9" in capsys.readouterr().out
+    assert "overlaps and failures: vot-toolkit (vot-toolkit 0.9" in capsys.readouterr().out
     assert json.loads((tmp_path / "r" / "reset.json").read_text())["rule"]["name"] == "vot-toolkit"
     assert cli.main(report + ["--protocol", "vot2016"]) != 0
     assert ("--protocol vot2016: these reset-based runs were made with the vot-toolkit rule"
