@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping
 
+from dcfkit.ablation.experiment import scope_title
 from dcfkit.ablation.sensitivity import METRICS, sensitivity
 from dcfkit.ablation.spec import AblationSpec, format_value, job_dir
 from dcfkit.analysis.report_html import evaluation_sections, sections
@@ -102,9 +103,10 @@ def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[s
         head.append(sensitivity_charts(spec, info["overall"]))
     folders = {**{v: job_dir(out, spec.dataset, k) for v, k in keys.items()}, **dict(spec.published)}
     extra = [("spec", str(spec.path)), ("dataset", f"{spec.dataset} at {spec.root}")]
-    return {"title": f"dcfkit ablation {spec.name}: {sections.count(len(trackers), 'variant')} on {spec.dataset}",
+    return {"title": f"dcfkit ablation {spec.name}: {sections.count(len(trackers), 'variant')} on {spec.dataset}, "
+                     f"{scope_title(spec.experiment, spec.max_frames)}",
             "protocol": scores.protocol.describe(),
-            "subtitle": f"{spec.description + ' · ' if spec.description else ''}"
+            "subtitle": f"{spec.description + ' · ' if spec.description else ''}{info['scope']} · "
                         f"{sections.count(len(sequences), 'sequence')}, {sum(len(s) for s in sequences)} frames",
             "trackers": trackers,
             "sections": [*head, *evaluation_sections(scores, sequences, results, trackers),

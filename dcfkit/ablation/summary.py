@@ -6,12 +6,12 @@ import json
 import logging
 from pathlib import Path
 
-from dcfkit.ablation.experiment import runs_dir
+from dcfkit.ablation.experiment import cut_title, runs_dir, scope_line
 from dcfkit.ablation.page import ablation_page
 from dcfkit.ablation.published import STATUS, read_published
 from dcfkit.ablation.sensitivity import plot_sensitivity, sensitivity_file
 from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir
-from dcfkit.analysis.plots import plot_curves
+from dcfkit.analysis.plots import plot_curves, plot_title
 from dcfkit.analysis.report import json_ready
 from dcfkit.analysis.report_html import PAGE, write_page
 from dcfkit.analysis.scoring import evaluate, protocol_record
@@ -62,8 +62,9 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     (:func:`~dcfkit.analysis.statistics.versus_baseline`); the spec's published results are
     scored and compared beside the variants (key and status ``published``). Under a spec's ``tre`` or ``sre``
     experiment a sequence's runs (``runs``, by default made here) are pooled. Returns ``{"overall",
-    "per_sequence", "statistics", "jobs", "files", "protocol"}`` (the
-    :class:`~dcfkit.protocols.Protocol`).
+    "per_sequence", "statistics", "jobs", "files", "protocol"`` (the
+    :class:`~dcfkit.protocols.Protocol`), ``"scope"}`` (the line naming the experiment, protocol and
+    ``--max-frames`` cut: :func:`~dcfkit.ablation.experiment.scope_line`, heading every output).
     """
     out = Path(out)
     jobs = jobs if jobs is not None else expand(spec, sequences)
@@ -87,6 +88,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
                  "status": status[j.key, j.sequence][0], "error": status[j.key, j.sequence][1]} for j in jobs]
     info = {"spec": str(spec.path), "name": spec.name, "description": spec.description,
             "protocol": protocol_record(scores.protocol), "experiment": spec.experiment,
+            "max_frames": spec.max_frames, "scope": scope_line(spec.experiment, protocol.name, spec.max_frames),
             "dataset": spec.dataset, "root": str(spec.root), "sequences": [s.name for s in sequences],
             "overall": overall, "per_sequence": per_sequence, "statistics": statistics, "jobs": job_rows,
             "grid": ({"base": spec.grid.base, "mode": spec.grid.mode,
@@ -98,7 +100,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
                          {**results, **published}, keys)
     files.append(write_page(page, out / PAGE))
     return {"overall": overall, "per_sequence": per_sequence, "statistics": statistics, "jobs": job_rows,
-            "files": files, "protocol": protocol}
+            "files": files, "protocol": protocol, "scope": info["scope"]}
 
 
 def _stored_runs(spec: AblationSpec, out: Path, runs: dict[str, list[Sequence]], jobs: list[Job]
@@ -143,11 +145,13 @@ def _write_files(spec: AblationSpec, out: Path, info: dict, curves: dict, protoc
     for stem in ("summary", "per_sequence"):
         for fmt, ext in (("markdown", "md"), ("csv", "csv")):
             path = out / f"{stem}.{ext}"
-            atomic_write(path, format_table(info["overall" if stem == "summary" else stem], fmt,
-                                            summary_columns(stem, protocol), protocol))
+            table = format_table(info["overall" if stem == "summary" else stem], fmt, summary_columns(stem, protocol),
+                                 protocol)
+            heading = f"# {spec.name}: {info['scope']}\n\n" if fmt == "markdown" else ""
+            atomic_write(path, heading + table)
             files.append(path)
     path = out / "statistics.txt"
-    atomic_write(path, "\n".join(statistics_lines(info["statistics"])) + "\n")
+    atomic_write(path, "\n".join([info["scope"], *statistics_lines(info["statistics"])]) + "\n")
     files.append(path)
     path = out / "summary.json"
     atomic_write(path, json.dumps(json_ready(info), indent=1, ensure_ascii=False, default=str) + "\n")
@@ -156,7 +160,8 @@ def _write_files(spec: AblationSpec, out: Path, info: dict, curves: dict, protoc
         files += plot_sensitivity(spec, info["overall"], out, protocol)
     else:  # named variants: the OTB plots, one curve each
         for kind in ("precision", "success"):
-            files += plot_curves(curves, kind, out / kind, protocol=protocol)
+            title = plot_title(kind, spec.experiment) + cut_title(spec.max_frames)
+            files += plot_curves(curves, kind, out / kind, title=title, protocol=protocol)
     return files
 
 
