@@ -74,11 +74,13 @@ class SearchSpec:
     startup_trials: int
     seed: int
     baselines: dict  # name -> resolved config
+    max_frames: int | None = None  # a quick try (--max-frames): each sequence's first frames only
 
     def load_sequences(self) -> list:
         if self.root is None:
             raise ConfigError(f"{self.path}: no dataset root: give dataset.root in the spec or --root")
-        return load_dataset(self.dataset, self.root, None if self.sequences is None else list(self.sequences))
+        found = load_dataset(self.dataset, self.root, None if self.sequences is None else list(self.sequences))
+        return [s.head(self.max_frames) for s in found]
 
     def config(self, params: Mapping[str, Any]) -> dict:
         """The base config with the sampled ``params`` (key -> sampled value) applied."""
