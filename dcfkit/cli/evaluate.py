@@ -168,6 +168,8 @@ def run_report(args: argparse.Namespace) -> int:
     protocol = evaluation.protocol.name  # --protocol, else the benchmark's
     print(format_table(evaluation.overall, args.format, columns("overall", protocol), protocol,
                        evaluation.statistics), end="")
+    if evaluation.settings["fps_note"] and args.format in ("table", "markdown"):
+        print(f"\n{evaluation.settings['fps_note']}")
     if args.format == "table":
         for tracker, rows in evaluation.platforms.items():  # ten lines at most: records may differ per sequence
             print(f"{tracker} platform: {'; '.join(counted_lines(dict(rows), sum(n for _, n in rows)))}")

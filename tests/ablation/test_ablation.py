@@ -364,8 +364,8 @@ grid: {base: dr2, parameters: {label.mu: [0, 0.5]}}
     ps = [stats["differences"][v]["auc"]["wilcoxon_p"] for v in ("strcf", "label.mu=0", "label.mu=0.5")]
     assert [stats["differences"][v]["auc"]["holm_p"] for v in ("strcf", "label.mu=0", "label.mu=0.5")] == \
         pytest.approx(holm(ps))
-    assert (out / "statistics.txt").read_text().startswith("statistics over 4 sequences: 95% BCa bootstrap")
-    assert (out / "summary.md").read_text().splitlines()[2].startswith("| variant | precision | auc | fps |")
+    assert (out / "statistics.txt").read_text().splitlines()[1].startswith("statistics over 4 sequences: 95% BCa")
+    assert (out / "summary.md").read_text().splitlines()[4].startswith("| variant | precision | auc | fps |")
     assert (out / "per_sequence.csv").read_text().count("\n") == 1 + total
     assert (out / "per_sequence.csv").read_text().splitlines()[0].endswith(",status,protocol")
     assert (out / "sensitivity_label.mu.png").stat().st_size > 0

@@ -15,7 +15,8 @@ def test_plot_titles_name_the_experiment():
     assert plot_title("precision", "tre") == "Precision plots of TRE"
 
 
-def test_an_sre_smoke_ablation_names_its_experiment_and_cut_everywhere(tmp_path, data, monkeypatch, capsys):  # noqa: F811
+def test_an_sre_smoke_ablation_names_its_experiment_and_cut_everywhere(tmp_path, data, monkeypatch,  # noqa: F811
+                                                                       capsys):
     titles = []
     plot = ablation_summary.plot_curves
 

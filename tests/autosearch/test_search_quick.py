@@ -94,7 +94,8 @@ def test_a_search_without_max_frames_resumes_one_recorded_before_the_option(tmp_
     Search(spec, tmp_path / "out").check_record()  # no error: whole sequences, the same ones
     cut = Search(dataclasses.replace(spec, max_frames=2), tmp_path / "out")
     path.write_text(json.dumps(record))
-    with pytest.raises(DcfkitError, match=r"--max-frames \(not given: whole sequences\), this search has --max-frames 2"):
+    with pytest.raises(DcfkitError, match=r"--max-frames \(not given: whole sequences\), this search has "
+                                          r"--max-frames 2"):
         cut.check_record()
 
 
