@@ -24,10 +24,12 @@ def inline_pool(monkeypatch):
     """A pool of two workers on a machine of four cores, its calls made in this process (no
     processes to start): what each run records is what a real pool's would."""
     def run_pool(calls, jobs, on_result, on_crash):
-        for key, (_, task, version, origin, timing) in calls.items():  # run_in_worker's arguments
-            on_result(key, runner.run_sequence(task, version, origin=origin, timing=timing))
+        for key, (fn, *args) in calls.items():
+            on_result(key, fn(*args))
 
     monkeypatch.setattr(runner, "run_pool", run_pool)
+    monkeypatch.setattr(runner, "worker_init", lambda *args: None)  # this process keeps its threads
+    monkeypatch.setattr(runner, "_worker_ready", False)
     monkeypatch.setattr(runner, "usable_cores", lambda: 4)
 
 
