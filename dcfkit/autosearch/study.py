@@ -47,7 +47,7 @@ def fingerprint(spec: SearchSpec, folds: list[list[str]], evaluator: Evaluator) 
             "experiments": list(spec.experiments), "folds": folds, "seed": spec.seed,
             "startup_trials": spec.startup_trials, "dataset": spec.dataset,
             "protocol": evaluator.protocol.name if evaluator.protocol else None,
-            "sequences": list(evaluator.sequences), "max_frames": spec.max_frames,
+            "sequences": sorted(evaluator.sequences), "max_frames": spec.max_frames,  # folds sort them too
             "data": {name: data_identity(seq) for name, seq in evaluator.sequences.items()}}
 
 
@@ -178,7 +178,6 @@ class Search:
             old = {**old, "data": mine["data"]}
         if old and "max_frames" not in old:  # recorded before --max-frames was: whole sequences
             old = {**old, "max_frames": None, "sequences": sorted(old.get("data") or {})}
-            mine = {**mine, "sequences": sorted(mine["sequences"])}
         changed = [k for k in mine if old.get(k) != mine[k]]
         for key, option in (("max_frames", "--max-frames"), ("sequences", "--sequences")):
             if key in changed:

@@ -67,19 +67,22 @@ def test_the_documented_quick_try_runs_and_records_its_options(tmp_path, quick, 
     assert cli.main(["search", *quick]) == 0
     out = tmp_path / "out"
     record = json.loads((out / "search.json").read_text())["fingerprint"]
-    assert record["max_frames"] == 30 and record["sequences"] == ["boat1", "building4", "wakeboard7", "wakeboard10"]
+    assert record["max_frames"] == 30 and record["sequences"] == ["boat1", "building4", "wakeboard10", "wakeboard7"]
     assert json.loads((out / "summary.json").read_text())["max_frames"] == 30
     assert "first 30 frames only (--max-frames 30" in (out / "summary.md").read_text()
     capsys.readouterr()
     for changed, message in ((["--max-frames", "20"], "made with --max-frames 30, this search has --max-frames 20"),
                              (["--sequences", "boat1,building4,wakeboard7"],
-                              "made with --sequences 'boat1,building4,wakeboard7,wakeboard10', this search has "
+                              "made with --sequences 'boat1,building4,wakeboard10,wakeboard7', this search has "
                               "--sequences 'boat1,building4,wakeboard7'")):
         argv = list(quick)
         argv[argv.index(changed[0]) + 1] = changed[1]
         assert cli.main(["search", *argv]) != 0
         err = capsys.readouterr().err
         assert message in err and "a new --out for a separate search" in err and "\n" not in err.strip()
+    argv = list(quick)
+    argv[argv.index("--sequences") + 1] = "wakeboard10,boat1,wakeboard7,building4"  # the same, in another order
+    assert cli.main(["search", *argv]) == 0  # resumed: every trial recorded, nothing run
 
 
 def test_a_search_without_max_frames_resumes_one_recorded_before_the_option(tmp_path, quick):
