@@ -3,11 +3,11 @@ from __future__ import annotations
 
 import json
 
+from test_ablation import data, write_spec  # noqa: F401  (the synthetic OTB folder)
+
 from dcfkit import cli
 from dcfkit.ablation import summary as ablation_summary
 from dcfkit.analysis.plots import plot_title
-
-from tests.ablation.test_ablation import data, write_spec  # noqa: F401  (the synthetic OTB folder)
 
 
 def test_plot_titles_name_the_experiment():
