@@ -21,6 +21,27 @@ def check_experiment(value: Any, where: str) -> str:
     return name
 
 
+def cut_title(max_frames: int | None) -> str:
+    """A smoke run's cut for a title, ``, first 50 frames (--max-frames 50)``; else ``""``."""
+    return f", first {max_frames} frames (--max-frames {max_frames})" if max_frames else ""
+
+
+def scope_title(experiment: str, max_frames: int | None = None) -> str:
+    """What an ablation's scores are of, for its titles: the experiment's name in capitals
+    (``TRE``) and a smoke run's :func:`cut_title`."""
+    return experiment.upper() + cut_title(max_frames)
+
+
+def scope_line(experiment: str, protocol: str, max_frames: int | None = None) -> str:
+    """One line naming the runs an ablation scored: ``experiment TRE (temporal robustness: 20
+    starts; each sequence's runs pooled), protocol otb`` and a smoke run's ``--max-frames`` cut."""
+    found = get_experiment(experiment)
+    pooled = "" if found.name == "ope" else "; each sequence's runs pooled, as the OTB toolkit's perfPlot.m"
+    cut = (f", each sequence's first {max_frames} frames only (--max-frames {max_frames}: a smoke run, "
+           f"not the benchmark's scores)" if max_frames else "")
+    return f"experiment {found.name.upper()} ({found.title}{pooled}), protocol {protocol}{cut}"
+
+
 def runs_dir(job_folder: Path, experiment: str) -> Path:
     """Where a run key's runs of ``experiment`` go: its folder (:func:`dcfkit.ablation.spec.job_dir`),
     and that folder's ``<experiment>/`` but for one pass."""

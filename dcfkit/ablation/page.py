@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping
 
+from dcfkit.ablation.experiment import scope_title
 from dcfkit.ablation.sensitivity import METRICS, sensitivity
 from dcfkit.ablation.spec import AblationSpec, format_value, job_dir
 from dcfkit.ablation.spec_keys import data_text
@@ -51,9 +52,10 @@ def _base(spec: AblationSpec) -> tuple[str, dict]:
     return spec.variants[0].name, spec.variants[0].config
 
 
-def variants_table(spec: AblationSpec, overall: list[dict], columns: tuple[str, ...], trackers: list[str]) -> dict:
+def variants_table(spec: AblationSpec, overall: list[dict], columns: tuple[str, ...], trackers: list[str],
+                   fps_note: str | None = None) -> dict:
     """The summary's rows (in ``columns``, the first the variant) with each variant's config
-    changes from the base."""
+    changes from the base; ``fps_note`` (:func:`dcfkit.running.speed.fps_note`) ends its note."""
     base_name, base = _base(spec)
     configs = {v.name: v.config for v in spec.variants}
     published = dict(spec.published)
@@ -62,7 +64,7 @@ def variants_table(spec: AblationSpec, overall: list[dict], columns: tuple[str, 
     table = sections.table("variants", "Variants", rows, ("variant", "changes", *columns[1:], "key"), trackers,
                            tracker_column="variant",
                            note=f"Changes from {base_name}, config key by config key. Click a column's name to "
-                                f"sort by it.")
+                                f"sort by it.{' ' + fps_note if fps_note else ''}")
     for column in table["columns"]:
         if column["key"] == "changes":
             column.update(type="lines", label="changes from the base")
@@ -95,7 +97,7 @@ def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[s
     ``columns``), ``scores`` what :func:`dcfkit.analysis.scoring.evaluate` returned for ``results``
     (variant -> sequence -> result), ``keys`` variant -> run key."""
     trackers = [*keys, *(name for name, _ in spec.published)]
-    head = [variants_table(spec, info["overall"], columns, trackers)]
+    head = [variants_table(spec, info["overall"], columns, trackers, info.get("fps_note"))]
     statistics = sections.statistics_table(info["statistics"], trackers, tracker_label="variant")
     if statistics is not None:
         head.append(statistics)
@@ -103,9 +105,10 @@ def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[s
         head.append(sensitivity_charts(spec, info["overall"]))
     folders = {**{v: job_dir(out, spec.dataset, k) for v, k in keys.items()}, **dict(spec.published)}
     extra = [("spec", shared_path(spec.path, out)), ("dataset", data_text(spec, out))]
-    return {"title": f"dcfkit ablation {spec.name}: {sections.count(len(trackers), 'variant')} on {spec.dataset}",
+    return {"title": f"dcfkit ablation {spec.name}: {sections.count(len(trackers), 'variant')} on {spec.dataset}, "
+                     f"{scope_title(spec.experiment, spec.max_frames)}",
             "protocol": scores.protocol.describe(),
-            "subtitle": f"{spec.description + ' · ' if spec.description else ''}"
+            "subtitle": f"{spec.description + ' · ' if spec.description else ''}{info['scope']} · "
                         f"{sections.count(len(sequences), 'sequence')}, {sum(len(s) for s in sequences)} frames",
             "trackers": trackers,
             "sections": [*head, *evaluation_sections(scores, sequences, results, trackers),

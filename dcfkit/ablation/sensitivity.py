@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 from typing import Any, Mapping
 
+from dcfkit.ablation.experiment import scope_title
 from dcfkit.ablation.spec import AblationSpec, format_value
 from dcfkit.analysis.plots import save_figure
 from dcfkit.protocols import DEFAULT
@@ -69,7 +70,8 @@ def sensitivity(spec: AblationSpec, overall: list[dict]) -> list[dict]:
                     "x": [float(v) for v in values] if numeric else list(range(len(values))),
                     "metrics": metrics, "band": band, "base_x": base_x, "base_name": format_value(base),
                     "axis": label if label == key else f"{label} ({key})",
-                    "title": f"{label} on {spec.dataset} ({n_seq} sequences), {what}"})
+                    "title": f"{label} on {spec.dataset} ({n_seq} sequences, "
+                             f"{scope_title(spec.experiment, spec.max_frames)}), {what}"})
     return out
 
 

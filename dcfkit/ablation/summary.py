@@ -6,14 +6,14 @@ import json
 import logging
 from pathlib import Path
 
-from dcfkit.ablation.experiment import runs_dir
+from dcfkit.ablation.experiment import cut_title, runs_dir, scope_line
 from dcfkit.ablation.page import ablation_page
 from dcfkit.ablation.published import STATUS, read_published
 from dcfkit.ablation.sensitivity import plot_sensitivity, sensitivity_file
 from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir
 from dcfkit.ablation.spec_keys import data_record
 from dcfkit.analysis.latex import comparison_table
-from dcfkit.analysis.plots import plot_curves
+from dcfkit.analysis.plots import plot_curves, plot_title
 from dcfkit.analysis.report import json_ready
 from dcfkit.analysis.report_html import PAGE, write_page
 from dcfkit.analysis.scoring import evaluate, protocol_record
@@ -26,6 +26,7 @@ from dcfkit.protocols import DEFAULT, get_protocol
 from dcfkit.running.files import atomic_write, read_json
 from dcfkit.running.provenance import shared_path
 from dcfkit.running.results import ResultStore
+from dcfkit.running.speed import fps_note
 
 SUMMARY_COLUMNS = ("variant", "precision", "auc", "fps", "sequences", "failed")
 SEQUENCE_COLUMNS = ("variant", "sequence", "precision", "auc", "fps", "frames", "status")
@@ -60,14 +61,16 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
 
     precision is the precision at 20 px, auc the area under the success curve (and under
     ``got10k`` also ao, sr50, sr75), fps the mean per-sequence frames per second of tracker
-    time (:mod:`dcfkit.analysis.report`). A job without result (failed or not run) is scored as a
-    total failure and counted in ``failed``. ``statistics`` compares each variant with the
+    time, of runs timed alone only (:mod:`dcfkit.running.speed`, ``fps_measured``). A job
+    without result (failed or not run) is scored as a total failure and counted in ``failed``. ``statistics`` compares each variant with the
     grid's base (when it names a variant) or the first variant
     (:func:`~dcfkit.analysis.statistics.versus_baseline`); the spec's published results are
     scored and compared beside the variants (key and status ``published``). Under a spec's ``tre`` or ``sre``
     experiment a sequence's runs (``runs``, by default made here) are pooled. Returns ``{"overall",
-    "per_sequence", "statistics", "jobs", "files", "protocol"}`` (the
-    :class:`~dcfkit.protocols.Protocol`).
+    "per_sequence", "statistics", "jobs", "files", "protocol"`` (the
+    :class:`~dcfkit.protocols.Protocol`), ``"scope"`` (the line naming the experiment, protocol and
+    ``--max-frames`` cut: :func:`~dcfkit.ablation.experiment.scope_line`, heading every output) and
+    ``"fps_note"}`` (whose fps is left out and why: :func:`dcfkit.running.speed.fps_note`).
     """
     out = Path(out)
     jobs = jobs if jobs is not None else expand(spec, sequences)
@@ -91,6 +94,8 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
                  "status": status[j.key, j.sequence][0], "error": status[j.key, j.sequence][1]} for j in jobs]
     info = {"spec": shared_path(spec.path, out), "name": spec.name, "description": spec.description,
             "protocol": protocol_record(scores.protocol), "experiment": spec.experiment,
+            "max_frames": spec.max_frames, "scope": scope_line(spec.experiment, protocol.name, spec.max_frames),
+            "fps_note": fps_note(overall, "variant"),
             **data_record(spec, out), "sequences": [s.name for s in sequences],
             "overall": overall, "per_sequence": per_sequence, "statistics": statistics, "jobs": job_rows,
             "grid": ({"base": spec.grid.base, "mode": spec.grid.mode,
@@ -103,7 +108,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
                          {**results, **published}, keys)
     files.append(write_page(page, out / PAGE))
     return {"overall": overall, "per_sequence": per_sequence, "statistics": statistics, "jobs": job_rows,
-            "files": files, "protocol": protocol}
+            "files": files, "protocol": protocol, "scope": info["scope"], "fps_note": info["fps_note"]}
 
 
 def _stored_runs(spec: AblationSpec, out: Path, runs: dict[str, list[Sequence]], jobs: list[Job]
@@ -130,12 +135,12 @@ def _rows(scores: dict, keys: dict, sequences: list[Sequence], status: dict, pro
     order = {v: i for i, v in enumerate(keys)}
     seq_order = {s.name: i for i, s in enumerate(sequences)}
     overall = sorted(({"variant": r["tracker"], "precision": r["precision"], "auc": r["auc"],
-                       **{k: r[k] for k in extra}, "fps": r["fps"],
+                       **{k: r[k] for k in extra}, "fps": r["fps"], "fps_measured": r["fps_measured"],
                        "sequences": r["sequences"], "failed": r["missing"], "key": keys[r["tracker"]]}
                       for r in scores.overall), key=lambda r: order[r["variant"]])
     per_sequence = sorted(({"variant": r["tracker"], "sequence": r["sequence"], "precision": r["precision"],
                             "auc": r["auc"], **{k: r[k] for k in extra}, "fps": r["fps"],
-                            "frames": frames[r["sequence"]],
+                            "fps_measured": r["fps_measured"], "frames": frames[r["sequence"]],
                             "status": status[r["tracker"], r["sequence"]][0]}
                            for r in scores.per_sequence),
                           key=lambda r: (order[r["variant"]], seq_order[r["sequence"]]))
@@ -148,11 +153,15 @@ def _write_files(spec: AblationSpec, out: Path, info: dict, curves: dict, protoc
     for stem in ("summary", "per_sequence"):
         for fmt, ext in (("markdown", "md"), ("csv", "csv")):
             path = out / f"{stem}.{ext}"
-            atomic_write(path, format_table(info["overall" if stem == "summary" else stem], fmt,
-                                            summary_columns(stem, protocol), protocol))
+            table = format_table(info["overall" if stem == "summary" else stem], fmt, summary_columns(stem, protocol),
+                                 protocol)
+            if fmt == "markdown":  # named: its experiment, protocol and cut; after it, whose fps is left out
+                table = f"# {spec.name}: {info['scope']}\n\n{table}" + (f"\n{info['fps_note']}\n"
+                                                                        if info["fps_note"] else "")
+            atomic_write(path, table)
             files.append(path)
     path = out / "statistics.txt"
-    atomic_write(path, "\n".join(statistics_lines(info["statistics"])) + "\n")
+    atomic_write(path, "\n".join([info["scope"], *statistics_lines(info["statistics"])]) + "\n")
     files.append(path)
     path = out / "summary.json"
     atomic_write(path, json.dumps(json_ready(info), indent=1, ensure_ascii=False, default=str) + "\n")
@@ -161,7 +170,8 @@ def _write_files(spec: AblationSpec, out: Path, info: dict, curves: dict, protoc
         files += plot_sensitivity(spec, info["overall"], out, protocol)
     else:  # named variants: the OTB plots, one curve each
         for kind in ("precision", "success"):
-            files += plot_curves(curves, kind, out / kind, protocol=protocol)
+            title = plot_title(kind, spec.experiment) + cut_title(spec.max_frames)
+            files += plot_curves(curves, kind, out / kind, title=title, protocol=protocol)
     return files
 
 

@@ -24,9 +24,15 @@ PLOT_STYLE = {
 }
 
 
+def plot_title(kind: str, experiment: str = "ope") -> str:
+    """``Success plots of TRE``: the title of a ``kind`` plot of ``experiment``'s runs."""
+    return PLOT_STYLE[kind]["title"].removesuffix(" of OPE") + f" of {experiment.upper()}"
+
+
 def plot_curves(curves: Mapping[str, Mapping], kind: str, path_stem, title: str | None = None,
                 formats: Seq[str] = ("png", "svg"), protocol: str | Protocol = DEFAULT) -> list[Path]:
     """OTB-style plot of one curve per tracker; legend ``Name [score]`` sorted by score.
+    ``title`` (default: :func:`plot_title` of OPE) names the experiment.
 
     ``curves`` maps tracker -> the dict of :func:`evaluate`'s ``curves`` (computed under
     ``protocol``, whose thresholds are the x axis and whose name ends the title); ``kind``

@@ -10,7 +10,9 @@ and every output names it, with the experiment and any ``--max-frames`` cut
 LaTeX captions (``overall.tex``: :func:`dcfkit.analysis.latex.comparison_table`). Averages
 weigh sequences as the protocol does unless ``weighting`` says otherwise. A tracker's
 ``fps`` is the mean over sequences of the per-sequence fps (frames / tracker time in that
-sequence), not total frames / total time. A sequence missing from a tracker's results is
+sequence), not total frames / total time, of runs timed alone only (``fps_measured``,
+:mod:`dcfkit.running.speed`; a note under the text and Markdown tables says whose fps is left
+out and why). A sequence missing from a tracker's results is
 scored as a total failure and counted in the ``missing`` column. :mod:`dcfkit.analysis.report_html`
 adds one self-contained HTML page of it all (``dcfkit report --html``).
 """
@@ -166,6 +168,7 @@ def json_ready(obj):
 
 REPORT_TABLES = ("overall", "per_sequence", "per_attribute")
 TABLE_FORMATS = (("table", "txt"), ("markdown", "md"), ("csv", "csv"), ("latex", "tex"))
+NOTED = ("table", "markdown")  # the formats a note may follow (:func:`dcfkit.running.speed.fps_note`)
 
 
 def report_file_names(sequences: Seq[Sequence]) -> list[str]:
@@ -189,11 +192,14 @@ def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
         paths.append(path)
 
     tables = REPORT_TABLES if evaluation.per_attribute else REPORT_TABLES[:2]
+    note = evaluation.settings.get("fps_note")  # whose fps is left out, and why
     for stem in tables:
         for fmt, ext in TABLE_FORMATS:
-            text(f"{stem}.{ext}", format_table(getattr(evaluation, stem), fmt, columns(stem, protocol), protocol,
-                                               evaluation.statistics if stem == "overall" else None,
-                                               experiment=experiment, max_frames=cut))
+            table = format_table(getattr(evaluation, stem), fmt, columns(stem, protocol), protocol,
+                                 evaluation.statistics if stem == "overall" else None,
+                                 experiment=experiment, max_frames=cut)
+            noted = note and fmt in NOTED and stem != "per_attribute"
+            text(f"{stem}.{ext}", table + (f"\n{note}\n" if noted else ""))
     head = [experiment_line(experiment, cut), evaluation.protocol.describe(), ""]
     text("statistics.txt", "\n".join(head + statistics_lines(evaluation.statistics)) + "\n")
     text("report.json", json.dumps(json_ready(evaluation.as_record()), indent=1) + "\n")

@@ -16,17 +16,21 @@ from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, benchmark_p
 from dcfkit.errors import shown
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
 from dcfkit.protocols import Protocol, get_protocol
-from dcfkit.running import platforms
+from dcfkit.running import platforms, speed
 
 log = logging.getLogger(__name__)
 
 
-def _boxes_and_fps(result) -> tuple[np.ndarray, float | None]:
+def _boxes_and_fps(result) -> tuple[np.ndarray, float | None, str | None]:
+    """(boxes, fps, how the fps was measured: :func:`dcfkit.running.speed.how_measured` of the
+    result's ``timing``, None without an fps)."""
     if hasattr(result, "boxes"):
-        return np.asarray(result.boxes, dtype=np.float64), getattr(result, "fps", None)
-    if isinstance(result, Mapping):
-        return np.asarray(result["boxes"], dtype=np.float64), result.get("fps")
-    return np.asarray(result, dtype=np.float64), None
+        boxes, fps, timing = result.boxes, getattr(result, "fps", None), getattr(result, "timing", None)
+    elif isinstance(result, Mapping):
+        boxes, fps, timing = result["boxes"], result.get("fps"), result.get("timing")
+    else:
+        boxes, fps, timing = result, None, None
+    return np.asarray(boxes, dtype=np.float64), fps, None if fps is None else speed.how_measured(timing)
 
 
 def _mean_or_none(values) -> float | None:
@@ -85,11 +89,13 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
     :func:`~dcfkit.datasets.benchmark_protocol`: LaSOT's for LaSOT, the OTB toolkit's for UAV123).
 
     A result is a :class:`dcfkit.running.results.SequenceResult`, a dict with ``boxes`` (and
-    optional ``fps``) or an ``(N, 4)`` array of 0-based boxes. ``weighting`` ``None`` averages
-    as the protocol does. ``missing``: ``"skip"`` scores the sequences every tracker has a
-    result for and names the others in ``settings["left_out"]`` (sequence -> the trackers
-    without a result); ``"fail"`` scores a missing result as a total failure, as the toolkits
-    do. Sequences whose ground truth is withheld after frame 1 (test splits) are left out
+    optional ``fps`` and ``timing``) or an ``(N, 4)`` array of 0-based boxes. A row's ``fps`` is
+    shown only when every run of it was timed alone, ``fps_measured`` says how
+    (:mod:`dcfkit.running.speed`), and ``settings["fps_note"]`` whose is left out and why.
+    ``weighting`` ``None`` averages as the protocol does. ``missing``: ``"skip"`` scores the
+    sequences every tracker has a result for and names the others in ``settings["left_out"]``
+    (sequence -> the trackers without a result); ``"fail"`` scores a missing result as a total
+    failure, as the toolkits do. Sequences whose ground truth is withheld after frame 1 (test splits) are left out
     (:func:`~dcfkit.datasets.scored_sequences`: a :class:`DatasetError` if that leaves none).
 
     ``experiment`` ``tre`` or ``sre`` (:mod:`dcfkit.experiments`): results are keyed by run
@@ -107,23 +113,26 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
         raise ValueError("reset-based runs are scored by dcfkit.analysis.reset_scores, not evaluate()")
     runs = runs if runs is not None else runs_by_sequence(scored_sequences(sequences), experiment)
     sequences, left_out = _complete(scored_sequences(sequences), results, missing, runs)
-    per_seq, fps, missing = {}, {}, {}
+    per_seq, fps, measured, missing = {}, {}, {}, {}
     for tracker, res in results.items():
-        per_seq[tracker], fps[tracker], missing[tracker] = _score_tracker(tracker, res, sequences, runs,
-                                                                          include_first, proto)
+        per_seq[tracker], (fps[tracker], measured[tracker]), missing[tracker] = _score_tracker(
+            tracker, res, sequences, runs, include_first, proto)
 
     overall, curves = [], {}
     for tracker in results:
         avg = metrics.average(per_seq[tracker].values(), weighting, proto)
         curves[tracker] = _curves(avg)
+        how = speed.combined(measured[tracker].values())
         overall.append({"tracker": tracker, **{k: avg[k] for k in keys},
-                        "fps": _mean_or_none(fps[tracker].values()),
+                        "fps": _mean_or_none(fps[tracker].values()) if how == speed.ALONE else None,
+                        "fps_measured": how,
                         "sequences": len(sequences), "missing": len(missing[tracker]), "frames": avg["frames"]})
     overall = _rank(overall, proto)
     ranked = [r["tracker"] for r in overall]
     per_sequence = [
         {"tracker": t, "sequence": s.name, **{k: per_seq[t][s.name][k] for k in keys},
-         "fps": fps[t][s.name], "frames": per_seq[t][s.name]["frames"]}
+         "fps": fps[t][s.name] if measured[t][s.name] == speed.ALONE else None,
+         "fps_measured": measured[t][s.name], "frames": per_seq[t][s.name]["frames"]}
         for t in ranked for s in sequences]
     attributes = _attribute_members(sequences)
     per_attribute, attribute_curves = _per_attribute(attributes, per_seq, ranked, weighting, proto)
@@ -132,7 +141,7 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
         curves=curves, attribute_curves=attribute_curves,
         attributes={a: len(n) for a, n in attributes.items()}, thresholds=proto.thresholds,
         settings={"protocol": proto.name, "experiment": experiment.name, "max_frames": cut_length(sequences),
-                  "include_first": include_first, "weighting": weighting,
+                  "include_first": include_first, "weighting": weighting, "fps_note": speed.fps_note(overall),
                   "missing": "skip" if left_out is not None else "fail", "left_out": left_out or {},
                   "datasets": dict(Counter(s.dataset or "unnamed" for s in sequences))},
         platforms={t: _platforms(res.values()) for t, res in results.items()},
@@ -168,39 +177,42 @@ def _platforms(results: Iterable) -> list[list]:
 
 
 def _score_tracker(tracker: str, res: Mapping, sequences: list[Sequence], runs: Mapping[str, list[Sequence]],
-                   include_first: bool, proto: Protocol) -> tuple[dict, dict, list]:
-    """(sequence -> scores, sequence -> fps, names of the sequences missing a run) of one
+                   include_first: bool, proto: Protocol) -> tuple[dict, tuple[dict, dict], list]:
+    """(sequence -> scores, (sequence -> fps, sequence -> how it was measured:
+    :func:`dcfkit.running.speed.combined`), names of the sequences missing a run) of one
     tracker's results, each sequence's runs pooled."""
-    scores, fps, missing = {}, {}, []
+    scores, fps, measured, missing = {}, {}, {}, []
     for seq in sequences:
-        pooled, speeds = [], []
+        pooled, speeds, kinds = [], [], []
         for run in runs[seq.name]:
-            boxes, speed = _run_boxes(tracker, res, run)
+            boxes, run_fps, kind = _run_boxes(tracker, res, run)
             pooled.append(metrics.score_sequence(boxes, run.ground_truth, include_first, proto))
-            speeds.append(speed)
+            speeds.append(run_fps)
+            kinds.append(kind)
         scores[seq.name] = pooled[0] if len(pooled) == 1 else metrics.pool_runs(pooled, proto)
-        fps[seq.name] = _mean_or_none(speeds)
+        fps[seq.name], measured[seq.name] = _mean_or_none(speeds), speed.combined(kinds)
         if any(run.name not in res for run in runs[seq.name]):
             missing.append(seq.name)
     if missing:
         log.warning("tracker %r has no results for %d of %d sequences (scored as failures; "
                     "report on the sequences that were run, e.g. with --sequences, to leave them out): %s",
                     tracker, len(missing), len(sequences), ", ".join(missing[:10]))
-    return scores, fps, missing
+    return scores, (fps, measured), missing
 
 
-def _run_boxes(tracker: str, res: Mapping, run: Sequence) -> tuple[np.ndarray, float | None]:
-    """(boxes, fps) of ``run`` in ``res`` (no boxes when it has none), checked not too long."""
+def _run_boxes(tracker: str, res: Mapping, run: Sequence) -> tuple[np.ndarray, float | None, str | None]:
+    """(boxes, fps, how it was measured) of ``run`` in ``res`` (no boxes when it has none),
+    checked not too long."""
     if run.name not in res:
-        return np.empty((0, 4)), None
-    boxes, fps = _boxes_and_fps(res[run.name])
+        return np.empty((0, 4)), None, None
+    boxes, fps, kind = _boxes_and_fps(res[run.name])
     if len(boxes) > len(run):
         raise DatasetError(f"tracker {shown(tracker)}, sequence {run.name!r}: {len(boxes)} boxes for "
                            f"{len(run)} frames")
     if len(boxes) < len(run):
         log.warning("tracker %r, sequence %r: %d boxes for %d frames; the last %d frames are "
                     "scored as failures", tracker, run.name, len(boxes), len(run), len(run) - len(boxes))
-    return boxes, fps
+    return boxes, fps, kind
 
 
 def _rank(rows: list[dict], proto: Protocol) -> list[dict]:

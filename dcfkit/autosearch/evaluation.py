@@ -61,6 +61,8 @@ class Evaluator:
         if todo:
             for folder in {t.folder for t in todo}:
                 ensure_writable(folder, what="the search's runs")
+            for task in todo:  # a --max-frames try never replaces a whole run of the config
+                ResultStore(task.folder).refuse_to_shorten(task.seq)
             warm_up_compiled(todo)
             execute(sorted(todo, key=lambda t: -len(t.seq)), on_result, jobs=self.jobs, executor=self.executor,
                     scheduler=self.scheduler, version=self.version)

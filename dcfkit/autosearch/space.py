@@ -76,13 +76,17 @@ class SearchSpec:
     seed: int
     baselines: dict  # name -> resolved config
     pool: tuple = ()  # pooled datasets: (name, root, origin) of each, ``dataset`` their names joined by "+"
+    max_frames: int | None = None  # a quick try (--max-frames): each sequence's first frames only
 
     def load_sequences(self) -> list:
+        """The spec's sequences (of every pooled dataset), each cut to ``max_frames`` if given."""
         if self.pool:
-            return pooled_sequences(self)
-        if self.root is None:
+            found = pooled_sequences(self)
+        elif self.root is None:
             raise ConfigError(f"{self.path}: no dataset root: give dataset.root in the spec or --root")
-        return load_dataset(self.dataset, self.root, None if self.sequences is None else list(self.sequences))
+        else:
+            found = load_dataset(self.dataset, self.root, None if self.sequences is None else list(self.sequences))
+        return [s.head(self.max_frames) for s in found]
 
     def config(self, params: Mapping[str, Any]) -> dict:
         """The base config with the sampled ``params`` (key -> sampled value) applied."""

@@ -49,6 +49,7 @@ def fingerprint(spec: SearchSpec, folds: list[list[str]], evaluator: Evaluator) 
             "experiments": list(spec.experiments), "folds": folds, "seed": spec.seed,
             "startup_trials": spec.startup_trials, "dataset": data_record(spec)["dataset"],
             "protocol": evaluator.protocol.name if evaluator.protocol else None,
+            "sequences": sorted(evaluator.sequences), "max_frames": spec.max_frames,  # folds sort them too
             "data": {name: data_identity(seq) for name, seq in evaluator.sequences.items()}}
 
 
@@ -177,7 +178,14 @@ class Search:
             log.warning("%s was written by dcfkit <= 0.9.0, without what identifies the data: the recorded "
                         "trials are taken to be on the data under %s", path, roots_text(self.spec))
             old = {**old, "data": mine["data"]}
+        if old and "max_frames" not in old:  # recorded before --max-frames was: whole sequences
+            old = {**old, "max_frames": None, "sequences": sorted(old.get("data") or {})}
         changed = [k for k in mine if old.get(k) != mine[k]]
+        for key, option in (("max_frames", "--max-frames"), ("sequences", "--sequences")):
+            if key in changed:
+                raise DcfkitError(f"{path}: its trials were made with {option} {_option_value(old[key])}, this "
+                                  f"search has {option} {_option_value(mine[key])}: give the recorded {option} to "
+                                  f"resume it, or a new --out for a separate search")
         if changed == ["data"]:
             was = old["data"] if isinstance(old["data"], dict) else {}
             differ = [n for n in mine["data"] if was.get(n) != mine["data"][n]]
@@ -256,6 +264,13 @@ class Search:
             self.check_record()
             studies = {study: self.run_study(study) for study in self.studies()}
             return summarize(self, studies)
+
+
+def _option_value(value: Any) -> str:
+    """A recorded ``--max-frames`` or ``--sequences`` as given on the command line."""
+    if value is None:
+        return "(not given: whole sequences)"
+    return shown(",".join(value)) if isinstance(value, list) else shown(value)
 
 
 def _shown_auc(value: float | None) -> str:

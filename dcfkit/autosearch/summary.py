@@ -65,7 +65,7 @@ def summarize(search, studies: dict[str, list[dict]]) -> dict:
     comparisons = _compare(search.names, held_out, baselines)
     final = best(studies[FINAL], FINAL)
     summary = {"name": spec.name, "spec": shared_path(spec.path, search.out), "dataset": data_record(spec)["dataset"],
-               "experiments": list(spec.experiments), "trials_per_study": spec.trials,
+               "experiments": list(spec.experiments), "trials_per_study": spec.trials, "max_frames": spec.max_frames,
                "sequences": search.names, "unscored": [n for n in search.names if not is_score(held_out[n]["auc"])],
                "folds": folds,
                "held_out": {"auc": mean_interval([held_out[n]["auc"] for n in search.names]).as_record(),
@@ -102,7 +102,7 @@ def summary_lines(summary: dict) -> list[str]:
     lines = [f"# Search {printable(summary['name'])}", "",
              f"{len(summary['sequences'])} sequences, {len(summary['folds'])} folds, "
              f"{summary['trials_per_study']} trials a study; objective: mean AUC over "
-             f"{' + '.join(summary['experiments'])} (each sequence's runs pooled).", "",
+             f"{' + '.join(summary['experiments'])} (each sequence's runs pooled){_cut(summary)}.", "",
              "| fold | held out | trial | training AUC | held-out AUC | values |", "|---|---|---|---|---|---|"]
     for f in summary["folds"]:
         lines.append(f"| {f['fold']} | {_cell(', '.join(f['held_out']))} | {f['trial']} | "
@@ -130,6 +130,13 @@ def summary_lines(summary: dict) -> list[str]:
               f"{printable(_values(final['params']))}; best.yaml. The search: {verdict}.", "", summary["method"] + "; "
               + summary["correction"] + " (beaten: significant and the interval above 0)."]
     return lines
+
+
+def _cut(summary: dict) -> str:
+    """A quick try's ``--max-frames`` cut, said where the objective is (older summaries have none)."""
+    n = summary.get("max_frames")
+    return (f"; each sequence's first {n} frames only (--max-frames {n}: a quick try, not a search to ship from)"
+            if n else "")
 
 
 def _values(params: dict) -> str:

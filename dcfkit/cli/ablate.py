@@ -75,9 +75,10 @@ def run(args: argparse.Namespace) -> int:
                        progress=not args.no_progress, protocol=args.protocol)
     summary = res["summary"]
     protocol = summary["protocol"]  # --protocol, else the benchmark's own
-    if spec.experiment != "ope":
-        print(f"experiment {spec.experiment}: each sequence's runs pooled, as the OTB toolkit's perfPlot.m")
+    print(f"{spec.name}: {summary['scope']}")
     print(format_table(summary["overall"], "markdown", summary_columns("summary", protocol), protocol), end="")
+    if summary["fps_note"]:
+        print(f"\n{summary['fps_note']}")
     print("\n" + "\n".join(statistics_lines(summary["statistics"])))
     print(f"\n{spec.name}: {len(res['jobs'])} jobs ({res['runs']} distinct runs): {len(res['done'])} run, "
           f"{len(res['skipped'])} already done, {len(res['failed'])} failed -> {Path(args.out)}")

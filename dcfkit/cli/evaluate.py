@@ -178,6 +178,8 @@ def run_report(args: argparse.Namespace) -> int:
     print(format_table(evaluation.overall, args.format, columns("overall", protocol), protocol,
                        evaluation.statistics, experiment=args.experiment,
                        max_frames=evaluation.settings["max_frames"]), end="")
+    if evaluation.settings["fps_note"] and args.format in ("table", "markdown"):
+        print(f"\n{evaluation.settings['fps_note']}")
     if args.format == "table":
         for tracker, rows in evaluation.platforms.items():  # ten lines at most: records may differ per sequence
             print(f"{tracker} platform: {'; '.join(counted_lines(dict(rows), sum(n for _, n in rows)))}")

@@ -6,8 +6,9 @@ import dataclasses
 import sys
 from pathlib import Path
 
-from dcfkit.cli.common import add_protocol_argument, executor_choice
+from dcfkit.cli.common import add_protocol_argument, executor_choice, frame_limit
 from dcfkit.config import shipped_config_dir
+from dcfkit.datasets.base import sequence_names
 from dcfkit.errors import DcfkitError
 from dcfkit.running.runner import usable_cores
 
@@ -33,6 +34,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="local process pool (default) or dask.distributed (default with --scheduler)")
     parser.add_argument("--scheduler", default=None, metavar="ADDR",
                         help="dask scheduler address (default: a LocalCluster)")
+    parser.add_argument("--sequences", default=None, metavar="LIST",
+                        help="comma-separated sequence names (default: the spec's 'sequences', else all); "
+                             "recorded, so a rerun must give the same")
+    parser.add_argument("--max-frames", type=frame_limit, default=None, metavar="N",
+                        help="a quick try: each sequence's first N frames only (its runs are of the cut sequences, "
+                             "never taken for full ones); recorded, so a rerun must give the same")
     add_protocol_argument(parser)
 
 
@@ -55,6 +62,9 @@ def run(args: argparse.Namespace) -> int:
         if args.trials < 1:
             raise DcfkitError(f"--trials must be >= 1, got {args.trials}")
         spec = dataclasses.replace(spec, trials=args.trials)
+    if args.sequences is not None:
+        spec = dataclasses.replace(spec, sequences=tuple(sequence_names(args.sequences, "--sequences")))
+    spec = dataclasses.replace(spec, max_frames=args.max_frames)
     if args.experiments is not None:
         names = [e.strip() for e in args.experiments.split(",") if e.strip()]
         if not names:

@@ -51,7 +51,8 @@ class SequenceResult:
     ``times`` ``(N,) float64`` seconds per frame and ``fps`` when known (None for imports);
     ``platform`` the :func:`dcfkit.running.platforms.record` of the run when its sidecar has one;
     ``resets`` the 1-based ``starts`` and ``failures`` of a reset-based run
-    (:mod:`dcfkit.running.resets`)."""
+    (:mod:`dcfkit.running.resets`); ``timing`` how its speed was measured
+    (:mod:`dcfkit.running.speed`; None in sidecars from before it was recorded)."""
 
     boxes: np.ndarray
     times: np.ndarray | None = None
@@ -59,6 +60,7 @@ class SequenceResult:
     run_key: str | None = None
     platform: dict | None = None
     resets: dict | None = None
+    timing: dict | None = None
 
 
 class ResultStore:
@@ -222,7 +224,8 @@ class ResultStore:
             results[name] = SequenceResult(read_boxes(self.boxes_path(name)), _times(meta),
                                            None if meta.get("fps") is None else float(meta["fps"]), key,
                                            meta.get("platform") if isinstance(meta.get("platform"), dict) else None,
-                                           meta.get("resets"))
+                                           meta.get("resets"),
+                                           meta.get("timing") if isinstance(meta.get("timing"), dict) else None)
             keys.setdefault(key, []).append(name)
         if len(keys) > 1:
             detail = "; ".join(f"{k}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}" for k, v in keys.items())

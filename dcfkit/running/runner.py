@@ -45,6 +45,7 @@ from dcfkit.running.provenance import (
 from dcfkit.running.resets import ResetTrack, track_with_resets
 from dcfkit.running.results import ResultStore
 from dcfkit.running.scheduler import connect as connect_scheduler, import_distributed
+from dcfkit.running.speed import timing_record
 from dcfkit.running.tracking import TrackerFailure, track
 
 log = logging.getLogger(__name__)
@@ -110,11 +111,12 @@ def warm_up_compiled(tasks: Iterable[RunTask]) -> None:
 
 
 def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | None = None,
-                 origin: Mapping | None = None) -> dict:
+                 origin: Mapping | None = None, timing: Mapping | None = None) -> dict:
     """Run ``task`` and store its boxes or its failure; returns ``{"sequence", "status",
     "frames", "error" (failed) or "fps" (done)}``. ``origin``: the client's
     :func:`~dcfkit.running.provenance.invocation` (default: this process's), recorded in the sidecar
-    with the machine that ran it."""
+    with the machine that ran it; ``timing``: how its speed was measured
+    (:func:`dcfkit.running.speed.timing_record`; default: alone, in this process)."""
     seq, store = task.seq, ResultStore(task.folder)
     _warm_up(task)
     reading = [0]  # the 1-based number of the frame being read, for errors in decoding
@@ -141,6 +143,7 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
     plugins = plugin_versions(task.config)
     meta = {"sequence": seq.name, "dataset": seq.dataset, "tracker": task.config.get("name"),
             "init_box": [float(v) for v in seq.init_box], "fps": run.fps,
+            "timing": dict(timing or timing_record("local", 1)),
             "total_time": float(np.nansum(run.times)),
             "run_key": task.key, "dcfkit_version": version, "plugins": plugins, "source": sources(plugins),
             "time": now(), **(origin or invocation()), "machine": machine(), "platform": platforms.record(),
@@ -219,7 +222,7 @@ def _die_with_parent(parent_pid: int) -> None:
 _worker_ready = False
 
 
-def run_in_worker(task: RunTask, version: str, origin: Mapping | None = None) -> dict:
+def run_in_worker(task: RunTask, version: str, origin: Mapping | None = None, timing: Mapping | None = None) -> dict:
     """:func:`run_sequence` in a pool or dask worker, which must run the client's dcfkit and plugins."""
     global _worker_ready
     if not _worker_ready:  # dask workers have no initializer: one OpenCV thread each
@@ -232,7 +235,7 @@ def run_in_worker(task: RunTask, version: str, origin: Mapping | None = None) ->
         plugins = ", ".join(plugin_versions(task.config)) or "none"
         raise DcfkitError(f"this worker's dcfkit code ({box_code()}) or plugins ({plugins}) are not the client's: "
                           f"install the same dcfkit source and plugin versions on every worker")
-    return run_sequence(task, version, origin=origin)
+    return run_sequence(task, version, origin=origin, timing=timing)
 
 
 def crash_message(seq: Sequence, exc: BaseException) -> str:
@@ -283,6 +286,7 @@ def _deliver(finished: Iterable, key_of: Callable, on_result: Callable, on_crash
 def _run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: str, origin: Mapping, on_result,
               on_crash) -> None:
     distributed = import_distributed()
+    timing = timing_record("dask", None if scheduler else pool_size(jobs, len(tasks)))
     with contextlib.ExitStack() as stack:
         if scheduler:
             client = stack.enter_context(connect_scheduler(scheduler))
@@ -292,7 +296,7 @@ def _run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: s
                     n_workers=worker_count(jobs, len(tasks)), threads_per_worker=1, processes=True,
                     dashboard_address=None))
             client = stack.enter_context(distributed.Client(cluster))
-        futures = [client.submit(run_in_worker, t, version, origin, pure=False,
+        futures = [client.submit(run_in_worker, t, version, origin, timing, pure=False,
                                  key=f"dcfkit-{t.key}-{t.seq.dataset}-{t.seq.name}") for t in tasks]
         by_key = {f.key: t for f, t in zip(futures, tasks)}
         try:
@@ -308,14 +312,18 @@ def usable_cores() -> int:
     return max(1, os.cpu_count() or 1)
 
 
+def pool_size(jobs: int, tasks: int) -> int:
+    """Local worker processes for ``tasks`` tasks at ``jobs``: at most one a task and one a usable core."""
+    return min(max(1, min(jobs, tasks)), usable_cores())
+
+
 def worker_count(jobs: int, tasks: int) -> int:
-    """Local worker processes for ``tasks`` tasks at ``jobs``: at most one a task and one a usable
-    core (more would only share the cores and multiply the memory: said in a warning)."""
-    wanted, cores = max(1, min(jobs, tasks)), usable_cores()
-    if wanted > cores:
+    """:func:`pool_size`, with a warning when ``jobs`` asks for more than the usable cores (more
+    would only share them and multiply the memory)."""
+    if max(1, min(jobs, tasks)) > usable_cores():
         log.warning("--jobs %d: running %d worker processes, one per usable core (more would only share them "
-                    "and multiply the memory)", jobs, cores)
-    return min(wanted, cores)
+                    "and multiply the memory)", jobs, usable_cores())
+    return pool_size(jobs, tasks)
 
 
 def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None], jobs: int = 1,
@@ -348,7 +356,8 @@ def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None]
         _run_dask(tasks, jobs, scheduler, version, origin, on_result, crashed)
     elif jobs == 1 or len(tasks) == 1:
         for task in tasks:
-            on_result(task, run_sequence(task, version, on_frame, origin))
+            on_result(task, run_sequence(task, version, on_frame, origin, timing_record("local", 1)))
     else:
-        run_pool({i: (run_in_worker, t, version, origin) for i, t in enumerate(tasks)}, jobs,
+        timing = timing_record("local", pool_size(jobs, len(tasks)))
+        run_pool({i: (run_in_worker, t, version, origin, timing) for i, t in enumerate(tasks)}, jobs,
                  lambda i, result: on_result(tasks[i], result), lambda i, exc: crashed(tasks[i], exc))

@@ -202,7 +202,8 @@ def test_cli_runs_and_lists_jobs(tmp_path, data, capsys):
     out = str(tmp_path / "out")
     assert cli.main(["ablate", spec, "--out", out, "--sequences", "seqB", "--jobs", "1", "--no-progress"]) == 0
     printed = capsys.readouterr().out
-    assert printed.startswith("protocol otb: OTB / UAV123 MATLAB toolkit")  # the default scoring rules, named
+    assert printed.startswith("spec: experiment OPE (one-pass evaluation), protocol otb\n"
+                              "protocol otb: OTB / UAV123 MATLAB toolkit")  # the default scoring rules, named
     assert "\n\n| variant | precision | auc | fps | sequences | failed |\n" in printed
     assert "1 jobs (1 distinct runs): 1 run, 0 already done, 0 failed" in printed
     assert all((tmp_path / "out" / f"{kind}.{ext}").is_file() for kind in ("precision", "success")
@@ -211,7 +212,7 @@ def test_cli_runs_and_lists_jobs(tmp_path, data, capsys):
     assert cli.main(["ablate", spec, "--out", out, "--sequences", "seqB", "--jobs", "1", "--no-progress",
                      "--protocol", "got10k"]) == 0
     printed = capsys.readouterr().out
-    assert printed.startswith("protocol got10k: ") and "0 run, 1 already done" in printed
+    assert printed.splitlines()[1].startswith("protocol got10k: ") and "0 run, 1 already done" in printed
     assert "| variant | precision | auc | ao | sr50 | sr75 | fps | sequences | failed |" in printed
     assert json.loads((tmp_path / "out" / "summary.json").read_text())["protocol"]["name"] == "got10k"
     assert cli.main(["ablate", spec, "--out", out, "--sequences", "seqC,seqB", "--dry-run"]) == 0
@@ -363,8 +364,8 @@ grid: {base: dr2, parameters: {label.mu: [0, 0.5]}}
     ps = [stats["differences"][v]["auc"]["wilcoxon_p"] for v in ("strcf", "label.mu=0", "label.mu=0.5")]
     assert [stats["differences"][v]["auc"]["holm_p"] for v in ("strcf", "label.mu=0", "label.mu=0.5")] == \
         pytest.approx(holm(ps))
-    assert (out / "statistics.txt").read_text().startswith("statistics over 4 sequences: 95% BCa bootstrap")
-    assert (out / "summary.md").read_text().splitlines()[2].startswith("| variant | precision | auc | fps |")
+    assert (out / "statistics.txt").read_text().splitlines()[1].startswith("statistics over 4 sequences: 95% BCa")
+    assert (out / "summary.md").read_text().splitlines()[4].startswith("| variant | precision | auc | fps |")
     assert (out / "per_sequence.csv").read_text().count("\n") == 1 + total
     assert (out / "per_sequence.csv").read_text().splitlines()[0].endswith(",status,protocol")
     assert (out / "sensitivity_label.mu.png").stat().st_size > 0

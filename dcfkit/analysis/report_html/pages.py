@@ -43,7 +43,8 @@ def report_page(evaluation: Mapping, sequences: Seq[Sequence], results: Mapping[
     trackers = [r["tracker"] for r in evaluation.overall]
     datasets = sorted({s.dataset for s in sequences if s.dataset})
     overall = sections.table("overall", "Overall", evaluation.overall, columns("overall", protocol.name),
-                             trackers, note="Click a column's name to sort by it.")
+                             trackers, note=" ".join(filter(None, (evaluation.settings.get("fps_note"),
+                                                                    "Click a column's name to sort by it."))))
     statistics = sections.statistics_table(evaluation.statistics, trackers)
     by_sequence = runs_by_sequence(sequences, experiment)
     body = evaluation_sections(evaluation, sequences, _first_runs(results, sequences, by_sequence), trackers)

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Iterable, Mapping
 from typing import Sequence as Seq
 
-from dcfkit.analysis.plots import PLOT_STYLE
+from dcfkit.analysis.plots import PLOT_STYLE, plot_title
 from dcfkit.analysis.report_html.provenance import folder_provenance
 from dcfkit.analysis.report_html.thumbnails import sequence_thumbnails
 from dcfkit.analysis.tables import SCORE_LABELS, statistics_scope
@@ -69,7 +69,9 @@ def _finite(value) -> bool:
 
 def curve_charts(evaluation: Mapping, trackers: Seq[str]) -> dict:
     """The success, precision and normalized precision plots of all sequences."""
-    charts = [curve_chart(kind, evaluation.curves, evaluation.thresholds[kind], trackers)
+    experiment = evaluation.settings.get("experiment", "ope")  # TRE's pooled runs are not OPE's
+    charts = [curve_chart(kind, evaluation.curves, evaluation.thresholds[kind], trackers,
+                          title=plot_title(kind, experiment))
               for kind in ("success", "precision", "norm_precision")]
     return {"kind": "charts", "id": "plots", "title": "Success and precision plots", "charts": charts}
 
