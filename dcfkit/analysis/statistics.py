@@ -21,14 +21,14 @@ CONFIDENCE = 0.95
 RESAMPLES = 10_000
 SEED = 0
 BATCH = 2 ** 21  # indices drawn at a time by the bootstrap (16 MiB): memory O(n), not O(RESAMPLES n)
-METHOD = (f"{CONFIDENCE:.0%} BCa bootstrap confidence intervals over sequences ({RESAMPLES:,} resamples, "
-          f"seed {SEED}); paired differences A - B per sequence with the two-sided Wilcoxon signed-rank p "
-          f"(zero differences dropped)")
 #: Relative to the scores' largest magnitude: resampled means, and paired differences, closer
 #: than this count as equal. 300 times the rounding error bound of a float mean of a million
-#: scores (numpy's pairwise sum: about 3e-15), and below the gaps between resampled means of
-#: scores spread by 1e-4 (about 1e-9).
+#: scores (numpy's pairwise sum: about 3e-15), and a thousandth of the smallest gap between a
+#: resampled mean and the mean of scores 0.5 +- 1e-4 (2e-9 with 6 to 39 scores).
 TIE_TOLERANCE = 1e-12
+METHOD = (f"{CONFIDENCE:.0%} BCa bootstrap confidence intervals over sequences ({RESAMPLES:,} resamples, "
+          f"seed {SEED}); paired differences A - B per sequence with the two-sided Wilcoxon signed-rank p "
+          f"(zero differences dropped); values within {TIE_TOLERANCE:g} of the scores' scale tie")
 HOLM = "p Holm-corrected across the comparisons shown; significant: corrected p < 0.05"
 
 
