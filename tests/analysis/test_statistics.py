@@ -9,6 +9,8 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import assume, given
+from hypothesis import strategies as st
 from scipy import stats
 
 from dcfkit.analysis import statistics
@@ -21,19 +23,17 @@ B = np.array([0.598, 0.470, 0.262, 0.650, 0.518, 0.341, 0.401, 0.560])
 
 def test_the_interval_of_a_mean_is_scipys_bca_bootstrap():
     got = mean_interval(A)
-    ci = stats.bootstrap((A,), np.mean, n_resamples=RESAMPLES, method="BCa",
-                         rng=np.random.default_rng(SEED)).confidence_interval
-    assert (got.mean, got.ci_low, got.ci_high, got.n) == (pytest.approx(A.mean()), pytest.approx(ci.low, abs=1e-12),
-                                                          pytest.approx(ci.high, abs=1e-12), 8)
+    low, high = _exact_ties_interval(A)  # in units of 0.001: 24 resampled means tie the mean
+    assert (got.mean, got.ci_low, got.ci_high, got.n) == (pytest.approx(A.mean()), pytest.approx(low, abs=1e-12),
+                                                          pytest.approx(high, abs=1e-12), 8)
     assert got.ci_low < got.mean < got.ci_high
 
 
 def test_a_paired_difference_is_the_bootstrap_and_wilcoxon_of_the_differences():
     d = paired_difference(A, B)
-    ci = stats.bootstrap((A - B,), np.mean, n_resamples=RESAMPLES, method="BCa",
-                         rng=np.random.default_rng(SEED)).confidence_interval
-    assert (d.mean, d.ci_low, d.ci_high) == (pytest.approx((A - B).mean()), pytest.approx(ci.low, abs=1e-12),
-                                             pytest.approx(ci.high, abs=1e-12))
+    low, high = _exact_ties_interval(A - B)
+    assert (d.mean, d.ci_low, d.ci_high) == (pytest.approx((A - B).mean()), pytest.approx(low, abs=1e-12),
+                                             pytest.approx(high, abs=1e-12))
     assert d.wilcoxon_p == pytest.approx(stats.wilcoxon(A - B).pvalue)  # the zero of sequence 5 dropped
     assert (d.won, d.lost, d.tied, d.n) == (6, 1, 1, 8)
 
@@ -113,28 +113,97 @@ def _tables(count: int) -> list[np.ndarray]:
                                                                                       np.array([0.3, 0.3, 0.9])]
 
 
+def _resampled_gaps(x: np.ndarray) -> np.ndarray:
+    """How far each of scipy's resampled means is from the sample mean, in units of the tie tolerance."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", stats.DegenerateDataWarning)
+        means = stats.bootstrap((x,), np.mean, n_resamples=RESAMPLES, method="percentile",
+                                rng=np.random.default_rng(SEED)).bootstrap_distribution
+    return np.abs(means - np.mean(x)) / (statistics.TIE_TOLERANCE * np.max(np.abs(x)))
+
+
+def _grid(x: np.ndarray) -> float | None:
+    """The unit of the decimal grid ``x`` lies on (1, 0.25, 0.1 or 0.001), if any."""
+    return next((unit for unit in (1.0, 0.25, 0.1, 0.001)
+                 if np.allclose(x / unit, np.round(x / unit), rtol=0, atol=1e-9)), None)
+
+
+def _exact_ties_interval(x: np.ndarray) -> tuple[float, float]:
+    """scipy's BCa interval where resampled means equal in exact arithmetic are equal floats, so
+    that scipy counts them half below the sample mean: scores on a decimal grid counted in its
+    units (integers, whose float sums are exact) and scaled back; other scores' means from
+    correctly rounded sums (math.fsum), equal for equal multisets."""
+    unit = _grid(x)
+    if unit is not None:
+        low, high = _scipy_interval(np.round(x / unit))
+        return low * unit, high * unit
+    exact_mean = lambda v, axis: np.apply_along_axis(math.fsum, axis, v) / v.shape[axis]  # noqa: E731
+    ci = stats.bootstrap((x,), exact_mean, n_resamples=RESAMPLES, method="BCa",
+                         rng=np.random.default_rng(SEED)).confidence_interval
+    return float(ci.low), float(ci.high)
+
+
 @pytest.mark.parametrize("x", _tables(40), ids=lambda x: f"n{len(x)}")
 def test_the_interval_is_scipys_bca_on_small_tables(x):
-    got = mean_interval(x)
-    assert (got.ci_low, got.ci_high) == pytest.approx(_scipy_interval(x), abs=1e-12, rel=0)
+    """scipy's interval with ties exact; and scipy's own where its float sums tie what ties
+    (no resampled mean within the tie tolerance of the sample mean but not equal to it)."""
+    got = (mean_interval(x).ci_low, mean_interval(x).ci_high)
+    assert got == pytest.approx(_exact_ties_interval(x), abs=1e-12, rel=0)
+    gaps = _resampled_gaps(x)
+    if not np.any((gaps > 0) & (gaps <= 1)):
+        assert got == pytest.approx(_scipy_interval(x), abs=1e-12, rel=0)
 
 
-def test_where_bca_is_undefined_the_interval_is_scipys_percentile_one(monkeypatch):
-    x = np.array([0.1, 0.4, 0.4, 0.35, 0.9])
-    monkeypatch.setattr(statistics, "_bca_levels", lambda *args: (math.nan, math.nan))
-    got = mean_interval(x)
-    assert (got.ci_low, got.ci_high) == pytest.approx(_scipy_interval(x, "percentile"), abs=1e-12, rel=0)
+def test_the_small_tables_hold_near_ties_and_none():
+    near = [np.any((gap > 0) & (gap <= 1)) for gap in map(_resampled_gaps, _tables(40))]
+    assert any(near) and not all(near)
 
 
-def test_memory_does_not_grow_with_resamples_times_sequences():
-    """scipy's BCa holds n x n jackknife indices and RESAMPLES x n resample indices: 480 MB at
-    3,000 sequences (10 GB at 30,000); drawn in batches the peak is a few batches, whatever n."""
-    rng = np.random.default_rng(1)
-    a, b = rng.random(3000), rng.random(3000)
-    tracemalloc.start()
-    try:
-        paired_difference(a, b)
-        _, peak = tracemalloc.get_traced_memory()
-    finally:
-        tracemalloc.stop()
-    assert peak < 64 * 2 ** 20  # a few batches of 2 ** 21 int64 indices and their values; 480 MB at once
+# six per-sequence AUCs (BACF's on the development sequences, docs/results.md): 166 of the
+# 10,000 resampled means are the sample's multiset again, equal to its mean short of last bits
+SIX = np.array([0.779, 0.718, 0.422, 0.588, 0.569, 0.305])
+
+
+def _last_bit_changes(x: np.ndarray):
+    """``x`` with one score moved by one ulp up or down, each score and direction in turn."""
+    for i, direction in itertools.product(range(len(x)), (np.inf, -np.inf)):
+        y = x.copy()
+        y[i] = np.nextafter(y[i], direction)
+        yield y
+
+
+def _largest_move(x: np.ndarray) -> float:
+    base = mean_interval(x)
+    return max(max(abs(got.ci_low - base.ci_low), abs(got.ci_high - base.ci_high))
+               for got in map(mean_interval, _last_bit_changes(x)))
+
+
+def test_a_last_bit_change_in_a_score_does_not_move_the_interval():
+    assert np.count_nonzero(_resampled_gaps(SIX) <= 1) == 166  # without the tie rule a bound moved by 0.0076
+    assert _largest_move(SIX) < 1e-12 * np.max(np.abs(SIX))
+
+
+@given(st.lists(st.integers(0, 1000), min_size=2, max_size=9), st.sampled_from([1e-3, 0.1, 1.0, 250.0]))
+def test_no_last_bit_change_moves_an_interval(counts, unit):
+    """Scores on a decimal grid (AUCs to 3 decimals, failure counts, ...): many ties."""
+    assume(any(counts))
+    x = np.array(counts) * unit
+    assert _largest_move(x) <= 1e-12 * np.max(np.abs(x))
+
+
+def test_a_last_bit_change_in_a_score_does_not_move_a_paired_difference():
+    other = np.array([0.763, 0.725, 0.613, 0.793, 0.636, 0.534])  # DR²Track's AUCs beside SIX
+    for a, b in [(SIX, other), (other + [0.05, 0, 0, 0, 0.01, 0.01], other)]:  # the second: 3 zeros, 2 tied
+        base = paired_difference(a, b)
+        for changed in itertools.chain(((y, b) for y in _last_bit_changes(a)), ((a, y) for y in _last_bit_changes(b))):
+            got = paired_difference(*changed)
+            assert (got.wilcoxon_p, got.won, got.lost, got.tied) == (base.wilcoxon_p, base.won, base.lost, base.tied)
+            assert max(abs(got.ci_low - base.ci_low), abs(got.ci_high - base.ci_high)) < 1e-12
+
+
+def test_differences_that_tie_in_decimals_are_tied_ranks():
+    # 0.612 - 0.598 and 0.330 - 0.344 are +-0.014, 6e-17 apart in binary: one average rank, as
+    # scipy gives the differences written exactly (in units of 0.001); by their bits 0.125
+    d = paired_difference([0.612, 0.330, 0.301, 0.702, 0.5, 0.47], [0.598, 0.344, 0.262, 0.650, 0.5, 0.4])
+    exact = stats.wilcoxon([14, -14, 39, 52, 70]).pvalue
+    assert (d.wilcoxon_p, d.won, d.lost, d.tied) == (pytest.approx(exact), 4, 1, 1)
