@@ -237,11 +237,11 @@ def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | No
 def score_and_write(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None, report_dir=None,
                     include_first: bool = True, weighting: str | None = None,
                     protocol: str | Protocol | None = None, *, missing: str = "skip",
-                    experiment: str | Experiment = "ope") -> tuple[dict, list[Path]]:
+                    experiment: str | Experiment = "ope", baseline: str | None = None) -> tuple[dict, list[Path]]:
     """:func:`write_report` that also returns what :func:`evaluate` returned: (evaluation, paths)."""
     report_dir = default_report_dir(out_dir, report_dir, experiment)
     _, _, evaluation = score_folders(out_dir, sequences, trackers, report_dir, include_first, weighting, protocol,
-                                     missing=missing, experiment=experiment)
+                                     missing=missing, experiment=experiment, baseline=baseline)
     return evaluation, write_files(evaluation, report_dir)
 
 
@@ -259,7 +259,7 @@ def default_report_dir(out_dir, report_dir=None, experiment: str | Experiment = 
 
 def score_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None, report_dir: Path,
                   include_first: bool = True, weighting: str | None = None, protocol: str | Protocol | None = None,
-                  *, missing: str = "skip", experiment: str | Experiment = "ope"
+                  *, missing: str = "skip", experiment: str | Experiment = "ope", baseline: str | None = None
                   ) -> tuple[dict[str, Path], dict[str, dict], dict]:
     """(tracker folders, their results, :func:`evaluate` of them) for a report into
     ``report_dir``, which is checked to take the report's files before the scoring. A test
@@ -283,4 +283,4 @@ def score_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | N
                            f"found under {clip(str(out_dir))}")
     ensure_writable(report_dir, report_file_names(sequences), "the report")  # before the scoring
     return folders, results, evaluate(results, sequences, include_first, weighting, protocol, missing, experiment,
-                                      by_sequence)
+                                      by_sequence, baseline)

@@ -125,10 +125,10 @@ def _fails(run: ResetRun, i: int, margin: float) -> bool:
 
 
 def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,
-                       report_dir=None, interval: tuple[int, int] | None = None, protocol: str | None = None
-                       ) -> tuple[dict, list[Path]]:
+                       report_dir=None, interval: tuple[int, int] | None = None, protocol: str | None = None,
+                       baseline: str | None = None) -> tuple[dict, list[Path]]:
     """Score the reset-based runs (``<tracker>/reset/``) of every tracker in ``out_dir`` on the
-    sequences all of them ran, with the rule they were made with (``protocol``, if given, must be
+    sequences all of them ran (differences from ``baseline``, by default the best), with the rule they were made with (``protocol``, if given, must be
     it: a :class:`ConfigError` if not, or if the runs were made with several), and write
     ``reset_overall`` and ``reset_per_sequence`` tables (``.txt``, ``.md``, ``.csv``;
     ``reset_overall.tex``: :func:`reset_latex`), ``statistics.txt`` and ``reset.json`` to
@@ -149,7 +149,7 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
     rule = _one_rule(results, protocol)
     names = [f"reset_{t}.{ext}" for t in RESET_COLUMNS for _, ext in TABLE_FORMATS if ext != "tex"]
     ensure_writable(report_dir, names + ["reset_overall.tex", "statistics.txt", "reset.json"], "the report")
-    scores = score_resets(results, {s.name: len(s) for s in sequences}, interval)
+    scores = score_resets(results, {s.name: len(s) for s in sequences}, interval, baseline)
     scores["experiment"] = experiment_record(EXPERIMENT)
     scores["max_frames"] = cut_length(sequences)
     scores["rule"] = {"name": rule.name, "title": rule.title, "tables": rule.tables}

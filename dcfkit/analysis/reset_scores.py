@@ -34,6 +34,7 @@ import numpy as np
 from scipy import stats
 
 from dcfkit.analysis import statistics
+from dcfkit.analysis.scoring import check_baseline
 from dcfkit.experiments.vot import BURN_IN, DEFAULT_RULE, get_rule
 
 __all__ = ["ResetRun", "eao", "eao_interval", "expected_overlaps", "fragments", "pooled_accuracy", "score_resets",
@@ -202,13 +203,14 @@ def _eao_with_ci(runs: Sequence[ResetRun], interval: tuple[int, int]) -> tuple[f
 
 
 def score_resets(results: Mapping[str, Mapping[str, ResetRun]], lengths: Mapping[str, int],
-                 interval: tuple[int, int] | None = None) -> dict:
+                 interval: tuple[int, int] | None = None, baseline: str | None = None) -> dict:
     """Score each tracker's runs (tracker -> sequence -> :class:`ResetRun`) on the sequences
     every tracker ran; ``lengths`` are all sequences' lengths, for the EAO interval (by
     default :func:`eao_interval` of them). Returns plain data: ``interval``, ``overall`` rows
     (``tracker``, ``accuracy``, ``failures``, ``eao`` with ``eao_ci_low`` and ``eao_ci_high``, ``sequences``, best EAO
     first), ``per_sequence`` rows, ``left_out`` (sequence -> the trackers without its run) and ``statistics``
-    (:func:`~dcfkit.analysis.statistics.versus_baseline` of accuracy and failures)."""
+    (:func:`~dcfkit.analysis.statistics.versus_baseline` of accuracy and failures, from ``baseline``,
+    by default the best)."""
     interval = interval or eao_interval(list(lengths.values()))
     names = [s for s in lengths if all(s in res for res in results.values())]
     left_out = {s: [t for t, res in results.items() if s not in res] for s in lengths if s not in names}
@@ -222,6 +224,7 @@ def score_resets(results: Mapping[str, Mapping[str, ResetRun]], lengths: Mapping
                         "failures": sum(r["failures"] for r in rows), **found, "sequences": len(rows)})
     overall.sort(key=lambda r: -r["eao"] if math.isfinite(r["eao"]) else math.inf)
     ranked = [r["tracker"] for r in overall]
+    check_baseline(baseline, ranked)
     return {"interval": list(interval), "overall": overall, "per_sequence": per_sequence, "left_out": left_out,
-            "statistics": statistics.versus_baseline(per_sequence, ranked, ("accuracy", "failures"))
+            "statistics": statistics.versus_baseline(per_sequence, ranked, ("accuracy", "failures"), baseline)
             if ranked else {}}

@@ -83,7 +83,8 @@ MISSING = ("skip", "fail")  # what evaluate() does with a sequence a tracker has
 def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
              include_first: bool = True, weighting: str | None = None,
              protocol: str | Protocol | None = None, missing: str = "fail",
-             experiment: str | Experiment = "ope", runs: Mapping[str, list[Sequence]] | None = None) -> Evaluation:
+             experiment: str | Experiment = "ope", runs: Mapping[str, list[Sequence]] | None = None,
+             baseline: str | None = None) -> Evaluation:
     """Score ``results`` (tracker -> sequence name -> boxes) on ``sequences`` under ``protocol``
     (by default the rules of the benchmark's published tables,
     :func:`~dcfkit.datasets.benchmark_protocol`: LaSOT's for LaSOT, the OTB toolkit's for UAV123).
@@ -102,7 +103,8 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
     name, and a sequence's score pools the frames of its runs (:func:`metrics.pool_runs`); a
     sequence lacks a result unless it has all its runs. ``runs``: sequence name -> its runs,
     when the caller made them already (:func:`dcfkit.experiments.runs_by_sequence`; an SRE
-    run reads its sequence's first frame).
+    run reads its sequence's first frame). ``baseline``: the tracker the paired differences are
+    taken from (default: the best; :func:`check_baseline`).
     """
     sequences = list(sequences)
     proto = get_protocol(protocol or benchmark_protocol(sequences))
@@ -129,6 +131,7 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
                         "sequences": len(sequences), "missing": len(missing[tracker]), "frames": avg["frames"]})
     overall = _rank(overall, proto)
     ranked = [r["tracker"] for r in overall]
+    check_baseline(baseline, ranked)
     per_sequence = [
         {"tracker": t, "sequence": s.name, **{k: per_seq[t][s.name][k] for k in keys},
          "fps": fps[t][s.name] if measured[t][s.name] == speed.ALONE else None,
@@ -145,7 +148,14 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
                   "missing": "skip" if left_out is not None else "fail", "left_out": left_out or {},
                   "datasets": dict(Counter(s.dataset or "unnamed" for s in sequences))},
         platforms={t: _platforms(res.values()) for t, res in results.items()},
-        statistics=versus_baseline(per_sequence, ranked, (proto.rank_key, "precision")) if ranked else {})
+        statistics=versus_baseline(per_sequence, ranked, (proto.rank_key, "precision"), baseline) if ranked else {})
+
+
+def check_baseline(baseline: str | None, trackers: list[str]) -> None:
+    """A :class:`DatasetError` unless ``baseline`` is None or one of ``trackers`` (``--baseline``)."""
+    if baseline is not None and baseline not in trackers:
+        raise DatasetError(f"--baseline {shown(baseline)}: no such tracker in this report; its trackers are "
+                           f"{', '.join(map(shown, trackers)) or 'none'}")
 
 
 def _complete(sequences: list[Sequence], results: Mapping[str, Mapping], missing: str,

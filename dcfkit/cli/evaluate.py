@@ -133,6 +133,9 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
     add_dataset_arguments(parser)
     parser.add_argument("--trackers", default=None,
                         help="comma-separated tracker folders (names in OUT or paths; default: all)")
+    parser.add_argument("--baseline", default=None, metavar="TRACKER",
+                        help="the tracker whose paired differences (Δ, CI, Wilcoxon p, won/tied/lost) every other "
+                             "is compared by, e.g. the one a new component extends (default: the best)")
     parser.add_argument("--format", choices=("table", "markdown", "csv", "latex"), default="table",
                         help="format of the table printed to stdout; every format names the experiment, the protocol "
                              "and a --max-frames cut (latex: a booktabs table a paper can take: each tracker's "
@@ -170,7 +173,8 @@ def run_report(args: argparse.Namespace) -> int:
             raise ConfigError("--html: reset-based runs have no report page (their tables, statistics.txt and "
                               "reset.json are written without it); leave --html out for --experiment reset")
         return _reset_report(args, sequences, trackers)
-    write = functools.partial(write_html_report if args.html else score_and_write, experiment=args.experiment)
+    write = functools.partial(write_html_report if args.html else score_and_write, experiment=args.experiment,
+                              baseline=args.baseline)
     evaluation, paths = write(args.out, sequences, trackers, args.report_dir, include_first=not args.skip_first,
                               weighting="frame" if args.frame_weighted else None, protocol=args.protocol,
                               missing=args.missing)
@@ -198,7 +202,8 @@ def run_report(args: argparse.Namespace) -> int:
 
 def _reset_report(args: argparse.Namespace, sequences: list, trackers: list[str] | None) -> int:
     """``report --experiment reset``: the accuracy, failures and EAO table and the statistics."""
-    scores, paths = write_reset_report(args.out, sequences, trackers, args.report_dir, protocol=args.protocol)
+    scores, paths = write_reset_report(args.out, sequences, trackers, args.report_dir, protocol=args.protocol,
+                                       baseline=args.baseline)
     print(reset_latex(scores) if args.format == "latex" else reset_table(scores, "overall", args.format), end="")
     if args.format == "table":
         for name, without in scores["left_out"].items():

@@ -17,7 +17,7 @@ from dcfkit.analysis.reset_scores import (
     score_resets,
     sequence_scores,
 )
-
+from dcfkit.datasets import DatasetError
 
 
 def ResetRun(*args) -> reset_scores.ResetRun:  # noqa: N802
@@ -109,6 +109,10 @@ def test_score_resets_rows_and_statistics():
     assert rows["a"]["eao_ci_low"] <= rows["a"]["eao"] <= rows["a"]["eao_ci_high"]
     differences = scores["statistics"]["differences"]["a"]
     assert differences["failures"]["mean"] == 0.5 and differences["accuracy"]["mean"] == pytest.approx(-0.05)
+    from_a = score_resets(results, {"s1": 30, "s2": 30}, interval=(12, 14), baseline="a")["statistics"]
+    assert from_a["baseline"] == "a" and from_a["differences"]["b"]["failures"]["mean"] == -0.5
+    with pytest.raises(DatasetError, match="--baseline 'c': no such tracker in this report; its trackers are 'b', 'a'"):
+        score_resets(results, {"s1": 30, "s2": 30}, interval=(12, 14), baseline="c")
 
 
 def test_the_eao_interval_leaves_out_resamples_without_an_eao():

@@ -1,6 +1,7 @@
 """evaluate(): its statistics over sequences, against scipy on the per-sequence scores."""
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import cv2
@@ -70,6 +71,32 @@ def test_report_prints_and_writes_the_statistics(tmp_path, monkeypatch, capsys):
     written = (tmp_path / "out_report" / "statistics.txt").read_text()
     assert written.splitlines()[3] == out.split("\n\n")[-2].splitlines()[0]
     assert written.startswith("experiment OPE (one-pass evaluation") and written.splitlines()[1].startswith("protocol ")
+
+
+def test_report_takes_the_differences_from_the_baseline_it_is_given(tmp_path, monkeypatch, capsys):
+    """``--baseline far``: every other tracker's paired difference is from far (the worst here),
+    in the printed LaTeX table and in report.json; a name that is no tracker is one clear error."""
+    import dcfkit.cli.evaluate
+
+    for tracker, by_sequence in RESULTS.items():
+        folder = tmp_path / "out" / tracker
+        folder.mkdir(parents=True)
+        for name, boxes in by_sequence.items():
+            (folder / f"{name}.txt").write_text("".join(f"{x + 1:.3f},{y + 1:.3f},{w:.3f},{h:.3f}\n"
+                                                        for x, y, w, h in boxes))
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: SEQUENCES)
+    report = ["report", str(tmp_path / "out"), "--root", str(tmp_path)]
+    assert cli.main(report + ["--baseline", "far", "--format", "latex"]) == 0
+    assert "the paired difference from far" in capsys.readouterr().out
+    statistics = json.loads((tmp_path / "out_report" / "report.json").read_text())["statistics"]
+    assert statistics["baseline"] == "far" and set(statistics["differences"]) == {"near", "same"}
+    auc = {t: np.array([r["auc"] for r in evaluate(RESULTS, SEQUENCES).per_sequence if r["tracker"] == t])
+           for t in RESULTS}
+    assert statistics["differences"]["near"]["auc"]["mean"] == pytest.approx((auc["near"] - auc["far"]).mean())
+    assert cli.main(report + ["--baseline", "nobody"]) == 2
+    err = capsys.readouterr().err
+    assert "--baseline 'nobody': no such tracker in this report; its trackers are" in err and "far" in err
+    assert len(err.strip().splitlines()) == 1
 
 
 def test_a_missing_result_is_left_out_and_named_unless_asked_to_fail():

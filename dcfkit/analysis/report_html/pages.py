@@ -77,7 +77,7 @@ def _first_runs(results: Mapping[str, Mapping], sequences: Seq[Sequence],
 def write_html_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None, report_dir=None,
                       include_first: bool = True, weighting: str | None = None,
                       protocol: str | Protocol | None = None, *, missing: str = "skip",
-                      experiment: str | Experiment = "ope") -> tuple[dict, list[Path]]:
+                      experiment: str | Experiment = "ope", baseline: str | None = None) -> tuple[dict, list[Path]]:
     """:func:`dcfkit.analysis.report.score_and_write` plus ``report.html``: one self-contained page with
     the tables (sortable, filterable), the plots, every sequence's frames with the boxes, and
     what produced the results. ``experiment``: one pass, ``tre`` or ``sre`` (reset-based runs
@@ -85,7 +85,8 @@ def write_html_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str]
     report_dir = default_report_dir(out_dir, report_dir, experiment)
     sequences = scored_sequences(sequences)  # the page shows the frames of the sequences scored only
     folders, results, evaluation = score_folders(out_dir, sequences, trackers, report_dir, include_first,
-                                                 weighting, protocol, missing=missing, experiment=experiment)
+                                                 weighting, protocol, missing=missing, experiment=experiment,
+                                                 baseline=baseline)
     paths = write_files(evaluation, report_dir)
     page = report_page(evaluation, sequences, results, folders, report_dir)
     return evaluation, paths + [write_page(page, report_dir / PAGE)]
