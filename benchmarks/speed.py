@@ -44,9 +44,9 @@ def sequences(root):
         print(f"no real data at {root!r}: synthetic frames only")
 
 
-def synthetic():
+def synthetic(n_frames: int):
     """A generated sequence of UAV123's frame size (its frames are all held in memory)."""
-    seq = make_sequence(n_frames=200, size=(720, 1280), target=(40, 70))
+    seq = make_sequence(n_frames=n_frames, size=(720, 1280), target=(40, 70))
     yield SYNTHETIC, seq.frames.__getitem__, len(seq.frames), seq.ground_truth[0]
 
 
@@ -89,6 +89,7 @@ def main():
                         help="sweeps over all sequences; each run's best fps counts (a shared machine slows "
                              "down for minutes at a time, so passes minutes apart filter that out)")
     parser.add_argument("--json", help="also write the table here")
+    parser.add_argument("--synthetic-frames", type=int, default=200, help="frames of the synthetic sequence")
     args = parser.parse_args()
     configs = args.configs.split(",")
     rows = []
@@ -99,7 +100,7 @@ def main():
         yield from sequences(args.root)
         if rows:  # before the synthetic frames, which are all held in memory
             rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-        yield from synthetic()
+        yield from synthetic(args.synthetic_frames)
 
     sweeps = [all_sequences()] + [sequences(args.root) for _ in range(args.passes - 1)]
     for sweep, runs in enumerate(sweeps):

@@ -3,6 +3,8 @@ library without argparse, and a reason on every import deferred into a function.
 from __future__ import annotations
 
 import ast
+import subprocess
+import sys
 from pathlib import Path
 
 import grimp
@@ -122,6 +124,24 @@ def test_only_the_cli_parses_arguments(graph):
     library = sorted(m for m in graph.find_modules_that_directly_import("argparse")
                      if m.startswith("dcfkit") and not m.startswith("dcfkit.cli"))
     assert not library, f"argparse outside dcfkit.cli: {library}"
+
+
+# the dcfkit.cli modules and the statistics stack loaded by parsing a command, in a fresh process
+LOADED_BY_TRAX = """import sys
+import dcfkit.cli
+try:
+    dcfkit.cli.main(["trax", "--help"])
+except SystemExit:
+    print(" ".join(sorted(m for m in sys.modules if m.startswith("dcfkit.cli.") or m == "scipy.stats")))
+"""
+
+
+def test_a_command_imports_only_its_own_module():
+    """``dcfkit trax`` (a process per sequence under the VOT toolkit) starts without the other
+    commands' modules and the statistics that eval and ablate load."""
+    run = subprocess.run([sys.executable, "-c", LOADED_BY_TRAX], capture_output=True, text=True, timeout=120)
+    loaded = run.stdout.splitlines()[-1:]
+    assert loaded == ["dcfkit.cli.parser dcfkit.cli.trax"], run.stdout[-2000:] + run.stderr[-2000:]
 
 
 def test_imports_inside_functions_say_why():

@@ -7,7 +7,7 @@ import errno
 import sys
 import warnings
 
-from dcfkit.cli.parser import build_parser
+from dcfkit.cli.parser import build_parser, named_command
 from dcfkit.errors import DcfkitError, DcfkitWarning, clip
 from dcfkit.running.provenance import running_command
 from dcfkit.running.tracking import interrupt_on_termination
@@ -27,7 +27,7 @@ def _one_line_warnings(show):
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    args = build_parser(only=named_command(sys.argv[1:] if argv is None else argv)).parse_args(argv)
     given = contextlib.nullcontext() if argv is None else running_command(["dcfkit", *argv])
     with warnings.catch_warnings(), interrupt_on_termination(), given:  # SIGTERM/SIGHUP end a command as Ctrl-C does
         warnings.showwarning = _one_line_warnings(warnings.showwarning)

@@ -55,7 +55,7 @@ def test_stages(tmp_path):
 @pytest.mark.slow
 def test_speed(tmp_path):
     out = run("speed.py", "--root", str(tmp_path / "none"), "--configs", "kcf", "--passes", "1", "--json", "speed.json",
-              tmp_path=tmp_path)
+              "--synthetic-frames", "4", tmp_path=tmp_path)
     assert "synthetic frames only" in out and "first frame in a fresh process" in out
     assert (tmp_path / "speed.json").is_file()
 

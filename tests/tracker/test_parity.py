@@ -45,14 +45,21 @@ FAITHFUL = ("arcf", "autotrack")  # shipped configs that are their authors' code
 AUTOTRACK_ROUNDING_BOUND = ("truck4_1", "wakeboard10")
 
 
-def compare_preset(preset, dataset, folder, sequences, reference, shared_data, tmp_path):
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory) -> Path:
+    """One results folder for the module: a preset's run of a sequence is tracked once and
+    compared with every reference it is tested against (run_one_pass skips intact runs)."""
+    return tmp_path_factory.mktemp("parity_runs")
+
+
+def compare_preset(preset, dataset, folder, sequences, reference, shared_data, runs):
     """Run ``configs/reference/<preset>.yaml`` (or the shipped config ``preset`` when it names no
-    reference preset: ARCF's and AutoTrack's are their authors' code) on the sequences and
-    compare it with ``reference``."""
+    reference preset: ARCF's and AutoTrack's are their authors' code) on the sequences, unless
+    ``runs`` holds that run already, and compare it with ``reference``."""
     seqs = load_dataset(dataset, shared_data / folder, sequences)
     config = load_config(preset if preset in FAITHFUL else f"reference/{preset}")
-    run_one_pass(config, seqs, tmp_path, progress=False)
-    table = compare_folders(tmp_path / config["name"], reference, seqs, protocol="otb")
+    run_one_pass(config, seqs, runs, progress=False)
+    table = compare_folders(runs / config["name"], reference, seqs, protocol="otb")
     assert [r["sequence"] for r in table["rows"]] == [s.name for s in seqs]
     return table["rows"]
 
@@ -65,33 +72,33 @@ def assert_within_the_bar(rows):
 
 @pytest.mark.parametrize("dataset,folder,sequences", [UAV + (None,), ("dtb70", "DTB70", ["Gull1"]),
                                                       ("uavdt", "UAVDT", ["S0601"])])
-def test_dr2track_reference_is_the_authors_code(dataset, folder, sequences, shared_data, tmp_path):
+def test_dr2track_reference_is_the_authors_code(dataset, folder, sequences, shared_data, runs):
     reference = OCTAVE_RUNS / "DR2Track" / folder
-    rows = compare_preset("dr2track", dataset, folder, sequences, reference, shared_data, tmp_path)
+    rows = compare_preset("dr2track", dataset, folder, sequences, reference, shared_data, runs)
     assert_within_the_bar(rows)
     for row in rows:  # box for box from frame 2 (their frame-1 box is their floored start)
-        ours, theirs = (read_boxes(f / f"{row['sequence']}.txt") for f in (tmp_path / "dr2track_reference", reference))
+        ours, theirs = (read_boxes(f / f"{row['sequence']}.txt") for f in (runs / "dr2track_reference", reference))
         assert np.abs(ours[1:] - theirs[1:]).max() <= 0.01, row
 
 
 @pytest.mark.parametrize("dataset,folder", [UAV, ("dtb70", "DTB70"), ("uavdt", "UAVDT")])
-def test_strcf_reference_is_the_authors_code_box_for_box(dataset, folder, shared_data, tmp_path):
+def test_strcf_reference_is_the_authors_code_box_for_box(dataset, folder, shared_data, runs):
     reference = OCTAVE_RUNS / "STRCF" / folder
-    rows = compare_preset("strcf", dataset, folder, None, reference, shared_data, tmp_path)
+    rows = compare_preset("strcf", dataset, folder, None, reference, shared_data, runs)
     assert_within_the_bar(rows)
     for row in rows:  # box for box: their boxes are whole pixels (report_tracking_result's round)
         assert row["iou"] == 1.0, row
 
 
-def test_bacf_reference_reproduces_the_published_boxes(shared_data, tmp_path):
+def test_bacf_reference_reproduces_the_published_boxes(shared_data, runs):
     sequences = ["boat1", "building4", "truck4_1", "truck4_2", "wakeboard10"]
     reference = shared_data / "reference_results" / "BACF" / "UAV123_10fps"
-    assert_within_the_bar(compare_preset("bacf", *UAV, sequences, reference, shared_data, tmp_path))
+    assert_within_the_bar(compare_preset("bacf", *UAV, sequences, reference, shared_data, runs))
 
 
-def test_bacf_reference_is_the_authors_code(shared_data, tmp_path):
+def test_bacf_reference_is_the_authors_code(shared_data, runs):
     reference = OCTAVE_RUNS / "BACF" / "UAV123_10fps"
-    for row in compare_preset("bacf", *UAV, ["wakeboard7", "truck4_1"], reference, shared_data, tmp_path):
+    for row in compare_preset("bacf", *UAV, ["wakeboard7", "truck4_1"], reference, shared_data, runs):
         assert row["iou"] == 1.0, row  # box for box (whole pixels: floor(target_sz), pos - floor(sz/2))
 
 
@@ -100,9 +107,9 @@ def test_bacf_reference_is_the_authors_code(shared_data, tmp_path):
     "wakeboard7, where scales 4 and 5 score 0.0089659 and 0.0089725; dcfkit's preset gives the Octave "
     "run's boxes exactly (test above). MATLAB's platform (the processor's SSE estimates in gradientMex, "
     "its BLAS and FFT) is not known."))
-def test_bacf_reference_on_wakeboard7_against_the_published_file(shared_data, tmp_path):
+def test_bacf_reference_on_wakeboard7_against_the_published_file(shared_data, runs):
     reference = shared_data / "reference_results" / "BACF" / "UAV123_10fps"
-    assert_within_the_bar(compare_preset("bacf", *UAV, ["wakeboard7"], reference, shared_data, tmp_path))
+    assert_within_the_bar(compare_preset("bacf", *UAV, ["wakeboard7"], reference, shared_data, runs))
 
 
 def published(tracker, shared_data):
@@ -110,26 +117,26 @@ def published(tracker, shared_data):
     return shared_data / "reference_results" / tracker / "UAV123_10fps"
 
 
-def test_arcf_reproduces_the_authors_published_scores(shared_data, tmp_path):
+def test_arcf_reproduces_the_authors_published_scores(shared_data, runs):
     """Issue 16's bar against the authors' MATLAB result files: |ΔAUC| <= 0.03 on every sequence,
     the mean within 0.02; and issue 13's against their code run here under Octave."""
-    rows = compare_preset("arcf", *UAV, None, published("ARCF-HC", shared_data), shared_data, tmp_path)
+    rows = compare_preset("arcf", *UAV, None, published("ARCF-HC", shared_data), shared_data, runs)
     assert all(abs(row["d_auc"]) <= 0.03 for row in rows), rows
     assert abs(sum(row["d_auc"] for row in rows)) / len(rows) <= 0.02
-    assert_within_the_bar(compare_preset("arcf", *UAV, None, OCTAVE_RUNS / "ARCF-HC" / "UAV123_10fps", shared_data,
-                                         tmp_path / "octave"))
+    octave = OCTAVE_RUNS / "ARCF-HC" / "UAV123_10fps"
+    assert_within_the_bar(compare_preset("arcf", *UAV, None, octave, shared_data, runs))  # the same run, not rerun
 
 
-def test_autotrack_reproduces_the_authors_published_scores(shared_data, tmp_path):
+def test_autotrack_reproduces_the_authors_published_scores(shared_data, runs):
     """Issue 16's bar on the four sequences whose occlusion tests rounding does not decide
     (the other two: the xfail below), against the published files and their code under Octave."""
     stable = [s for s in ("boat1", "building4", "truck4_1", "truck4_2", "wakeboard7", "wakeboard10")
               if s not in AUTOTRACK_ROUNDING_BOUND]
-    rows = compare_preset("autotrack", *UAV, stable, published("AutoTrack", shared_data), shared_data, tmp_path)
+    rows = compare_preset("autotrack", *UAV, stable, published("AutoTrack", shared_data), shared_data, runs)
     assert all(abs(row["d_auc"]) <= 0.03 for row in rows), rows
     assert abs(sum(row["d_auc"] for row in rows)) / len(rows) <= 0.02
     assert_within_the_bar(compare_preset("autotrack", *UAV, stable, OCTAVE_RUNS / "AutoTrack" / "UAV123_10fps",
-                                         shared_data, tmp_path / "octave"))
+                                         shared_data, runs))
 
 
 @pytest.mark.xfail(strict=True, reason=(
@@ -137,9 +144,9 @@ def test_autotrack_reproduces_the_authors_published_scores(shared_data, tmp_path
     "response map) is decided by float32 rounding where it sits near its threshold: on truck4_1 and "
     "wakeboard10 the published MATLAB file, the authors' code under Octave and dcfkit part there "
     "(truck4_1 AUC 0.535 / 0.529 / 0.595, wakeboard10 0.412 / 0.452 / 0.500)"))
-def test_autotrack_on_its_rounding_bound_sequences(shared_data, tmp_path):
+def test_autotrack_on_its_rounding_bound_sequences(shared_data, runs):
     rows = compare_preset("autotrack", *UAV, list(AUTOTRACK_ROUNDING_BOUND), published("AutoTrack", shared_data),
-                          shared_data, tmp_path)
+                          shared_data, runs)
     assert all(abs(row["d_auc"]) <= 0.03 for row in rows), rows
 
 
