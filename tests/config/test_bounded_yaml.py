@@ -28,7 +28,9 @@ from dcfkit.errors import ConfigError, DcfkitError, RegistryError
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 SHIPPED = sorted(CONFIGS.glob("*.yaml")) + sorted((CONFIGS / "reference").glob("*.yaml"))
-STEPS = 5 * config.MAX_VALUES  # Steps of one load: a value is composed, measured and copied once or twice
+# Steps (below) of one load: each of its at most MAX_VALUES values is composed, measured and
+# copied once or twice; the most any test here takes is 3,087, a bomb expanded takes millions
+STEPS = 5 * config.MAX_VALUES
 PEAK_BYTES = 30 * 2**20  # Python allocations of one refusal (tracemalloc's peak); a bomb wanted GBs
 MESSAGE_CHARS = 1000  # an error message, whatever the size of the value it is about
 
