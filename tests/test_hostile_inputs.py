@@ -90,6 +90,7 @@ plausible = st.tuples(st.floats(-60, 100), st.floats(-60, 75), st.floats(0.5, 10
 @example(box=(10, 10, 1e-300, 1e-300))  # cannot convert NaN
 @example(box=(-1e12, -1e12, 2e12, 2e12))  # integer overflow
 @example(box=(0, 0, 960, 720))  # ten times the image: the largest box kept
+@example(box=(0, 0, 1, 2))  # BACF's floored size of a 1-px target shrinking: an empty box
 def test_any_initial_box_is_tracked_or_refused_in_bounded_memory_and_work(box):
     """Every shipped tracker either refuses the box with an InputError naming it, or tracks the
     next frame to a finite box of positive size; in under 200 MB and 1.5e9 elements worked on

@@ -55,15 +55,18 @@ def geometry(p: TrackerParams, target: np.ndarray, area_of: np.ndarray | None = 
 
 def reported_box(centre: np.ndarray, size: np.ndarray, convention: str) -> tuple[float, float, float, float]:
     """The (x, y, w, h) box, 0-based, of a target at ``centre`` (y, x) of ``size`` (h, w), as
-    ``tracker.box_output`` says: 'exact', 'rounded', or the authors' 'half_size' / 'floor_half'."""
+    ``tracker.box_output`` says: 'exact', 'rounded', or the authors' 'half_size' / 'floor_half'.
+    A rounded size is at least one pixel: below a pixel the authors' codes report an empty box,
+    which no toolkit scores as a box (docs/reference.md)."""
     (cy, cx) = centre
     if convention == "half_size":  # DR²Track's [pos - round(size) / 2, round(size)]
-        h, w = round_half_away(size)
+        h, w = np.maximum(round_half_away(size), 1.0)
         return float(cx - w / 2), float(cy - h / 2), float(w), float(h)
     if convention == "floor_half":  # BACF's [pos - floor(floor(size) / 2), floor(size)]
-        h, w = np.floor(size)
+        h, w = np.maximum(np.floor(size), 1.0)
         return float(cx - np.floor(w / 2)), float(cy - np.floor(h / 2)), float(w), float(h)
     box = centre_size_to_box(centre, size)
     if convention == "rounded":  # round([pos - (sz - 1)/2, sz]), 1-based
-        return tuple(float(v) for v in round_half_away(np.add(box, (1, 1, 0, 0))) - (1, 1, 0, 0))
+        x, y, w, h = round_half_away(np.add(box, (1, 1, 0, 0))) - (1, 1, 0, 0)
+        return float(x), float(y), float(max(w, 1.0)), float(max(h, 1.0))
     return box

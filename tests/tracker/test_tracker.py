@@ -13,6 +13,7 @@ from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.errors import ConfigError, InputError, TrackingError
 from dcfkit.numerics.patches import round_half_away
 from dcfkit.numerics.response import shift_spectrum
+from dcfkit.tracker.geometry import reported_box
 
 CONFIGS = ["strcf", "bacf", "dr2track", "kcf", "dsst", "configs/ablations/dr2track_no_dr.yaml",
            "configs/ablations/dr2track_no_ma.yaml"]
@@ -470,6 +471,19 @@ def test_box_output(output, box, expected):
     tracker.init(image, box)
     assert tracker.scale == 1.0
     np.testing.assert_allclose(tracker.box, expected, atol=1e-9)
+
+
+@pytest.mark.parametrize("convention, expected", [
+    ("floor_half", (20.0, 10.0, 1.0, 1.0)),   # floor(0.3), floor(0.4) = 0 -> 1; x = 20 - floor(1 / 2)
+    ("half_size", (19.5, 9.5, 1.0, 1.0)),     # round(0.3), round(0.4) = 0 -> 1; x = 20 - 1 / 2
+    ("rounded", (20.0, 10.0, 1.0, 1.0)),      # x = round(20 - (0.3 - 1) / 2 + 1) - 1 = 20; w = round(0.3) -> 1
+    ("exact", (20.35, 10.3, 0.3, 0.4)),       # not rounded: the size itself, positive
+])
+def test_a_rounded_box_keeps_a_pixel_below_a_pixel(convention, expected):
+    """A target smaller than a pixel (centre (y, x) = (10, 20), size (h, w) = (0.4, 0.3)) is
+    reported with at least one pixel, never the empty box the authors' floor or round gives."""
+    box = reported_box(np.array([10.0, 20.0]), np.array([0.4, 0.3]), convention)
+    np.testing.assert_allclose(box, expected, atol=1e-12)
 
 
 def sliding_frames(n, step, width=160):
