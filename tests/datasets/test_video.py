@@ -87,9 +87,17 @@ def serve_folder(tmp_path):
     server.server_close()
 
 
+def _ctrl_c_as_in_a_terminal() -> None:
+    """SIGINT's default action in the child: a background job of a non-interactive shell (CI
+    started with ``&``, nohup) ignores SIGINT, and a Python started so keeps ignoring it, where
+    a command run from a terminal gets Ctrl-C as KeyboardInterrupt."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def dcfkit_track(*args: str, **popen) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
-    return subprocess.Popen([sys.executable, "-m", "dcfkit.cli", "track", *args], env=env, text=True, **popen)
+    return subprocess.Popen([sys.executable, "-m", "dcfkit.cli", "track", *args], env=env, text=True,
+                            preexec_fn=_ctrl_c_as_in_a_terminal, **popen)
 
 
 def lines_of(stream) -> queue.Queue:
