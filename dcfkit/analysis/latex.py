@@ -51,13 +51,14 @@ def latex_table(rows: Seq[Mapping], columns: Seq[str], protocol: str | Protocol,
 
 
 def comparison_table(statistics: Mapping, setting: Seq[str], name: str = "Tracker",
-                     lead: Seq[tuple[str, Mapping[str, str]]] = ()) -> str:
+                     lead: Seq[tuple[str, Mapping[str, str]]] = (), datasets: Mapping[str, int] | None = None) -> str:
     """The statistics of :func:`~dcfkit.analysis.statistics.versus_baseline` as a booktabs
     ``table`` a paper can take: per tracker and score its mean with the confidence interval,
     then its paired difference from the baseline (Delta) with the interval, the Wilcoxon p
     (``*``: significant after Holm's correction) and the sequences won/tied/lost (fewer
     failures win). ``setting``: the caption's first sentences (experiment, protocol); ``lead``:
-    columns before the scores, (header, tracker -> LaTeX cell)."""
+    columns before the scores, (header, tracker -> LaTeX cell); ``datasets``: the sequences
+    scored per dataset, named in the caption."""
     means, baseline = statistics["means"], statistics["baseline"]
     keys = list(next(iter(means.values())))
     head = [" & " * (1 + len(lead)) + " & ".join(rf"\multicolumn{{4}}{{c}}{{{escape(_HEADERS.get(k, k))}}}"
@@ -72,7 +73,8 @@ def comparison_table(statistics: Mapping, setting: Seq[str], name: str = "Tracke
             cells.append(interval_cell(found[key]))
             cells += _difference_cells(key, statistics["differences"].get(tracker, {}).get(key))
         body.append(" & ".join(cells) + r" \\")
-    caption = _sentences([*setting, f"Means over the {statistics['sequences']} sequences every {name.lower()} ran",
+    over = f" ({', '.join(f'{d} {n}' for d, n in datasets.items())})" if datasets else ""  # escaped with the sentence
+    caption = _sentences([*setting, f"Means over the {statistics['sequences']} sequences every {name.lower()} ran{over}",
                           statistics["method"]])
     caption += (rf" $\Delta$: the paired difference from {escape(baseline)} (--: {escape(baseline)} itself); "
                 rf"$p$: its Wilcoxon p, $^{{*}}$ where significant after Holm's correction across the "

@@ -197,7 +197,8 @@ def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
         for fmt, ext in TABLE_FORMATS:
             table = format_table(getattr(evaluation, stem), fmt, columns(stem, protocol), protocol,
                                  evaluation.statistics if stem == "overall" else None,
-                                 experiment=experiment, max_frames=cut)
+                                 experiment=experiment, max_frames=cut,
+                                 datasets=evaluation.settings["datasets"])
             noted = note and fmt in NOTED and stem != "per_attribute"
             text(f"{stem}.{ext}", table + (f"\n{note}\n" if noted else ""))
     head = [experiment_line(experiment, cut), evaluation.protocol.describe(), ""]

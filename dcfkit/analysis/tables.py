@@ -98,12 +98,12 @@ def score_line(row: Mapping, protocol: str | Protocol = DEFAULT) -> str:
 
 def format_table(rows: Seq[Mapping], fmt: str, columns: Seq[str], protocol: str | Protocol = DEFAULT,
                  statistics: Mapping | None = None, *, experiment: str | Experiment | None = None,
-                 max_frames: int | None = None) -> str:
+                 max_frames: int | None = None, datasets: Mapping[str, int] | None = None) -> str:
     """:func:`format_rows` naming the scoring protocol and, if given, the ``experiment`` and the
     ``--max-frames`` cut (:mod:`dcfkit.analysis.setting`): first lines (``table``, ``markdown``),
     last columns ``protocol``, ``experiment`` and ``max_frames`` (``csv``, so the file stays one
     table), or the caption of a LaTeX table (``latex``: with ``statistics``, the comparison
-    table of :func:`~dcfkit.analysis.latex.comparison_table`)."""
+    table of :func:`~dcfkit.analysis.latex.comparison_table`, naming the ``datasets``)."""
     proto = get_protocol(protocol)
     setting = {} if experiment is None else {"experiment": get_experiment(experiment).name}
     if max_frames is not None:
@@ -111,7 +111,7 @@ def format_table(rows: Seq[Mapping], fmt: str, columns: Seq[str], protocol: str 
     if fmt == "latex":
         lines = [experiment_line(experiment, max_frames)] if experiment is not None else []
         if statistics:
-            return comparison_table(statistics, [*lines, proto.describe()])
+            return comparison_table(statistics, [*lines, proto.describe()], datasets=datasets)
         return latex_table(rows, columns, proto, lines)
     if fmt == "csv":
         return format_rows([{**r, "protocol": proto.name, **setting} for r in rows], fmt,

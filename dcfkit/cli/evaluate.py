@@ -139,7 +139,8 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--format", choices=("table", "markdown", "csv", "latex"), default="table",
                         help="format of the table printed to stdout; every format names the experiment, the protocol "
                              "and a --max-frames cut (latex: a booktabs table a paper can take: each tracker's "
-                             "scores with confidence intervals, its difference from the best with its interval, "
+                             "scores with confidence intervals, its difference from the --baseline (default: the best) with "
+                             "its interval, "
                              "Wilcoxon p and sequences won/tied/lost)")
     parser.add_argument("--report-dir", type=Path, default=None,
                         help="default: OUT_report beside OUT (OUT_report/<experiment> but for ope): out of the folder "
@@ -181,7 +182,8 @@ def run_report(args: argparse.Namespace) -> int:
     protocol = evaluation.protocol.name  # --protocol, else the benchmark's
     print(format_table(evaluation.overall, args.format, columns("overall", protocol), protocol,
                        evaluation.statistics, experiment=args.experiment,
-                       max_frames=evaluation.settings["max_frames"]), end="")
+                       max_frames=evaluation.settings["max_frames"], datasets=evaluation.settings["datasets"]),
+          end="")
     if evaluation.settings["fps_note"] and args.format in ("table", "markdown"):
         print(f"\n{evaluation.settings['fps_note']}")
     if args.format == "table":

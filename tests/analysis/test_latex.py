@@ -137,6 +137,14 @@ def test_format_table_gives_the_comparison_with_statistics_and_names_a_cut():
     assert "W/T/L" in text
 
 
+def test_the_caption_names_the_pooled_datasets():
+    statistics = versus_baseline(per_sequence(base=BASE, x_1=OTHER), ["base", "x_1"], ("auc", "precision"))
+    text = format_table([], "latex", (), "otb", statistics, experiment="ope",
+                        datasets={"uav123_10fps": 6, "dtb70": 1, "uavdt": 1})
+    assert r"every tracker ran (uav123\_10fps 6, dtb70 1, uavdt 1)." in text
+    check_structure(text)
+
+
 def test_the_tables_compile(tmp_path):
     compile_latex(comparison() + latex_table(ROWS, COLUMNS, "otb"), tmp_path)
 
