@@ -3,7 +3,7 @@ the best value bold and the second underlined; :func:`comparison_table` gives ea
 scores with their confidence intervals and its paired difference from a baseline with its
 interval, Wilcoxon p and the sequences won, tied and lost (:mod:`dcfkit.analysis.statistics`).
 Each caption names the experiment, the protocol and the sequences; the tables need
-``\\usepackage{booktabs}`` only."""
+``\\usepackage{booktabs}``, and for the comparison tables ``\\usepackage{graphicx}``."""
 from __future__ import annotations
 
 import math
@@ -80,7 +80,7 @@ def comparison_table(statistics: Mapping, setting: Seq[str], name: str = "Tracke
                 rf"$p$: its Wilcoxon p, $^{{*}}$ where significant after Holm's correction across the "
                 rf"comparisons of a score (corrected $p < 0.05$); W/T/L: the sequences it scored better, "
                 rf"the same, worse on.")
-    return _table(caption, "l" * (1 + len(lead)) + "rrrr" * len(keys), head, body)
+    return _table(caption, "l" * (1 + len(lead)) + "rrrr" * len(keys), head, body, wide=True)
 
 
 def interval_cell(interval: Mapping | None, signed: bool = False) -> str:
@@ -123,9 +123,18 @@ def _sentences(parts: Seq[str]) -> str:
     return " ".join(out)
 
 
-def _table(caption: str, align: str, head: Seq[str], body: Seq[str]) -> str:
-    return "\n".join([r"\begin{table}", r"\centering", rf"\caption{{{caption}}}", rf"\begin{{tabular}}{{{align}}}",
-                      r"\toprule", *head, r"\midrule", *body, r"\bottomrule", r"\end{tabular}", r"\end{table}"]) + "\n"
+# a wide table shrunk to the line only when it is wider (graphicx's \resizebox, \width its own width)
+_FIT = r"\resizebox{\ifdim\width>\linewidth\linewidth\else\width\fi}{!}{%"
+
+
+def _table(caption: str, align: str, head: Seq[str], body: Seq[str], wide: bool = False) -> str:
+    """A booktabs float; ``wide``: ``table*`` (both columns of a two-column paper), a smaller
+    font, narrower column gaps and shrunk to the line if still wider (graphicx), which a
+    comparison's 4 columns per score need."""
+    env, fit, end = ("table*", [r"\small", r"\setlength{\tabcolsep}{3.5pt}"], "}") if wide else ("table", [], "")
+    return "\n".join([rf"\begin{{{env}}}", r"\centering", *fit, rf"\caption{{{caption}}}", *([_FIT] if wide else []),
+                      rf"\begin{{tabular}}{{{align}}}", r"\toprule", *head, r"\midrule", *body, r"\bottomrule",
+                      r"\end{tabular}" + end, rf"\end{{{env}}}"]) + "\n"
 
 
 def _places(values: Seq) -> dict:

@@ -39,7 +39,8 @@ def check_structure(text: str) -> None:
     assert re.findall(r"\\begin\{(\w+)\}", text) == re.findall(r"\\end\{(\w+)\}", text)[::-1]
     known = {"begin", "end", "centering", "caption", "toprule", "midrule", "bottomrule", "cmidrule", "multicolumn",
              "scriptsize", "textbf", "underline", "Delta", "textless", "textgreater", "textbackslash",
-             "textasciitilde", "textasciicircum"}
+             "textasciitilde", "textasciicircum", "small", "setlength", "tabcolsep", "resizebox", "ifdim", "width",
+             "linewidth", "else", "fi"}
     assert set(re.findall(r"\\([A-Za-z]+)", text)) <= known
     width = len(re.search(r"\\begin\{tabular\}\{(\w+)\}", text).group(1))
     rows = text.split("\\toprule\n")[1].split("\n\\bottomrule")[0].splitlines()
@@ -51,14 +52,17 @@ def check_structure(text: str) -> None:
 
 
 def compile_latex(text: str, tmp_path) -> None:
-    """Compile ``text`` in a minimal document (booktabs only) when pdflatex is installed."""
+    """Compile ``text`` in a minimal two-column paper (booktabs and graphicx) when pdflatex is
+    installed: no error, and no table wider than the page (an overfull box)."""
     if shutil.which("pdflatex") is None:
         pytest.skip("pdflatex is not installed; the structure is checked by check_structure")
-    (tmp_path / "t.tex").write_text("\\documentclass{article}\n\\usepackage{booktabs}\n\\begin{document}\n"
+    (tmp_path / "t.tex").write_text("\\documentclass[twocolumn]{article}\n\\usepackage{booktabs}\n"
+                                    "\\usepackage{graphicx}\n\\begin{document}\n"
                                     f"{text}\\end{{document}}\n")
     done = subprocess.run(["pdflatex", "-interaction=nonstopmode", "-halt-on-error", "t.tex"], cwd=tmp_path,
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stdout[-2000:]
+    assert "Overfull \\hbox" not in done.stdout, done.stdout[-2000:]
 
 
 def test_best_bold_second_underlined_ties_share_and_other_columns_plain():

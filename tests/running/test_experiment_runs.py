@@ -193,7 +193,7 @@ variants:
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["experiment"] == "tre" and all(r["failed"] == 0 for r in summary["overall"])
     latex = (tmp_path / "out" / "summary.tex").read_text()  # the variants compared, as a paper's table
-    assert latex.startswith("\\begin{table}") and r"\caption{Ablation tre. Experiment TRE (" in latex
+    assert latex.startswith("\\begin{table*}") and r"\caption{Ablation tre. Experiment TRE (" in latex
     assert "Variant & Mean [CI] & $\\Delta$ [CI] & $p$ & W/T/L" in latex and "difference from kcf" in latex
     assert len(list((tmp_path / "out" / "jobs").glob(f"otb/*/tre/seqA_{runs:03d}.json"))) == 2
     bad = write_spec(tmp_path / "bad.yaml", "name: x\ndataset: otb\nexperiment: reset\nvariants: {k: kcf}\n")
