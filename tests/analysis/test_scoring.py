@@ -34,6 +34,16 @@ RESULTS = {"near": {s.name: shifted(k) for k, s in enumerate(SEQUENCES)},       
            "same": {s.name: shifted(k) for k, s in enumerate(SEQUENCES)}}          # as near
 
 
+def write_results(out: Path, results: dict) -> None:
+    """``results`` (tracker -> sequence -> 0-based boxes) as ``OUT/<tracker>/<sequence>.txt``, 1-based."""
+    for tracker, by_sequence in results.items():
+        folder = out / tracker
+        folder.mkdir(parents=True)
+        for name, boxes in by_sequence.items():
+            (folder / f"{name}.txt").write_text("".join(f"{x + 1:.3f},{y + 1:.3f},{w:.3f},{h:.3f}\n"
+                                                        for x, y, w, h in boxes))
+
+
 def test_each_tracker_has_its_interval_and_each_other_its_paired_difference_from_the_best():
     ev = evaluate(RESULTS, SEQUENCES)
     st = ev.statistics
@@ -58,12 +68,7 @@ def test_each_tracker_has_its_interval_and_each_other_its_paired_difference_from
 def test_report_prints_and_writes_the_statistics(tmp_path, monkeypatch, capsys):
     import dcfkit.cli.evaluate
 
-    for tracker, by_sequence in RESULTS.items():
-        folder = tmp_path / "out" / tracker
-        folder.mkdir(parents=True)
-        for name, boxes in by_sequence.items():
-            (folder / f"{name}.txt").write_text("".join(f"{x + 1:.3f},{y + 1:.3f},{w:.3f},{h:.3f}\n"
-                                                        for x, y, w, h in boxes))
+    write_results(tmp_path / "out", RESULTS)
     monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: SEQUENCES)
     assert cli.main(["report", str(tmp_path / "out"), "--root", str(tmp_path)]) == 0
     out = capsys.readouterr().out
@@ -78,12 +83,7 @@ def test_report_takes_the_differences_from_the_baseline_it_is_given(tmp_path, mo
     in the printed LaTeX table and in report.json; a name that is no tracker is one clear error."""
     import dcfkit.cli.evaluate
 
-    for tracker, by_sequence in RESULTS.items():
-        folder = tmp_path / "out" / tracker
-        folder.mkdir(parents=True)
-        for name, boxes in by_sequence.items():
-            (folder / f"{name}.txt").write_text("".join(f"{x + 1:.3f},{y + 1:.3f},{w:.3f},{h:.3f}\n"
-                                                        for x, y, w, h in boxes))
+    write_results(tmp_path / "out", RESULTS)
     monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: SEQUENCES)
     report = ["report", str(tmp_path / "out"), "--root", str(tmp_path)]
     assert cli.main(report + ["--baseline", "far", "--format", "latex"]) == 0
@@ -125,13 +125,7 @@ def test_no_complete_sequence_is_an_error_that_says_what_to_do():
 def test_report_names_what_it_left_out(tmp_path, monkeypatch, capsys):
     import dcfkit.cli.evaluate
 
-    for tracker, by_sequence in RESULTS.items():
-        folder = tmp_path / "out" / tracker
-        folder.mkdir(parents=True)
-        for name, boxes in by_sequence.items():
-            if not (tracker == "far" and name == "c"):
-                (folder / f"{name}.txt").write_text("".join(f"{x + 1:.3f},{y + 1:.3f},{w:.3f},{h:.3f}\n"
-                                                            for x, y, w, h in boxes))
+    write_results(tmp_path / "out", {**RESULTS, "far": {k: v for k, v in RESULTS["far"].items() if k != "c"}})
     monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: SEQUENCES)
     assert cli.main(["report", str(tmp_path / "out"), "--root", str(tmp_path)]) == 0
     out = capsys.readouterr().out

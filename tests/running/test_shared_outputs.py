@@ -24,9 +24,9 @@ def test_nothing_personal_in_sidecars_and_reports(tmp_path, seqs, monkeypatch): 
     monkeypatch.setenv("HOME", str(tmp_path))  # the frames lie in the user's home: tmp_path/data
     monkeypatch.setattr(platform, "node", lambda: HOST)
     provenance.machine.cache_clear()
-    (tmp_path / "work").mkdir()
-    monkeypatch.chdir(tmp_path / "work")
-    out = tmp_path / "work" / "out"
+    (tmp_path / "project").mkdir()
+    monkeypatch.chdir(tmp_path / "project")
+    out = tmp_path / "project" / "out"
     with running_command(["dcfkit", "eval", "drift.yaml", "--root", str(tmp_path / "data"), "--out", str(out)]):
         run_one_pass(CONFIG, seqs, out, make_tracker=Counter(), progress=False)
         failed = run_one_pass({"name": "broken"}, seqs[:1], out, make_tracker=Counter({1: (2, ValueError)}),
@@ -42,7 +42,7 @@ def test_nothing_personal_in_sidecars_and_reports(tmp_path, seqs, monkeypatch): 
         for personal in (HOST, str(tmp_path), os.getcwd()):
             assert personal not in text, f"{path.name} holds {personal}"
     meta = json.loads((out / "drift" / "a.json").read_text())
-    assert meta["command"] == ["dcfkit", "eval", "drift.yaml", "--root", "~/data", "--out", "~/work/out"]
+    assert meta["command"] == ["dcfkit", "eval", "drift.yaml", "--root", "~/data", "--out", "~/project/out"]
     assert {"cpu", "cores", "system", "python"} <= set(meta["machine"]) and meta["platform"]["blas"]
     error = json.loads((out / "broken" / "a.error").read_text())
     assert error["frame_file"] == "~/data/a/00003.jpg"
