@@ -128,8 +128,9 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
                        report_dir=None, interval: tuple[int, int] | None = None, protocol: str | None = None,
                        baseline: str | None = None) -> tuple[dict, list[Path]]:
     """Score the reset-based runs (``<tracker>/reset/``) of every tracker in ``out_dir`` on the
-    sequences all of them ran (differences from ``baseline``, by default the best), with the rule they were made with (``protocol``, if given, must be
-    it: a :class:`ConfigError` if not, or if the runs were made with several), and write
+    sequences all of them ran (differences from ``baseline``, by default the best), with the
+    rule they were made with (``protocol``, if given, must be it: a :class:`ConfigError` if not,
+    or if the runs were made with several), and write
     ``reset_overall`` and ``reset_per_sequence`` tables (``.txt``, ``.md``, ``.csv``;
     ``reset_overall.tex``: :func:`reset_latex`), ``statistics.txt`` and ``reset.json`` to
     ``report_dir`` (default ``<out_dir>_report/reset``), each naming the experiment, the rule
