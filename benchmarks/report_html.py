@@ -25,8 +25,8 @@ from dcfkit.analysis.report_html import report_page, write_page
 from dcfkit.config import load_config
 from dcfkit.datasets import ATTRIBUTE_NAMES, Sequence
 from dcfkit.datasets.synthetic import make_sequence
-from dcfkit.running.provenance import dcfkit_version, invocation, machine, now, run_key
-from dcfkit.running.results import ResultStore
+from dcfkit.store.provenance import dcfkit_version, invocation, machine, now, run_key
+from dcfkit.store.results import ResultStore
 
 CONFIGS = ("kcf", "dsst", "strcf", "bacf", "dr2track", "arcf", "autotrack")
 

@@ -32,7 +32,7 @@ from dcfkit.analysis.compare import compare_folders
 from dcfkit.analysis.report import write_report
 from dcfkit.analysis.statistics import mean_interval, paired_difference, versus_baseline
 from dcfkit.datasets import Sequence
-from dcfkit.running.files import checksum, format_boxes
+from dcfkit.store.files import checksum, format_boxes
 
 STAGES = ("statistics", "compare", "report")
 TRACKERS = {"kcf": 4.0, "strcf": 2.0}  # tracker -> the boxes' noise (pixels)

@@ -1,7 +1,7 @@
 """A build step for setuptools (``cmdclass`` in pyproject.toml), never imported by dcfkit: a
 wheel built from a git checkout (``pip install .``) carries ``dcfkit/_source.json``, the
 checkout's commit and whether tracked files had uncommitted changes, which
-:func:`dcfkit.running.code_state.built_source` reads. Standard library and setuptools only:
+:func:`dcfkit.store.code_state.built_source` reads. Standard library and setuptools only:
 it runs in the build environment, before dcfkit or its dependencies are installed."""
 from __future__ import annotations
 

@@ -7,7 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from dcfkit.running.code_state import code_digest
+from dcfkit.store.code_state import code_digest
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -33,7 +33,7 @@ def test_installed_package_finds_its_configs_and_runs_the_demo(pip_install_copy,
     if git:  # the source state: recorded at build time, and the installed files' digest
         commit = subprocess.run(["git", "-C", str(site.parent / "source"), "rev-parse", "HEAD"], capture_output=True,
                                 text=True, check=True).stdout.strip()
-        state = subprocess.run([sys.executable, "-c", "import json; from dcfkit.running.provenance import sources; "
+        state = subprocess.run([sys.executable, "-c", "import json; from dcfkit.store.provenance import sources; "
                                 "print(json.dumps(sources([])))"], cwd=tmp_path, env=env, capture_output=True,
                                text=True, timeout=120)
         assert state.returncode == 0, state.stderr

@@ -310,7 +310,7 @@ def test_union_and_fixed_tuple_annotations_are_checked():
 def test_result_hashes_change_with_the_version_of_a_plugin_the_config_uses(monkeypatch):
     from dcfkit.config import load_config
     from dcfkit.errors import DcfkitError
-    from dcfkit.running.provenance import dcfkit_version, run_key
+    from dcfkit.store.provenance import dcfkit_version, run_key
     from dcfkit.running.runner import RunTask, run_in_worker
 
     def registry_with(version):
@@ -382,7 +382,7 @@ def test_configs_that_are_not_dcfkit_trackers_still_hash(config):
     or another name, and different when any other value in it changes."""
     import re
 
-    from dcfkit.running.provenance import run_key
+    from dcfkit.store.provenance import run_key
 
     digest = run_key(config)
     assert re.fullmatch(r"[0-9a-f]{16}", digest)

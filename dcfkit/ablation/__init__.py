@@ -3,7 +3,7 @@
 A spec (YAML, docs/ablation.md) names a dataset, variants (a config plus dotted overrides)
 and optionally a grid around a base config. It expands to one :class:`Job` per (variant,
 sequence) with its resolved config; jobs are stored per *run* under
-``OUT/jobs/<dataset>/<run key>/`` (a :class:`~dcfkit.running.results.ResultStore`), so
+``OUT/jobs/<dataset>/<run key>/`` (a :class:`~dcfkit.store.results.ResultStore`), so
 variants with the same parameters share one run, and a rerun skips intact runs. Runs go to
 a local process pool or dask.distributed; the summary tables, plots and ``report.html``
 follow (docs/ablation.md lists the files).

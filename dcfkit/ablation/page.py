@@ -11,7 +11,7 @@ from dcfkit.ablation.spec import AblationSpec, format_value, job_dir
 from dcfkit.ablation.spec_keys import data_text
 from dcfkit.analysis.report_html import evaluation_sections, sections
 from dcfkit.analysis.report_html.provenance import this_process
-from dcfkit.running.provenance import LABEL_KEYS, shared_path
+from dcfkit.store.provenance import LABEL_KEYS, shared_path
 
 
 def flatten(config: Any, prefix: str = "") -> dict[str, Any]:
@@ -55,7 +55,7 @@ def _base(spec: AblationSpec) -> tuple[str, dict]:
 def variants_table(spec: AblationSpec, overall: list[dict], columns: tuple[str, ...], trackers: list[str],
                    fps_note: str | None = None) -> dict:
     """The summary's rows (in ``columns``, the first the variant) with each variant's config
-    changes from the base; ``fps_note`` (:func:`dcfkit.running.speed.fps_note`) ends its note."""
+    changes from the base; ``fps_note`` (:func:`dcfkit.store.timing.fps_note`) ends its note."""
     base_name, base = _base(spec)
     configs = {v.name: v.config for v in spec.variants}
     published = dict(spec.published)

@@ -12,9 +12,9 @@ from dcfkit.ablation.summary import output_names, summarize
 from dcfkit.datasets import benchmark_protocol
 from dcfkit.errors import DcfkitError, shown
 from dcfkit.experiments import runs_by_sequence
-from dcfkit.running.files import atomic_write, ensure_writable, exclusive, read_json
-from dcfkit.running.provenance import LABEL_KEYS, dcfkit_version
-from dcfkit.running.results import ResultStore
+from dcfkit.store.files import atomic_write, ensure_writable, exclusive, read_json
+from dcfkit.store.provenance import LABEL_KEYS, dcfkit_version
+from dcfkit.store.results import ResultStore
 from dcfkit.running.runner import RunTask, execute, usable_cores, warm_up_compiled
 
 

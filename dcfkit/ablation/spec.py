@@ -21,7 +21,7 @@ from dcfkit.config.bounded_yaml import read_yaml
 from dcfkit.datasets import load_dataset
 from dcfkit.datasets.base import sequence_names
 from dcfkit.errors import ConfigError, DcfkitError, clip, shown
-from dcfkit.running.provenance import dcfkit_version, run_key
+from dcfkit.store.provenance import dcfkit_version, run_key
 
 SPEC_KEYS = ("name", "description", "dataset", "sequences", "experiment", "variants", "grid", "published")
 VARIANT_KEYS = ("config", "overrides", "description")
@@ -86,7 +86,7 @@ class AblationSpec:
 @dataclasses.dataclass(frozen=True)
 class Job:
     """One tracker run to do: ``variant`` on ``sequence`` with the resolved ``config``;
-    ``key`` names the run's result folder (:func:`dcfkit.running.provenance.run_key`)."""
+    ``key`` names the run's result folder (:func:`dcfkit.store.provenance.run_key`)."""
 
     variant: str
     config: dict

@@ -9,7 +9,7 @@ from typing import Any, Mapping
 from dcfkit.datasets import DatasetError, canonical_name, load_datasets
 from dcfkit.errors import ConfigError, clip, shown
 from dcfkit.params import closest
-from dcfkit.running.provenance import shared_path
+from dcfkit.store.provenance import shared_path
 
 
 def as_mapping(value: Any, where: str, what: str) -> dict:

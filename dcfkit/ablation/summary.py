@@ -23,10 +23,10 @@ from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.datasets import Sequence
 from dcfkit.experiments import runs_by_sequence
 from dcfkit.protocols import DEFAULT, get_protocol
-from dcfkit.running.files import atomic_write, read_json
-from dcfkit.running.provenance import shared_path
-from dcfkit.running.results import ResultStore
-from dcfkit.running.speed import fps_note
+from dcfkit.store.files import atomic_write, read_json
+from dcfkit.store.provenance import shared_path
+from dcfkit.store.results import ResultStore
+from dcfkit.store.timing import fps_note
 
 SUMMARY_COLUMNS = ("variant", "precision", "auc", "fps", "sequences", "failed")
 SEQUENCE_COLUMNS = ("variant", "sequence", "precision", "auc", "fps", "frames", "status")
@@ -61,7 +61,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
 
     precision is the precision at 20 px, auc the area under the success curve (and under
     ``got10k`` also ao, sr50, sr75), fps the mean per-sequence frames per second of tracker
-    time, of runs timed alone only (:mod:`dcfkit.running.speed`, ``fps_measured``). A job
+    time, of runs timed alone only (:mod:`dcfkit.store.timing`, ``fps_measured``). A job
     without result (failed or not run) is scored as a total failure and counted in ``failed``. ``statistics`` compares each variant with the
     grid's base (when it names a variant) or the first variant
     (:func:`~dcfkit.analysis.statistics.versus_baseline`); the spec's published results are
@@ -70,7 +70,7 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     "per_sequence", "statistics", "jobs", "files", "protocol"`` (the
     :class:`~dcfkit.protocols.Protocol`), ``"scope"`` (the line naming the experiment, protocol and
     ``--max-frames`` cut: :func:`~dcfkit.ablation.experiment.scope_line`, heading every output) and
-    ``"fps_note"}`` (whose fps is left out and why: :func:`dcfkit.running.speed.fps_note`).
+    ``"fps_note"}`` (whose fps is left out and why: :func:`dcfkit.store.timing.fps_note`).
     """
     out = Path(out)
     jobs = jobs if jobs is not None else expand(spec, sequences)

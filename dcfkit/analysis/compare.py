@@ -18,7 +18,7 @@ The ``mean`` row averages precision and AUC as the protocol averages sequences, 
 per-sequence IoUs with equal weights. Sequences found in only one folder, in both but not
 in the dataset, or whose dcfkit sidecar says the file is damaged, are listed in ``left_out``.
 ``platforms`` lists each folder's platforms as their sidecars record them
-(:mod:`dcfkit.running.platforms`; "not recorded" for files without one) and ``platform_differences``
+(:mod:`dcfkit.store.platforms`; "not recorded" for files without one) and ``platform_differences``
 what differs between the two files of a sequence, each with its count of sequences unless all have
 it (ten lines at most, then a count of the others): boxes from different platforms can part where a
 float decision is close (docs/architecture.md). A sequence with a non-finite score (no frame
@@ -40,8 +40,8 @@ from dcfkit.analysis.statistics import METHOD, mean_interval, paired_difference
 from dcfkit.datasets import DatasetError, Sequence, benchmark_protocol, read_boxes, scored_sequences
 from dcfkit.errors import clip, shown
 from dcfkit.protocols import Protocol, get_protocol
-from dcfkit.running import platforms
-from dcfkit.running.results import ResultStore, result_files
+from dcfkit.store import platforms
+from dcfkit.store.results import ResultStore, result_files
 
 __all__ = ["COLUMNS", "PLATFORM_NOISE", "compare_folders", "counted_lines", "first_divergence", "noise_floor",
            "score_statistics", "series_iou"]
@@ -188,7 +188,7 @@ def counted_lines(counts: Mapping[str, int], total: int, limit: int = 10) -> lis
 def _intact_files(folder, sequences: Mapping[str, Sequence]
                   ) -> tuple[dict[str, Path], list[str], dict[str, dict | None]]:
     """The result files of ``folder``, apart the sequences whose dcfkit sidecar says the file is
-    damaged or stale (:meth:`~dcfkit.running.results.ResultStore.stale`: made from another first
+    damaged or stale (:meth:`~dcfkit.store.results.ResultStore.stale`: made from another first
     box or on other data than ``sequences`` now hold; never compared, each logged), and each
     file's platform record (None without one).
     Files without a sidecar are taken as they are; reset-based runs are refused

@@ -9,7 +9,7 @@ from typing import Sequence as Seq
 
 from dcfkit.analysis.scoring import best_first
 from dcfkit.protocols import DEFAULT, Protocol, get_protocol
-from dcfkit.running.files import atomic_write
+from dcfkit.store.files import atomic_write
 
 #: title, axis labels, score and legend place of the plots of each curve kind
 PLOT_STYLE = {

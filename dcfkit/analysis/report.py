@@ -11,7 +11,7 @@ LaTeX captions (``overall.tex``: :func:`dcfkit.analysis.latex.comparison_table`)
 weigh sequences as the protocol does unless ``weighting`` says otherwise. A tracker's
 ``fps`` is the mean over sequences of the per-sequence fps (frames / tracker time in that
 sequence), not total frames / total time, of runs timed alone only (``fps_measured``,
-:mod:`dcfkit.running.speed`; a note under the text and Markdown tables says whose fps is left
+:mod:`dcfkit.store.timing`; a note under the text and Markdown tables says whose fps is left
 out and why). A sequence missing from a tracker's results is
 scored as a total failure and counted in the ``missing`` column. :mod:`dcfkit.analysis.report_html`
 adds one self-contained HTML page of it all (``dcfkit report --html``).
@@ -37,8 +37,8 @@ from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequ
 from dcfkit.errors import clip, shown
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
 from dcfkit.protocols import Protocol
-from dcfkit.running.files import atomic_write, ensure_writable
-from dcfkit.running.results import import_results, load_results
+from dcfkit.store.files import atomic_write, ensure_writable
+from dcfkit.store.results import import_results, load_results
 
 # the scoring, tables and plots are here too, as the report uses them
 __all__ = ["columns", "default_report_dir", "evaluate", "format_rows", "format_table", "gather_results", "json_ready",
@@ -168,7 +168,7 @@ def json_ready(obj):
 
 REPORT_TABLES = ("overall", "per_sequence", "per_attribute")
 TABLE_FORMATS = (("table", "txt"), ("markdown", "md"), ("csv", "csv"), ("latex", "tex"))
-NOTED = ("table", "markdown")  # the formats a note may follow (:func:`dcfkit.running.speed.fps_note`)
+NOTED = ("table", "markdown")  # the formats a note may follow (:func:`dcfkit.store.timing.fps_note`)
 
 
 def report_file_names(sequences: Seq[Sequence]) -> list[str]:

@@ -21,9 +21,9 @@ from dcfkit.datasets import DatasetError, Sequence, scored_sequences
 from dcfkit.errors import ConfigError, clip
 from dcfkit.experiments import EXPERIMENTS
 from dcfkit.experiments.vot import RULES, SKIP, get_rule
-from dcfkit.running.files import atomic_write, ensure_writable
-from dcfkit.running.resets import next_start
-from dcfkit.running.results import ResultStore
+from dcfkit.store.files import atomic_write, ensure_writable
+from dcfkit.experiments.vot import next_start
+from dcfkit.store.results import ResultStore
 
 log = logging.getLogger(__name__)
 
@@ -71,7 +71,7 @@ def resets_problem(run: ResetRun) -> str | None:
     rule (:class:`~dcfkit.experiments.vot.ResetRule`) gives from its boxes and ground truth, or
     None. The loop is the runs' own (:mod:`dcfkit.running.resets`): a failure is the first frame
     after a start whose box does not overlap the ground truth; the next start is
-    :func:`~dcfkit.running.resets.next_start` from :data:`~dcfkit.experiments.vot.SKIP` frames
+    :func:`~dcfkit.experiments.vot.next_start` from :data:`~dcfkit.experiments.vot.SKIP` frames
     later (dcfkit <= 0.9.0 did not move a start past a box off the image: that start is taken
     too). A decision the rounding of the boxes could turn is taken either way; frames no tracker
     ran must have no box."""

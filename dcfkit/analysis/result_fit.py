@@ -10,7 +10,7 @@ from typing import Sequence as Seq
 
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.errors import clip, printable
-from dcfkit.running.results import ResultStore, result_files
+from dcfkit.store.results import ResultStore, result_files
 
 NAMES = 5  # the most sequence names a message lists
 

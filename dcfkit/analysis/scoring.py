@@ -16,13 +16,13 @@ from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, benchmark_p
 from dcfkit.errors import shown
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
 from dcfkit.protocols import Protocol, get_protocol
-from dcfkit.running import platforms, speed
+from dcfkit.store import platforms, timing as speed
 
 log = logging.getLogger(__name__)
 
 
 def _boxes_and_fps(result) -> tuple[np.ndarray, float | None, str | None]:
-    """(boxes, fps, how the fps was measured: :func:`dcfkit.running.speed.how_measured` of the
+    """(boxes, fps, how the fps was measured: :func:`dcfkit.store.timing.how_measured` of the
     result's ``timing``, None without an fps)."""
     if hasattr(result, "boxes"):
         boxes, fps, timing = result.boxes, getattr(result, "fps", None), getattr(result, "timing", None)
@@ -89,10 +89,10 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
     (by default the rules of the benchmark's published tables,
     :func:`~dcfkit.datasets.benchmark_protocol`: LaSOT's for LaSOT, the OTB toolkit's for UAV123).
 
-    A result is a :class:`dcfkit.running.results.SequenceResult`, a dict with ``boxes`` (and
+    A result is a :class:`dcfkit.store.results.SequenceResult`, a dict with ``boxes`` (and
     optional ``fps`` and ``timing``) or an ``(N, 4)`` array of 0-based boxes. A row's ``fps`` is
     shown only when every run of it was timed alone, ``fps_measured`` says how
-    (:mod:`dcfkit.running.speed`), and ``settings["fps_note"]`` whose is left out and why.
+    (:mod:`dcfkit.store.timing`), and ``settings["fps_note"]`` whose is left out and why.
     ``weighting`` ``None`` averages as the protocol does. ``missing``: ``"skip"`` scores the
     sequences every tracker has a result for and names the others in ``settings["left_out"]``
     (sequence -> the trackers without a result); ``"fail"`` scores a missing result as a total
@@ -189,7 +189,7 @@ def _platforms(results: Iterable) -> list[list]:
 def _score_tracker(tracker: str, res: Mapping, sequences: list[Sequence], runs: Mapping[str, list[Sequence]],
                    include_first: bool, proto: Protocol) -> tuple[dict, tuple[dict, dict], list]:
     """(sequence -> scores, (sequence -> fps, sequence -> how it was measured:
-    :func:`dcfkit.running.speed.combined`), names of the sequences missing a run) of one
+    :func:`dcfkit.store.timing.combined`), names of the sequences missing a run) of one
     tracker's results, each sequence's runs pooled."""
     scores, fps, measured, missing = {}, {}, {}, []
     for seq in sequences:

@@ -12,9 +12,9 @@ from dcfkit.analysis.scoring import evaluate
 from dcfkit.datasets import Sequence, benchmark_protocol
 from dcfkit.experiments import runs_by_sequence
 from dcfkit.protocols import get_protocol
-from dcfkit.running.files import ensure_writable
-from dcfkit.running.provenance import dcfkit_version, run_key
-from dcfkit.running.results import ResultStore
+from dcfkit.store.files import ensure_writable
+from dcfkit.store.provenance import dcfkit_version, run_key
+from dcfkit.store.results import ResultStore
 from dcfkit.running.runner import RunTask, execute, warm_up_compiled
 
 log = logging.getLogger(__name__)

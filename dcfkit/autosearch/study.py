@@ -24,9 +24,9 @@ from dcfkit.autosearch.space import SearchSpec, active
 from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, summarize
 from dcfkit.datasets import scored_sequences
 from dcfkit.errors import DcfkitError, clip, shown
-from dcfkit.running.files import atomic_write, ensure_writable, exclusive, make_dir, read_json
-from dcfkit.running.provenance import shared_path
-from dcfkit.running.results import data_identity
+from dcfkit.store.files import atomic_write, ensure_writable, exclusive, make_dir, read_json
+from dcfkit.store.provenance import shared_path
+from dcfkit.store.results import data_identity
 
 log = logging.getLogger(__name__)
 

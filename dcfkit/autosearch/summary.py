@@ -11,8 +11,8 @@ import yaml
 from dcfkit.ablation.spec_keys import data_record
 from dcfkit.analysis.statistics import HOLM, METHOD, holm, mean_interval, paired_difference
 from dcfkit.errors import DcfkitError, printable
-from dcfkit.running.files import atomic_write
-from dcfkit.running.provenance import shared_path
+from dcfkit.store.files import atomic_write
+from dcfkit.store.provenance import shared_path
 
 FINAL = "all"  # the final study's name: every sequence chooses
 

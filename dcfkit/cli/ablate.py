@@ -13,7 +13,7 @@ from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.cli.common import add_max_frames_argument, add_protocol_argument, executor_choice, variant_count
 from dcfkit.config import shipped_config_dir
 from dcfkit.experiments import runs_by_sequence
-from dcfkit.running.results import ResultStore
+from dcfkit.store.results import ResultStore
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -39,7 +39,7 @@ from dcfkit.experiments import runs_by_sequence
 from dcfkit.experiments.vot import get_rule
 from dcfkit.integrations.opencv import opencv_tracker
 from dcfkit.running.evaluation import check_one_pass, results_folder, run_one_pass, tracker_name
-from dcfkit.running.results import load_results
+from dcfkit.store.results import load_results
 
 
 def add_eval_arguments(parser: argparse.ArgumentParser) -> None:

@@ -18,8 +18,8 @@ from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.datasets.video import READ_TIMEOUT, FrameSource, open_source
 from dcfkit.datasets.video_writer import DEFAULT_FPS, VideoWriter, check_output_file
 from dcfkit.errors import InputError, clip
-from dcfkit.running.files import StoreError, format_boxes, format_confidence, format_times
-from dcfkit.running.results import CONFIDENCE_END, TIME_END
+from dcfkit.store.files import StoreError, format_boxes, format_confidence, format_times
+from dcfkit.store.results import CONFIDENCE_END, TIME_END
 from dcfkit.running.tracking import INTERRUPTS, Step, steps, termination_deferred, track
 from dcfkit.tracker.tracker import load_tracker
 

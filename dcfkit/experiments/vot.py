@@ -18,6 +18,7 @@ from typing import Callable
 import numpy as np
 
 from dcfkit.errors import DcfkitError, shown
+from dcfkit.experiments.starts import start_problem
 from dcfkit.experiments.raster import NO_BOUNDS, trax2016_overlap, vottoolkit_overlap
 
 __all__ = ["BURN_IN", "DEFAULT_RULE", "RULES", "SKIP", "ResetRule", "get_rule", "valid_box"]
@@ -104,3 +105,12 @@ def get_rule(name: str | None) -> ResetRule:
         return RULES[DEFAULT_RULE if name is None else name]
     except KeyError:
         raise DcfkitError(f"unknown reset-based protocol {shown(name)}; one of: {', '.join(RULES)}") from None
+
+
+def next_start(gt: np.ndarray, frame: int, image_size: tuple[int, int] | None = None) -> int | None:
+    """The first frame from ``frame`` (0-based) with a valid ground truth that, when the
+    ``(height, width)`` is given, a tracker can start from (:func:`start_problem`), or None."""
+    for i in range(frame, len(gt)):
+        if valid_box(gt[i]) and (image_size is None or start_problem(gt[i], image_size) is None):
+            return i
+    return None

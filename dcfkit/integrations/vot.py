@@ -21,7 +21,7 @@ from typing import Iterable
 from dcfkit.datasets import Sequence
 from dcfkit.datasets.layout import sequence_name_problem
 from dcfkit.errors import DatasetError, clip, shown
-from dcfkit.running.files import StoreError, atomic_write, make_dir
+from dcfkit.store.files import StoreError, atomic_write, make_dir
 
 FRAME_DIGITS = 8  # color/00000001.jpg, as the VOT datasets name their frames
 DEFAULT_FPS = 30  # the VOT toolkit's own default: written for a dataset whose frame rate dcfkit does not know

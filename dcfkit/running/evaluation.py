@@ -5,15 +5,15 @@ Trackers come from a factory ``make_tracker(config) -> tracker``, called once pe
 (default: :func:`dcfkit.load_tracker`); a tracker is any object with ``init(image, box)``
 and ``update(image) -> box`` (:mod:`dcfkit.running.tracking`). Results go to
 ``OUT/<config name>/`` (``OUT/<config name>/<experiment>/`` but for one pass), a
-:class:`dcfkit.running.results.ResultStore`: one file of 1-based boxes and one sidecar per run
+:class:`dcfkit.store.results.ResultStore`: one file of 1-based boxes and one sidecar per run
 (per-frame tracker seconds, image decoding excluded; before its first run of a dcfkit config
 a process runs a throw-away copy of the tracker on the first frame, untimed, so that one-time
 loading of compiled code is not counted).
 
 On rerun a run is skipped when its results are intact and from the same run key
-(:func:`dcfkit.running.provenance.run_key`); damaged and failed runs are run again. A run
+(:func:`dcfkit.store.provenance.run_key`); damaged and failed runs are run again. A run
 never replaces an intact one of more frames (``--max-frames``), and two evaluations never
-write the same run (:mod:`dcfkit.running.claims`).
+write the same run (:mod:`dcfkit.store.claims`).
 """
 from __future__ import annotations
 
@@ -28,10 +28,10 @@ from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.errors import ConfigError, shown
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
 from dcfkit.experiments.vot import get_rule
-from dcfkit.running.claims import claimed
-from dcfkit.running.files import ensure_writable, make_dir, remove_temporary_files
-from dcfkit.running.provenance import dcfkit_version, json_default, run_key
-from dcfkit.running.results import ResultStore, same_data
+from dcfkit.store.claims import claimed
+from dcfkit.store.files import ensure_writable, make_dir, remove_temporary_files
+from dcfkit.store.provenance import dcfkit_version, json_default, run_key
+from dcfkit.store.results import ResultStore, same_data
 from dcfkit.running.runner import RunTask, execute, warm_up_compiled
 
 __all__ = ["check_one_pass", "experiment_runs", "results_folder", "run_one_pass", "tracker_name"]

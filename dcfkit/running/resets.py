@@ -13,7 +13,7 @@ import numpy as np
 
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.experiments.starts import start_problem
-from dcfkit.experiments.vot import DEFAULT_RULE, SKIP, ResetRule, get_rule, valid_box
+from dcfkit.experiments.vot import DEFAULT_RULE, SKIP, ResetRule, get_rule, next_start
 from dcfkit.running.tracking import Track, TrackerFailure, steps
 
 
@@ -44,15 +44,6 @@ class ResetTrack(Track):
         tracked = np.isfinite(self.times)
         total = float(self.times[tracked].sum())
         return int(tracked.sum()) / total if total > 0 else None
-
-
-def next_start(gt: np.ndarray, frame: int, image_size: tuple[int, int] | None = None) -> int | None:
-    """The first frame from ``frame`` (0-based) with a valid ground truth that, when the
-    ``(height, width)`` is given, a tracker can start from (:func:`start_problem`), or None."""
-    for i in range(frame, len(gt)):
-        if valid_box(gt[i]) and (image_size is None or start_problem(gt[i], image_size) is None):
-            return i
-    return None
 
 
 def track_with_resets(make_tracker: Callable[[], object], seq: Sequence, frame: Callable[[int], np.ndarray],

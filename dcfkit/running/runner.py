@@ -3,7 +3,7 @@ process pool or on dask.distributed. ``dcfkit eval`` (:mod:`dcfkit.running.evalu
 ``dcfkit ablate`` (:mod:`dcfkit.ablation`) differ only in which runs they ask for.
 
 Each run is :func:`dcfkit.running.tracking.track` on a fresh tracker, written to a
-:class:`dcfkit.running.results.ResultStore`; a tracker exception fails only its run (an
+:class:`dcfkit.store.results.ResultStore`; a tracker exception fails only its run (an
 ``.error`` naming the 1-based frame and its file). Workers have one BLAS/OpenMP/OpenCV
 thread each and die with the parent.
 """
@@ -29,10 +29,10 @@ from dcfkit.datasets import Sequence
 from dcfkit.experiments.vot import DEFAULT_RULE
 from dcfkit.errors import DcfkitError, shown
 from dcfkit.registry import PluginWarning
-from dcfkit.running import platforms
-from dcfkit.running.files import StoreError
-from dcfkit.running.code_state import box_code
-from dcfkit.running.provenance import (
+from dcfkit.store import platforms
+from dcfkit.store.files import StoreError
+from dcfkit.store.code_state import box_code
+from dcfkit.store.provenance import (
     dcfkit_version,
     invocation,
     machine,
@@ -43,9 +43,9 @@ from dcfkit.running.provenance import (
     without_home,
 )
 from dcfkit.running.resets import ResetTrack, track_with_resets
-from dcfkit.running.results import ResultStore
+from dcfkit.store.results import ResultStore
 from dcfkit.running.scheduler import connect as connect_scheduler, import_distributed
-from dcfkit.running.speed import timing_record
+from dcfkit.store.timing import timing_record
 from dcfkit.running.tracking import TrackerFailure, track
 
 log = logging.getLogger(__name__)
@@ -114,9 +114,9 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
                  origin: Mapping | None = None, timing: Mapping | None = None) -> dict:
     """Run ``task`` and store its boxes or its failure; returns ``{"sequence", "status",
     "frames", "error" (failed) or "fps" (done)}``. ``origin``: the client's
-    :func:`~dcfkit.running.provenance.invocation` (default: this process's), recorded in the sidecar
+    :func:`~dcfkit.store.provenance.invocation` (default: this process's), recorded in the sidecar
     with the machine that ran it; ``timing``: how its speed was measured
-    (:func:`dcfkit.running.speed.timing_record`; default: alone, in this process)."""
+    (:func:`dcfkit.store.timing.timing_record`; default: alone, in this process)."""
     seq, store = task.seq, ResultStore(task.folder)
     _warm_up(task)
     reading = [0]  # the 1-based number of the frame being read, for errors in decoding

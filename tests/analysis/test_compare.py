@@ -12,8 +12,8 @@ import pytest
 from dcfkit import cli
 from dcfkit.analysis.compare import PLATFORM_NOISE, compare_folders, first_divergence, series_iou
 from dcfkit.datasets import DatasetError, Sequence
-from dcfkit.running import platforms
-from dcfkit.running.results import ResultStore
+from dcfkit.store import platforms
+from dcfkit.store.results import ResultStore
 
 GT = np.array([[10, 10, 10, 10]] * 5, dtype=float)  # 0-based in memory; files hold x + 1
 
@@ -178,7 +178,7 @@ def test_reference_results_against_themselves_and_another_tracker(shared_data, u
 
 
 def test_a_damaged_dcfkit_result_is_left_out_not_compared(tmp_path):
-    from dcfkit.running.results import ResultStore
+    from dcfkit.store.results import ResultStore
 
     seqs = [sequence("a"), sequence("b")]
     ours, theirs = tmp_path / "ours", tmp_path / "theirs"

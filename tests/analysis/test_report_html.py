@@ -28,7 +28,7 @@ from dcfkit.analysis.report_html.provenance import folder_provenance
 from dcfkit.analysis.report_html.thumbnails import choose_frames, crop_window
 from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset
-from dcfkit.running import platforms as dcfkit_platforms
+from dcfkit.store import platforms as dcfkit_platforms
 
 HOSTILE = "<img src=x onerror=alert(1)>&amp;</script>"  # user text that must stay text
 HOSTILE_NAME = "<img src=x onerror=alert(1)><script>alert(2)"  # as a tracker (a folder name: no slash)

@@ -11,7 +11,7 @@ from dcfkit.analysis.report_html.sections import statistics_table
 from dcfkit.analysis.statistics import versus_baseline
 from dcfkit.analysis.tables import statistics_lines
 from dcfkit.datasets import Sequence
-from dcfkit.running.results import ResultStore
+from dcfkit.store.results import ResultStore
 
 GT = np.array([[10, 10, 10, 10]] * 5, dtype=float)
 

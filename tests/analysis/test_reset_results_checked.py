@@ -21,7 +21,7 @@ from dcfkit.analysis.reset_scores import ResetRun
 from dcfkit.datasets import Sequence, load_dataset
 from dcfkit.experiments.vot import get_rule
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.running.files import format_boxes
+from dcfkit.store.files import format_boxes
 from dcfkit.running.resets import track_with_resets
 
 N = 30

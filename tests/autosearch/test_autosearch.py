@@ -25,7 +25,7 @@ from dcfkit.autosearch.summary import best
 from dcfkit.config import load_config
 from dcfkit.datasets import DatasetWarning, load_dataset
 from dcfkit.errors import ConfigError, DcfkitError
-from dcfkit.running.results import ResultStore
+from dcfkit.store.results import ResultStore
 
 pytest.importorskip("optuna")
 

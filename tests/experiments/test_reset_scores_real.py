@@ -10,7 +10,8 @@ from libtrax import Trax, library_path
 from dcfkit.analysis.reset_scores import ResetRun, score_resets
 from dcfkit.datasets import load_dataset, read_boxes
 from dcfkit.experiments.vot import SKIP
-from dcfkit.running.resets import next_start, track_with_resets
+from dcfkit.experiments.vot import next_start
+from dcfkit.running.resets import track_with_resets
 
 TRACKERS = ("KCF", "STRCF")  # one that fails often, one that seldom does
 

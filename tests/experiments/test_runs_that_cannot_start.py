@@ -16,7 +16,7 @@ from dcfkit.experiments.otb import SRE_SHIFTS, tre_starts
 from dcfkit.experiments.starts import start_problem
 from dcfkit.running.evaluation import run_one_pass
 from dcfkit.running.resets import SKIP, track_with_resets
-from dcfkit.running.results import load_results
+from dcfkit.store.results import load_results
 from dcfkit.tracker.checks import check_box
 
 N, HEIGHT, WIDTH = 30, 40, 50

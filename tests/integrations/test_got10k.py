@@ -22,7 +22,7 @@ from dcfkit.datasets import load_dataset, read_frame
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.errors import ConfigError, InputError, TrackingError
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.running.results import load_results
+from dcfkit.store.results import load_results
 from dcfkit.running.tracking import track
 
 ONE_BASED = np.array([1.0, 1.0, 0.0, 0.0])

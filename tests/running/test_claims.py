@@ -12,7 +12,7 @@ import pytest
 from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixture)
 
 from dcfkit.errors import DcfkitError
-from dcfkit.running.claims import claimed
+from dcfkit.store.claims import claimed
 from dcfkit.running.evaluation import run_one_pass
 
 pytest.importorskip("fcntl", reason="POSIX file locks")
@@ -54,7 +54,7 @@ def test_a_live_claim_refuses_the_same_runs_and_a_killed_one_lapses(tmp_path, se
             run_one_pass(CONFIG, seqs, tmp_path, make_tracker=Counter(), progress=False)
         assert not list(folder.glob("*.txt"))  # nothing was run
         assert run_one_pass(CONFIG, [seqs[0]], tmp_path, make_tracker=Counter(), progress=False)["done"] == ["a"]
-    killed = ("import os, signal, sys; from dcfkit.running.claims import claimed\n"
+    killed = ("import os, signal, sys; from dcfkit.store.claims import claimed\n"
               "with claimed(sys.argv[1], ['b', 'c'], 'dcfkit eval', str): os.kill(os.getpid(), signal.SIGKILL)")
     assert subprocess.run([sys.executable, "-c", killed, str(folder)], timeout=120).returncode == -9
     assert len(list((folder / ".locks").glob("*.claims"))) == 1  # left by the killed run

@@ -9,10 +9,10 @@ import pytest
 from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixture)
 
 from dcfkit.analysis.report_html.provenance import describe_sources
-from dcfkit.running import code_state, provenance
-from dcfkit.running.code_state import code_digest
+from dcfkit.store import code_state, provenance
+from dcfkit.store.code_state import code_digest
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.running.provenance import package_source, run_key
+from dcfkit.store.provenance import package_source, run_key
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +49,7 @@ def test_box_code_changes_the_key(tree, relative):
 
 
 @pytest.mark.parametrize("relative", ["cli/parser.py", "analysis/report.py", "analysis/report_html/report.css",
-                                      "running/results.py", "running/provenance.py", "ablation/spec.py"])
+                                      "store/results.py", "store/provenance.py", "ablation/spec.py"])
 def test_code_that_changes_no_box_keeps_the_key(tree, relative):
     assert edited(tree, relative, lambda text: text + b"\n/* one more line */\n") == code_digest(tree)
 
@@ -117,6 +117,6 @@ def old_key(config) -> str:
 
 
 def provenance_of(out):
-    from dcfkit.running.results import load_results
+    from dcfkit.store.results import load_results
 
     return load_results(out, "drift", ["a", "b", "c"])

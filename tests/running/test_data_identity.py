@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 from test_evaluation import CONFIG, Counter, gt_boxes, seqs  # noqa: F401  (seqs: a fixture)
 
-from dcfkit.running import results
+from dcfkit.store import results
 from dcfkit.running.evaluation import run_one_pass
 
 

@@ -20,11 +20,12 @@ from dcfkit.datasets import DatasetError, Sequence, load_dataset
 from dcfkit.errors import ConfigError, DcfkitError
 from dcfkit.integrations.opencv import OpenCVUnavailable, available_opencv_trackers, opencv_tracker
 from dcfkit.registry import PluginWarning
-from dcfkit.running import evaluation, provenance, results, runner
-from dcfkit.running import files as store_files
+from dcfkit.running import evaluation, runner
+from dcfkit.store import provenance, results
+from dcfkit.store import files as store_files
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.running.provenance import run_key
-from dcfkit.running.results import import_results, load_results
+from dcfkit.store.provenance import run_key
+from dcfkit.store.results import import_results, load_results
 
 N_FRAMES = 6
 

@@ -1,4 +1,4 @@
-"""The platform record (dcfkit.running.platforms): what it holds, in sidecars and reports, and the
+"""The platform record (dcfkit.store.platforms): what it holds, in sidecars and reports, and the
 warning of `dcfkit compare` and `dcfkit report` when result folders come from different platforms."""
 import json
 import os
@@ -13,9 +13,9 @@ from dcfkit import cli
 from dcfkit.analysis.compare import compare_folders
 from dcfkit.analysis.scoring import evaluate
 from dcfkit.datasets import load_dataset
-from dcfkit.running import platforms
+from dcfkit.store import platforms
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.running.results import load_results
+from dcfkit.store.results import load_results
 
 RECORD = {"arch": "x86_64", "cpu": "Some CPU (cpu family 6, model 85)", "simd": "X86_V2 X86_V3",
           "blas": "openblas 0.3 Haswell", "libc": "glibc 2.36", "libraries": {"numpy": "2.4.6", "scipy": "1.17.1"},
@@ -37,7 +37,7 @@ def test_record_sees_the_switches_of_another_platform():
     env = {**os.environ, "OPENBLAS_CORETYPE": "Prescott"}
     if x86:  # numpy refuses to disable features it does not dispatch on this architecture
         env["NPY_DISABLE_CPU_FEATURES"] = "X86_V3 X86_V4 AVX512_ICL"
-    out = subprocess.run([sys.executable, "-c", "import json; from dcfkit.running import platforms; "
+    out = subprocess.run([sys.executable, "-c", "import json; from dcfkit.store import platforms; "
                           "print(json.dumps(platforms.record()))"], env=env, capture_output=True, text=True, check=True)
     rec = json.loads(out.stdout)
     if x86:
@@ -135,7 +135,7 @@ def test_report_command_names_each_trackers_platform(tmp_path, seqs, capsys):  #
 def test_the_blas_recorded_is_numpys_whichever_library_loaded_first(monkeypatch):
     """A worker that imports scipy or OpenCV first lists their BLAS first: the record must not
     change with it (eval --jobs 2 once warned of two platforms on one machine)."""
-    from dcfkit.running import platforms
+    from dcfkit.store import platforms
 
     numpy_blas = {"user_api": "blas", "internal_api": "openblas", "version": "0.3.31", "architecture": "Haswell",
                   "filepath": "/site-packages/numpy.libs/libscipy_openblas64_.so"}

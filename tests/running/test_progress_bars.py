@@ -9,7 +9,8 @@ import pytest
 from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixture)
 
 from dcfkit.ablation import run as ablation_run
-from dcfkit.running import provenance, runner
+from dcfkit.running import runner
+from dcfkit.store import provenance
 from dcfkit.running.evaluation import run_one_pass
 
 

@@ -14,9 +14,9 @@ from dcfkit.analysis.report_html.provenance import describe_sources
 from dcfkit.config import load_config
 from dcfkit.datasets import Sequence
 from dcfkit.datasets.synthetic import make_sequence
-from dcfkit.running import code_state, provenance
+from dcfkit.store import code_state, provenance
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.running.provenance import git_state, package_source
+from dcfkit.store.provenance import git_state, package_source
 
 needs_git = pytest.mark.skipif(shutil.which("git") is None, reason="git is not installed")
 

@@ -7,7 +7,8 @@ import pytest
 
 from dcfkit.datasets import Sequence
 from dcfkit.experiments.vot import SKIP, valid_box
-from dcfkit.running.resets import next_start, track_with_resets
+from dcfkit.experiments.vot import next_start
+from dcfkit.running.resets import track_with_resets
 from dcfkit.running.tracking import TrackerFailure
 
 N = 30

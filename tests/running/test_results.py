@@ -16,10 +16,10 @@ from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixtur
 
 from dcfkit.analysis import report
 from dcfkit.errors import DcfkitError
-from dcfkit.running import files, results
+from dcfkit.store import files, results
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.running.provenance import run_key
-from dcfkit.running.results import ResultStore, load_results
+from dcfkit.store.provenance import run_key
+from dcfkit.store.results import ResultStore, load_results
 
 
 @contextlib.contextmanager

@@ -13,9 +13,9 @@ from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixtur
 
 from dcfkit.analysis import report
 from dcfkit.analysis.report_html import write_html_report
-from dcfkit.running import provenance
+from dcfkit.store import provenance
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.running.provenance import running_command, without_home
+from dcfkit.store.provenance import running_command, without_home
 
 HOST = "alices-laptop.example"
 

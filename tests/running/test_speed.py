@@ -1,5 +1,5 @@
 """How a run's speed was measured: recorded in its sidecar, and fps shown as a score only for
-runs timed alone (dcfkit.running.speed)."""
+runs timed alone (dcfkit.store.timing)."""
 from __future__ import annotations
 
 import json
@@ -15,8 +15,8 @@ from dcfkit.analysis.scoring import evaluate
 from dcfkit.datasets import Sequence
 from dcfkit.running import runner
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.running.results import load_results
-from dcfkit.running.speed import ADVICE, fps_note
+from dcfkit.store.results import load_results
+from dcfkit.store.timing import ADVICE, fps_note
 
 
 @pytest.fixture

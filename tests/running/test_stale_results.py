@@ -14,7 +14,7 @@ from test_experiment_runs import seqs  # noqa: F401  (a fixture: two 25-frame se
 from dcfkit import cli
 from dcfkit.datasets import DatasetError
 from dcfkit.running.evaluation import experiment_runs, results_folder, run_one_pass
-from dcfkit.running.results import load_results
+from dcfkit.store.results import load_results
 
 CONFIG = {"name": "drift", "drift": 1.0}
 

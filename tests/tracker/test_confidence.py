@@ -8,7 +8,7 @@ import pytest
 
 from dcfkit import load_tracker
 from dcfkit.datasets.synthetic import make_sequence
-from dcfkit.running.files import format_confidence
+from dcfkit.store.files import format_confidence
 from dcfkit.running.tracking import Track, track
 from dcfkit.tracker.confidence import NO_CONFIDENCE, Confidence, apce, confidence_of
 
@@ -113,8 +113,8 @@ def test_eval_writes_time_and_confidence_files_beside_the_boxes(tmp_path):
 
     from dcfkit.datasets import Sequence
     from dcfkit.running.evaluation import run_one_pass
-    from dcfkit.running.files import checksum
-    from dcfkit.running.results import ResultStore, load_results, result_files
+    from dcfkit.store.files import checksum
+    from dcfkit.store.results import ResultStore, load_results, result_files
 
     seq = make_sequence(n_frames=10, seed=5)
     paths = []

@@ -20,7 +20,7 @@ from typing import Mapping
 
 import numpy as np
 
-from dcfkit.running.files import atomic_write
+from dcfkit.store.files import atomic_write
 
 DIGITS = 4  # decimals of the floats in the page's data: scores are shown with 3
 

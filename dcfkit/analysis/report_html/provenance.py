@@ -1,6 +1,6 @@
-"""What produced a report's results, read from the result sidecars (:mod:`dcfkit.running.results`):
+"""What produced a report's results, read from the result sidecars (:mod:`dcfkit.store.results`):
 commands, dcfkit and plugin versions, run keys (config hashes), machines, platforms
-(:mod:`dcfkit.running.platforms`), times, config.
+(:mod:`dcfkit.store.platforms`), times, config.
 
 Sidecars written before dcfkit recorded the command and the machine lack them; they are
 then "not recorded", and imported result files (no sidecars) have nothing recorded. A page is
@@ -13,8 +13,8 @@ from collections import Counter
 from pathlib import Path
 from typing import Iterable, Mapping
 
-from dcfkit.running import platforms
-from dcfkit.running.provenance import (
+from dcfkit.store import platforms
+from dcfkit.store.provenance import (
     command_line,
     dcfkit_version,
     invocation,
@@ -23,13 +23,13 @@ from dcfkit.running.provenance import (
     shared_path,
     without_home,
 )
-from dcfkit.running.results import ResultStore
+from dcfkit.store.results import ResultStore
 
 NOT_RECORDED = "not recorded"
 
 
 def describe_machine(record) -> str:
-    """``CPU, N cores, OS, Python x.y`` of a :func:`dcfkit.running.provenance.machine` record
+    """``CPU, N cores, OS, Python x.y`` of a :func:`dcfkit.store.provenance.machine` record
     (an older record's ``host`` left out)."""
     if not isinstance(record, Mapping):
         return NOT_RECORDED
@@ -71,7 +71,7 @@ def describe_sources(record) -> str:
 
 def folder_provenance(folder: Path, names: Iterable[str], base: Path | None = None) -> dict:
     """What the sidecars of sequences ``names`` in ``folder`` record: ``folder`` (relative to
-    ``base``, the page's folder: :func:`~dcfkit.running.provenance.shared_path`),
+    ``base``, the page's folder: :func:`~dcfkit.store.provenance.shared_path`),
     ``sequences`` (sidecars read), ``run_keys``, ``versions``, ``plugins``, ``sources`` (git
     commits), ``commands``,
     ``machines``, ``platforms`` (each ``[[value, sequences], ...]``), ``times`` (first, last) and

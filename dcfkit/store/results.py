@@ -4,7 +4,7 @@ Per sequence: ``<seq>.txt`` (1-based ``x,y,w,h`` per frame, ``%.3f``: the toolki
 ``<seq>.time``, ``<seq>.confidence``, and the sidecar ``<seq>.json`` (run key, checksums,
 config, versions), written last to mark it done; ``<seq>.error`` instead when the tracker
 raised (docs/evaluation.md, "Running", has every field). Every file is written whole or not
-at all (:mod:`dcfkit.running.files`), and a result is used only while its ``.txt`` has the
+at all (:mod:`dcfkit.store.files`), and a result is used only while its ``.txt`` has the
 checksum its sidecar recorded (:meth:`ResultStore.problem`).
 """
 from __future__ import annotations
@@ -24,7 +24,7 @@ import numpy as np
 
 from dcfkit.datasets import DatasetError, Sequence, read_boxes
 from dcfkit.errors import clip, shown
-from dcfkit.running.files import (
+from dcfkit.store.files import (
     atomic_write,
     checksum,
     format_boxes,
@@ -33,7 +33,7 @@ from dcfkit.running.files import (
     make_dir,
     read_json,
 )
-from dcfkit.running.provenance import json_default, now, without_home
+from dcfkit.store.provenance import json_default, now, without_home
 
 log = logging.getLogger(__name__)
 
@@ -49,10 +49,10 @@ TOOLKIT_TIME_SUFFIX, TOOLKIT_CONFIDENCE_SUFFIX = "_time", "_confidence"  # <sequ
 class SequenceResult:
     """A tracker's result on one sequence: ``boxes`` ``(N, 4) float64`` 0-based;
     ``times`` ``(N,) float64`` seconds per frame and ``fps`` when known (None for imports);
-    ``platform`` the :func:`dcfkit.running.platforms.record` of the run when its sidecar has one;
+    ``platform`` the :func:`dcfkit.store.platforms.record` of the run when its sidecar has one;
     ``resets`` the 1-based ``starts`` and ``failures`` of a reset-based run
     (:mod:`dcfkit.running.resets`); ``timing`` how its speed was measured
-    (:mod:`dcfkit.running.speed`; None in sidecars from before it was recorded)."""
+    (:mod:`dcfkit.store.timing`; None in sidecars from before it was recorded)."""
 
     boxes: np.ndarray
     times: np.ndarray | None = None

@@ -25,8 +25,8 @@ import numpy as np
 from dcfkit import __version__
 from dcfkit.config.slots import components
 from dcfkit.registry import get_registry
-from dcfkit.running.code_state import box_code, built_source
-from dcfkit.running.platforms import cpu_model
+from dcfkit.store.code_state import box_code, built_source
+from dcfkit.store.platforms import cpu_model
 
 _COMMAND: contextvars.ContextVar[list | None] = contextvars.ContextVar("dcfkit_command", default=None)
 
@@ -63,7 +63,7 @@ def run_key(config: Mapping, version: str | None = None, reset_rule: str | None 
     """The identity of a run: 16 hex digits of SHA-256 over the canonical JSON (sorted keys)
     of ``config`` without its ``name`` and ``description`` (they change no box), the dcfkit
     version, the digest of dcfkit's box code (``code``, default
-    :func:`~dcfkit.running.code_state.box_code`: an edited tracker gives new results at the
+    :func:`~dcfkit.store.code_state.box_code`: an edited tracker gives new results at the
     same version), the versions of the plugins whose components the config uses (a plugin's
     new release gives new results; configs of built-ins only keep their keys), and for a
     reset-based run the ``reset_rule`` whose failures restarted it (its boxes depend on it)."""
@@ -163,7 +163,7 @@ def git_state(folder: str) -> dict | None:
 def package_source(distribution: str, package_dir: str | None = None) -> dict | None:
     """Where an installed package's code came from: the git state of the work tree it runs from
     (``package_dir``'s parent holds ``.git``: a checkout, an editable install), else the state
-    its build recorded (``pip install .`` of a checkout: :func:`~dcfkit.running.code_state.built_source`),
+    its build recorded (``pip install .`` of a checkout: :func:`~dcfkit.store.code_state.built_source`),
     else the commit pip recorded for a VCS install or the git state of the folder of an
     editable one (PEP 610 ``direct_url.json``); None when nothing says (a release from an index)."""
     if package_dir is not None and (found := git_state(os.path.dirname(os.path.abspath(package_dir)))):
@@ -185,7 +185,7 @@ def package_source(distribution: str, package_dir: str | None = None) -> dict | 
 
 
 def sources(plugins: list[str]) -> dict:
-    """:func:`package_source` of dcfkit, with ``code`` (:func:`~dcfkit.running.code_state.box_code`),
+    """:func:`package_source` of dcfkit, with ``code`` (:func:`~dcfkit.store.code_state.box_code`),
     and of each of ``plugins`` (``"name version"``, as :func:`plugin_versions` lists them), by
     distribution name (results sidecars record it)."""
     found = {"dcfkit": {**(package_source("dcfkit", str(Path(__file__).resolve().parents[1])) or {}),
