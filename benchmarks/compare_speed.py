@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parents[1]
-# The loop is written out, not dcfkit.running.tracking.track: the other checkout may predate it.
+# The loop is written out, not dcfkit.experiments.loop.track: the other checkout may predate it.
 RUN = """
 import os, sys, time
 import cv2

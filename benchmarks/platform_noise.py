@@ -87,7 +87,7 @@ def work(args) -> int:
 
     import dcfkit
     from dcfkit.config import load_config
-    from dcfkit.running.tracking import track
+    from dcfkit.experiments.loop import track
 
     cv2.setNumThreads(1)
     boxes = {}

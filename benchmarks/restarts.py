@@ -29,7 +29,7 @@ import dcfkit  # noqa: E402
 from dcfkit.ablation import load_spec  # noqa: E402
 from dcfkit.analysis.metrics import iou, score_sequence  # noqa: E402
 from dcfkit.datasets import load_dataset  # noqa: E402
-from dcfkit.running.tracking import track  # noqa: E402
+from dcfkit.experiments.loop import track  # noqa: E402
 
 LOST_TAIL = 10  # frames at the end of a segment that must all miss for it to count as lost
 

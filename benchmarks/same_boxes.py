@@ -24,7 +24,7 @@ import numpy as np  # noqa: E402
 
 import dcfkit  # noqa: E402
 from dcfkit.datasets.synthetic import make_sequence  # noqa: E402
-from dcfkit.running.tracking import track  # noqa: E402
+from dcfkit.experiments.loop import track  # noqa: E402
 
 cv2.setNumThreads(1)
 

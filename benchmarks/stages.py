@@ -25,7 +25,7 @@ import cv2  # noqa: E402
 import dcfkit  # noqa: E402
 import dcfkit.tracker.tracker as tracker_module  # noqa: E402
 from dcfkit.datasets.synthetic import make_sequence  # noqa: E402
-from dcfkit.running.tracking import track  # noqa: E402
+from dcfkit.experiments.loop import track  # noqa: E402
 
 cv2.setNumThreads(1)
 TOTALS = collections.defaultdict(float)

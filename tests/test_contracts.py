@@ -21,7 +21,7 @@ from dcfkit.components.scale.pyramid import Pyramid
 from dcfkit.components.search.strategies import MotionAware
 from dcfkit.components.solvers import ADMMStrcf
 from dcfkit.contracts import ContractViolation, array, pair, scalar, within_grid
-from dcfkit.running.tracking import TrackerFailure, track
+from dcfkit.experiments.loop import TrackerFailure, track
 
 PROVIDER = "evil-plugin"
 

@@ -163,3 +163,37 @@ def test_every_package_is_installed():
     listed = set(tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
     found = {".".join(p.parent.relative_to(PACKAGE.parent).parts) for p in PACKAGE.rglob("__init__.py")}
     assert found <= listed, f"add to pyproject.toml [tool.setuptools] packages: {sorted(found - listed)}"
+
+
+def test_analysis_reads_results_without_the_runner(graph):
+    """Scoring and reports reach results through dcfkit.store, never through dcfkit.running."""
+    found = sorted((m, i) for m in graph.modules if m.startswith("dcfkit.analysis")
+                   for i in graph.find_modules_directly_imported_by(m) if i.startswith("dcfkit.running"))
+    assert not found, f"analysis imports the runner: {found}"
+
+
+def experiment_names_compared(tree: ast.AST, names: set[str]) -> list[int]:
+    """Lines that compare a value with an experiment's name (``x == "tre"``, ``x in ("ope", "sre")``)."""
+    def named(node) -> bool:
+        if isinstance(node, ast.Constant):
+            return isinstance(node.value, str) and node.value.lower() in names
+        return isinstance(node, (ast.Tuple, ast.List, ast.Set)) and any(named(e) for e in node.elts)
+    return [node.lineno for node in ast.walk(tree) if isinstance(node, ast.Compare)
+            and any(named(side) for side in (node.left, *node.comparators))]
+
+
+def test_no_experiment_name_is_compared_outside_experiments():
+    """The runner, scoring, reports and commands call the experiment's strategy
+    (dcfkit.experiments.base.Experiment); only dcfkit/experiments/ knows an experiment by name."""
+    from dcfkit.experiments import EXPERIMENTS  # deferred: the layout tests read files first
+
+    names = set(EXPERIMENTS)
+    found = [f"{path.relative_to(PACKAGE.parent)}:{line}" for path in sources()
+             if "experiments" not in path.relative_to(PACKAGE).parts
+             for line in experiment_names_compared(ast.parse(path.read_text(encoding="utf-8")), names)]
+    assert not found, f"experiment names compared outside dcfkit/experiments/: {found}"
+
+
+def test_the_name_check_sees_a_comparison():
+    tree = ast.parse("if args.experiment == 'reset':\n    pass\nok = kind in ('ope', 'tre')\nfine = x == 'otb'\n")
+    assert experiment_names_compared(tree, {"ope", "tre", "sre", "reset"}) == [1, 3]

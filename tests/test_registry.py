@@ -486,7 +486,7 @@ def test_a_real_interrupt_while_a_plugin_loads_still_interrupts(monkeypatch, sig
     imported is the user's: it ends the command, and is not blamed on the plugin."""
     import signal
 
-    from dcfkit.running.tracking import Interrupted, interrupt_on_termination
+    from dcfkit.signals import Interrupted, interrupt_on_termination
 
     if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
         pytest.skip("Ctrl-C is not Python's default KeyboardInterrupt here")

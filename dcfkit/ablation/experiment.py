@@ -6,18 +6,20 @@ from pathlib import Path
 from typing import Any
 
 from dcfkit.errors import ConfigError, shown
-from dcfkit.experiments import get_experiment
+from dcfkit.experiments import EXPERIMENTS, get_experiment
 
-ABLATION_EXPERIMENTS = ("ope", "tre", "sre")  # scored as one-pass results are (dcfkit.experiments)
+# the experiments whose runs are scored as one-pass results are (OTB's measures), which an ablation's summary reads
+ABLATION_EXPERIMENTS = tuple(name for name, e in EXPERIMENTS.items() if e.scoring == "otb")
 
 
 def check_experiment(value: Any, where: str) -> str:
     """``value`` as the name of an experiment an ablation can run, or a :class:`ConfigError`."""
     name = value.lower() if isinstance(value, str) else value
     if name not in ABLATION_EXPERIMENTS:
-        reset = (" (reset-based runs: dcfkit eval --experiment reset, then dcfkit report --experiment reset)"
-                 if name == "reset" else "")
-        raise ConfigError(f"{where}: expected one of {', '.join(ABLATION_EXPERIMENTS)}, got {shown(value)}{reset}")
+        other = EXPERIMENTS.get(name) if isinstance(name, str) else None
+        hint = (f" ({other.name} runs: dcfkit eval --experiment {other.name}, then dcfkit report --experiment "
+                f"{other.name})" if other is not None else "")
+        raise ConfigError(f"{where}: expected one of {', '.join(ABLATION_EXPERIMENTS)}, got {shown(value)}{hint}")
     return name
 
 
@@ -36,7 +38,7 @@ def scope_line(experiment: str, protocol: str, max_frames: int | None = None) ->
     """One line naming the runs an ablation scored: ``experiment TRE (temporal robustness: 20
     starts; each sequence's runs pooled), protocol otb`` and a smoke run's ``--max-frames`` cut."""
     found = get_experiment(experiment)
-    pooled = "" if found.name == "ope" else "; each sequence's runs pooled, as the OTB toolkit's perfPlot.m"
+    pooled = "; each sequence's runs pooled, as the OTB toolkit's perfPlot.m" if found.pooled else ""
     cut = (f", each sequence's first {max_frames} frames only (--max-frames {max_frames}: a smoke run, "
            f"not the benchmark's scores)" if max_frames else "")
     return f"experiment {found.name.upper()} ({found.title}{pooled}), protocol {protocol}{cut}"

@@ -9,6 +9,7 @@ from typing import Any, Iterable, Mapping
 from dcfkit.analysis.report import read_folder
 from dcfkit.datasets import Sequence
 from dcfkit.errors import ConfigError, clip, shown
+from dcfkit.experiments import get_experiment
 
 log = logging.getLogger(__name__)
 
@@ -21,7 +22,7 @@ def parse_published(spec_path: Path, raw: Any, variants: Iterable[str], experime
         return ()
     if not isinstance(raw, Mapping) or not raw:
         raise ConfigError(f"{spec_path}: published: expected a mapping of names to result folders, got {shown(raw)}")
-    if experiment != "ope":
+    if get_experiment(experiment).folder:  # runs of their own, which published one-pass results do not have
         raise ConfigError(f"{spec_path}: published: published results are one-pass results; the spec's experiment "
                           f"is {experiment}, whose runs they do not have")
     taken, found = set(variants), []

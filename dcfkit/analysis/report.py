@@ -269,9 +269,9 @@ def score_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | N
     if _holds_results(report_dir, {s.name for s in sequences}):
         raise DatasetError(f"{report_dir} holds a tracker's results; write the report elsewhere with --report-dir")
     experiment = get_experiment(experiment)
-    if experiment.resets:
-        raise DatasetError("reset-based results are scored by dcfkit.analysis.reset_report (dcfkit report "
-                           "--experiment reset)")
+    if experiment.scoring != "otb":
+        raise DatasetError(f"{experiment.name} results are scored by their own scoring ({experiment.scoring}): "
+                           f"dcfkit report --experiment {experiment.name}")
     by_sequence = runs_by_sequence(sequences, experiment)
     runs = [run for found in by_sequence.values() for run in found]
     folders = tracker_folders(out_dir, runs, trackers, exclude=[report_dir], sub=experiment.folder)

@@ -69,7 +69,7 @@ ROUNDING = 1e-3  # the most a result file's %.3f moves a box's edge (x and w eac
 def resets_problem(run: ResetRun) -> str | None:
     """Where (``frame <n>``, 1-based) the ``starts`` and ``failures`` of ``run`` part from those its
     rule (:class:`~dcfkit.experiments.vot.ResetRule`) gives from its boxes and ground truth, or
-    None. The loop is the runs' own (:mod:`dcfkit.running.resets`): a failure is the first frame
+    None. The loop is the runs' own (:mod:`dcfkit.experiments.reset`): a failure is the first frame
     after a start whose box does not overlap the ground truth; the next start is
     :func:`~dcfkit.experiments.vot.next_start` from :data:`~dcfkit.experiments.vot.SKIP` frames
     later (dcfkit <= 0.9.0 did not move a start past a box off the image: that start is taken

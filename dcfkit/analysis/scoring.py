@@ -111,8 +111,8 @@ def evaluate(results: Mapping[str, Mapping], sequences: Iterable[Sequence],
     weighting = weighting or proto.weighting
     keys = proto.score_keys
     experiment = get_experiment(experiment)
-    if experiment.resets:
-        raise ValueError("reset-based runs are scored by dcfkit.analysis.reset_scores, not evaluate()")
+    if experiment.scoring != "otb":
+        raise ValueError(f"{experiment.name} runs are scored by their own scoring ({experiment.scoring}), not evaluate()")
     runs = runs if runs is not None else runs_by_sequence(scored_sequences(sequences), experiment)
     sequences, left_out = _complete(scored_sequences(sequences), results, missing, runs)
     per_seq, fps, measured, missing = {}, {}, {}, {}

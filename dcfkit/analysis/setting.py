@@ -20,7 +20,7 @@ def experiment_line(experiment: str | Experiment, max_frames: int | None = None)
     pooled``, and ``; a smoke run: each sequence cut to its first N frames (--max-frames N)``."""
     exp = get_experiment(experiment)
     line = f"experiment {exp.name.upper()} ({exp.title}; {exp.source})"
-    if exp.folder and not exp.resets:
+    if exp.pooled:
         line += ", each sequence's runs pooled"
     return line + cut_phrase(max_frames)
 

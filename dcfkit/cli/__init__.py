@@ -10,7 +10,7 @@ import warnings
 from dcfkit.cli.parser import build_parser, named_command
 from dcfkit.errors import DcfkitError, DcfkitWarning, clip
 from dcfkit.store.provenance import running_command
-from dcfkit.running.tracking import interrupt_on_termination
+from dcfkit.signals import interrupt_on_termination
 
 __all__ = ["build_parser", "main"]
 

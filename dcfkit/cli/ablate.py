@@ -12,7 +12,7 @@ from dcfkit.ablation.spec import MAX_VARIANTS, job_dir
 from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.cli.common import add_max_frames_argument, add_protocol_argument, executor_choice, variant_count
 from dcfkit.config import shipped_config_dir
-from dcfkit.experiments import runs_by_sequence
+from dcfkit.experiments import get_experiment, runs_by_sequence
 from dcfkit.store.results import ResultStore
 
 
@@ -49,18 +49,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _dry_run(spec, out: Path) -> int:
-    seqs = spec.load_sequences()
-    runs = runs_by_sequence(seqs, spec.experiment)
+    seqs, experiment = spec.load_sequences(), get_experiment(spec.experiment)
+    runs = runs_by_sequence(seqs, experiment)
     jobs = expand(spec, seqs)
     for job in jobs:
         store = ResultStore(runs_dir(job_dir(out, spec.dataset, job.key), spec.experiment))
         done = sum(store.status(run, job.key) == "done" for run in runs[job.sequence])
         state = "done" if done == len(runs[job.sequence]) else "todo"
-        count = f" ({done} of {len(runs[job.sequence])} {spec.experiment} runs done)" if spec.experiment != "ope" else ""
+        count = f" ({done} of {len(runs[job.sequence])} {spec.experiment} runs done)" if experiment.folder else ""
         print(f"{state}  {job.key}  {job.variant}  {job.sequence}{count}")
     print(f"{len(jobs)} jobs, {len({(j.key, j.sequence) for j in jobs})} distinct runs"
           + (f" ({spec.experiment}: {sum(len(r) for r in runs.values())} runs of {len(seqs)} sequences per variant)"
-             if spec.experiment != "ope" else ""))
+             if experiment.folder else ""))
     return 0
 
 

@@ -59,19 +59,25 @@ def add_protocol_argument(parser: argparse.ArgumentParser, reset: bool = False) 
                              "docs/evaluation.md lists the differences")
 
 
-def check_protocol(args: argparse.Namespace) -> None:
-    """A :class:`ConfigError` if ``--protocol`` does not fit ``--experiment``: the reset-based
-    experiment takes one of its rules, the others a scoring protocol."""
-    from dcfkit.experiments.vot import RULES  # lazy: as add_protocol_argument
+def check_protocol(args: argparse.Namespace):
+    """The :class:`~dcfkit.experiments.Experiment` ``--experiment`` names, bound to ``--protocol``
+    when that is one of the experiment's own rules; a :class:`ConfigError` if ``--protocol`` does
+    not fit: an experiment with rules of its own (the reset-based one) takes one of them, the
+    others a scoring protocol."""
+    from dcfkit.experiments import EXPERIMENTS, get_experiment  # lazy: as add_protocol_argument
 
+    experiment = get_experiment(args.experiment)
     if args.protocol is None:
-        return
-    if args.experiment == "reset" and args.protocol not in RULES:
-        raise ConfigError(f"--protocol {args.protocol} scores one-pass runs; --experiment reset takes "
-                          f"{' or '.join(RULES)} (the toolkit whose overlap decides failures and scores)")
-    if args.experiment != "reset" and args.protocol in RULES:
-        raise ConfigError(f"--protocol {args.protocol} is a rule of the reset-based experiment; give --experiment "
-                          f"reset, or for --experiment {args.experiment} one of {', '.join(PROTOCOLS)}")
+        return experiment
+    rules = experiment.rules
+    if rules and args.protocol not in rules:
+        raise ConfigError(f"--protocol {args.protocol} scores one-pass runs; --experiment {experiment.name} takes "
+                          f"{' or '.join(rules)} (the toolkit whose overlap decides failures and scores)")
+    owner = next((e.name for e in EXPERIMENTS.values() if args.protocol in e.rules), None)
+    if not rules and owner is not None:
+        raise ConfigError(f"--protocol {args.protocol} is a rule of the {owner} experiment; give --experiment "
+                          f"{owner}, or for --experiment {experiment.name} one of {', '.join(PROTOCOLS)}")
+    return experiment.bind(args.protocol)
 
 
 def add_dataset_arguments(parser: argparse.ArgumentParser, root_help: str = "benchmark root folder") -> None:

@@ -35,8 +35,7 @@ from dcfkit.config import load_config
 from dcfkit.config.overrides import parse_overrides
 from dcfkit.datasets import benchmark_protocol, load_datasets, scored_sequences
 from dcfkit.errors import ConfigError, printable, shown
-from dcfkit.experiments import runs_by_sequence
-from dcfkit.experiments.vot import get_rule
+from dcfkit.experiments import Experiment, runs_by_sequence
 from dcfkit.integrations.opencv import opencv_tracker
 from dcfkit.running.evaluation import check_one_pass, results_folder, run_one_pass, tracker_name
 from dcfkit.store.results import load_results
@@ -85,47 +84,55 @@ def distinct_names(specs: list[str], resolved: list[tuple[dict, Callable | None]
 
 def run_eval(args: argparse.Namespace) -> int:
     """Run each config on the dataset and print its scores; exit status 1 if a sequence failed."""
-    check_protocol(args)
-    rule = args.protocol if args.experiment == "reset" else None
+    experiment = check_protocol(args)
     sequences = [s.head(args.max_frames) for s in load_datasets(args.dataset, args.root, args.sequences)]
-    if args.protocol is None and args.experiment != "reset":  # pooled benchmarks of different rules: refused
+    if args.protocol is None and experiment.scoring == "otb":  # pooled benchmarks of different rules: refused
         benchmark_protocol(sequences)
     overrides = parse_overrides(args.overrides)
     resolved = distinct_names(args.configs, [_resolve_config(spec, overrides) for spec in args.configs])
     for config, _ in resolved:  # every config's folder and results checked before the first runs
-        check_one_pass(config, sequences, args.out, args.experiment, rule)
+        check_one_pass(config, sequences, args.out, experiment)
     status = 0
     for config, factory in resolved:
         summary = run_one_pass(config, sequences, args.out, make_tracker=factory,
-                               jobs=args.jobs, progress=not args.no_progress, experiment=args.experiment,
-                               reset_rule=rule)
+                               jobs=args.jobs, progress=not args.no_progress, experiment=experiment)
         print(f"{summary['tracker']}: {len(summary['done'])} run, {len(summary['skipped'])} "
               f"already done, {len(summary['failed'])} failed -> {summary['dir']}")
-        print(f"  {_scores(args, summary['tracker'], sequences)}")
+        print(f"  {_scores(args, experiment, summary['tracker'], sequences)}")
         for message in summary["failed"].values():
             print(f"  FAILED {message}")
         status = status or (1 if summary["failed"] else 0)
     return status
 
 
-def _scores(args: argparse.Namespace, tracker: str, sequences: list) -> str:
+def _scores(args: argparse.Namespace, experiment: Experiment, tracker: str, sequences: list) -> str:
     """The score line of one tracker's results, or why there is none (a test split)."""
     if all(s.ground_truth_withheld for s in sequences):
         return (f"no scores: the ground truth of these {len(sequences)} sequences is withheld after frame 1 "
                 f"(a test split); submit {Path(args.out) / tracker}/<sequence>.txt to the benchmark's server "
                 f"(docs/evaluation.md, 'Test splits')")
-    folder = results_folder(args.out, {"name": tracker}, args.experiment)
-    if args.experiment == "reset":
-        scored = scored_sequences(sequences)
-        row = score_resets({tracker: reset_runs(folder, scored)}, {s.name: len(s) for s in scored})["overall"][0]
-        return (f"EAO {row['eao']:.3f}, accuracy {row['accuracy']:.3f}, {row['failures']} failures on "
-                f"{row['sequences']} sequences (reset-based, {get_rule(args.protocol).title})")
-    by_sequence = runs_by_sequence(scored_sequences(sequences), args.experiment)
+    folder = results_folder(args.out, {"name": tracker}, experiment)
+    return SCORE_LINES[experiment.scoring](args, experiment, tracker, folder, scored_sequences(sequences))
+
+
+def _otb_score_line(args: argparse.Namespace, experiment: Experiment, tracker: str, folder: Path,
+                    sequences: list) -> str:
+    by_sequence = runs_by_sequence(sequences, experiment)
     runs = [run for found in by_sequence.values() for run in found]
     scores = evaluate({tracker: load_results(folder.parent, folder.name, runs)}, sequences, protocol=args.protocol,
-                      experiment=args.experiment, runs=by_sequence)
+                      experiment=experiment, runs=by_sequence)
     line = score_line(scores.overall[0], scores.protocol.name)
-    return line if args.experiment == "ope" else f"{line}, {args.experiment.upper()} runs pooled per sequence"
+    return f"{line}, {experiment.name.upper()} runs pooled per sequence" if experiment.pooled else line
+
+
+def _reset_score_line(args: argparse.Namespace, experiment: Experiment, tracker: str, folder: Path,
+                      sequences: list) -> str:
+    row = score_resets({tracker: reset_runs(folder, sequences)}, {s.name: len(s) for s in sequences})["overall"][0]
+    return (f"EAO {row['eao']:.3f}, accuracy {row['accuracy']:.3f}, {row['failures']} failures on "
+            f"{row['sequences']} sequences (reset-based, {experiment.rules[experiment.rule].title})")
+
+
+SCORE_LINES = {"otb": _otb_score_line, "reset": _reset_score_line}  # by Experiment.scoring
 
 
 def add_report_arguments(parser: argparse.ArgumentParser) -> None:
@@ -166,22 +173,19 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run_report(args: argparse.Namespace) -> int:
     """Print the overall table and write the report files."""
-    check_protocol(args)
+    experiment = check_protocol(args)
     sequences = [s.head(args.max_frames) for s in load_datasets(args.dataset, args.root, args.sequences)]
     trackers = [t for t in args.trackers.split(",") if t] if args.trackers else None
-    if args.experiment == "reset":
-        if args.html:
-            raise ConfigError("--html: reset-based runs have no report page (their tables, statistics.txt and "
-                              "reset.json are written without it); leave --html out for --experiment reset")
-        return _reset_report(args, sequences, trackers)
-    write = functools.partial(write_html_report if args.html else score_and_write, experiment=args.experiment,
+    if experiment.scoring != "otb":
+        return OTHER_REPORTS[experiment.scoring](args, experiment, sequences, trackers)
+    write = functools.partial(write_html_report if args.html else score_and_write, experiment=experiment,
                               baseline=args.baseline)
     evaluation, paths = write(args.out, sequences, trackers, args.report_dir, include_first=not args.skip_first,
                               weighting="frame" if args.frame_weighted else None, protocol=args.protocol,
                               missing=args.missing)
     protocol = evaluation.protocol.name  # --protocol, else the benchmark's
     print(format_table(evaluation.overall, args.format, columns("overall", protocol), protocol,
-                       evaluation.statistics, experiment=args.experiment,
+                       evaluation.statistics, experiment=experiment,
                        max_frames=evaluation.settings["max_frames"], datasets=evaluation.settings["datasets"]),
           end="")
     if evaluation.settings["fps_note"] and args.format in ("table", "markdown"):
@@ -202,8 +206,12 @@ def run_report(args: argparse.Namespace) -> int:
     return 0
 
 
-def _reset_report(args: argparse.Namespace, sequences: list, trackers: list[str] | None) -> int:
+def _reset_report(args: argparse.Namespace, experiment: Experiment, sequences: list,
+                  trackers: list[str] | None) -> int:
     """``report --experiment reset``: the accuracy, failures and EAO table and the statistics."""
+    if args.html:
+        raise ConfigError(f"--html: reset-based runs have no report page (their tables, statistics.txt and "
+                          f"reset.json are written without it); leave --html out for --experiment {experiment.name}")
     scores, paths = write_reset_report(args.out, sequences, trackers, args.report_dir, protocol=args.protocol,
                                        baseline=args.baseline)
     print(reset_latex(scores) if args.format == "latex" else reset_table(scores, "overall", args.format), end="")
@@ -213,6 +221,9 @@ def _reset_report(args: argparse.Namespace, sequences: list, trackers: list[str]
         print("\n" + "\n".join(statistics_lines(scores["statistics"])))
         print(f"\n{len(paths)} files written to {paths[0].parent}")
     return 0
+
+
+OTHER_REPORTS = {"reset": _reset_report}  # by Experiment.scoring; "otb" is run_report's own
 
 
 def add_compare_arguments(p: argparse.ArgumentParser) -> None:

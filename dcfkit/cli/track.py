@@ -20,7 +20,8 @@ from dcfkit.datasets.video_writer import DEFAULT_FPS, VideoWriter, check_output_
 from dcfkit.errors import InputError, clip
 from dcfkit.store.files import StoreError, format_boxes, format_confidence, format_times
 from dcfkit.store.results import CONFIDENCE_END, TIME_END
-from dcfkit.running.tracking import INTERRUPTS, Step, steps, termination_deferred, track
+from dcfkit.experiments.loop import Step, steps, track
+from dcfkit.signals import INTERRUPTS, termination_deferred
 from dcfkit.tracker.tracker import load_tracker
 
 TRACK_NOTES = f"""--video reads a file, a camera (0 is the first), a stream URL or a named pipe one frame at a

@@ -12,37 +12,17 @@ sequence is scored on the others.
 """
 from __future__ import annotations
 
-import dataclasses
 import warnings
-from typing import Callable, Iterable
+from typing import Iterable
 
 from dcfkit.datasets import DatasetWarning, Sequence
 from dcfkit.errors import DcfkitError, shown
+from dcfkit.experiments.base import Experiment
 from dcfkit.experiments.otb import sre_plan, tre_plan
 from dcfkit.experiments.starts import Plan
+from dcfkit.experiments.reset import ResetExperiment
 
 __all__ = ["EXPERIMENTS", "Experiment", "get_experiment", "left_out_runs", "runs_by_sequence"]
-
-
-@dataclasses.dataclass(frozen=True)
-class Experiment:
-    """``plan(sequence)`` gives the runs of one sequence and those left out (:class:`Plan`),
-    ``runs(sequence)`` the former; ``folder`` is the sub-folder of a tracker's results that
-    holds them (``""`` for one-pass results); ``resets`` marks VOT's
-    reset-based runs, which re-initialise the tracker after each failure; ``first_box``
-    whether the runs need frame 1's ground truth (TRE and reset-based runs start at the first
-    valid one)."""
-
-    name: str
-    title: str
-    source: str
-    plan: Callable[[Sequence], Plan]
-    folder: str
-    resets: bool = False
-    first_box: bool = True
-
-    def runs(self, seq: Sequence) -> list[Sequence]:
-        return self.plan(seq).runs
 
 
 def _one_run(seq: Sequence) -> Plan:
@@ -52,22 +32,25 @@ def _one_run(seq: Sequence) -> Plan:
 EXPERIMENTS: dict[str, Experiment] = {e.name: e for e in (
     Experiment("ope", "one-pass evaluation", "Wu et al., TPAMI 2015", _one_run, ""),
     Experiment("tre", "temporal robustness: 20 starts", "Wu et al., TPAMI 2015; OTB toolkit splitSeqTRE.m",
-               tre_plan, "tre", first_box=False),
+               tre_plan, "tre", first_box=False, pooled=True),
     Experiment("sre", "spatial robustness: 8 shifts, 4 scales", "Wu et al., TPAMI 2015; OTB toolkit shiftInitBB.m",
-               sre_plan, "sre"),
-    Experiment("reset", "reset-based: re-initialised 5 frames after each failure",
-               "Kristan et al., TPAMI 2016 (VOT2016); vot-toolkit", _one_run, "reset", resets=True, first_box=False),
+               sre_plan, "sre", pooled=True),
+    ResetExperiment("reset", "reset-based: re-initialised 5 frames after each failure",
+                    "Kristan et al., TPAMI 2016 (VOT2016); vot-toolkit", _one_run, "reset", first_box=False,
+                    scoring="reset"),
 )}
 
 
-def get_experiment(experiment: str | Experiment) -> Experiment:
-    """The :class:`Experiment` named ``experiment``; an Experiment passes through."""
+def get_experiment(experiment: str | Experiment, protocol: str | None = None) -> Experiment:
+    """The :class:`Experiment` named ``experiment`` (an Experiment passes through), bound to the
+    rule ``protocol`` names if it is one of the experiment's own (:meth:`Experiment.bind`)."""
     if isinstance(experiment, Experiment):
-        return experiment
+        return experiment.bind(protocol) if protocol is not None else experiment
     try:
-        return EXPERIMENTS[str(experiment).lower()]
+        found = EXPERIMENTS[str(experiment).lower()]
     except KeyError:
         raise DcfkitError(f"unknown experiment {shown(experiment)}; one of: {', '.join(EXPERIMENTS)}") from None
+    return found.bind(protocol) if protocol is not None else found
 
 
 _SAID: set[str] = set()  # the left-out runs warned of

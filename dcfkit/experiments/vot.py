@@ -21,7 +21,7 @@ from dcfkit.errors import DcfkitError, shown
 from dcfkit.experiments.starts import start_problem
 from dcfkit.experiments.raster import NO_BOUNDS, trax2016_overlap, vottoolkit_overlap
 
-__all__ = ["BURN_IN", "DEFAULT_RULE", "RULES", "SKIP", "ResetRule", "get_rule", "valid_box"]
+__all__ = ["BURN_IN", "DEFAULT_RULE", "RULES", "SKIP", "ResetRule", "get_rule", "next_start", "valid_box"]
 
 SKIP = 5  # frames from a failure to the next start (vot-toolkit's skip_initialize)
 BURN_IN = 10  # frames from each start left out of accuracy, the start included

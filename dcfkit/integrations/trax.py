@@ -37,7 +37,7 @@ from dcfkit import __version__
 from dcfkit.datasets import read_frame
 from dcfkit.errors import DcfkitError, InputError, MissingDependency
 from dcfkit.integrations.trax_stream import ProtocolError, framed_connection
-from dcfkit.running.tracking import track
+from dcfkit.experiments.loop import track
 from dcfkit.tracker.confidence import confidence_of
 from dcfkit.tracker.tracker import Tracker
 
@@ -129,7 +129,7 @@ def _session(server, link: _Link, config: Mapping[str, Any]) -> None:
 
 class _Run:
     """One object, from its ``initialize`` to the next ``initialize`` or ``quit``: the frames as
-    :func:`dcfkit.running.tracking.track` reads them (numbered from 1, the initialising frame), and the
+    :func:`dcfkit.experiments.loop.track` reads them (numbered from 1, the initialising frame), and the
     replies it sends."""
 
     def __init__(self, server, link: _Link, request):

@@ -3,7 +3,7 @@
 
 Trackers come from a factory ``make_tracker(config) -> tracker``, called once per sequence
 (default: :func:`dcfkit.load_tracker`); a tracker is any object with ``init(image, box)``
-and ``update(image) -> box`` (:mod:`dcfkit.running.tracking`). Results go to
+and ``update(image) -> box`` (:mod:`dcfkit.experiments.loop`). Results go to
 ``OUT/<config name>/`` (``OUT/<config name>/<experiment>/`` but for one pass), a
 :class:`dcfkit.store.results.ResultStore`: one file of 1-based boxes and one sidecar per run
 (per-frame tracker seconds, image decoding excluded; before its first run of a dcfkit config
@@ -27,7 +27,6 @@ import numpy as np
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.errors import ConfigError, shown
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
-from dcfkit.experiments.vot import get_rule
 from dcfkit.store.claims import claimed
 from dcfkit.store.files import ensure_writable, make_dir, remove_temporary_files
 from dcfkit.store.provenance import dcfkit_version, json_default, run_key
@@ -92,19 +91,12 @@ def _say_what_is_recomputed(store: ResultStore, metas: dict, todo: list[Sequence
                     ", ".join(replaced[:10]))
 
 
-def _reset_rule_of(meta: dict | None) -> str | None:
-    """The rule a reset-based run's sidecar records (None: none, as dcfkit <= 0.9.0 wrote them)."""
-    resets = (meta or {}).get("resets")
-    return resets.get("rule") if isinstance(resets, dict) else None
-
-
-def _say_other_rule(store: ResultStore, metas: dict, todo: list[Sequence], rule: str) -> None:
-    """Say so when reset-based results are recomputed because another failure rule made them."""
-    other = {s.name: _reset_rule_of(metas[s.name]) or "dcfkit <= 0.9.0's continuous overlap" for s in todo
-             if isinstance((metas[s.name] or {}).get("resets"), dict) and _reset_rule_of(metas[s.name]) != rule}
+def _say_other_rule(store: ResultStore, metas: dict, todo: list[Sequence], experiment: Experiment) -> None:
+    """Say so when results are recomputed because the experiment's other rules made them."""
+    other = {s.name: why for s in todo if (why := experiment.stored_elsewise(metas[s.name])) is not None}
     if other:
-        log.warning("%s: recomputing %d reset-based result(s) whose failures another rule decided (%s), with %s's: "
-                    "%s", store.folder, len(other), ", ".join(sorted(set(other.values()))), rule,
+        log.warning("%s: recomputing %d %s result(s) whose failures another rule decided (%s), with %s's: "
+                    "%s", store.folder, len(other), experiment.name, ", ".join(sorted(set(other.values()))), experiment.rule,
                     ", ".join(list(other)[:10]))
 
 
@@ -120,19 +112,19 @@ def experiment_runs(sequences: Iterable[Sequence], experiment: str | Experiment 
     return [run for runs in runs_by_sequence(sequences, experiment).values() for run in runs]
 
 
-def _plan(config: dict, sequences: list[Sequence], runs: list[Sequence], out_dir, experiment: Experiment,
-          rule: str | None = None) -> tuple[ResultStore, str, list[Sequence], dict]:
+def _plan(config: dict, sequences: list[Sequence], runs: list[Sequence], out_dir, experiment: Experiment
+          ) -> tuple[ResultStore, str, list[Sequence], dict]:
     """(store, run key, runs to do, every run's sidecar), after every check that needs no
     tracking: the first boxes, the benchmark of the results there, that no run replaces one of
-    more frames, and (when anything is to run) that the folder takes the result files. ``rule``:
-    a reset-based run's failure rule, part of its key."""
+    more frames, and (when anything is to run) that the folder takes the result files. The
+    experiment's rule, if it has one, is part of the key."""
     if experiment.first_box:
         _check_first_boxes(sequences)
-    key = run_key(config, reset_rule=rule if experiment.resets else None)
+    key = run_key(config, rule=experiment.rule)
     store = ResultStore(results_folder(out_dir, config, experiment))
     metas = {s.name: store.sidecar(s.name) for s in runs}  # each read once
     todo = [s for s in runs if store.status(s, key, metas[s.name]) != "done"
-            or (experiment.resets and _reset_rule_of(metas[s.name]) != rule)]
+            or experiment.stored_elsewise(metas[s.name]) is not None]
     _check_same_dataset(store, metas, todo)
     for run in todo:
         store.refuse_to_shorten(run, metas[run.name])
@@ -147,8 +139,8 @@ def check_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, expe
     """Raise now what :func:`run_one_pass` would raise before tracking (``dcfkit eval`` checks
     every config this way before it runs the first)."""
     sequences = list(sequences)
-    _plan(dict(config), sequences, experiment_runs(sequences, experiment), out_dir, get_experiment(experiment),
-          get_rule(reset_rule).name)
+    experiment = get_experiment(experiment, reset_rule)
+    _plan(dict(config), sequences, experiment_runs(sequences, experiment), out_dir, experiment)
 
 
 def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_tracker=None,
@@ -168,24 +160,21 @@ def run_one_pass(config: Mapping, sequences: Iterable[Sequence], out_dir, make_t
     ``skipped`` (already done), ``failed`` (run -> message), runs named as
     :mod:`dcfkit.experiments` names them (one pass: the sequences' names).
     """
-    config, sequences, experiment = dict(config), list(sequences), get_experiment(experiment)
-    rule = get_rule(reset_rule).name
+    config, sequences, experiment = dict(config), list(sequences), get_experiment(experiment, reset_rule)
     folder = results_folder(out_dir, config, experiment)
     if not folder.is_dir():
         make_dir(folder)  # a first run: the locks need the folder
     runs = experiment_runs(sequences, experiment)
-    kind = "sequence" if experiment.name == "ope" else "run"
+    kind = "run" if experiment.folder else "sequence"
     with claimed(folder, [run.name for run in runs], "dcfkit eval",  # other runs of this folder may go on alongside
                  lambda name: f"{tracker_name(config)}'s results of {kind} {name!r} to {folder}"):
-        store, key, todo, metas = _plan(config, sequences, runs, out_dir, experiment, rule)
+        store, key, todo, metas = _plan(config, sequences, runs, out_dir, experiment)
         _say_what_is_recomputed(store, metas, todo, config, key)
-        if experiment.resets:
-            _say_other_rule(store, metas, todo, rule)
+        _say_other_rule(store, metas, todo, experiment)
         remove_temporary_files(store.folder, [f for s in todo for f in store.file_names(s.name)])
         summary = {"tracker": tracker_name(config), "dir": store.folder, "run_key": key,
                    "done": [], "skipped": [s.name for s in runs if s not in todo], "failed": {}}
-        _run(summary, [RunTask(config, s, store.folder, key, make_tracker, experiment.resets, rule)
-                       for s in todo],
+        _run(summary, [RunTask(config, s, store.folder, key, make_tracker, experiment) for s in todo],
              jobs, progress, dcfkit_version())
     order = {s.name: i for i, s in enumerate(runs)}
     summary["done"].sort(key=order.get)

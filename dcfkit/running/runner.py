@@ -2,7 +2,8 @@
 process pool or on dask.distributed. ``dcfkit eval`` (:mod:`dcfkit.running.evaluation`) and
 ``dcfkit ablate`` (:mod:`dcfkit.ablation`) differ only in which runs they ask for.
 
-Each run is :func:`dcfkit.running.tracking.track` on a fresh tracker, written to a
+Each run is tracked as its experiment says (:meth:`dcfkit.experiments.base.Experiment.track`)
+from a fresh tracker, and written to a
 :class:`dcfkit.store.results.ResultStore`; a tracker exception fails only its run (an
 ``.error`` naming the 1-based frame and its file). Workers have one BLAS/OpenMP/OpenCV
 thread each and die with the parent.
@@ -26,8 +27,9 @@ import cv2
 import numpy as np
 
 from dcfkit.datasets import Sequence
-from dcfkit.experiments.vot import DEFAULT_RULE
 from dcfkit.errors import DcfkitError, shown
+from dcfkit.experiments import EXPERIMENTS, Experiment
+from dcfkit.experiments.loop import TrackerFailure
 from dcfkit.registry import PluginWarning
 from dcfkit.store import platforms
 from dcfkit.store.files import StoreError
@@ -42,11 +44,9 @@ from dcfkit.store.provenance import (
     sources,
     without_home,
 )
-from dcfkit.running.resets import ResetTrack, track_with_resets
 from dcfkit.store.results import ResultStore
 from dcfkit.running.scheduler import connect as connect_scheduler, import_distributed
 from dcfkit.store.timing import timing_record
-from dcfkit.running.tracking import TrackerFailure, track
 
 log = logging.getLogger(__name__)
 
@@ -56,18 +56,16 @@ _THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS",
 
 @dataclasses.dataclass(frozen=True)
 class RunTask:
-    """One run to do: ``config`` on ``seq`` into the store at ``folder`` under ``key``.
-    ``make_tracker(config)`` builds the tracker (None: :func:`dcfkit.load_tracker`);
-    ``resets``: VOT's reset-based run (:mod:`dcfkit.running.resets`), its failures decided by
-    the :class:`~dcfkit.experiments.vot.ResetRule` named ``rule``."""
+    """One run to do: ``config`` on ``seq`` into the store at ``folder`` under ``key``, tracked as
+    ``experiment`` tracks its runs (bound to its rule, if it has one).
+    ``make_tracker(config)`` builds the tracker (None: :func:`dcfkit.load_tracker`)."""
 
     config: dict
     seq: Sequence
     folder: Path
     key: str
     make_tracker: Callable | None = None
-    resets: bool = False
-    rule: str = DEFAULT_RULE
+    experiment: Experiment = EXPERIMENTS["ope"]
 
 
 # --------------------------------------------------------------------------- one run
@@ -129,14 +127,9 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
         return (task.make_tracker or load_dcfkit_tracker)(dict(task.config))
 
     tracker = None
-    tick = (lambda *_: on_frame()) if on_frame else None
     try:
         tracker = make()
-        if task.resets:
-            first = [tracker]  # the tracker made above starts the run; each restart gets a fresh one
-            run = track_with_resets(lambda: first.pop() if first else make(), seq, read, tick, task.rule)
-        else:
-            run = track(tracker, (read(i) for i in range(len(seq))), seq.init_box, tick)
+        run = task.experiment.track(tracker, make, seq, read, on_frame)
     except Exception as exc:
         frame = exc.frame if isinstance(exc, TrackerFailure) else reading[0] or None
         return record_failure(task, version, _failure_message(seq, exc, tracker is None, frame), exc, frame)
@@ -148,9 +141,7 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
             "run_key": task.key, "dcfkit_version": version, "plugins": plugins, "source": sources(plugins),
             "time": now(), **(origin or invocation()), "machine": machine(), "platform": platforms.record(),
             "config": task.config,
-            "times": run.times.tolist()}
-    if isinstance(run, ResetTrack):
-        meta["resets"] = run.record()
+            "times": run.times.tolist(), **task.experiment.record(run)}
     store.write(seq, run.boxes, meta, run.times, run.confidence)
     return {"sequence": seq.name, "status": "done", "fps": run.fps, "frames": len(seq)}
 
@@ -231,7 +222,7 @@ def run_in_worker(task: RunTask, version: str, origin: Mapping | None = None, ti
     if dcfkit_version() != version:
         raise DcfkitError(f"this worker runs dcfkit {dcfkit_version()}, the client {version}; "
                           f"install the same version on every worker")
-    if task.make_tracker is None and run_key(task.config, version, task.rule if task.resets else None) != task.key:
+    if task.make_tracker is None and run_key(task.config, version, task.experiment.rule) != task.key:
         plugins = ", ".join(plugin_versions(task.config)) or "none"
         raise DcfkitError(f"this worker's dcfkit code ({box_code()}) or plugins ({plugins}) are not the client's: "
                           f"install the same dcfkit source and plugin versions on every worker")

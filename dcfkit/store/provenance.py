@@ -58,23 +58,24 @@ def plugin_versions(config: Mapping) -> list[str]:
     return get_registry().plugin_versions(used) if used else []  # e.g. an OpenCV baseline: no registry
 
 
-def run_key(config: Mapping, version: str | None = None, reset_rule: str | None = None,
+def run_key(config: Mapping, version: str | None = None, rule: str | None = None,
             code: str | None = None) -> str:
     """The identity of a run: 16 hex digits of SHA-256 over the canonical JSON (sorted keys)
     of ``config`` without its ``name`` and ``description`` (they change no box), the dcfkit
     version, the digest of dcfkit's box code (``code``, default
     :func:`~dcfkit.store.code_state.box_code`: an edited tracker gives new results at the
     same version), the versions of the plugins whose components the config uses (a plugin's
-    new release gives new results; configs of built-ins only keep their keys), and for a
-    reset-based run the ``reset_rule`` whose failures restarted it (its boxes depend on it)."""
+    new release gives new results; configs of built-ins only keep their keys), and the
+    experiment's ``rule`` when it has one (:attr:`~dcfkit.experiments.base.Experiment.rule`:
+    the reset-based experiment's failures restart its runs, so its boxes depend on it)."""
     payload = {"config": {k: v for k, v in config.items() if k not in LABEL_KEYS},
                "dcfkit": version if version is not None else dcfkit_version(),
                "code": code if code is not None else box_code()}
     plugins = plugin_versions(config)
     if plugins:
         payload["plugins"] = plugins
-    if reset_rule is not None:
-        payload["reset_rule"] = reset_rule
+    if rule is not None:
+        payload["rule"] = rule
     text = json.dumps(payload, sort_keys=True, separators=(",", ":"), default=json_default)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 

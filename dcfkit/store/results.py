@@ -51,7 +51,7 @@ class SequenceResult:
     ``times`` ``(N,) float64`` seconds per frame and ``fps`` when known (None for imports);
     ``platform`` the :func:`dcfkit.store.platforms.record` of the run when its sidecar has one;
     ``resets`` the 1-based ``starts`` and ``failures`` of a reset-based run
-    (:mod:`dcfkit.running.resets`); ``timing`` how its speed was measured
+    (:mod:`dcfkit.experiments.reset`); ``timing`` how its speed was measured
     (:mod:`dcfkit.store.timing`; None in sidecars from before it was recorded)."""
 
     boxes: np.ndarray

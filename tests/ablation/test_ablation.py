@@ -500,7 +500,7 @@ def test_a_folder_where_an_ablation_file_goes_is_refused_before_tracking(tmp_pat
                                                         "variants: {s: {config: strcf}}\n"))
     out = tmp_path / "out"
     (out / in_the_way.format(key=expand(spec)[0].key)).mkdir(parents=True)
-    monkeypatch.setattr("dcfkit.running.runner.track", lambda *a, **k: pytest.fail("tracked before the check"))
+    monkeypatch.setattr("dcfkit.experiments.base.track", lambda *a, **k: pytest.fail("tracked before the check"))
     with pytest.raises(DcfkitError, match=r"cannot write the ablation.*: [^ ]+ is a folder; move it away"):
         run_ablation(spec, out, jobs=1, progress=False)
 
@@ -520,7 +520,7 @@ def test_an_unwritable_job_folder_is_refused_before_tracking(tmp_path, data, mon
         return real(*args, dir=dir, **kwargs)
 
     monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
-    monkeypatch.setattr("dcfkit.running.runner.track", lambda *a, **k: pytest.fail("tracked before the check"))
+    monkeypatch.setattr("dcfkit.experiments.base.track", lambda *a, **k: pytest.fail("tracked before the check"))
     with pytest.raises(DcfkitError, match=r"cannot write the ablation's results to .*: Permission denied"):
         run_ablation(spec, tmp_path / "out", jobs=1, progress=False)
 

@@ -22,7 +22,7 @@ from dcfkit.datasets import Sequence, load_dataset
 from dcfkit.experiments.vot import get_rule
 from dcfkit.running.evaluation import run_one_pass
 from dcfkit.store.files import format_boxes
-from dcfkit.running.resets import track_with_resets
+from dcfkit.experiments.reset import track_with_resets
 
 N = 30
 CONFIG = {"name": "drift", "drift": 4.0}  # 4 px a frame off a 20 px wide target: a failure every few frames

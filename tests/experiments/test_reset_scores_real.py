@@ -11,7 +11,7 @@ from dcfkit.analysis.reset_scores import ResetRun, score_resets
 from dcfkit.datasets import load_dataset, read_boxes
 from dcfkit.experiments.vot import SKIP
 from dcfkit.experiments.vot import next_start
-from dcfkit.running.resets import track_with_resets
+from dcfkit.experiments.reset import track_with_resets
 
 TRACKERS = ("KCF", "STRCF")  # one that fails often, one that seldom does
 

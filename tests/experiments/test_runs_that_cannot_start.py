@@ -15,7 +15,7 @@ from dcfkit.experiments import left_out_runs, runs_by_sequence
 from dcfkit.experiments.otb import SRE_SHIFTS, tre_starts
 from dcfkit.experiments.starts import start_problem
 from dcfkit.running.evaluation import run_one_pass
-from dcfkit.running.resets import SKIP, track_with_resets
+from dcfkit.experiments.reset import SKIP, track_with_resets
 from dcfkit.store.results import load_results
 from dcfkit.tracker.checks import check_box
 

@@ -23,7 +23,7 @@ from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.errors import ConfigError, InputError, TrackingError
 from dcfkit.running.evaluation import run_one_pass
 from dcfkit.store.results import load_results
-from dcfkit.running.tracking import track
+from dcfkit.experiments.loop import track
 
 ONE_BASED = np.array([1.0, 1.0, 0.0, 0.0])
 

@@ -39,7 +39,7 @@ def test_the_same_source_has_the_same_digest(tree):
 
 
 @pytest.mark.parametrize("relative", ["tracker/tracker.py", "components/solvers/base.py", "numerics/fft.py",
-                                      "config/tracker_params.py", "running/tracking.py", "data/uav123_sequences.tsv"])
+                                      "config/tracker_params.py", "experiments/loop.py", "data/uav123_sequences.tsv"])
 def test_box_code_changes_the_key(tree, relative):
     same = code_digest(tree)
     changed = edited(tree, relative, lambda text: text + b"\n# one more line\n")

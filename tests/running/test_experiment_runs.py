@@ -116,7 +116,7 @@ def test_the_reset_rule_is_part_of_a_run_and_of_its_report(tmp_path, capsys, cap
 
 @pytest.mark.parametrize("experiment, protocol, said", [
     ("reset", "otb", "--protocol otb scores one-pass runs; --experiment reset takes vot2016 or vot-toolkit"),
-    ("ope", "vot2016", "--protocol vot2016 is a rule of the reset-based experiment; give --experiment reset"),
+    ("ope", "vot2016", "--protocol vot2016 is a rule of the reset experiment; give --experiment reset"),
 ])
 def test_a_protocol_of_another_experiment_is_an_error(tmp_path, capsys, experiment, protocol, said):
     for command in ("eval", "report"):
@@ -198,7 +198,7 @@ variants:
     assert len(list((tmp_path / "out" / "jobs").glob(f"otb/*/tre/seqA_{runs:03d}.json"))) == 2
     bad = write_spec(tmp_path / "bad.yaml", "name: x\ndataset: otb\nexperiment: reset\nvariants: {k: kcf}\n")
     with pytest.raises(ConfigError, match=r"bad.yaml: experiment: expected one of ope, tre, sre, got 'reset' "
-                                          r"\(reset-based runs: dcfkit eval --experiment reset"):
+                                          r"\(reset runs: dcfkit eval --experiment reset"):
         load_spec(bad)
 
 

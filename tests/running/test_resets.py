@@ -8,8 +8,8 @@ import pytest
 from dcfkit.datasets import Sequence
 from dcfkit.experiments.vot import SKIP, valid_box
 from dcfkit.experiments.vot import next_start
-from dcfkit.running.resets import track_with_resets
-from dcfkit.running.tracking import TrackerFailure
+from dcfkit.experiments.reset import track_with_resets
+from dcfkit.experiments.loop import TrackerFailure
 
 N = 30
 IMAGE = np.zeros((50, 60, 3), np.uint8)

@@ -231,7 +231,7 @@ def test_a_write_failure_mid_run_stops_the_run_whatever_the_jobs(tmp_path, seqs,
 def test_a_terminated_eval_keeps_finished_sequences_and_leaves_no_partial_file(tmp_path, seqs):
     from test_evaluation import DriftTracker
 
-    from dcfkit.running.tracking import Interrupted, interrupt_on_termination
+    from dcfkit.signals import Interrupted, interrupt_on_termination
 
     class Terminated(DriftTracker):
         def update(self, image):

@@ -1,4 +1,4 @@
-"""The one frame loop (dcfkit.running.tracking.steps, and track, which collects it) and the termination signals."""
+"""The one frame loop (dcfkit.experiments.loop.steps, and track, which collects it) and the termination signals."""
 from __future__ import annotations
 
 import os
@@ -7,7 +7,8 @@ import signal
 import numpy as np
 import pytest
 
-from dcfkit.running.tracking import Interrupted, TrackerFailure, interrupt_on_termination, steps, track
+from dcfkit.experiments.loop import TrackerFailure, steps, track
+from dcfkit.signals import Interrupted, interrupt_on_termination
 
 
 class Stepper:
@@ -101,7 +102,7 @@ def test_an_ignored_sighup_stays_ignored_as_under_nohup():
 
 
 def test_termination_is_held_back_during_a_final_write():
-    from dcfkit.running.tracking import termination_deferred
+    from dcfkit.signals import termination_deferred
 
     written = []
     with pytest.raises(Interrupted):

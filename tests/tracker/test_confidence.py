@@ -9,7 +9,7 @@ import pytest
 from dcfkit import load_tracker
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.store.files import format_confidence
-from dcfkit.running.tracking import Track, track
+from dcfkit.experiments.loop import Track, track
 from dcfkit.tracker.confidence import NO_CONFIDENCE, Confidence, apce, confidence_of
 
 

@@ -11,7 +11,7 @@ from dcfkit.analysis.report_html.document import write_page
 from dcfkit.analysis.report_html.provenance import this_process
 from dcfkit.analysis.setting import cut_phrase, experiment_line
 from dcfkit.datasets import Sequence, scored_sequences
-from dcfkit.experiments import Experiment, runs_by_sequence
+from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
 from dcfkit.protocols import Protocol
 
 PAGE = "report.html"
@@ -38,7 +38,7 @@ def report_page(evaluation: Mapping, sequences: Seq[Sequence], results: Mapping[
     result) read from ``folders`` (tracker -> folder, shown relative to ``report_dir``) and scored
     as ``evaluation``. Under TRE or SRE the frames show each sequence's first run (TRE's from
     frame 1, SRE's first shifted box)."""
-    protocol, experiment = evaluation.protocol, evaluation.settings.get("experiment", "ope")
+    protocol, experiment = evaluation.protocol, get_experiment(evaluation.settings.get("experiment", "ope"))
     cut = evaluation.settings.get("max_frames")
     trackers = [r["tracker"] for r in evaluation.overall]
     datasets = sorted({s.dataset for s in sequences if s.dataset})
@@ -48,12 +48,12 @@ def report_page(evaluation: Mapping, sequences: Seq[Sequence], results: Mapping[
     statistics = sections.statistics_table(evaluation.statistics, trackers)
     by_sequence = runs_by_sequence(sequences, experiment)
     body = evaluation_sections(evaluation, sequences, _first_runs(results, sequences, by_sequence), trackers)
-    if experiment != "ope":
+    if experiment.folder:  # runs of their own: a sequence's frames show one of them
         for section in body:
             if section["id"] == "frames":
-                section["note"] += f" {experiment.upper()}: the boxes of each sequence's first run."
+                section["note"] += f" {experiment.name.upper()}: the boxes of each sequence's first run."
     on = ", ".join(datasets) or "sequences"
-    kind = "" if experiment == "ope" else f" ({experiment.upper()})"
+    kind = f" ({experiment.name.upper()})" if experiment.folder else ""
     return {"title": f"dcfkit report{kind}: {sections.count(len(trackers), 'tracker')} on {on}",
             "protocol": f"{experiment_line(experiment, cut)}; {protocol.describe()}",
             "subtitle": f"{sections.count(len(sequences), 'sequence')}, {sum(len(s) for s in sequences)} frames"

@@ -1,26 +1,21 @@
 """The one frame loop: initialise on the first frame, update on the rest, time, collect boxes.
 
 Every run path uses :func:`steps`, which yields each frame as it is tracked: ``dcfkit track``
-directly (it writes each box as it comes), and through :func:`track`, which collects them,
-``dcfkit eval`` and ``ablate`` (:mod:`dcfkit.running.runner`), the demo and the benchmarks. A
+directly (it writes each box as it comes), an experiment's runs through :func:`track`, which
+collects them (or, for VOT's restarts, :mod:`dcfkit.experiments.reset`), the demo and the benchmarks. A
 tracker is any object with ``init(image, box)`` and ``update(image) -> box``; boxes are
 ``(x, y, w, h)`` floats, **0-based**. Frame numbers in messages are **1-based**, as in the
 benchmarks' file names and annotations.
 """
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-import os
-import signal
 import time
 from typing import Callable, Iterable, Iterator
 
 import numpy as np
 
 from dcfkit.errors import DcfkitError, shown
-from dcfkit.signals import handlers_replaced
-from dcfkit.tracker.confidence import confidence_of
 
 OnFrame = Callable[[int, np.ndarray, np.ndarray, object], None]
 
@@ -55,54 +50,6 @@ class TrackerFailure(DcfkitError):
         self.detail = message
 
 
-class Interrupted(KeyboardInterrupt):
-    """SIGTERM or SIGHUP, raised in the main thread like Ctrl-C so that ``finally`` blocks
-    keep what was computed."""
-
-    def __init__(self, signum: int):
-        super().__init__(signal.Signals(signum).name)
-        self.signum = signum
-
-
-TERMINATION = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name))
-
-
-INTERRUPTS = (signal.SIGINT, *TERMINATION)  # Ctrl-C too
-
-
-def _termination_handled_by(handler, signums=TERMINATION):
-    """Handle ``signums`` (SIGTERM and SIGHUP) with ``handler`` in the block, except a signal
-    ignored when it starts (``nohup`` ignores SIGHUP); yields the handlers it replaced (None
-    off the main thread, where signals are left alone)."""
-    return handlers_replaced(signums, lambda previous: None if previous is signal.SIG_IGN else handler)
-
-
-def _interrupt(signum, frame):
-    raise Interrupted(signum)
-
-
-def interrupt_on_termination():
-    """Turn SIGTERM and SIGHUP into :class:`Interrupted` while the block runs (e.g. a run under
-    ``timeout`` or a closed terminal keeps its boxes, as Ctrl-C does)."""
-    return _termination_handled_by(_interrupt)
-
-
-@contextlib.contextmanager
-def termination_deferred(signums=TERMINATION):
-    """Hold ``signums`` (SIGTERM and SIGHUP; :data:`INTERRUPTS` adds Ctrl-C) back while the
-    block runs (a final write is never cut short); one that arrived meanwhile is handled as it
-    would have been, when the block ends."""
-    arrived = []
-    with _termination_handled_by(lambda signum, frame: arrived.append(signum), signums) as saved:
-        yield
-    if arrived and saved is not None:
-        handler = saved[arrived[0]]
-        if callable(handler):
-            handler(arrived[0], None)
-        else:  # the default action: end the process, as the signal would have
-            os.kill(os.getpid(), arrived[0])
-
-
 def as_box(value, frame: int) -> np.ndarray:
     """``value`` as a float64 ``(4,)`` box, or a :class:`TrackerFailure` saying what it was."""
     try:
@@ -129,6 +76,8 @@ def steps(tracker, frames: Iterable[np.ndarray], init_box) -> Iterator[Step]:
     first with ``init_box``, ``update`` on each later one. Each frame's confidence is read from
     ``tracker.last_confidence`` after the frame's time is taken (:func:`confidence_of`). A
     tracker exception becomes a :class:`TrackerFailure` naming the frame and the call."""
+    from dcfkit.tracker.confidence import confidence_of  # deferred: dcfkit.tracker loads the tracker's components
+
     for index, image in enumerate(frames):  # decoding happens here: not timed
         start = time.perf_counter()
         try:

@@ -1,4 +1,5 @@
-"""The frame loop of VOT's reset-based experiment (:mod:`dcfkit.experiments.vot`): track,
+"""VOT's reset-based experiment as a strategy (:class:`ResetExperiment`; its rules are
+:mod:`dcfkit.experiments.vot`'s) and its frame loop: track,
 and start a fresh tracker from the ground truth :data:`~dcfkit.experiments.vot.SKIP` frames
 after each failure, or from the first frame after that whose ground truth a tracker can start
 from (:func:`~dcfkit.experiments.starts.start_problem`), as vot-toolkit moves a start past
@@ -7,14 +8,15 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-from typing import Callable
+from typing import Callable, Mapping
 
 import numpy as np
 
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.experiments.starts import start_problem
-from dcfkit.experiments.vot import DEFAULT_RULE, SKIP, ResetRule, get_rule, next_start
-from dcfkit.running.tracking import Track, TrackerFailure, steps
+from dcfkit.experiments.base import Experiment, Read, Tick
+from dcfkit.experiments.loop import Track, TrackerFailure, steps
+from dcfkit.experiments.vot import DEFAULT_RULE, RULES, SKIP, ResetRule, get_rule, next_start
 
 
 @dataclasses.dataclass
@@ -96,3 +98,44 @@ def _segment(tracker, seq: Sequence, frame: Callable[[int], np.ndarray], start: 
     except TrackerFailure as exc:  # steps numbers the frames from this start
         raise TrackerFailure(start + exc.frame, exc.detail) from exc.__cause__
     return None
+
+
+def rule_of(meta: Mapping | None) -> str | None:
+    """The rule a reset-based run's sidecar records (None: none, as dcfkit <= 0.9.0 wrote them)."""
+    resets = (meta or {}).get("resets")
+    return resets.get("rule") if isinstance(resets, dict) else None
+
+
+@dataclasses.dataclass(frozen=True)
+class ResetExperiment(Experiment):
+    """VOT's reset-based experiment: one run of each sequence, a fresh tracker started from the
+    ground truth :data:`SKIP` frames after each failure that ``reset_rule`` decides
+    (:mod:`dcfkit.experiments.reset`); the rule is part of the run key and of the sidecar."""
+
+    reset_rule: str = DEFAULT_RULE
+
+    @property
+    def rules(self) -> Mapping[str, ResetRule]:
+        return RULES
+
+    def bind(self, protocol: str | None) -> "ResetExperiment":
+        return dataclasses.replace(self, reset_rule=get_rule(protocol).name)
+
+    @property
+    def rule(self) -> str:
+        return self.reset_rule
+
+    def track(self, tracker, make_tracker: Callable[[], object], run: Sequence, read: Read, tick: Tick | None = None):
+        first = [tracker]  # the tracker made by the caller starts the run; each restart gets a fresh one
+        return track_with_resets(lambda: first.pop() if first else make_tracker(), run, read, tick, self.reset_rule)
+
+    def record(self, result) -> dict:
+        return {"resets": result.record()}
+
+    def stored_elsewise(self, meta: Mapping | None) -> str | None:
+        if not isinstance((meta or {}).get("resets"), dict) or rule_of(meta) == self.reset_rule:
+            return None
+        return rule_of(meta) or "dcfkit <= 0.9.0's continuous overlap"
+
+    def describe(self) -> str:
+        return f"{super().describe()}, failures by {self.reset_rule}"

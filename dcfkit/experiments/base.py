@@ -1,0 +1,76 @@
+"""What an experiment is: a strategy that owns the runs it makes of each sequence, how a run is
+tracked, what of it enters the run key and the sidecar, and how its runs are scored
+(docs/architecture.md, "Where to add"). The runner, scoring, the reports and the command line
+call these methods; none of them tests an experiment's name."""
+from __future__ import annotations
+
+import dataclasses
+from typing import Callable, Mapping
+
+import numpy as np
+
+from dcfkit.datasets import Sequence
+from dcfkit.experiments.loop import track
+from dcfkit.experiments.starts import Plan
+
+Read = Callable[[int], np.ndarray]  # frame i (0-based) of the run's sequence, decoded
+Tick = Callable[[], None]  # called after every tracked frame (progress bars)
+
+
+@dataclasses.dataclass(frozen=True)
+class Experiment:
+    """An experiment whose runs are each tracked once from their first box (OPE, TRE, SRE).
+
+    ``plan(sequence)`` gives a sequence's runs and those left out (:class:`Plan`); ``folder`` is
+    the sub-folder of a tracker's results that holds them (``""``: the tracker's folder);
+    ``first_box``: whether the runs need frame 1's ground truth; ``pooled``: whether a
+    sequence's score pools several runs; ``scoring``: which of analysis's scorings reads its
+    runs (``"otb"``: OTB's success and precision; ``"reset"``: VOT's accuracy, failures and
+    EAO; :mod:`dcfkit.analysis.scorings`)."""
+
+    name: str
+    title: str
+    source: str
+    plan: Callable[[Sequence], Plan]
+    folder: str
+    first_box: bool = True
+    pooled: bool = False
+    scoring: str = "otb"
+
+    def runs(self, seq: Sequence) -> list[Sequence]:
+        return self.plan(seq).runs
+
+    @property
+    def rules(self) -> Mapping[str, object]:
+        """The ``--protocol`` values that are this experiment's own rules (they change its runs,
+        not only their scores); empty: it takes a scoring protocol."""
+        return {}
+
+    def bind(self, protocol: str | None) -> "Experiment":
+        """This experiment with the rule ``protocol`` names, if it is one of :attr:`rules`."""
+        return self
+
+    @property
+    def rule(self) -> str | None:
+        """The name of the rule bound into the runs (part of the run key), or None."""
+        return None
+
+    def track(self, tracker, make_tracker: Callable[[], object], run: Sequence, read: Read,
+              tick: Tick | None = None):
+        """Track ``run`` with ``tracker`` (``make_tracker()`` makes another), frames read by ``read``;
+        returns a :class:`~dcfkit.experiments.loop.Track`."""
+        return track(tracker, (read(i) for i in range(len(run))), run.init_box,
+                     (lambda *_: tick()) if tick else None)
+
+    def record(self, result) -> dict:
+        """What a run's sidecar records of the experiment, besides its boxes."""
+        return {}
+
+    def stored_elsewise(self, meta: Mapping | None) -> str | None:
+        """Why a stored run (sidecar ``meta``) was made under other rules of this experiment, to be
+        recomputed; None if it was not."""
+        return None
+
+    def describe(self) -> str:
+        """``TRE (temporal robustness: 20 starts)`` for titles and settings lines."""
+        return f"{self.name.upper()} ({self.title})"
