@@ -8,18 +8,19 @@ from typing import Any
 from dcfkit.errors import ConfigError, shown
 from dcfkit.experiments import EXPERIMENTS, get_experiment
 
-# the experiments whose runs are scored as one-pass results are (OTB's measures), which an ablation's summary reads
-ABLATION_EXPERIMENTS = tuple(name for name, e in EXPERIMENTS.items() if e.scoring == "otb")
+def ablation_experiments() -> tuple[str, ...]:
+    """The experiments an ablation can run: those whose runs OTB's measures score, which its summary reads."""
+    return tuple(name for name, e in EXPERIMENTS.items() if e.scoring == "otb")
 
 
 def check_experiment(value: Any, where: str) -> str:
     """``value`` as the name of an experiment an ablation can run, or a :class:`ConfigError`."""
     name = value.lower() if isinstance(value, str) else value
-    if name not in ABLATION_EXPERIMENTS:
+    if name not in ablation_experiments():
         other = EXPERIMENTS.get(name) if isinstance(name, str) else None
         hint = (f" ({other.name} runs: dcfkit eval --experiment {other.name}, then dcfkit report --experiment "
                 f"{other.name})" if other is not None else "")
-        raise ConfigError(f"{where}: expected one of {', '.join(ABLATION_EXPERIMENTS)}, got {shown(value)}{hint}")
+        raise ConfigError(f"{where}: expected one of {', '.join(ablation_experiments())}, got {shown(value)}{hint}")
     return name
 
 

@@ -70,7 +70,7 @@ class AblationSpec:
     variants: tuple           # of Variant: named variants first, then the grid's, in spec order
     grid: Grid | None
     max_frames: int | None = None  # a smoke run: each sequence's first frames only
-    experiment: str = "ope"  # the runs of each sequence: one of ABLATION_EXPERIMENTS
+    experiment: str = "ope"  # the runs of each sequence: one of ablation_experiments()
     published: tuple = ()  # (name, folder) of result files scored beside the variants, never run
     pool: tuple = ()  # pooled datasets: (name, root, origin) of each, ``dataset`` their names joined by "+"
 

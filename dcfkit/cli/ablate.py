@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 
 from dcfkit.ablation import expand, load_spec, run_ablation, summary_columns, variant_names
-from dcfkit.ablation.experiment import ABLATION_EXPERIMENTS, runs_dir
+from dcfkit.ablation.experiment import ablation_experiments, runs_dir
 from dcfkit.ablation.spec import MAX_VARIANTS, job_dir
 from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.cli.common import add_max_frames_argument, add_protocol_argument, executor_choice, variant_count
@@ -43,7 +43,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="list the jobs and whether each is done; run nothing")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_max_frames_argument(parser)
-    parser.add_argument("--experiment", choices=ABLATION_EXPERIMENTS, default=None,
+    parser.add_argument("--experiment", choices=ablation_experiments(), default=None,
                         help="the runs of each sequence (default: the spec's 'experiment', else ope); tre and sre "
                              "pool each sequence's 20 or 12 runs (docs/evaluation.md, 'Experiments')")
 
