@@ -197,3 +197,30 @@ def test_no_experiment_name_is_compared_outside_experiments():
 def test_the_name_check_sees_a_comparison():
     tree = ast.parse("if args.experiment == 'reset':\n    pass\nok = kind in ('ope', 'tre')\nfine = x == 'otb'\n")
     assert experiment_names_compared(tree, {"ope", "tre", "sre", "reset"}) == [1, 3]
+
+
+# docs/architecture.md's layers, top to bottom; a package in one row imports none above it
+LAYERS = (("cli", "ablation", "autosearch", "integrations"), ("analysis",), ("running",), ("store",),
+          ("experiments",), ("tracker",), ("config",), ("components",), ("numerics",), ("datasets",))
+
+
+def imports_climbing(graph) -> list[tuple[str, str]]:
+    """(importer, imported) pairs where a package imports one of a layer above its own."""
+    rank = {f"dcfkit.{package}": row for row, packages in enumerate(LAYERS) for package in packages}
+
+    def row(module: str):
+        return rank.get(".".join(module.split(".")[:2]))
+
+    return sorted((m, i) for m in graph.modules if row(m) is not None
+                  for i in graph.find_modules_directly_imported_by(m)
+                  if row(i) is not None and row(i) < row(m))
+
+
+def test_no_import_climbs_a_layer(graph):
+    assert not imports_climbing(graph), f"imports of a layer above: {imports_climbing(graph)}"
+
+
+def test_the_layer_check_sees_a_climbing_import():
+    graph = grimp.build_graph("dcfkit", cache_dir=None)
+    graph.add_import(importer="dcfkit.store.results", imported="dcfkit.running.runner")
+    assert ("dcfkit.store.results", "dcfkit.running.runner") in imports_climbing(graph)
