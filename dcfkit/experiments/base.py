@@ -70,7 +70,3 @@ class Experiment:
         """Why a stored run (sidecar ``meta``) was made under other rules of this experiment, to be
         recomputed; None if it was not."""
         return None
-
-    def describe(self) -> str:
-        """``TRE (temporal robustness: 20 starts)`` for titles and settings lines."""
-        return f"{self.name.upper()} ({self.title})"

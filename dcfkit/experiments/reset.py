@@ -136,6 +136,3 @@ class ResetExperiment(Experiment):
         if not isinstance((meta or {}).get("resets"), dict) or rule_of(meta) == self.reset_rule:
             return None
         return rule_of(meta) or "dcfkit <= 0.9.0's continuous overlap"
-
-    def describe(self) -> str:
-        return f"{super().describe()}, failures by {self.reset_rule}"
