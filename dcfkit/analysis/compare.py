@@ -36,7 +36,7 @@ import numpy as np
 
 from dcfkit.analysis import metrics
 from dcfkit.analysis.report import refuse_reset_runs
-from dcfkit.analysis.statistics import METHOD, mean_interval, paired_difference
+from dcfkit.analysis.statistics import METHOD, Difference, mean_interval, paired_difference
 from dcfkit.datasets import DatasetError, Sequence, benchmark_protocol, read_boxes, scored_sequences
 from dcfkit.errors import clip, shown
 from dcfkit.protocols import Protocol, get_protocol
@@ -138,21 +138,25 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
 
 
 def score_statistics(rows: list[dict]) -> dict:
-    """Per score (AUC, precision): each folder's mean with its interval, the paired difference
+    """Per score (AUC, precision): each folder's mean with its interval (``results``,
+    ``reference``: :class:`~dcfkit.analysis.stats.results.Interval`), the paired ``difference``
     results - reference (:mod:`dcfkit.analysis.statistics`) and ``non_finite``, the sequences
     left out of them for a non-finite score in either folder; the AUC's and the precision's
     difference and Wilcoxon p also at the top level, for scripts."""
     found = {}
     for score in ("auc", "precision"):
         ours, theirs = [r[score] for r in rows], [r[f"{score}_ref"] for r in rows]
-        found[score] = {"results": mean_interval(ours).as_record(), "reference": mean_interval(theirs).as_record(),
-                        "difference": paired_difference(ours, theirs).as_record(),
-                        "non_finite": _non_finite(rows, f"d_{score}")}
-    pick = lambda d: {k: d[k] for k in ("mean", "ci_low", "ci_high")}  # noqa: E731
+        found[score] = {"results": mean_interval(ours), "reference": mean_interval(theirs),
+                        "difference": paired_difference(ours, theirs), "non_finite": _non_finite(rows, f"d_{score}")}
+    auc, precision = found["auc"]["difference"], found["precision"]["difference"]
     return {"statistics": {"method": METHOD, **found},
-            "auc_difference": pick(found["auc"]["difference"]), "wilcoxon_p": found["auc"]["difference"]["wilcoxon_p"],
-            "precision_difference": pick(found["precision"]["difference"]),
-            "precision_wilcoxon_p": found["precision"]["difference"]["wilcoxon_p"]}
+            "auc_difference": _interval_only(auc), "wilcoxon_p": auc.wilcoxon_p,
+            "precision_difference": _interval_only(precision), "precision_wilcoxon_p": precision.wilcoxon_p}
+
+
+def _interval_only(difference: Difference) -> dict:
+    """The mean and interval of a difference's record (the top-level keys scripts read)."""
+    return {k: v for k, v in difference.as_record().items() if k in ("mean", "ci_low", "ci_high")}
 
 
 def noise_floor(rows: list[dict]) -> dict:

@@ -10,7 +10,12 @@ import math
 from typing import Mapping
 from typing import Sequence as Seq
 
+from dcfkit.analysis.stats import columns
+from dcfkit.analysis.stats.columns import DIFFERENCE, LOWER_IS_BETTER, MEAN, headers, interval_cell
+from dcfkit.analysis.stats.results import Comparison
 from dcfkit.protocols import Protocol, get_protocol
+
+__all__ = ["LOWER_IS_BETTER", "comparison_table", "escape", "interval_cell", "latex_table"]
 
 _ESCAPES = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{",
             "}": r"\}", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}",
@@ -20,7 +25,6 @@ _HEADERS = {"ao": "AO", "sr50": "SR$_{0.5}$", "sr75": "SR$_{0.75}$", "auc": "AUC
             "attribute": "Attribute", "name": "Attribute name", "sequences": "Seq.", "missing": "Missing",
             "frames": "Frames", "variant": "Variant", "accuracy": "Accuracy", "failures": "Failures",
             "eao": "EAO"}
-LOWER_IS_BETTER = frozenset({"failures"})  # scores whose won and lost sequences are those with fewer
 
 
 def escape(text) -> str:
@@ -50,68 +54,40 @@ def latex_table(rows: Seq[Mapping], columns: Seq[str], protocol: str | Protocol,
     return _table(caption, align, [head], body)
 
 
-def comparison_table(statistics: Mapping, setting: Seq[str], name: str = "Tracker",
+def comparison_table(statistics: Comparison, setting: Seq[str], name: str = "Tracker",
                      lead: Seq[tuple[str, Mapping[str, str]]] = (), datasets: Mapping[str, int] | None = None) -> str:
-    """The statistics of :func:`~dcfkit.analysis.statistics.versus_baseline` as a booktabs
-    ``table`` a paper can take: per tracker and score its mean with the confidence interval,
-    then its paired difference from the baseline (Delta) with the interval, the Wilcoxon p
-    (``*``: significant after Holm's correction) and the sequences won/tied/lost (fewer
-    failures win). ``setting``: the caption's first sentences (experiment, protocol); ``lead``:
+    """A :class:`~dcfkit.analysis.stats.results.Comparison` as a booktabs ``table`` a paper can
+    take: per tracker and score the columns declared for ``latex``
+    (:mod:`dcfkit.analysis.stats.columns`: its mean with the confidence interval, its paired
+    difference from the baseline (Delta) with the interval, the Wilcoxon p (``*``: significant
+    after Holm's correction) and the sequences won/tied/lost (fewer failures win); ``--`` for
+    the baseline's). ``setting``: the caption's first sentences (experiment, protocol); ``lead``:
     columns before the scores, (header, tracker -> LaTeX cell); ``datasets``: the sequences
     scored per dataset, named in the caption."""
-    means, baseline = statistics["means"], statistics["baseline"]
-    keys = list(next(iter(means.values())))
-    head = [" & " * (1 + len(lead)) + " & ".join(rf"\multicolumn{{4}}{{c}}{{{escape(_HEADERS.get(k, k))}}}"
-                                           for k in keys) + r" \\",
-            "".join(rf"\cmidrule(lr){{{2 + len(lead) + 4 * i}-{5 + len(lead) + 4 * i}}}" for i in range(len(keys))),
+    keys, baseline, skip = statistics.scores, statistics.baseline, 1 + len(lead)
+    per = len(headers(MEAN, "latex")) + len(headers(DIFFERENCE, "latex"))  # columns per score
+    head = [" & " * skip + " & ".join(rf"\multicolumn{{{per}}}{{c}}{{{escape(_HEADERS.get(k, k))}}}"
+                                      for k in keys) + r" \\",
+            "".join(rf"\cmidrule(lr){{{1 + skip + per * i}-{skip + per * (i + 1)}}}" for i in range(len(keys))),
             " & ".join([escape(name), *(escape(h) for h, _ in lead)]
-                       + [r"Mean [CI] & $\Delta$ [CI] & $p$ & W/T/L"] * len(keys)) + r" \\"]
+                       + [" & ".join(headers(MEAN, "latex") + headers(DIFFERENCE, "latex"))] * len(keys)) + r" \\"]
     body = []
-    for tracker, found in means.items():
-        cells = [escape(tracker), *(cells.get(tracker, "--") for _, cells in lead)]
+    for tracker, found in statistics.means.items():
+        row = [escape(tracker), *(cells.get(tracker, "--") for _, cells in lead)]
         for key in keys:
-            cells.append(interval_cell(found[key]))
-            cells += _difference_cells(key, statistics["differences"].get(tracker, {}).get(key))
-        body.append(" & ".join(cells) + r" \\")
+            difference = statistics.differences.get(tracker, {}).get(key)
+            row += columns.cells(MEAN, "latex", found[key], key)
+            row += (columns.cells(DIFFERENCE, "latex", difference, key) if difference is not None
+                    else ["--"] * len(headers(DIFFERENCE, "latex")))
+        body.append(" & ".join(row) + r" \\")
     over = f" ({', '.join(f'{d} {n}' for d, n in datasets.items())})" if datasets else ""  # escaped with the sentence
-    caption = _sentences([*setting, f"Means over the {statistics['sequences']} sequences every {name.lower()} ran{over}",
-                          statistics["method"]])
+    caption = _sentences([*setting, f"Means over the {statistics.sequences} sequences every {name.lower()} ran{over}",
+                          statistics.method])
     caption += (rf" $\Delta$: the paired difference from {escape(baseline)} (--: {escape(baseline)} itself); "
                 rf"$p$: its Wilcoxon p, $^{{*}}$ where significant after Holm's correction across the "
                 rf"comparisons of a score (corrected $p < 0.05$); W/T/L: the sequences it scored better, "
                 rf"the same, worse on.")
-    return _table(caption, "l" * (1 + len(lead)) + "rrrr" * len(keys), head, body, wide=True)
-
-
-def interval_cell(interval: Mapping | None, signed: bool = False) -> str:
-    r"""``0.452 {\scriptsize [0.401, 0.498]}`` (signed: in math mode, with real minus signs)."""
-    if not interval or not _finite(interval.get("mean")):
-        return "--"
-    text = _signed(interval["mean"]) if signed else f"{interval['mean']:.3f}"
-    if _finite(interval.get("ci_low")) and _finite(interval.get("ci_high")):
-        low, high = ((_signed(interval[k]) if signed else f"{interval[k]:.3f}") for k in ("ci_low", "ci_high"))
-        text += rf" {{\scriptsize [{low}, {high}]}}"
-    return text
-
-
-def _difference_cells(key: str, d: Mapping | None) -> list[str]:
-    """Delta [CI], p, W/T/L of one difference (the baseline's: dashes)."""
-    if not d:
-        return ["--"] * 3
-    p = d["wilcoxon_p"]
-    p_text = "--" if not _finite(p) else "$<$0.001" if p < 0.001 else f"{p:.3f}"
-    if d.get("significant") and _finite(p):
-        p_text += "$^{*}$"
-    won, lost = (d["lost"], d["won"]) if key in LOWER_IS_BETTER else (d["won"], d["lost"])
-    return [interval_cell(d, signed=True), p_text, f"{won}/{d['tied']}/{lost}"]
-
-
-def _signed(value: float) -> str:
-    return f"${value:+.3f}$"
-
-
-def _finite(value) -> bool:
-    return isinstance(value, (int, float)) and math.isfinite(value)
+    return _table(caption, "l" * skip + "r" * per * len(keys), head, body, wide=True)
 
 
 def _sentences(parts: Seq[str]) -> str:

@@ -32,6 +32,7 @@ from dcfkit.analysis.plots import plot_curves
 from dcfkit.analysis.scoring import Evaluation, evaluate
 from dcfkit.analysis.result_fit import check_results_fit, other_folders
 from dcfkit.analysis.setting import cut_length, experiment_line
+from dcfkit.analysis.stats.results import Comparison, Interval
 from dcfkit.analysis.tables import columns, format_rows, format_table, score_line, statistics_lines
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
 from dcfkit.errors import clip, shown
@@ -154,7 +155,10 @@ def _holds_results(folder: Path, names: set[str]) -> bool:
 
 
 def json_ready(obj):
-    """``obj`` with arrays as lists and non-finite floats as None, for ``json.dumps``."""
+    """``obj`` with arrays as lists, typed statistics as their records
+    (:mod:`dcfkit.analysis.stats.results`) and non-finite floats as None, for ``json.dumps``."""
+    if isinstance(obj, (Interval, Comparison)):
+        return json_ready(obj.as_record())
     if isinstance(obj, dict):
         return {k: json_ready(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):

@@ -16,6 +16,7 @@ from dcfkit.analysis.report import TABLE_FORMATS, default_report_dir, json_ready
 from dcfkit.analysis.result_fit import check_results_fit, other_folders
 from dcfkit.analysis.reset_scores import ResetRun, score_resets
 from dcfkit.analysis.setting import cut_length, experiment_line, experiment_record
+from dcfkit.analysis.stats.results import Interval
 from dcfkit.analysis.tables import format_rows, statistics_lines
 from dcfkit.datasets import DatasetError, Sequence, scored_sequences
 from dcfkit.errors import ConfigError, clip
@@ -187,7 +188,7 @@ def reset_latex(scores: dict) -> str:
     """The overall scores of :func:`score_resets` as a LaTeX comparison table
     (:func:`~dcfkit.analysis.latex.comparison_table`): each tracker's EAO with its interval, then
     its accuracy and failures with their intervals and paired differences from the best."""
-    eao = {r["tracker"]: interval_cell({"mean": r["eao"], "ci_low": r["eao_ci_low"], "ci_high": r["eao_ci_high"]})
+    eao = {r["tracker"]: interval_cell(Interval(r["eao"], r["eao_ci_low"], r["eao_ci_high"], r["sequences"]))
            for r in scores["overall"]}
     if not scores["statistics"]:
         raise DatasetError("no tracker's reset-based runs to tabulate")

@@ -11,7 +11,7 @@ import numpy as np
 
 from dcfkit.analysis import metrics
 from dcfkit.analysis.setting import cut_length, experiment_record
-from dcfkit.analysis.statistics import versus_baseline
+from dcfkit.analysis.statistics import Comparison, versus_baseline
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, benchmark_protocol, scored_sequences
 from dcfkit.errors import shown
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
@@ -48,7 +48,8 @@ class Evaluation:
     sequences; ``settings`` how they were scored, with ``datasets`` (dataset -> sequences scored:
     several when roots were pooled); ``platforms`` tracker -> ``[[platform, sequences], ...]``; ``statistics`` each
     tracker's ranking score and precision with confidence intervals and its paired difference
-    from the best (:func:`dcfkit.analysis.statistics.versus_baseline`).
+    from the best (a :class:`~dcfkit.analysis.stats.results.Comparison` of
+    :func:`dcfkit.analysis.statistics.versus_baseline`; ``{}`` without trackers).
     """
 
     protocol: Protocol
@@ -61,7 +62,7 @@ class Evaluation:
     thresholds: dict
     settings: dict
     platforms: dict
-    statistics: dict
+    statistics: Comparison | dict
 
     def as_record(self) -> dict:
         """The scores as plain data (``report.json``): the protocol and the experiment as their

@@ -17,6 +17,12 @@ from typing import Sequence
 import numpy as np
 from scipy import special, stats
 
+from dcfkit.analysis.stats.columns import DIFFERENCE, MEAN, computed
+from dcfkit.analysis.stats.results import Comparison, Corrected, Difference, Interval
+
+__all__ = ["Comparison", "Corrected", "Difference", "Interval", "holm", "mean_interval", "paired_difference",
+           "versus_baseline", "wilcoxon_p"]
+
 CONFIDENCE = 0.95
 RESAMPLES = 10_000
 SEED = 0
@@ -32,34 +38,11 @@ METHOD = (f"{CONFIDENCE:.0%} BCa bootstrap confidence intervals over sequences (
 HOLM = "p Holm-corrected across the comparisons shown; significant: corrected p < 0.05"
 
 
-@dataclasses.dataclass(frozen=True)
-class Interval:
-    """A mean over ``n`` sequences and its bootstrap confidence interval (NaN with fewer than two)."""
-
-    mean: float
-    ci_low: float
-    ci_high: float
-    n: int
-
-    def as_record(self) -> dict:
-        return dataclasses.asdict(self)
-
-
-@dataclasses.dataclass(frozen=True)
-class Difference(Interval):
-    """A paired difference A - B: its mean and interval, the Wilcoxon p, and the sequences
-    where A scored higher (``won``), lower (``lost``) or the same (``tied``)."""
-
-    wilcoxon_p: float
-    won: int
-    lost: int
-    tied: int
-
-
 def mean_interval(values: Sequence[float]) -> Interval:
-    """The mean of the finite ``values`` and its BCa bootstrap interval."""
+    """The mean of the finite ``values`` and its BCa bootstrap interval, with the statistics added
+    to the declaration (:func:`~dcfkit.analysis.stats.columns.computed`) in ``extra``."""
     x = _finite(values)
-    return _interval(x, _tolerance(x))
+    return dataclasses.replace(_interval(x, _tolerance(x)), extra=computed(MEAN, x))
 
 
 def _interval(x: np.ndarray, tolerance: float) -> Interval:
@@ -82,7 +65,8 @@ def paired_difference(a: Sequence[float], b: Sequence[float]) -> Difference:
     tolerance = _tolerance(np.r_[a[finite], b[finite]])
     interval, ranked = _interval(d, tolerance), _tied(d, tolerance)
     return Difference(interval.mean, interval.ci_low, interval.ci_high, interval.n, wilcoxon_p(ranked),
-                      int((ranked > 0).sum()), int((ranked < 0).sum()), int((ranked == 0).sum()))
+                      int((ranked > 0).sum()), int((ranked < 0).sum()), int((ranked == 0).sum()),
+                      extra=computed(DIFFERENCE, a[finite], b[finite]))
 
 
 def wilcoxon_p(differences: np.ndarray) -> float:
@@ -182,16 +166,15 @@ def _bca_levels(x: np.ndarray, means: np.ndarray, alpha: float, tolerance: float
 
 
 def versus_baseline(per_sequence: Sequence[dict], trackers: Sequence[str], keys: Sequence[str],
-                    baseline: str | None = None) -> dict:
+                    baseline: str | None = None) -> Comparison:
     """Each tracker's mean of each score in ``keys`` with its interval, over the sequences every
     tracker has a row for, and each other tracker's paired difference from ``baseline`` (by
     default the first tracker), its Wilcoxon p Holm-corrected per score across the trackers.
 
-    ``per_sequence`` rows have ``tracker``, ``sequence`` and the scores. Returns plain data:
-    ``method``, ``correction``, ``baseline``, ``sequences`` (how many), ``means`` (tracker ->
-    score -> :class:`Interval`), ``differences`` (tracker -> score -> :class:`Difference`
-    with ``holm_p`` and ``significant``) and ``non_finite`` (tracker -> score -> the sequences
-    left out of its mean and differences for a non-finite score; only those with any).
+    ``per_sequence`` rows have ``tracker``, ``sequence`` and the scores. Returns a
+    :class:`Comparison`: ``sequences`` (how many), ``means`` (tracker -> score -> :class:`Interval`),
+    ``differences`` (tracker -> score -> :class:`Corrected`) and ``non_finite`` (tracker -> score ->
+    the sequences left out of its mean and differences for a non-finite score; only those with any).
     """
     baseline = baseline if baseline is not None else trackers[0]
     table: dict[str, dict[str, dict]] = {t: {} for t in trackers}
@@ -205,11 +188,11 @@ def versus_baseline(per_sequence: Sequence[dict], trackers: Sequence[str], keys:
     for key in keys:
         found = [paired_difference(scores[t][key], scores[baseline][key]) for t in others]
         for t, d, p in zip(others, found, holm([d.wilcoxon_p for d in found])):
-            differences[t][key] = {**d.as_record(), "holm_p": p, "significant": bool(p < 0.05)}
+            differences[t][key] = Corrected.of(d, p, bool(p < 0.05))
     non_finite = {t: {k: [s for s, bad in zip(shared, ~np.isfinite(np.asarray(scores[t][k], dtype=float))) if bad]
                       for k in keys} for t in trackers}
-    return {"method": METHOD, "correction": HOLM, "baseline": baseline, "sequences": len(shared),
-            "means": {t: {k: mean_interval(scores[t][k]).as_record() for k in keys} for t in trackers},
-            "differences": differences,
-            "non_finite": {t: {k: v for k, v in found.items() if v} for t, found in non_finite.items()
-                           if any(found.values())}}
+    return Comparison(METHOD, HOLM, baseline, len(shared),
+                      means={t: {k: mean_interval(scores[t][k]) for k in keys} for t in trackers},
+                      differences=differences,
+                      non_finite={t: {k: v for k, v in found.items() if v} for t, found in non_finite.items()
+                                  if any(found.values())})

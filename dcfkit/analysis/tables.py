@@ -9,6 +9,8 @@ from typing import Sequence as Seq
 
 from dcfkit.analysis.latex import comparison_table, latex_table
 from dcfkit.analysis.setting import experiment_line
+from dcfkit.analysis.stats.columns import DIFFERENCE, MEAN, cells
+from dcfkit.analysis.stats.results import Comparison
 from dcfkit.errors import printable, shown
 from dcfkit.experiments import Experiment, get_experiment
 from dcfkit.protocols import DEFAULT, Protocol, get_protocol
@@ -120,26 +122,18 @@ def format_table(rows: Seq[Mapping], fmt: str, columns: Seq[str], protocol: str 
     return f"{head}{proto.describe()}\n\n" + format_rows(rows, fmt, columns)
 
 
-def interval_text(interval: Mapping, signed: bool = False) -> str:
-    """``0.452 [0.401, 0.498]``: a mean and its confidence interval (none: the mean alone)."""
-    fmt = "{:+.3f}" if signed else "{:.3f}"
-    low, high = interval["ci_low"], interval["ci_high"]
-    bounds = f" [{fmt.format(low)}, {fmt.format(high)}]" if math.isfinite(low) and math.isfinite(high) else ""
-    return fmt.format(interval["mean"]) + bounds
-
-
 def comparison_lines(statistics: Mapping, names: tuple[str, str] = ("results", "reference")) -> list[str]:
-    """One line per score of :func:`dcfkit.analysis.compare.score_statistics`: both means with
-    their intervals, the difference with its interval, the Wilcoxon p and won/lost/tied, and
-    the sequences left out for a non-finite score."""
+    """One line per score of :func:`dcfkit.analysis.compare.score_statistics`: both means and
+    the difference with the declared statistics (:mod:`dcfkit.analysis.stats.columns`, format
+    ``pair``: intervals, the Wilcoxon p, won/lost/tied), and the sequences left out for a
+    non-finite score."""
     lines = [f"statistics: {statistics['method']}"]
     for score in ("auc", "precision"):
         s = statistics[score]
-        d = s["difference"]
-        lines.append(f"  {SCORE_LABELS.get(score, score):<9} {names[0]} {interval_text(s['results'])}   "
-                     f"{names[1]} {interval_text(s['reference'])}   {names[0]} - {names[1]} {interval_text(d, signed=True)}   "
-                     f"Wilcoxon p {d['wilcoxon_p']:.3g}   won {d['won']}, lost {d['lost']}, tied {d['tied']} "
-                     f"of {d['n']}")
+        mean = {side: "".join(cells(MEAN, "pair", s[side], score)) for side in ("results", "reference")}
+        lines.append(f"  {SCORE_LABELS.get(score, score):<9} {names[0]} {mean['results']}   "
+                     f"{names[1]} {mean['reference']}   {names[0]} - {names[1]} "
+                     + "".join(cells(DIFFERENCE, "pair", s["difference"], score)))
         if s.get("non_finite"):
             lines.append(f"  {'':<9} left out, {non_finite_text(s['non_finite'], SCORE_LABELS.get(score, score))}")
     return lines
@@ -169,47 +163,59 @@ def noise_floor_line(floor: Mapping, sequences: int) -> str:
             f"{floor['auc_sequence']:.3f}")
 
 
-def statistics_lines(statistics: Mapping) -> list[str]:
-    """The statistics of :func:`dcfkit.analysis.statistics.versus_baseline` as text: each
-    tracker's means with their intervals, the sequences left out of them for a non-finite score,
-    then each difference from the baseline ('*': significant)."""
+def statistics_lines(statistics: Comparison | Mapping) -> list[str]:
+    """A :class:`~dcfkit.analysis.stats.results.Comparison` as text: each tracker's means, the
+    sequences left out of them for a non-finite score, then each difference from the baseline,
+    with the statistics declared for ``text`` (:mod:`dcfkit.analysis.stats.columns`)."""
     if not statistics:
         return []
-    means, width = statistics["means"], max(len(t) for t in statistics["means"])
-    keys = list(next(iter(means.values())))
+    means, width = statistics.means, max(len(t) for t in statistics.means)
     over, left_out = statistics_scope(statistics)
-    lines = [f"statistics over {over} sequences: {statistics['method']}; {statistics['correction']}"]
-    lines += [f"  {t:<{width}}  " + "   ".join(f"{SCORE_LABELS.get(k, k)} {interval_text(m[k])}" for k in keys)
-              for t, m in means.items()]
+    lines = [f"statistics over {over} sequences: {statistics.method}; {statistics.correction}"]
+    lines += [f"  {t:<{width}}  " + "   ".join(f"{SCORE_LABELS.get(k, k)} " + "".join(cells(MEAN, "text", m[k], k))
+                                               for k in statistics.scores) for t, m in means.items()]
     lines += [f"  {line}" for line in left_out]
-    for tracker, found in statistics["differences"].items():
-        for key in keys:
-            d = found[key]
-            lines.append(f"  {tracker} - {statistics['baseline']}: {SCORE_LABELS.get(key, key)} "
-                         f"{interval_text(d, signed=True)}, Wilcoxon p {d['wilcoxon_p']:.3g} (Holm {d['holm_p']:.3g})"
-                         f"{' *' if d['significant'] else ''}, won {d['won']}, lost {d['lost']}, tied {d['tied']}")
+    for tracker, found in statistics.differences.items():
+        for key in statistics.scores:
+            lines.append(f"  {tracker} - {statistics.baseline}: {SCORE_LABELS.get(key, key)} "
+                         + "".join(cells(DIFFERENCE, "text", found[key], key)))
     return lines
 
 
-def statistics_scope(statistics: Mapping) -> tuple[str, list[str]]:
+def statistics_scope(statistics: Comparison) -> tuple[str, list[str]]:
     """(how many sequences the statistics of :func:`statistics_lines` are over: ``5``, or ``3 of
     the 5`` when a non-finite score left two out of every one, and ``left out of ...`` phrases
     naming the sequences a non-finite score left out)."""
-    left_out = _left_out(statistics, list(next(iter(statistics["means"].values()))))
+    left_out = _left_out(statistics, statistics.scores)
     everywhere = left_out.get("every mean and difference", [])
-    over = (f"{statistics['sequences'] - len(everywhere)} of the {statistics['sequences']}" if everywhere
-            else f"{statistics['sequences']}")
+    over = f"{statistics.sequences - len(everywhere)} of the {statistics.sequences}" if everywhere else \
+        f"{statistics.sequences}"
     return over, [f"left out of {where}: {non_finite_text(names, 'score')}" for where, names in left_out.items()]
 
 
-def _left_out(statistics: Mapping, keys: Seq[str]) -> dict[str, list[str]]:
+def statistics_rows(statistics: Comparison) -> tuple[list[dict], list[str]]:
+    """(rows, columns) of a :class:`~dcfkit.analysis.stats.results.Comparison` as one flat table
+    for :func:`format_rows` (text, Markdown, CSV): a row per tracker and score, its mean's record
+    (``mean``, ``ci_low``, ...) then its difference's, each key prefixed ``d_`` (none for the
+    baseline), the added statistics included."""
+    rows = []
+    for tracker, found in statistics.means.items():
+        for key, mean in found.items():
+            difference = statistics.differences.get(tracker, {}).get(key)
+            rows.append({"tracker": tracker, "score": key, **mean.as_record(),
+                         **{f"d_{k}": v for k, v in (difference.as_record() if difference else {}).items()}})
+    names = list(dict.fromkeys(k for row in rows for k in row))
+    return rows, names
+
+
+def _left_out(statistics: Comparison, keys: Seq[str]) -> dict[str, list[str]]:
     """Where -> the sequences left out for a non-finite score: one entry, ``every mean and
     difference``, when the same sequences are left out of each tracker's every score (a
     sequence no tracker could be scored on), else one per list of sequences naming its scores."""
     groups: dict[tuple, list[str]] = {}
-    for tracker, found in statistics.get("non_finite", {}).items():
+    for tracker, found in statistics.non_finite.items():
         for key, names in found.items():
             groups.setdefault(tuple(names), []).append(f"{tracker}'s {SCORE_LABELS.get(key, key)}")
-    if len(groups) == 1 and len(next(iter(groups.values()))) == len(statistics["means"]) * len(keys):
+    if len(groups) == 1 and len(next(iter(groups.values()))) == len(statistics.means) * len(keys):
         return {"every mean and difference": list(next(iter(groups)))}
     return {", ".join(where): list(names) for names, where in groups.items()}

@@ -9,6 +9,8 @@ import numpy as np
 import yaml
 
 from dcfkit.ablation.spec_keys import data_record
+from dcfkit.analysis.stats.columns import DIFFERENCE, MEAN, cells, headers
+from dcfkit.analysis.stats.results import Corrected, Interval
 from dcfkit.analysis.statistics import HOLM, METHOD, holm, mean_interval, paired_difference
 from dcfkit.errors import DcfkitError, printable
 from dcfkit.store.files import atomic_write
@@ -91,10 +93,8 @@ def _compare(names: list[str], held_out: dict, baselines: dict) -> dict:
     the baselines; ``significant``: Holm p < 0.05 and the interval above 0."""
     diffs = {name: paired_difference([held_out[n]["auc"] for n in names], [s[n]["auc"] for n in names])
              for name, s in baselines.items()}
-    out = {}
-    for (name, d), p in zip(diffs.items(), holm([d.wilcoxon_p for d in diffs.values()])):
-        out[name] = {**d.as_record(), "holm_p": p, "significant": bool(p < 0.05 and d.ci_low > 0)}
-    return out
+    return {name: Corrected.of(d, p, bool(p < 0.05 and d.ci_low > 0)).as_record()
+            for (name, d), p in zip(diffs.items(), holm([d.wilcoxon_p for d in diffs.values()]))}
 
 
 def summary_lines(summary: dict) -> list[str]:
@@ -112,17 +112,14 @@ def summary_lines(summary: dict) -> list[str]:
     if unscored:
         lines += ["", f"Left out of the means and tests, having no frame the protocol scores ({len(unscored)} of "
                       f"{len(summary['sequences'])}): {printable(', '.join(unscored))}."]
-    h = summary["held_out"]["auc"]
-    lines += ["", f"Held-out AUC of the search: {_n(h['mean'], '.4f')} "
-                  f"[{_n(h['ci_low'], '.4f')}, {_n(h['ci_high'], '.4f')}]", "",
-              "| baseline | AUC | search − baseline | 95% CI | won / lost / tied | Wilcoxon p | Holm p | beaten |",
-              "|---|---|---|---|---|---|---|---|"]
-    for name, c in summary["comparisons"].items():
-        b = summary["baselines"][name]["auc"]
-        lines.append(f"| {_cell(name)} | {_n(b['mean'], '.4f')} | {_n(c['mean'], '+.4f')} | "
-                     f"[{_n(c['ci_low'], '+.4f')}, {_n(c['ci_high'], '+.4f')}] | "
-                     f"{c['won']} / {c['lost']} / {c['tied']} | {_n(c['wilcoxon_p'], '.3f')} | "
-                     f"{_n(c['holm_p'], '.3f')} | {'yes' if c['significant'] else 'no'} |")
+    h = Interval.from_record(summary["held_out"]["auc"])
+    heads = ["baseline", *headers(MEAN, "search", "AUC"), *headers(DIFFERENCE, "search")]
+    lines += ["", f"Held-out AUC of the search: {_n(h.mean, '.4f')} [{_n(h.ci_low, '.4f')}, {_n(h.ci_high, '.4f')}]",
+              "", "| " + " | ".join(heads) + " |", "|" + "---|" * len(heads)]
+    for name, record in summary["comparisons"].items():  # the statistics declared for "search"
+        found = (cells(MEAN, "search", Interval.from_record(summary["baselines"][name]["auc"]), "auc")
+                 + cells(DIFFERENCE, "search", Corrected.from_record(record), "auc"))
+        lines.append("| " + " | ".join([_cell(name), *found]) + " |")
     final = summary["final"]
     verdict = ("it beats every baseline on held-out folds" if summary["beats_every_baseline"]
                else "it does not beat every baseline on held-out folds: do not ship it")

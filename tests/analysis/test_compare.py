@@ -202,8 +202,8 @@ def test_the_comparison_carries_its_uncertainty(folders, tmp_path, capsys, monke
     assert set(res["auc_difference"]) == {"mean", "ci_low", "ci_high"} == set(res["precision_difference"])
     assert res["wilcoxon_p"] == 1.0 and res["precision_wilcoxon_p"] == 1.0  # one non-zero difference, or none
     auc = res["statistics"]["auc"]
-    assert (auc["difference"]["won"], auc["difference"]["lost"], auc["difference"]["tied"]) == (0, 1, 1)
-    assert auc["results"]["mean"] == pytest.approx(res["mean"]["auc"]) and auc["reference"]["n"] == 2
+    assert (auc["difference"].won, auc["difference"].lost, auc["difference"].tied) == (0, 1, 1)
+    assert auc["results"].mean == pytest.approx(res["mean"]["auc"]) and auc["reference"].n == 2
     assert "bootstrap" in res["statistics"]["method"]
     import dcfkit.cli.evaluate
 
@@ -211,7 +211,7 @@ def test_the_comparison_carries_its_uncertainty(folders, tmp_path, capsys, monke
     assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "statistics: 95% BCa bootstrap" in out
-    assert f"AUC       ours {auc['results']['mean']:.3f} [" in out and "won 0, lost 1, tied 1 of 2" in out
+    assert f"AUC       ours {auc['results'].mean:.3f} [" in out and "won 0, lost 1, tied 1 of 2" in out
     assert cli.main(["compare", str(ours), str(theirs), "--root", str(tmp_path), "--format", "json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["auc_difference"] == pytest.approx(res["auc_difference"]) and data["wilcoxon_p"] == 1.0

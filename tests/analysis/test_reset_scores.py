@@ -107,10 +107,10 @@ def test_score_resets_rows_and_statistics():
     assert rows["a"]["accuracy"] == pytest.approx((4.5 + 20) / 25) == pooled_accuracy([good, clean])
     assert rows["b"]["eao"] == 1.0 and rows["a"]["eao"] < 1.0
     assert rows["a"]["eao_ci_low"] <= rows["a"]["eao"] <= rows["a"]["eao_ci_high"]
-    differences = scores["statistics"]["differences"]["a"]
-    assert differences["failures"]["mean"] == 0.5 and differences["accuracy"]["mean"] == pytest.approx(-0.05)
+    differences = scores["statistics"].differences["a"]
+    assert differences["failures"].mean == 0.5 and differences["accuracy"].mean == pytest.approx(-0.05)
     from_a = score_resets(results, {"s1": 30, "s2": 30}, interval=(12, 14), baseline="a")["statistics"]
-    assert from_a["baseline"] == "a" and from_a["differences"]["b"]["failures"]["mean"] == -0.5
+    assert from_a.baseline == "a" and from_a.differences["b"]["failures"].mean == -0.5
     with pytest.raises(DatasetError, match="--baseline 'c': no such tracker in this report; its trackers are 'b', 'a'"):
         score_resets(results, {"s1": 30, "s2": 30}, interval=(12, 14), baseline="c")
 

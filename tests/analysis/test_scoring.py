@@ -1,6 +1,7 @@
 """evaluate(): its statistics over sequences, against scipy on the per-sequence scores."""
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -49,19 +50,19 @@ def test_each_tracker_has_its_interval_and_each_other_its_paired_difference_from
     st = ev.statistics
     auc = {t: np.array([r["auc"] for r in ev.per_sequence if r["tracker"] == t]) for t in RESULTS}
     best = ev.overall[0]["tracker"]
-    assert st["baseline"] == best in ("near", "same") and st["sequences"] == 5
+    assert st.baseline == best in ("near", "same") and st.sequences == 5
     ci = stats.bootstrap((auc["far"],), np.mean, method="BCa", rng=np.random.default_rng(0)).confidence_interval
-    assert st["means"]["far"]["auc"] == pytest.approx({"mean": auc["far"].mean(), "ci_low": ci.low,
-                                                        "ci_high": ci.high, "n": 5})
-    far = st["differences"]["far"]["auc"]
-    assert far["mean"] == pytest.approx((auc["far"] - auc[best]).mean())
-    assert far["wilcoxon_p"] == pytest.approx(stats.wilcoxon(auc["far"] - auc[best]).pvalue)
-    assert (far["won"], far["lost"]) == (0, int(np.sum(auc["far"] < auc[best])))
+    assert st.means["far"]["auc"].as_record() == pytest.approx({"mean": auc["far"].mean(), "ci_low": ci.low,
+                                                                 "ci_high": ci.high, "n": 5})
+    far = st.differences["far"]["auc"]
+    assert far.mean == pytest.approx((auc["far"] - auc[best]).mean())
+    assert far.wilcoxon_p == pytest.approx(stats.wilcoxon(auc["far"] - auc[best]).pvalue)
+    assert (far.won, far.lost) == (0, int(np.sum(auc["far"] < auc[best])))
     other = "same" if best == "near" else "near"
-    tie = st["differences"][other]["auc"]
-    assert (tie["mean"], tie["wilcoxon_p"], tie["tied"], tie["significant"]) == (0, 1.0, 5, False)
+    tie = st.differences[other]["auc"]
+    assert (tie.mean, tie.wilcoxon_p, tie.tied, tie.significant) == (0, 1.0, 5, False)
     # Holm over the two comparisons: the tie's p of 1 leaves far's p doubled
-    assert far["holm_p"] == pytest.approx(min(1.0, 2 * far["wilcoxon_p"]))
+    assert far.holm_p == pytest.approx(min(1.0, 2 * far.wilcoxon_p))
     assert ev.as_record()["statistics"] == st
 
 
@@ -209,12 +210,12 @@ def test_the_statistics_say_which_sequences_a_non_finite_score_left_out():
                           dataset="test") for n in ("x", "y")]
     results = {t: {**r, "x": GT[:1].copy(), "y": GT[:1].copy()} for t, r in RESULTS.items()}
     st = evaluate(results, SEQUENCES[:3] + one_frame, protocol="got10k").statistics
-    assert st["sequences"] == 5 and st["non_finite"]["far"] == {"ao": ["x", "y"], "precision": ["x", "y"]}
-    assert {m["ao"]["n"] for m in st["means"].values()} == {3}
+    assert st.sequences == 5 and st.non_finite["far"] == {"ao": ["x", "y"], "precision": ["x", "y"]}
+    assert {m["ao"].n for m in st.means.values()} == {3}
     lines = statistics_lines(st)
     assert lines[0].startswith("statistics over 3 of the 5 sequences: ")
     assert ("  left out of every mean and difference: a non-finite score (no frame counted) in 2 sequences (x, y)"
             in lines)
-    st["non_finite"] = {"far": {"ao": ["x"]}}  # one tracker's one score: named as such
+    st = dataclasses.replace(st, non_finite={"far": {"ao": ["x"]}})  # one tracker's one score: named as such
     assert statistics_lines(st)[0].startswith("statistics over 5 sequences: ")
     assert "  left out of far's AO: a non-finite score (no frame counted) in 1 sequence (x)" in statistics_lines(st)

@@ -43,7 +43,7 @@ def test_two_layouts_pool_into_one_set_scored_and_tested_over_all(roots):
     scores = evaluate(results, pooled)
     assert {r["sequences"] for r in scores.overall} == {4}
     assert scores.settings["datasets"] == {"uav123_10fps": 2, "dtb70": 2}
-    assert scores.statistics["sequences"] == 4
+    assert scores.statistics.sequences == 4
     # each sequence scores as it does in its own dataset's evaluation; the mean and test run over all four
     apart = [row for part in (alone[:2], alone[2:]) for row in
              evaluate({t: {s.name: r[s.name] for s in part} for t, r in results.items()}, part).per_sequence]
@@ -51,9 +51,9 @@ def test_two_layouts_pool_into_one_set_scored_and_tested_over_all(roots):
     assert sorted(scores.per_sequence, key=key) == sorted(apart, key=key)
     off = [r["auc"] for r in apart if r["tracker"] == "off"]
     exact = [r["auc"] for r in apart if r["tracker"] == "exact"]
-    assert scores.statistics["means"]["off"]["auc"] == mean_interval(off).as_record()
-    difference = scores.statistics["differences"]["off"]["auc"]
-    assert difference["mean"] == pytest.approx(np.mean(np.subtract(off, exact)))
+    assert scores.statistics.means["off"]["auc"] == mean_interval(off)
+    difference = scores.statistics.differences["off"]["auc"]
+    assert difference.mean == pytest.approx(np.mean(np.subtract(off, exact)))
 
 
 def test_compare_on_pooled_roots_reads_every_root(roots, tmp_path, capsys):

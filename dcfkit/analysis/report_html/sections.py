@@ -15,6 +15,8 @@ from typing import Sequence as Seq
 from dcfkit.analysis.plots import PLOT_STYLE, plot_title
 from dcfkit.analysis.report_html.provenance import folder_provenance
 from dcfkit.analysis.report_html.thumbnails import sequence_thumbnails
+from dcfkit.analysis.stats.columns import DIFFERENCE, MEAN, fill, shown
+from dcfkit.analysis.stats.results import Comparison
 from dcfkit.analysis.tables import SCORE_LABELS, statistics_scope
 from dcfkit.datasets import ATTRIBUTE_NAMES, Sequence
 
@@ -109,45 +111,42 @@ def provenance(folders: Mapping[str, Path], names: Iterable[str], trackers: Seq[
             "extra": [list(e) for e in extra], "trackers": entries}
 
 
-def statistics_table(statistics: Mapping, trackers: Seq[str], tracker_label: str = "tracker") -> dict | None:
-    """The statistics of :func:`dcfkit.analysis.statistics.versus_baseline` as a table: each
-    tracker's scores with their intervals (drawn as bars), its difference from the baseline
-    ('*': significant after Holm's correction) and the corrected p; the method as its note."""
+def statistics_table(statistics: Comparison | Mapping, trackers: Seq[str], tracker_label: str = "tracker") -> dict | None:
+    """A :class:`~dcfkit.analysis.stats.results.Comparison` as a table: per score the columns
+    declared for ``html`` (:mod:`dcfkit.analysis.stats.columns`: each tracker's score with its
+    interval and its difference from the baseline, drawn as bars, '*' where significant after
+    Holm's correction, and the corrected p); the method as its note."""
     if not statistics:
         return None
-    names = list(statistics["means"])
-    keys = list(statistics["means"][names[0]])
+    names = list(statistics.means)
     columns = [{"key": "tracker", "label": tracker_label, "type": "tracker", "digits": 0}]
     rows = [[trackers.index(t)] for t in names]
-    for key in keys:
+    for key in statistics.scores:
         label = COLUMN_LABELS.get(key, key)
-        means = [statistics["means"][t][key] for t in names]
-        diffs = [statistics["differences"].get(t, {}).get(key) for t in names]
-        columns += [_interval_column(f"{key}_ci", label, means),
-                    _interval_column(f"d_{key}", f"{label} \u2212 {statistics['baseline']}", [d for d in diffs if d]),
-                    {"key": f"{key}_holm_p", "label": f"{label} Holm p", "type": "num", "digits": 3}]
-        for row, mean, diff in zip(rows, means, diffs):
-            row += [_interval(mean), _interval(diff), diff["holm_p"] if diff else None]
+        found = {MEAN: [statistics.means[t][key] for t in names],
+                 DIFFERENCE: [statistics.differences.get(t, {}).get(key) for t in names]}
+        for level, results in found.items():
+            for _, cell in shown(level, "html"):
+                values = [None if r is None else cell.render(r, key) for r in results]
+                columns.append(_stat_column(cell, level, fill(cell.key, score=key),
+                                            fill(cell.header, score=label, baseline=statistics.baseline), values))
+                for row, value in zip(rows, values):
+                    row.append(value)
     over, left_out = statistics_scope(statistics)
-    note = " ".join([f"Over {over} sequences every tracker ran: {statistics['method']}; {statistics['correction']} "
+    note = " ".join([f"Over {over} sequences every tracker ran: {statistics.method}; {statistics.correction} "
                      f"(marked *)."] + [f"{line[0].upper()}{line[1:]}." for line in left_out])
     return {"kind": "table", "id": "statistics", "title": "Confidence and significance", "columns": columns,
             "rows": rows, "filter": False, "note": note}
 
 
-def _interval(found: Mapping | None) -> list | None:
-    """[mean, low, high, significant] of an interval (None values where undefined)."""
-    if not found:
-        return None
-    finite = lambda v: v if v is not None and math.isfinite(v) else None  # noqa: E731
-    return [finite(found["mean"]), finite(found["ci_low"]), finite(found["ci_high"]), bool(found.get("significant"))]
-
-
-def _interval_column(key: str, label: str, intervals: Seq[Mapping]) -> dict:
-    """A column of intervals on a common scale: from the lowest to the highest bound (and 0 for
-    differences, whose bars are read against it)."""
-    values = [v for i in intervals for v in (i["ci_low"], i["mean"], i["ci_high"]) if v is not None and math.isfinite(v)]
-    if key.startswith("d_"):
-        values.append(0.0)
-    low, high = (min(values), max(values)) if values else (0.0, 1.0)
+def _stat_column(cell, level: str, key: str, label: str, values: Seq) -> dict:
+    """A statistic's column; one of intervals (``[mean, low, high, significant]``) on a common
+    scale: from the lowest to the highest bound (and 0 for differences, whose bars are read
+    against it)."""
+    if cell.kind != "interval":
+        return {"key": key, "label": label, "type": cell.kind, "digits": 3}
+    bounds = [v for value in values if value for v in value[:3] if v is not None]
+    if level == DIFFERENCE:
+        bounds.append(0.0)
+    low, high = (min(bounds), max(bounds)) if bounds else (0.0, 1.0)
     return {"key": key, "label": label, "type": "interval", "digits": 3, "domain": [low, high]}
