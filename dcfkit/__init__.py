@@ -1,15 +1,10 @@
 """dcfkit: discriminative correlation filter trackers assembled from registered components."""
 from __future__ import annotations
 
-import os as _os
-
 # part of every run key (dcfkit.store.provenance.run_key): bump it when boxes change (docs/changes.md)
 __version__ = "0.10.0"
 
 __all__ = ["__version__", "load_tracker", "load_config", "Tracker"]
-
-# the old names of moved modules (dcfkit/_moved/__init__.py)
-__path__.append(_os.path.join(__path__[0], "_moved"))
 
 
 def __getattr__(name):  # lazy: importing dcfkit does no work

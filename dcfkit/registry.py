@@ -202,8 +202,9 @@ class Registry:
                                 f"registered {kind}s: {', '.join(sorted(entries)) or 'none'}{skipped}")
         return entries[name]
 
-    def build(self, kind: str, spec: Mapping[str, Any] | str, where: str) -> Component:
-        """Instantiate a component from ``{'name': ..., **params}`` (or a bare name)."""
+    def resolve(self, kind: str, spec: Mapping[str, Any] | str, where: str) -> tuple[Entry, Any]:
+        """The entry and checked ``Params`` of ``{'name': ..., **params}`` (or a bare name),
+        without building the component; a ConfigError naming ``where`` and the key otherwise."""
         if isinstance(spec, str):
             spec = {"name": spec}
         if not isinstance(spec, Mapping) or not isinstance(spec.get("name"), str):  # a config's mistake
@@ -218,6 +219,11 @@ class Registry:
         where = f"{where} ({kind} '{name}')"
         params = parse_params(entry.cls.Params, values, where)
         check_contract_values(entry.contract, params, where)
+        return entry, params
+
+    def build(self, kind: str, spec: Mapping[str, Any] | str, where: str) -> Component:
+        """The component of ``spec`` (:meth:`resolve`), its hooks checked on every call."""
+        entry, params = self.resolve(kind, spec, where)
         return checked(entry.cls(params), entry.provider, entry.contract.hooks())
 
     def _check_kind(self, kind: str) -> dict[str, Entry]:

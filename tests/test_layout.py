@@ -11,6 +11,8 @@ import grimp
 import mccabe
 import pytest
 
+import dcfkit
+
 PACKAGE = Path(__file__).resolve().parents[1] / "dcfkit"
 MAX_LINES = 60  # of a function's body, its docstring left out
 MAX_COMPLEXITY = 15  # McCabe, as flake8 counts it
@@ -110,6 +112,14 @@ def test_the_top_level_shows_the_layers():
     assert len(modules) <= 12, modules
     families = ("features", "labels", "regularizers", "solvers", "search", "scale")
     assert all((PACKAGE / "components" / f / "__init__.py").is_file() for f in families)
+
+
+def test_no_shim_of_the_moved_modules_is_left():
+    """The 0.6 module paths that dcfkit/_moved kept went in 0.11 (docs/changes.md): no ``_moved``
+    package or module, and no folder added to dcfkit's import path to find them."""
+    left = [str(p.relative_to(PACKAGE.parent)) for p in PACKAGE.rglob("_moved*") if p.is_dir() or p.suffix == ".py"]
+    assert not left, f"remove {left}"
+    assert [Path(p).resolve() for p in dcfkit.__path__] == [PACKAGE]
 
 
 def test_modules_stay_small():

@@ -19,7 +19,6 @@ adds one self-contained HTML page of it all (``dcfkit report --html``).
 from __future__ import annotations
 
 import json
-import logging
 import math
 import os
 from pathlib import Path
@@ -33,7 +32,7 @@ from dcfkit.analysis.scoring import Evaluation, evaluate
 from dcfkit.analysis.result_fit import check_results_fit, other_folders
 from dcfkit.analysis.setting import cut_length, experiment_line
 from dcfkit.analysis.stats.results import Comparison, Interval
-from dcfkit.analysis.tables import columns, format_rows, format_table, score_line, statistics_lines
+from dcfkit.analysis.tables import columns, format_table, statistics_lines
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
 from dcfkit.errors import clip, shown
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
@@ -41,21 +40,8 @@ from dcfkit.protocols import Protocol
 from dcfkit.store.files import atomic_write, ensure_writable
 from dcfkit.store.results import import_results, load_results
 
-# the scoring, tables and plots are here too, as the report uses them
-__all__ = ["columns", "default_report_dir", "evaluate", "format_rows", "format_table", "gather_results", "json_ready",
-           "plot_curves", "read_folder", "refuse_reset_runs", "score_and_write", "score_folders", "score_line",
-           "tracker_folders", "write_files", "write_report"]
-
-log = logging.getLogger(__name__)
-
-
-# --------------------------------------------------------------------------- tables
-
-
-# --------------------------------------------------------------------------- plots
-
-
-# --------------------------------------------------------------------------- report
+__all__ = ["default_report_dir", "gather_results", "json_ready", "named_folder", "read_folder", "refuse_reset_runs",
+           "report_file_names", "score_and_write", "score_folders", "tracker_folders", "write_files", "write_report"]
 
 
 def gather_results(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | None = None,

@@ -11,12 +11,13 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from dcfkit.analysis.compare import COLUMNS, compare_folders, counted_lines
-from dcfkit.analysis.report import columns, json_ready, named_folder, score_and_write
+from dcfkit.analysis.report import json_ready, named_folder, score_and_write
 from dcfkit.analysis.report_html import write_html_report
 from dcfkit.analysis.reset_report import reset_latex, reset_runs, reset_table, write_reset_report
 from dcfkit.analysis.reset_scores import score_resets
 from dcfkit.analysis.scoring import MISSING, evaluate
 from dcfkit.analysis.tables import (
+    columns,
     comparison_lines,
     format_table,
     noise_floor_line,

@@ -22,22 +22,18 @@ from __future__ import annotations
 
 import copy
 import os
-import sys
-import types
 from pathlib import Path
 from typing import Any, Mapping
 
-from dcfkit.config import bounded_yaml
-from dcfkit.config.bounded_yaml import MAX_DEPTH, MAX_TEXT, MAX_VALUES, MAX_YAML_BYTES, check_value, read_yaml, unshared
+from dcfkit.config.bounded_yaml import check_value, read_yaml, unshared
 from dcfkit.config.overrides import merge, parse_overrides, parse_value, set_dotted
-from dcfkit.config.slots import KINDS, REGULARIZER_ROLES, SLOTS, TOP_LEVEL, components, resolve
+from dcfkit.config.slots import KINDS, SLOTS, TOP_LEVEL, Slot, components, resolve
 from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.errors import ConfigError, DcfkitError, clip, shown
 
-__all__ = ["KINDS", "MAX_BASE_CHAIN", "MAX_DEPTH", "MAX_TEXT", "MAX_VALUES", "MAX_YAML_BYTES", "REGULARIZER_ROLES",
-           "SLOTS", "TOP_LEVEL", "TrackerParams", "check_value", "components", "load_config", "merge",
-           "parse_overrides", "parse_value", "read_yaml", "resolve", "set_dotted", "shipped_config",
-           "shipped_config_dir"]
+__all__ = ["KINDS", "MAX_BASE_CHAIN", "SLOTS", "Slot", "TOP_LEVEL", "TrackerParams", "check_value", "components",
+           "load_config", "merge", "parse_overrides", "parse_value", "read_yaml", "resolve", "set_dotted",
+           "shipped_config", "shipped_config_dir"]
 
 MAX_BASE_CHAIN = 32  # files in one 'base:' chain
 
@@ -134,15 +130,3 @@ def _find(source: str | Path) -> Path:
     shipped = sorted(p.stem for p in folder.glob("*.yaml")) if folder.is_dir() else []
     raise ConfigError(f"config not found: {clip(str(source))}"
                       + (f"; shipped configs: {', '.join(shipped)}" if shipped else ""))
-
-
-class _Settable(types.ModuleType):
-    """``dcfkit.config.MAX_VALUES = n`` sets the limit where it is read (:mod:`.bounded_yaml`)."""
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        if name in ("MAX_DEPTH", "MAX_TEXT", "MAX_VALUES", "MAX_YAML_BYTES"):
-            setattr(bounded_yaml, name, value)
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Settable

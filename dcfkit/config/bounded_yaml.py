@@ -1,5 +1,6 @@
 """YAML read within bounds: size, values, text and depth (docs/hardening.md). The limits are
-read when used: a program that needs more sets e.g. ``dcfkit.config.MAX_VALUES = 10**6``."""
+read when used: a program that needs more sets e.g. ``dcfkit.config.bounded_yaml.MAX_VALUES =
+10**6``."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -10,8 +11,8 @@ import yaml
 from dcfkit.errors import ConfigError, clip, shown
 
 # Bounds on what a config, an ablation spec or a --set value may be, far beyond any real one
-# (the shipped configs and specs: at most 6.4 KB, 409 values, 5 levels). Read when used: a
-# program that needs more sets e.g. ``dcfkit.config.MAX_VALUES = 10**6`` before loading.
+# (the shipped configs and specs: at most 6.4 KB, 409 values, 5 levels). Read when used: a program
+# that needs more sets e.g. ``dcfkit.config.bounded_yaml.MAX_VALUES = 10**6`` before loading.
 MAX_YAML_BYTES = 256 * 1024  # a YAML file or --set value (PyYAML takes up to 0.3 s to read that here)
 
 
@@ -24,13 +25,15 @@ MAX_TEXT = 1024 * 1024  # characters of the scalars in one document or value, an
 MAX_DEPTH = 32  # levels of mappings and lists nested in one another
 
 
-DEEP = "nested more than {} levels deep (dcfkit.config.MAX_DEPTH)"
+DEEP = "nested more than {} levels deep (dcfkit.config.bounded_yaml.MAX_DEPTH)"
 
 
-LARGE = "more than {} values, each alias counted as the values it stands for (dcfkit.config.MAX_VALUES)"
+LARGE = ("more than {} values, each alias counted as the values it stands for "
+         "(dcfkit.config.bounded_yaml.MAX_VALUES)")
 
 
-LONG = "more than {} characters, each alias counted as the text it stands for (dcfkit.config.MAX_TEXT)"
+LONG = ("more than {} characters, each alias counted as the text it stands for "
+        "(dcfkit.config.bounded_yaml.MAX_TEXT)")
 
 
 class OverLimit(Exception):
@@ -182,7 +185,7 @@ def unshared(value: Any) -> Any:
 def load_yaml(text: str) -> Any:
     """``text`` read by :class:`_BoundedLoader`: raises yaml.YAMLError (not YAML) or :class:`OverLimit`."""
     if len(text) > MAX_YAML_BYTES:
-        raise OverLimit(f"longer than {MAX_YAML_BYTES} characters (dcfkit.config.MAX_YAML_BYTES)", [])
+        raise OverLimit(f"longer than {MAX_YAML_BYTES} characters (dcfkit.config.bounded_yaml.MAX_YAML_BYTES)", [])
     return yaml.load(text, Loader=_BoundedLoader)
 
 
@@ -200,7 +203,7 @@ def read_yaml(path: Path) -> dict:
     except OSError as exc:
         raise ConfigError(f"cannot read config {path}: {exc.strerror}") from None
     if len(raw) > MAX_YAML_BYTES:
-        raise ConfigError(f"{path}: larger than {MAX_YAML_BYTES} bytes (dcfkit.config.MAX_YAML_BYTES); "
+        raise ConfigError(f"{path}: larger than {MAX_YAML_BYTES} bytes (dcfkit.config.bounded_yaml.MAX_YAML_BYTES); "
                           f"is it a config?")
     try:
         data = load_yaml(raw.decode("utf-8"))

@@ -18,7 +18,7 @@ PACKAGE = Path(__file__).resolve().parents[1]
 # the parts of dcfkit that change no box: they read and score results, parse commands, or
 # record where results came from; everything else (tracker, components, numerics, config
 # parsing, datasets, experiments, the frame loop, the box file format, ...) is in the digest
-NOT_BOX_CODE = ("_build_hook.py", "_moved", "ablation", "analysis", "autosearch", "cli", "configs",
+NOT_BOX_CODE = ("_build_hook.py", "ablation", "analysis", "autosearch", "cli", "configs",
                 "running/evaluation.py", "running/scheduler.py", "store/__init__.py", "store/claims.py",
                 "store/code_state.py", "store/platforms.py", "store/provenance.py", "store/results.py",
                 "store/timing.py")

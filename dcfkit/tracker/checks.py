@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from dcfkit.components.scale.dsst import DSST
+from dcfkit.config.slots import SLOTS
 from dcfkit.contracts import ContractViolation
 from dcfkit.errors import ConfigError, InputError, shown
 from dcfkit.limits import SAMPLE_PIXELS_VARIABLE, sample_budget
@@ -71,11 +72,11 @@ def read_only(w2: np.ndarray) -> np.ndarray:
 def check_terms(tracker) -> None:
     """ConfigError if a regularizer is configured that the solver has no term for (``Solver.terms``):
     it would be ignored."""
-    for role, regularizer in (("spatial", tracker.spatial), ("temporal", tracker.temporal)):
-        if regularizer is not None and role not in tracker.solver.terms:
-            raise ConfigError(f"{tracker.name}: solver '{tracker.solver.name}' has no {role} term, so "
-                              f"regularizers.{role} '{regularizer.name}' would be ignored: "
-                              f"set regularizers.{role}: null")
+    for slot in SLOTS:
+        regularizer = getattr(tracker, slot.name) if slot.role is not None else None
+        if regularizer is not None and slot.role not in tracker.solver.terms:
+            raise ConfigError(f"{tracker.name}: solver '{tracker.solver.name}' has no {slot.role} term, so "
+                              f"{slot.key} '{regularizer.name}' would be ignored: set {slot.key}: null")
 
 
 def check_spectra(tracker) -> None:

@@ -24,6 +24,7 @@ from dcfkit.components.features.base import extract_stack
 from dcfkit.components.labels.base import Detection, gaussian_label
 from dcfkit.components.scale.base import scale_limits
 from dcfkit.config import load_config
+from dcfkit.config.slots import SLOTS, build
 from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.contracts import naming_the_frame
 from dcfkit.errors import InputError, TrackingError
@@ -54,21 +55,16 @@ class Tracker:
     """A DCF tracker assembled from components (see :func:`dcfkit.load_tracker`)."""
 
     def __init__(self, config: Mapping[str, Any]):
+        """``config``: as :func:`dcfkit.load_config` resolved it. Each slot of
+        :data:`dcfkit.config.slots.SLOTS` is built once, into the attribute the slot names."""
         registry = get_registry()
         self.config = dict(config)
         self.name = config["name"]
         self.params = TrackerParams(**config["tracker"])
-        build = lambda kind, spec, where: registry.build(kind, spec, f"{self.name}: {where}")  # noqa: E731
-        self.features = [build("feature", f, f"features[{i}]") for i, f in enumerate(config["features"])]
-        self.label = build("label", config["label"], "label")
-        regs = config["regularizers"]
-        self.spatial = build("regularizer", regs["spatial"], "regularizers.spatial") if regs.get("spatial") else None
-        self.temporal = build("regularizer", regs["temporal"], "regularizers.temporal") if regs.get("temporal") else None
-        self.solver = build("solver", config["solver"], "solver")
+        for slot in SLOTS:
+            setattr(self, slot.name, build(slot, registry, config, self.name))
         check_terms(self)
         check_spectra(self)
-        self.search = build("search", config["search"], "search")
-        self.scale_estimator = build("scale", config["scale"], "scale")
         self.fft = make_fft(self.params.fft_backend, full=self.params.spectra == "full")
         self.frame = 0
         # diagnostics of the last frame: the response map (cells, centred: fftshift), the image box

@@ -30,7 +30,7 @@ CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 SHIPPED = sorted(CONFIGS.glob("*.yaml")) + sorted((CONFIGS / "reference").glob("*.yaml"))
 # Steps (below) of one load: each of its at most MAX_VALUES values is composed, measured and
 # copied once or twice; the most any test here takes is 3,087, a bomb expanded takes millions
-STEPS = 5 * config.MAX_VALUES
+STEPS = 5 * bounded_yaml.MAX_VALUES
 PEAK_BYTES = 30 * 2**20  # Python allocations of one refusal (tracemalloc's peak); a bomb wanted GBs
 MESSAGE_CHARS = 1000  # an error message, whatever the size of the value it is about
 
@@ -150,7 +150,7 @@ def test_alias_bombs_in_a_config_are_refused_in_few_steps(tmp_path, text, key):
     path = tmp_path / "bomb.yaml"
     path.write_text(text.format(bomb=alias_bomb()))
     assert path.stat().st_size < 1024
-    assert_refused(bounded(load_config, path), str(path), key, "dcfkit.config.MAX_VALUES")
+    assert_refused(bounded(load_config, path), str(path), key, "dcfkit.config.bounded_yaml.MAX_VALUES")
 
 
 def test_a_merge_key_bomb_is_refused_in_few_steps(tmp_path):
@@ -158,7 +158,7 @@ def test_a_merge_key_bomb_is_refused_in_few_steps(tmp_path):
     lines = ["  m0: &m0 {k: 1}"] + [f"  m{i}: &m{i} {{<<: [*m{i - 1}, *m{i - 1}], k{i}: 1}}" for i in range(1, 40)]
     path = tmp_path / "merge.yaml"
     path.write_text("base: strcf\nx:\n" + "\n".join(lines) + "\n")
-    assert_refused(bounded(load_config, path), str(path), "x", "dcfkit.config.MAX_VALUES")
+    assert_refused(bounded(load_config, path), str(path), "x", "dcfkit.config.bounded_yaml.MAX_VALUES")
 
 
 def _track_with_set(argument: str) -> None:
@@ -168,7 +168,8 @@ def _track_with_set(argument: str) -> None:
 
 @pytest.mark.parametrize("key", ["name", "description", "label.mu"])
 def test_an_alias_bomb_as_a_set_value_is_refused_in_few_steps(key):
-    assert_refused(bounded(_track_with_set, f"{key}={alias_bomb()}"), f"--set {key}", "dcfkit.config.MAX_VALUES")
+    assert_refused(bounded(_track_with_set, f"{key}={alias_bomb()}"), f"--set {key}",
+                   "dcfkit.config.bounded_yaml.MAX_VALUES")
 
 
 @pytest.mark.parametrize("text,key", [
@@ -178,7 +179,7 @@ def test_an_alias_bomb_as_a_set_value_is_refused_in_few_steps(key):
 def test_alias_bombs_in_an_ablation_spec_are_refused_in_few_steps(tmp_path, text, key):
     path = tmp_path / "spec.yaml"
     path.write_text(text.format(bomb=alias_bomb()))
-    assert_refused(bounded(load_spec, path), str(path), key, "dcfkit.config.MAX_VALUES")
+    assert_refused(bounded(load_spec, path), str(path), key, "dcfkit.config.bounded_yaml.MAX_VALUES")
 
 
 def test_aliases_of_a_long_text_are_refused_in_few_steps(tmp_path):
@@ -186,7 +187,8 @@ def test_aliases_of_a_long_text_are_refused_in_few_steps(tmp_path):
     path = tmp_path / "spec.yaml"
     path.write_text("dataset: otb\ngrid:\n  base: dr2track\n  parameters:\n    description: [[&s " + "x" * 100_000
                     + ", " + ", ".join(["*s"] * 2000) + "]]\n")
-    assert_refused(bounded(load_spec, path), str(path), "grid.parameters.description", "dcfkit.config.MAX_TEXT")
+    assert_refused(bounded(load_spec, path), str(path), "grid.parameters.description",
+                   "dcfkit.config.bounded_yaml.MAX_TEXT")
 
 
 def test_an_alias_inside_its_own_anchor_is_refused(tmp_path):
@@ -241,7 +243,7 @@ def test_any_alias_document_is_loaded_or_refused_in_few_steps(tmp_path_factory, 
     outcome = bounded(_load_with_value(tmp_path_factory.mktemp("alias"), place, value))
     assert outcome["kind"] in ("ok", "ConfigError"), outcome
     assert outcome["steps"] < STEPS and outcome["peak"] < PEAK_BYTES and outcome["length"] < MESSAGE_CHARS, outcome
-    if leaves > config.MAX_VALUES:
+    if leaves > bounded_yaml.MAX_VALUES:
         assert "MAX_VALUES" in outcome["message"], outcome
 
 
@@ -309,16 +311,17 @@ def test_deeply_nested_ablation_overrides_are_config_errors(tmp_path):
 
 
 def test_the_bounds_are_where_the_docs_say_and_can_be_raised(monkeypatch, tmp_path):
-    depth = config.MAX_DEPTH
+    depth = bounded_yaml.MAX_DEPTH
     assert config.parse_value("[" * depth + "1" + "]" * depth) is not None
-    with pytest.raises(ConfigError, match="dcfkit.config.MAX_DEPTH"):
+    with pytest.raises(ConfigError, match="dcfkit.config.bounded_yaml.MAX_DEPTH"):
         config.parse_value("[" * (depth + 1) + "1" + "]" * (depth + 1))
-    many = "[" + ", ".join(["1"] * config.MAX_VALUES) + "]"  # the list and its items: one value too many
-    with pytest.raises(ConfigError, match="dcfkit.config.MAX_VALUES"):
+    many = "[" + ", ".join(["1"] * bounded_yaml.MAX_VALUES) + "]"  # the list and its items: one value too many
+    with pytest.raises(ConfigError, match="dcfkit.config.bounded_yaml.MAX_VALUES"):
         config.parse_value(many)
-    assert len(config.parse_value("[" + ", ".join(["1"] * (config.MAX_VALUES - 1)) + "]")) == config.MAX_VALUES - 1
-    monkeypatch.setattr(config, "MAX_VALUES", 2 * config.MAX_VALUES)
-    assert len(config.parse_value(many)) == config.MAX_VALUES // 2
+    fewer = bounded_yaml.MAX_VALUES - 1
+    assert len(config.parse_value("[" + ", ".join(["1"] * fewer) + "]")) == fewer
+    monkeypatch.setattr(bounded_yaml, "MAX_VALUES", 2 * bounded_yaml.MAX_VALUES)
+    assert len(config.parse_value(many)) == bounded_yaml.MAX_VALUES // 2
     (tmp_path / "c0.yaml").write_text("base: strcf\n")
     for i in range(1, config.MAX_BASE_CHAIN):  # strcf.yaml and c0 ... c30: the longest chain
         (tmp_path / f"c{i}.yaml").write_text(f"base: c{i - 1}.yaml\n")
@@ -333,16 +336,17 @@ def test_huge_files_are_refused_without_reading_them(tmp_path):
         file.truncate(2**33)  # 8 GB, sparse
     tracemalloc.start()
     try:
-        with pytest.raises(ConfigError, match=r"huge.yaml: larger than \d+ bytes \(dcfkit.config.MAX_YAML_BYTES\)"):
+        with pytest.raises(ConfigError,
+                           match=r"huge.yaml: larger than \d+ bytes \(dcfkit.config.bounded_yaml.MAX_YAML_BYTES\)"):
             load_config(huge)
         with pytest.raises(ConfigError, match=r"huge.yaml: larger than"):
             load_spec(huge)
         peak = tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()
-    assert peak < 2 * config.MAX_YAML_BYTES  # its first MAX_YAML_BYTES + 1 bytes read, no more
+    assert peak < 2 * bounded_yaml.MAX_YAML_BYTES  # its first MAX_YAML_BYTES + 1 bytes read, no more
     with pytest.raises(ConfigError, match=r"--set name: longer than \d+ characters"):
-        parse_overrides(["name=" + "x" * (config.MAX_YAML_BYTES + 1)])
+        parse_overrides(["name=" + "x" * (bounded_yaml.MAX_YAML_BYTES + 1)])
 
 
 def test_a_huge_product_grid_is_refused_before_it_is_made(tmp_path):

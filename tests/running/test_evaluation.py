@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from dcfkit.analysis import report, tables
+from dcfkit.analysis.scoring import evaluate
 from dcfkit.cli import evaluate as cli_evaluate
 from dcfkit.datasets import DatasetError, Sequence, load_dataset
 from dcfkit.errors import ConfigError, DcfkitError
@@ -442,7 +443,7 @@ def test_import_results(tmp_path):
 def test_evaluate_scores_and_sorting(seqs):
     perfect = {s.name: gt_boxes() for s in seqs}
     shifted = {s.name: gt_boxes(x0=32.0) for s in seqs[:2]}  # far off; "c" missing
-    ev = report.evaluate({"shifted": shifted, "perfect": perfect}, seqs)
+    ev = evaluate({"shifted": shifted, "perfect": perfect}, seqs)
     top, low = ev.overall
     assert top["tracker"] == "perfect" and top["auc"] == pytest.approx(20 / 21) and top["precision"] == 1
     # otb scores frame 1 with the ground truth: 1/6 on a and b; c has no results: 0
@@ -464,7 +465,7 @@ def test_evaluate_scores_and_sorting(seqs):
 def test_short_results_are_scored_as_failures_with_a_warning(seqs, caplog):
     short = {s.name: gt_boxes()[:2] for s in seqs[:1]}
     with caplog.at_level("WARNING"):
-        ev = report.evaluate({"short": short}, seqs[:1])
+        ev = evaluate({"short": short}, seqs[:1])
     assert f"'short', sequence 'a': 2 boxes for {N_FRAMES} frames" in caplog.text
     assert ev.overall[0]["precision"] == pytest.approx(2 / N_FRAMES)  # not copied forward by otb's rule
 
@@ -578,7 +579,7 @@ def test_real_sequence_with_opencv_kcf(tmp_path, shared_data):
     run_one_pass({"name": "kcf"}, [short], tmp_path, make_tracker=opencv_tracker("KCF"), progress=False)
     first = (tmp_path / "kcf" / "boat1.txt").read_text().splitlines()[0]
     assert first == "393.000,328.000,155.000,319.000"  # the annotation file's first line
-    ev = report.evaluate({"kcf": load_results(tmp_path, "kcf", [short])}, [short])
+    ev = evaluate({"kcf": load_results(tmp_path, "kcf", [short])}, [short])
     assert ev.overall[0]["auc"] > 0.5 and ev.overall[0]["fps"] > 0
 
 

@@ -15,6 +15,7 @@ import pytest
 from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixture)
 
 from dcfkit.analysis import report
+from dcfkit.analysis.scoring import evaluate
 from dcfkit.errors import DcfkitError
 from dcfkit.store import files, results
 from dcfkit.running.evaluation import run_one_pass
@@ -60,7 +61,7 @@ def test_a_result_file_cut_short_is_never_scored_and_is_recomputed(tmp_path, seq
     loaded = load_results(tmp_path, "drift", seqs)
     assert sorted(loaded) == ["b", "c"]
     assert "a.txt is not the file its run wrote" in caplog.text
-    scores = report.evaluate({"drift": loaded}, seqs)
+    scores = evaluate({"drift": loaded}, seqs)
     assert scores.overall[0]["missing"] == 1
     # recomputed: the next run redoes exactly that sequence
     counter = Counter()

@@ -5,11 +5,12 @@ from pathlib import Path
 from typing import Iterable, Mapping
 from typing import Sequence as Seq
 
-from dcfkit.analysis.report import columns, default_report_dir, score_folders, write_files
+from dcfkit.analysis.report import default_report_dir, score_folders, write_files
 from dcfkit.analysis.report_html import sections
 from dcfkit.analysis.report_html.document import write_page
 from dcfkit.analysis.report_html.provenance import this_process
 from dcfkit.analysis.setting import cut_phrase, experiment_line
+from dcfkit.analysis.tables import columns
 from dcfkit.datasets import Sequence, scored_sequences
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
 from dcfkit.protocols import Protocol
