@@ -213,14 +213,15 @@ def test_anchors_still_work_and_an_override_changes_one_place(tmp_path):
 
 
 def _alias_document(levels: int, fan: int, merge: bool) -> tuple[str, int]:
-    """A YAML flow value of anchors on anchors, and its number of leaves once expanded."""
+    """A YAML flow value of anchors on anchors, and its number of leaves once expanded: ``fan ** levels``
+    of plain aliases; of merge keys one per key (``k``, ``k1`` ...), as each merge keeps one value a key."""
     if merge:
         text = "&a0 {k: 1}"
         for i in range(1, levels):
             text = f"&a{i} {{<<: [{text}" + f", *a{i - 1}" * (fan - 1) + f"], k{i}: 1}}"
     else:
         text = alias_bomb(levels, fan)
-    return text, fan ** levels
+    return text, levels if merge else fan ** levels
 
 
 def _load_with_value(tmp_path: Path, place: str, value: str):
