@@ -167,7 +167,8 @@ class RunPlan:
             for p in self.entries:
                 say_what_is_recomputed(p.store, p.metas, p.todo, p.entry.config, p.name, p.key)
                 say_other_rule(p.store, p.metas, p.todo, self.experiment)
-                remove_temporary_files(p.store.folder, [f for run in p.todo for f in p.store.file_names(run.name)])
+                # every run of the folder it claims: none is being written by another command
+                remove_temporary_files(p.store.folder, [f for run in p.runs for f in p.store.file_names(run.name)])
             self.execute(jobs, executor, scheduler, progress)
         return self
 
