@@ -42,11 +42,11 @@ def folder_names(labels: Iterable[str], reserved: Iterable[str] = ()) -> dict[st
     labels = list(dict.fromkeys(labels))
     taken = {name.casefold() for name in reserved}
     names = {}
-    for label in labels:  # usable labels first: an unusable one never takes a usable one's name
+    for label in sorted(labels):  # usable labels first (an unusable one never takes their names), sorted
         if folder_problem(label) is None and label.casefold() not in taken:
             names[label] = label
             taken.add(label.casefold())
-    for label in labels:
+    for label in sorted(labels):
         if label in names:
             continue
         name = _usable(label)

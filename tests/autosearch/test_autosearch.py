@@ -321,3 +321,36 @@ def test_a_search_killed_with_sigkill_resumes_to_the_same_result(tmp_path, data)
         assert (out / path.relative_to(tmp_path / "whole")).read_bytes() == path.read_bytes(), path
     whole, again = (json.loads((d / "summary.json").read_text()) for d in (tmp_path / "whole", out))
     assert again == {**whole, "spec": again["spec"]}
+
+
+def test_trials_of_one_config_share_their_runs_and_a_baseline_has_its_own_folder(tmp_path, data, monkeypatch,
+                                                                                   capsys):
+    from test_evaluation import DriftTracker  # a fake tracker: the runs it makes are counted
+
+    from dcfkit.autosearch.evaluation import Evaluator
+    from dcfkit.running import runner
+
+    made = []
+    monkeypatch.setattr(runner, "_warm_up", lambda task: None)
+    monkeypatch.setattr(runner, "load_dcfkit_tracker", lambda config: made.append(config) or DriftTracker(config))
+    out, names = tmp_path / "out", ["seqA", "seqB"]
+    evaluator = Evaluator(out, "otb", load_dataset("otb", data), ["ope"], jobs=1, baselines=["KCF"])
+    config = load_config("kcf")
+    first = evaluator.scores(config, names)
+    assert len(made) == 2 and sorted(p.name for p in (out / "trials" / evaluator.key(config)).glob("*.txt")) == [
+        "seqA.txt", "seqB.txt"]  # OUT/trials/<run key>/
+    assert evaluator.scores({**config, "name": "trial 7"}, names) == first and len(made) == 2  # its runs reused
+    assert evaluator.scores(config, names, baseline="KCF") == first and len(made) == 4
+    assert sorted(p.name for p in (out / "baselines" / "KCF").glob("*.txt")) == ["seqA.txt", "seqB.txt"]
+    assert cli.main(["compare", str(out / "trials" / evaluator.key(config)), str(out / "baselines" / "KCF"),
+                     "--dataset", "otb", "--root", str(data)]) == 0  # eval's layout: compare reads it
+
+
+def test_a_search_warns_once_of_runs_in_the_old_layout(tmp_path, data, caplog):
+    spec = load_search_spec(write(tmp_path / "s.yaml", SPEC.replace("trials: 3", "trials: 1")))
+    (tmp_path / "out" / "jobs" / "otb").mkdir(parents=True)  # as dcfkit 0.10 kept a search's runs
+    with caplog.at_level("WARNING"):
+        Search(spec, tmp_path / "out", {"jobs": 1}).run()
+    said = [r.getMessage() for r in caplog.records if "old layout" in r.getMessage()]
+    assert len(said) == 1 and "OUT/trials/<run key>/, OUT/baselines/<name>/" in said[0]
+    assert (tmp_path / "out" / "baselines" / "KCF").is_dir()
