@@ -1,8 +1,7 @@
-"""An ablation's experiment (:mod:`dcfkit.experiments`): which ones it can run, and where
-their runs go."""
+"""An ablation's experiment (:mod:`dcfkit.experiments`): which ones it can run, and how its
+outputs name it."""
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 from dcfkit.errors import ConfigError, shown
@@ -43,10 +42,3 @@ def scope_line(experiment: str, protocol: str, max_frames: int | None = None) ->
     cut = (f", each sequence's first {max_frames} frames only (--max-frames {max_frames}: a smoke run, "
            f"not the benchmark's scores)" if max_frames else "")
     return f"experiment {found.name.upper()} ({found.title}{pooled}), protocol {protocol}{cut}"
-
-
-def runs_dir(job_folder: Path, experiment: str) -> Path:
-    """Where a run key's runs of ``experiment`` go: its folder (:func:`dcfkit.ablation.spec.job_dir`),
-    and that folder's ``<experiment>/`` but for one pass."""
-    sub = get_experiment(experiment).folder
-    return job_folder / sub if sub else job_folder

@@ -7,7 +7,7 @@ from typing import Any, Mapping
 
 from dcfkit.ablation.experiment import scope_title
 from dcfkit.ablation.sensitivity import METRICS, sensitivity
-from dcfkit.ablation.spec import AblationSpec, format_value, job_dir
+from dcfkit.ablation.spec import AblationSpec, format_value
 from dcfkit.ablation.spec_keys import data_text
 from dcfkit.analysis.report_html import evaluation_sections, sections
 from dcfkit.analysis.report_html.provenance import this_process
@@ -94,7 +94,7 @@ def sensitivity_charts(spec: AblationSpec, overall: list[dict]) -> dict:
 def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[str, ...], scores: Mapping,
                   sequences: list, results: Mapping[str, Mapping], keys: Mapping[str, str]) -> dict:
     """The page of an ablation: ``info`` is its ``summary.json`` (the summary table in
-    ``columns``), ``scores`` what :func:`dcfkit.analysis.scoring.evaluate` returned for ``results``
+    ``columns``, each variant's ``folders``), ``scores`` what :func:`dcfkit.analysis.scoring.evaluate` returned for ``results``
     (variant -> sequence -> result), ``keys`` variant -> run key."""
     trackers = [*keys, *(name for name, _ in spec.published)]
     head = [variants_table(spec, info["overall"], columns, trackers, info.get("fps_note"))]
@@ -103,7 +103,7 @@ def ablation_page(spec: AblationSpec, out: Path, info: Mapping, columns: tuple[s
         head.append(statistics)
     if spec.grid is not None:
         head.append(sensitivity_charts(spec, info["overall"]))
-    folders = {**{v: job_dir(out, spec.dataset, k) for v, k in keys.items()}, **dict(spec.published)}
+    folders = {**{v: out / info["folders"][v] for v in keys}, **dict(spec.published)}
     extra = [("spec", shared_path(spec.path, out)), ("dataset", data_text(spec, out))]
     return {"title": f"dcfkit ablation {spec.name}: {sections.count(len(trackers), 'variant')} on {spec.dataset}, "
                      f"{scope_title(spec.experiment, spec.max_frames)}",

@@ -1,21 +1,27 @@
-"""Running an ablation spec's jobs: each distinct (run key, sequence) once, through
-:func:`dcfkit.running.runner.execute`, into ``OUT/jobs/<dataset>/<key>/``."""
+"""Running an ablation spec: one run plan (:mod:`dcfkit.running.plan`) of its variants, each
+stored under its folder ``OUT/<variant>/[<experiment>/]`` (:mod:`dcfkit.ablation.layout`),
+each distinct (run key, run) tracked once; then the summary."""
 from __future__ import annotations
 
-import contextlib
 import json
 from pathlib import Path
 
-from dcfkit.ablation.experiment import runs_dir
-from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir, variant_names
+from dcfkit.ablation.layout import CONFIGS, variant_entries, variant_folders, warn_old_layout
+from dcfkit.ablation.spec import AblationSpec, Job, expand, variant_names
 from dcfkit.ablation.summary import output_names, summarize
 from dcfkit.datasets import benchmark_protocol
 from dcfkit.errors import DcfkitError, shown
-from dcfkit.experiments import runs_by_sequence
+from dcfkit.running.plan import RunPlan
+from dcfkit.running.progress import RunBar
+from dcfkit.running.runner import usable_cores
 from dcfkit.store.files import atomic_write, ensure_writable, exclusive, read_json
 from dcfkit.store.provenance import LABEL_KEYS, dcfkit_version
-from dcfkit.store.results import ResultStore
-from dcfkit.running.runner import RunTask, execute, usable_cores, warm_up_compiled
+
+
+def ablation_plan(spec: AblationSpec, out: Path, sequences: list, version: str | None = None) -> RunPlan:
+    """The run plan of ``spec``'s variants on ``sequences`` under ``out``."""
+    folders = variant_folders(spec, output_names(spec))
+    return RunPlan(variant_entries(spec, folders), sequences, spec.experiment, out, "the ablation's results", version)
 
 
 def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str = "local",
@@ -46,64 +52,34 @@ def run_ablation(spec: AblationSpec, out, jobs: int | None = None, executor: str
         benchmark_protocol(seqs)
     version = dcfkit_version()
     job_list = expand(spec, seqs, version)
-    runs = runs_by_sequence(seqs, spec.experiment)
-    tasks: dict[tuple[str, str], RunTask] = {}
-    for job in job_list:
-        for run in runs[job.sequence]:
-            tasks.setdefault((job.key, run.name), RunTask(job.config, run, runs_dir(job_dir(out, spec.dataset, job.key), spec.experiment), job.key))
+    warn_old_layout(out, "dcfkit ablate", "OUT/<variant>/")
+    plan = ablation_plan(spec, out, seqs, version)
     ensure_writable(out, output_names(spec), "the ablation")
     with exclusive(out / ".lock", "dcfkit ablate", f"to {out}"):
-        _prepare(out, tasks.values(), job_list, version)
-        todo = sorted((t for t in tasks.values() if not ResultStore(t.folder).is_done(t.seq, t.key)),
-                      key=lambda t: -len(t.seq))  # longest first: the workers end together
-        for task in todo:
-            ResultStore(task.folder).refuse_to_shorten(task.seq)
-        result = {"jobs": job_list, "runs": len(tasks), "done": [],
-                  "skipped": [k for k, t in tasks.items() if t not in todo], "failed": {}}
-        _run(spec, result, todo, len(tasks), variant_names(job_list), jobs, executor, scheduler, progress, version)
-        result["summary"] = summarize(spec, out, seqs, job_list, protocol, runs)
+        _write_configs(out, job_list, version)
+        variants = variant_names(job_list)
+        plan.run("dcfkit ablate", jobs, executor, scheduler,
+                 RunBar(spec.name, progress, lambda shared: variants[shared.task.key]))
+        result = {"jobs": job_list, **_outcome(plan)}
+        result["summary"] = summarize(spec, out, seqs, job_list, protocol, plan.by_sequence)
     return result
 
 
-def _prepare(out: Path, tasks, job_list: list[Job], version: str) -> None:
-    """Before anything runs: stale temporary files removed, every result folder checked
-    writable, and ``OUT/configs/<key>.json`` written for each run key."""
-    # left by a killed run (in a run key's folder or its experiment's sub-folder); never read
-    for stale in [*(out / "jobs").glob("*/*/.*.tmp"), *(out / "jobs").glob("*/*/*/.*.tmp")]:
-        with contextlib.suppress(OSError):
-            stale.unlink()
-    by_folder: dict[Path, list[str]] = {}
-    for task in tasks:
-        by_folder.setdefault(task.folder, []).extend(ResultStore(task.folder).file_names(task.seq.name))
-    for folder, names in by_folder.items():
-        ensure_writable(folder, names, "the ablation's results")
-    ensure_writable(out / "configs", sorted({f"{j.key}.json" for j in job_list}), "the ablation's configs")
+def _write_configs(out: Path, job_list: list[Job], version: str) -> None:
+    """``OUT/configs/<key>.json`` for each run key, (re)written where missing or damaged."""
+    ensure_writable(out / CONFIGS, sorted({f"{j.key}.json" for j in job_list}), "the ablation's configs")
     for job in {j.key: j for j in job_list}.values():
-        path = out / "configs" / f"{job.key}.json"
+        path = out / CONFIGS / f"{job.key}.json"
         if (read_json(path) or {}).get("key") != job.key:  # missing or damaged: (re)write the record
             stripped = {k: v for k, v in job.config.items() if k not in LABEL_KEYS}
             atomic_write(path, json.dumps({"key": job.key, "dcfkit_version": version, "config": stripped},
                                           indent=1) + "\n")
 
 
-def _run(spec, result, todo, total, variants, jobs, executor, scheduler, progress, version) -> None:
-    """Execute ``todo`` with a progress bar in runs, recording each outcome in ``result``."""
-    from tqdm.auto import tqdm  # lazy: tqdm.auto probes for Jupyter on import
-
-    warm_up_compiled(todo)  # numba compiles here, not in the first jobs the bar times
-    bar = tqdm(total=total, initial=total - len(todo), unit="job", desc=spec.name,
-               disable=None if progress and todo else True, dynamic_ncols=True)  # None: on a terminal only
-
-    def on_result(task: RunTask, res: dict) -> None:
-        if res["status"] == "done":
-            result["done"].append((task.key, task.seq.name))
-        else:
-            result["failed"][task.key, task.seq.name] = res["error"]
-            bar.write(f"FAILED {', '.join(variants[task.key])}: {res['error']}")
-        bar.set_postfix_str(f"{variants[task.key][0]} / {task.seq.name}", refresh=False)
-        bar.update(1)
-
-    try:
-        execute(todo, on_result, jobs=jobs, executor=executor, scheduler=scheduler, version=version)
-    finally:
-        bar.close()
+def _outcome(plan: RunPlan) -> dict:
+    """``runs`` (the distinct (key, run) pairs), ``done`` and ``failed`` (tracked now), ``skipped``."""
+    pairs = list(dict.fromkeys((p.key, run.name) for p in plan.entries for run in p.runs))
+    tracked = {(s.task.key, s.task.seq.name): result for s, result in plan.tracked}
+    return {"runs": len(pairs), "done": [pair for pair, r in tracked.items() if r["status"] == "done"],
+            "skipped": [pair for pair in pairs if pair not in tracked],
+            "failed": {pair: r["error"] for pair, r in tracked.items() if r["status"] != "done"}}

@@ -337,9 +337,3 @@ def expand(spec: AblationSpec, sequences: Iterable | None = None, version: str |
     version = version if version is not None else dcfkit_version()
     keys = {v.name: run_key(v.config, version) for v in spec.variants}
     return [Job(v.name, v.config, seq, keys[v.name]) for v in spec.variants for seq in names]
-
-
-def job_dir(out: Path, dataset: str, key: str) -> Path:
-    """The result store of run ``key``: ``OUT/jobs/<dataset>/<key>/``."""
-    return out / "jobs" / dataset / key
-

@@ -6,11 +6,12 @@ import json
 import logging
 from pathlib import Path
 
-from dcfkit.ablation.experiment import cut_title, runs_dir, scope_line
+from dcfkit.ablation.experiment import cut_title, scope_line
+from dcfkit.ablation.layout import variant_folders
 from dcfkit.ablation.page import ablation_page
 from dcfkit.ablation.published import STATUS, read_published
 from dcfkit.ablation.sensitivity import plot_sensitivity, sensitivity_file
-from dcfkit.ablation.spec import AblationSpec, Job, expand, job_dir
+from dcfkit.ablation.spec import AblationSpec, Job, expand
 from dcfkit.ablation.spec_keys import data_record
 from dcfkit.analysis.latex import comparison_table
 from dcfkit.analysis.plots import plot_curves, plot_title
@@ -23,6 +24,7 @@ from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.datasets import Sequence
 from dcfkit.experiments import runs_by_sequence
 from dcfkit.protocols import DEFAULT, get_protocol
+from dcfkit.running.layout import store_folder
 from dcfkit.store.files import atomic_write, read_json
 from dcfkit.store.provenance import shared_path
 from dcfkit.store.results import ResultStore
@@ -76,14 +78,15 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     jobs = jobs if jobs is not None else expand(spec, sequences)
     keys = {j.variant: j.key for j in jobs}
     runs = runs if runs is not None else runs_by_sequence(sequences, spec.experiment)
-    status, stored = _stored_runs(spec, out, runs, jobs)
-    results = {variant: stored[key] for variant, key in keys.items()}
+    folders = variant_folders(spec, output_names(spec))
+    status, stored = _stored_runs(spec, out, runs, jobs, folders)
+    results = {variant: stored[variant] for variant in keys}
     published = read_published(spec.published, sequences)
     with _quiet(logging.getLogger("dcfkit.analysis.scoring")):  # missing runs are counted in 'failed'
         scores = evaluate({**results, **published}, sequences, protocol=protocol, experiment=spec.experiment,
                           runs=runs)
     protocol = scores.protocol
-    states = {(v, s.name): status[key, s.name] for v, key in keys.items() for s in sequences}
+    states = {(v, s.name): status[v, s.name] for v in keys for s in sequences}
     states.update({(name, s.name): (STATUS if s.name in found else "missing", None)
                    for name, found in published.items() for s in sequences})
     overall, per_sequence = _rows(scores, {**keys, **dict.fromkeys(published, STATUS)}, sequences, states, protocol)
@@ -91,12 +94,12 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
     baseline = spec.grid.base if spec.grid is not None and spec.grid.base in keys else variants[0]
     statistics = versus_baseline(scores.per_sequence, variants, (protocol.rank_key, "precision"), baseline)
     job_rows = [{"variant": j.variant, "sequence": j.sequence, "key": j.key,
-                 "status": status[j.key, j.sequence][0], "error": status[j.key, j.sequence][1]} for j in jobs]
+                 "status": status[j.variant, j.sequence][0], "error": status[j.variant, j.sequence][1]} for j in jobs]
     info = {"spec": shared_path(spec.path, out), "name": spec.name, "description": spec.description,
             "protocol": protocol_record(scores.protocol), "experiment": spec.experiment,
             "max_frames": spec.max_frames, "scope": scope_line(spec.experiment, protocol.name, spec.max_frames),
             "fps_note": fps_note(overall, "variant"),
-            **data_record(spec, out), "sequences": [s.name for s in sequences],
+            **data_record(spec, out), "sequences": [s.name for s in sequences], "folders": folders,
             "overall": overall, "per_sequence": per_sequence, "statistics": statistics, "jobs": job_rows,
             "grid": ({"base": spec.grid.base, "mode": spec.grid.mode,
                       "parameters": {k: {"label": lab, "values": vals}
@@ -111,19 +114,23 @@ def summarize(spec: AblationSpec, out, sequences: list, jobs: list[Job] | None =
             "files": files, "protocol": protocol, "scope": info["scope"], "fps_note": info["fps_note"]}
 
 
-def _stored_runs(spec: AblationSpec, out: Path, runs: dict[str, list[Sequence]], jobs: list[Job]
-                 ) -> tuple[dict, dict]:
-    """``status[key, sequence]`` = (status, error) and ``stored[key]`` = the intact results (run
-    name -> result) of the sequences whose every run is done."""
+def _stored_runs(spec: AblationSpec, out: Path, runs: dict[str, list[Sequence]], jobs: list[Job],
+                 folders: dict[str, str]) -> tuple[dict, dict]:
+    """``status[variant, sequence]`` = (status, error) and ``stored[variant]`` = the intact results
+    (run name -> result) of the sequences whose every run is done, read from each variant's
+    folder (``folders``: :func:`~dcfkit.ablation.layout.variant_folders`)."""
     status: dict[tuple[str, str], tuple[str, str | None]] = {}
     stored: dict[str, dict] = {}
-    for key in dict.fromkeys(j.key for j in jobs):
-        folder = runs_dir(job_dir(out, spec.dataset, key), spec.experiment)
-        names = list(dict.fromkeys(j.sequence for j in jobs if j.key == key))
+    by_variant: dict[str, list[Job]] = {}
+    for job in jobs:
+        by_variant.setdefault(job.variant, []).append(job)
+    for variant, found in by_variant.items():
+        folder = store_folder(out, folders[variant], spec.experiment)
+        names = list(dict.fromkeys(j.sequence for j in found))
         for name in names:
-            status[key, name] = _status(folder, key, runs[name])
-        done = [run for n in names if status[key, n][0] == "done" for run in runs[n]]
-        stored[key] = ResultStore(folder).load(done) if done else {}
+            status[variant, name] = _status(folder, found[0].key, runs[name])
+        done = [run for n in names if status[variant, n][0] == "done" for run in runs[n]]
+        stored[variant] = ResultStore(folder).load(done) if done else {}
     return status, stored
 
 

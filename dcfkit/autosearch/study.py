@@ -18,6 +18,7 @@ import numpy as np
 import optuna
 from optuna.trial import TrialState
 
+from dcfkit.ablation.layout import warn_old_layout
 from dcfkit.ablation.spec_keys import data_record, roots_text
 from dcfkit.autosearch.evaluation import Evaluator
 from dcfkit.autosearch.space import SearchSpec, active
@@ -145,7 +146,8 @@ class Search:
         seqs = scored_sequences(spec.load_sequences())  # a test split's sequence could not score a trial
         self.names = [s.name for s in seqs]
         self.folds = make_folds(self.names, spec.folds, spec.seed)
-        self.evaluator = Evaluator(self.out, spec.dataset, seqs, spec.experiments, **(evaluator_options or {}))
+        self.evaluator = Evaluator(self.out, spec.dataset, seqs, spec.experiments, **(evaluator_options or {}),
+                                   baselines=spec.baselines)
 
     def training(self, study: str) -> list[str]:
         if study == FINAL:
@@ -163,7 +165,7 @@ class Search:
         recorded = read_json(path)  # None: missing, unreadable or not an object
         if recorded is not None:
             self._check_fingerprint(path, recorded.get("fingerprint"), mine)
-        elif any((self.out / "trials").glob("*/*.json")):
+        elif any(any((self.out / "trials" / study).glob("*.json")) for study in self.studies()):
             state = "not a search record as dcfkit writes it" if path.exists() else "missing"
             raise DcfkitError(f"{path} is {state}, yet {self.out / 'trials'} holds trial records: nothing shows which "
                               f"search made them; give a new --out, or remove {self.out / 'trials'} to start again")
@@ -260,6 +262,7 @@ class Search:
     def run(self) -> dict:
         """Every study, then the held-out scores and the comparison (:mod:`dcfkit.autosearch.summary`)."""
         ensure_writable(self.out, ("search.json",), "the search")
+        warn_old_layout(self.out, "dcfkit search", "OUT/trials/<run key>/, OUT/baselines/<name>/")
         with exclusive(self.out / ".lock", "dcfkit search", f"to {self.out}"):
             self.check_record()
             studies = {study: self.run_study(study) for study in self.studies()}

@@ -63,7 +63,7 @@ def summarize(search, studies: dict[str, list[dict]]) -> dict:
         held_out.update(scores)
         folds.append({"fold": i + 1, "held_out": names, "trial": chosen["number"], "params": chosen["params"],
                       "training_auc": chosen["value"], "held_out_auc": mean_auc(scores, names)})
-    baselines = {name: ev.scores(config, search.names) for name, config in spec.baselines.items()}
+    baselines = {name: ev.scores(config, search.names, baseline=name) for name, config in spec.baselines.items()}
     comparisons = _compare(search.names, held_out, baselines)
     final = best(studies[FINAL], FINAL)
     summary = {"name": spec.name, "spec": shared_path(spec.path, search.out), "dataset": data_record(spec)["dataset"],

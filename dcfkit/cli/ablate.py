@@ -7,13 +7,12 @@ import re
 from pathlib import Path
 
 from dcfkit.ablation import expand, load_spec, run_ablation, summary_columns, variant_names
-from dcfkit.ablation.experiment import ablation_experiments, runs_dir
-from dcfkit.ablation.spec import MAX_VARIANTS, job_dir
+from dcfkit.ablation.experiment import ablation_experiments
+from dcfkit.ablation.run import ablation_plan
+from dcfkit.ablation.spec import MAX_VARIANTS
 from dcfkit.analysis.tables import format_table, statistics_lines
 from dcfkit.cli.common import add_max_frames_argument, add_protocol_argument, executor_choice, variant_count
 from dcfkit.config import shipped_config_dir
-from dcfkit.experiments import get_experiment, runs_by_sequence
-from dcfkit.store.results import ResultStore
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -22,7 +21,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec", metavar="SPEC",
                         help=f"ablation spec YAML, or a shipped one by name ({', '.join(shipped)})")
     parser.add_argument("--out", required=True, type=Path,
-                        help="results folder (OUT/jobs/..., OUT/summary.md, ...); reruns resume")
+                        help="results folder (OUT/<variant>/..., OUT/summary.md, ...); reruns resume")
     parser.add_argument("--jobs", type=int, default=None,
                         help="worker processes (default: the usable cores); with dask and no "
                              "--scheduler, the LocalCluster's workers")
@@ -49,12 +48,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _dry_run(spec, out: Path) -> int:
-    seqs, experiment = spec.load_sequences(), get_experiment(spec.experiment)
-    runs = runs_by_sequence(seqs, experiment)
+    """Each job, done or to do in its variant's folder; reads only."""
+    seqs = spec.load_sequences()
+    plan = ablation_plan(spec, out, seqs).read()
+    runs, experiment = plan.by_sequence, plan.experiment
+    todo = {p.name: {run.name for run in p.todo} for p in plan.entries}
+    folders = dict(zip((v.name for v in spec.variants), (p.name for p in plan.entries)))
     jobs = expand(spec, seqs)
     for job in jobs:
-        store = ResultStore(runs_dir(job_dir(out, spec.dataset, job.key), spec.experiment))
-        done = sum(store.status(run, job.key) == "done" for run in runs[job.sequence])
+        done = sum(run.name not in todo[folders[job.variant]] for run in runs[job.sequence])
         state = "done" if done == len(runs[job.sequence]) else "todo"
         count = f" ({done} of {len(runs[job.sequence])} {spec.experiment} runs done)" if experiment.folder else ""
         print(f"{state}  {job.key}  {job.variant}  {job.sequence}{count}")

@@ -18,7 +18,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec", metavar="SPEC",
                         help=f"search spec YAML, or a shipped one by name ({', '.join(shipped)})")
     parser.add_argument("--out", required=True, type=Path,
-                        help="search folder (OUT/trials/..., OUT/jobs/..., OUT/summary.md, OUT/best.yaml); "
+                        help="search folder (OUT/trials/..., OUT/baselines/..., OUT/summary.md, OUT/best.yaml); "
                              "reruns resume, with more --trials if given")
     parser.add_argument("--root", type=Path, action="append", default=None,
                         help="benchmark root folder (default: the spec's dataset.root, relative to the spec); "

@@ -1,10 +1,12 @@
-"""Claims on the runs of a results folder: two evaluations never write the same run, while runs
-on other sequences of one folder may go on alongside, and whatever the number of runs an
-evaluation holds two open files at most (docs/evaluation.md, "Running").
+"""Claims on the runs of results folders: two commands never write the same run, while runs
+on other sequences of one folder may go on alongside, and whatever the number of runs and
+folders a command holds two open files at most (docs/evaluation.md, "Running").
 
-``FOLDER/.locks/<owner>.claims`` lists the runs an evaluation writes and ``<owner>.lock``, which
-it holds (``flock``) until it ends, says it still runs: a killed one's claims lapse with its
-lock. ``.locks/.guard`` is held only while claims are checked and made.
+``FOLDER/.locks/<owner>.claims`` lists the runs a command writes there and ``<owner>.lock``,
+which it holds (``flock``) until it ends, says it still runs: a killed one's claims lapse with
+its lock. The locks of one command in several folders are hard links to one file (a lock is
+the file's, whichever name opens it), so an ablation of a thousand variants holds one.
+``.locks/.guard`` is held only while claims are checked and made.
 """
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ import logging
 import os
 import secrets
 from pathlib import Path
-from typing import Callable, Iterable
+from typing import Callable, Iterable, Mapping
 
 from dcfkit.errors import DcfkitError
 
@@ -34,37 +36,73 @@ def claimed(folder: Path, names: Iterable[str], command: str, what: Callable[[st
     live ``command`` holds one of them, naming it with ``what(name)``. Where no lock can be
     taken (not POSIX, a read-only folder, a file system without ``flock``) the run goes on
     unclaimed, with a warning."""
+    with claimed_folders({Path(folder): (names, what)}, command):
+        yield
+
+
+@contextlib.contextmanager
+def claimed_folders(claims: Mapping[Path, tuple[Iterable[str], Callable[[str], str]]], command: str):
+    """:func:`claimed` for several folders at once: ``{folder: (names, what)}``, each folder's
+    claims checked and made in turn (none held if one is refused), one lock held for all."""
     if fcntl is None:
         yield
         return
-    locks = Path(folder) / ".locks"
-    mine, held, names = locks / f"{os.getpid()}-{secrets.token_hex(4)}", None, set(names)
+    owner = _Owner(f"{os.getpid()}-{secrets.token_hex(4)}")
     try:
-        with contextlib.suppress(FileExistsError):
-            locks.mkdir()
-        # read-only: flock needs no write access, so another user's guard serves too
-        with open(os.open(locks / ".guard", os.O_RDONLY | os.O_CREAT, 0o666)) as guard:
-            fcntl.flock(guard, fcntl.LOCK_EX)  # brief: held by others only while they claim
-            _check_claims(locks, names, command, what)
-            held = open(mine.with_suffix(LOCK), "a+")
-            fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            mine.with_suffix(CLAIMS).write_text(json.dumps(sorted(names)), encoding="utf-8")
-    except OSError as exc:
-        if held is not None:
-            held.close()
-        log.warning("cannot create the lock %s (%s): running without it", exc.filename or mine.with_suffix(LOCK),
-                    exc.strerror)
-        yield
-        return
-    try:
+        for folder, (names, what) in claims.items():
+            owner.claim(Path(folder) / ".locks", set(names), command, what)
         yield
     finally:
-        for end in (CLAIMS, LOCK):
-            with contextlib.suppress(OSError):
-                mine.with_suffix(end).unlink()
-        held.close()
+        owner.release()
 
 
+class _Owner:
+    """This process's claims: the files it made in each ``.locks`` and the lock files it holds
+    open (one, unless a folder's file system takes no hard link to it)."""
+
+    def __init__(self, name: str):
+        self.name, self.made, self.held = name, [], []
+
+    def claim(self, locks: Path, names: set[str], command: str, what: Callable[[str], str]) -> None:
+        """Check ``locks``'s claims, then lock and claim ``names`` there; a warning, and the
+        folder unclaimed, if a lock cannot be made there."""
+        mine = locks / self.name
+        try:
+            with contextlib.suppress(FileExistsError):
+                locks.mkdir()
+            # read-only: flock needs no write access, so another user's guard serves too
+            with open(os.open(locks / ".guard", os.O_RDONLY | os.O_CREAT, 0o666)) as guard:
+                fcntl.flock(guard, fcntl.LOCK_EX)  # brief: held by others only while they claim
+                _check_claims(locks, names, command, what)
+                self._lock(mine.with_suffix(LOCK))
+                self.made.append(mine.with_suffix(CLAIMS))
+                mine.with_suffix(CLAIMS).write_text(json.dumps(sorted(names)), encoding="utf-8")
+        except OSError as exc:
+            log.warning("cannot create the lock %s (%s): running without it", exc.filename or mine.with_suffix(LOCK),
+                        exc.strerror)
+
+    def _lock(self, path: Path) -> None:
+        """Hold a lock at ``path``: a hard link to the one held, else a file of its own."""
+        if self.held:
+            with contextlib.suppress(OSError):  # another file system, or none that links: a lock of its own
+                os.link(self.held[0].name, path)
+                self.made.append(path)
+                return
+        handle = open(path, "a+")
+        self.made.append(path)
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            handle.close()
+            raise
+        self.held.append(handle)
+
+    def release(self) -> None:
+        """Remove the claims, then the locks made (a claim never outlives its lock), then let go
+        of the locks held."""
+        _remove(*sorted(self.made, key=lambda path: path.suffix != CLAIMS))
+        for handle in self.held:
+            handle.close()
 def _check_claims(locks: Path, names: set[str], command: str, what: Callable[[str], str]) -> None:
     """Raise if an owner in ``locks`` that is alive, or whose lock cannot be read (another
     user's, or something else in its place), claims one of ``names``; remove dead ones' claims."""

@@ -19,7 +19,8 @@ PACKAGE = Path(__file__).resolve().parents[1]
 # record where results came from; everything else (tracker, components, numerics, config
 # parsing, datasets, experiments, the frame loop, the box file format, ...) is in the digest
 NOT_BOX_CODE = ("_build_hook.py", "ablation", "analysis", "autosearch", "cli", "configs",
-                "running/evaluation.py", "running/scheduler.py", "store/__init__.py", "store/claims.py",
+                "running/checks.py", "running/evaluation.py", "running/layout.py", "running/plan.py",
+                "running/progress.py", "running/scheduler.py", "store/__init__.py", "store/claims.py",
                 "store/code_state.py", "store/platforms.py", "store/provenance.py", "store/results.py",
                 "store/timing.py")
 CODE_FILES = (".py", ".tsv")  # sources and the tables they read; configs enter the key resolved

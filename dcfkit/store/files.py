@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import glob
 import hashlib
 import json
 import logging
@@ -81,11 +80,16 @@ def ensure_writable(folder: Path, names: Iterable[str] = (), what: str = "result
 
 
 def remove_temporary_files(folder: Path, names: Iterable[str]) -> None:
-    """Remove what a killed run left of writing ``folder/<name>`` (never read)."""
-    for name in names:
-        for stale in folder.glob(f".{glob.escape(name)}.*.tmp"):
+    """Remove what a killed run left of writing ``folder/<name>`` (never read): the
+    ``.<name>.<random>.tmp`` files of :func:`atomic_write`, the folder listed once."""
+    names = set(names)
+    with contextlib.suppress(OSError):
+        with os.scandir(folder) as found:
+            stale = [entry.path for entry in found if entry.name.startswith(".") and entry.name.endswith(".tmp")
+                     and entry.name[1:-4].rpartition(".")[0] in names]
+        for path in stale:
             with contextlib.suppress(OSError):
-                stale.unlink()
+                os.unlink(path)
 
 
 @contextlib.contextmanager

@@ -25,6 +25,7 @@ import numpy as np
 from dcfkit.datasets import DatasetError, Sequence, read_boxes
 from dcfkit.errors import clip, shown
 from dcfkit.store.files import (
+    StoreError,
     atomic_write,
     checksum,
     format_boxes,
@@ -202,6 +203,24 @@ class ResultStore:
                 stale.unlink()
         make_dir(self.folder)
         atomic_write(self.error_path(seq.name), json.dumps(record, indent=1, default=json_default) + "\n")
+
+    def copy_run(self, source: "ResultStore", name: str) -> None:
+        """Make run ``name`` here what it is in ``source`` (the same run key's run, made once for
+        both), file by file as :meth:`write` and :meth:`write_failure` order them: the sidecar
+        removed first and written last, each file written whole; a file ``source`` lacks, removed."""
+        with contextlib.suppress(FileNotFoundError):
+            self.sidecar_path(name).unlink()
+        make_dir(self.folder)
+        for path in (*self._written(name), self.error_path(name), self.sidecar_path(name)):
+            try:
+                data = (source.folder / path.name).read_bytes()
+            except FileNotFoundError:
+                with contextlib.suppress(FileNotFoundError):
+                    path.unlink()
+                continue
+            except OSError as exc:
+                raise StoreError(f"cannot read {clip(str(source.folder / path.name))}: {exc.strerror}") from None
+            atomic_write(path, data)
 
     def load(self, sequences: Iterable[Sequence | str]) -> dict[str, SequenceResult]:
         """Intact results for ``sequences`` (names or :class:`Sequence`); others (not run,

@@ -240,7 +240,7 @@ def test_cli_names_the_variants_of_a_failed_run(tmp_path, data, capsys):
 def done_sidecars(out: Path) -> dict[Path, tuple]:
     """Sidecars of finished runs -> (inode, mtime_ns, content)."""
     return {p: (p.stat().st_ino, p.stat().st_mtime_ns, p.read_bytes())
-            for p in out.glob("jobs/*/*/*.json")}
+            for p in out.glob("*/*.json") if p.parent.name != "configs"}
 
 
 def children(pid: int) -> list[int]:
@@ -347,6 +347,7 @@ grid: {base: dr2, parameters: {label.mu: [0, 0.5]}}
     assert f"{total - len(before)} run, {len(before)} already done, 0 failed" in rerun.stdout
     after = done_sidecars(out)
     assert len(after) == total
+    keys = {j.variant: j.key for j in expand(load_spec(spec))}
     for path, state in before.items():  # not rewritten: same file, same time, same content
         assert after[path] == state, path
     assert not list(out.rglob("*.tmp"))  # temporary files of the killed run are gone, never read
@@ -354,9 +355,10 @@ grid: {base: dr2, parameters: {label.mu: [0, 0.5]}}
         meta = json.loads(side.read_text())
         boxes = read_boxes(side.with_suffix(".txt"))
         assert meta["frames"] == len(boxes) == N_FRAMES and len(meta["times"]) == N_FRAMES
-        assert meta["run_key"] == side.parent.name
+        assert meta["run_key"] == keys[side.parent.name]  # OUT/<variant>/, the variant's run key
     summary = json.loads((out / "summary.json").read_text())
     assert [r["variant"] for r in summary["overall"]] == ["dr2", "strcf", "label.mu=0", "label.mu=0.5"]
+    assert summary["folders"] == {v: v for v in keys}
     assert all(r["failed"] == 0 and 0 <= r["precision"] <= 1 for r in summary["overall"])
     assert summary["protocol"]["name"] == "otb"
     stats = summary["statistics"]  # every variant against the grid's base, Holm across the three
@@ -385,9 +387,9 @@ variants: {s: {config: strcf, overrides: {scale.n_scales: 3}}}
     assert sorted(res["done"]) == [(key, "seqA"), (key, "seqC")]
     assert list(res["failed"]) == [(key, "seqB")]
     assert "0005.jpg" in res["failed"][key, "seqB"] and "not a readable image" in res["failed"][key, "seqB"]
-    record = json.loads((out / "jobs" / "otb" / key / "seqB.error").read_text())
+    record = json.loads((out / "s" / "seqB.error").read_text())
     assert record["frame"] == 5 and record["frame_file"] == str(broken.resolve())
-    assert not (out / "jobs" / "otb" / key / "seqB.txt").exists()
+    assert not (out / "s" / "seqB.txt").exists()
     rows = {r["sequence"]: r for r in res["summary"]["per_sequence"]}
     assert [rows[s]["status"] for s in ("seqA", "seqB", "seqC")] == ["done", "failed", "done"]
     assert res["summary"]["overall"][0]["failed"] == 1
@@ -404,7 +406,7 @@ variants: {s: {config: strcf, overrides: {scale.n_scales: 3}}}
     tracker = load_tracker("strcf", overrides={"scale.n_scales": 3})
     tracker.init(seq.frame(0), seq.init_box)
     direct = np.array([seq.init_box] + [tracker.update(seq.frame(i)) for i in range(1, len(seq))])
-    stored = read_boxes(out / "jobs" / "otb" / key / "seqA.txt")
+    stored = read_boxes(out / "s" / "seqA.txt")
     np.testing.assert_allclose(stored, direct, atol=5e-4)
 
     # a rerun retries the failure only
@@ -429,7 +431,7 @@ variants:
         dask = run_ablation(spec, tmp_path / "dask", executor="dask", scheduler=cluster.scheduler_address,
                             progress=False)
     assert len(local["done"]) == len(dask["done"]) == 4 and not local["failed"] and not dask["failed"]
-    files = sorted(p.relative_to(tmp_path / "local") for pattern in ("jobs/*/*/*.txt", "jobs/*/*/*.confidence")
+    files = sorted(p.relative_to(tmp_path / "local") for pattern in ("*/*.txt", "*/*.confidence")
                    for p in (tmp_path / "local").glob(pattern))  # the boxes and the confidence; timings differ
     assert len(files) == 8
     for rel in files:
@@ -456,9 +458,9 @@ def test_a_second_run_on_the_same_folder_is_refused(tmp_path, data):
         fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
         with pytest.raises(DcfkitError, match="another `dcfkit ablate` is writing to"):
             run_ablation(spec, out, jobs=1, progress=False)
-    assert not (out / "jobs").exists()
-    (out / "jobs").write_text("")  # a file where the job folders go: refused before anything runs
-    with pytest.raises(DcfkitError, match=r"cannot create the folder .*jobs"):
+    assert not (out / "s").exists()
+    (out / "s").write_text("")  # a file where the variant's folder goes: refused before anything runs
+    with pytest.raises(DcfkitError, match=r"cannot create the folder .*/s\b"):
         run_ablation(spec, out, jobs=1, progress=False)
 
 
@@ -468,7 +470,7 @@ def test_a_damaged_run_is_not_scored_and_is_recomputed(tmp_path, data):
     out = tmp_path / "out"
     first = run_ablation(spec, out, jobs=1, progress=False)
     key = expand(spec)[0].key
-    txt = out / "jobs" / "otb" / key / "seqB.txt"
+    txt = out / "s" / "seqB.txt"
     good = txt.read_bytes()
     txt.write_bytes(good[:-6])  # truncate -s -6: the last height loses its decimals
     summary = ablation.summarize(spec, out, spec.load_sequences())
@@ -494,7 +496,7 @@ def test_eval_and_ablate_key_a_run_alike(tmp_path, data):
     assert json.loads((tmp_path / "eval" / "my-strcf" / "seqA.json").read_text())["run_key"] == job.key
 
 
-@pytest.mark.parametrize("in_the_way", ["jobs/otb/{key}/seqB.json", "precision.png", "configs/{key}.json"])
+@pytest.mark.parametrize("in_the_way", ["s/seqB.json", "precision.png", "configs/{key}.json"])
 def test_a_folder_where_an_ablation_file_goes_is_refused_before_tracking(tmp_path, data, in_the_way, monkeypatch):
     spec = load_spec(write_spec(tmp_path / "spec.yaml", "dataset: {name: otb, root: data}\nsequences: [seqA, seqB]\n"
                                                         "variants: {s: {config: strcf}}\n"))
@@ -510,7 +512,7 @@ def test_an_unwritable_job_folder_is_refused_before_tracking(tmp_path, data, mon
 
     spec = load_spec(write_spec(tmp_path / "spec.yaml", "dataset: {name: otb, root: data}\nsequences: [seqA]\n"
                                                         "variants: {s: {config: strcf}}\n"))
-    folder = tmp_path / "out" / "jobs" / "otb" / expand(spec)[0].key
+    folder = tmp_path / "out" / "s"
     folder.mkdir(parents=True)
     real = tempfile.mkstemp
 
@@ -529,7 +531,7 @@ def test_a_smoke_ablation_never_replaces_the_full_results(tmp_path, data, capsys
     spec = str(write_spec(tmp_path / "spec.yaml", "dataset: {name: otb, root: data}\nvariants: {k: {config: kcf}}\n"))
     base = ["ablate", spec, "--out", str(tmp_path / "out"), "--sequences", "seqA", "--jobs", "1", "--no-progress"]
     assert cli.main(base) == 0
-    (full,) = (tmp_path / "out" / "jobs").glob("*/*/seqA.txt")
+    (full,) = (tmp_path / "out").glob("*/seqA.txt")
     before = full.read_bytes()
     capsys.readouterr()
     assert cli.main(base + ["--max-frames", "5"]) != 0

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_ablation import done_sidecars, write_otb
+from test_ablation import write_otb
 
 from dcfkit import cli
 from dcfkit.ablation import load_spec
@@ -51,6 +51,19 @@ def data(tmp_path):
     for i, name in enumerate(("seqA", "seqB", "seqC", "seqD")):
         write_otb(root, name, seed=i, n_frames=8)
     return root
+
+
+STUDIES = ("fold1", "fold2", "all")  # SPEC's: two folds, then the final study
+
+
+def records(out: Path) -> list[Path]:
+    """The trial records, OUT/trials/<study>/<n>.json."""
+    return sorted(p for study in STUDIES for p in (out / "trials" / study).glob("*.json"))
+
+
+def trial_runs(out: Path) -> list[Path]:
+    """The sidecars of the trials' finished runs, OUT/trials/<run key>/<sequence>.json."""
+    return [p for p in out.glob("trials/*/*.json") if p.parent.name not in STUDIES]
 
 
 def write(path: Path, text: str) -> Path:
@@ -238,7 +251,7 @@ def test_a_search_scores_each_folds_choice_on_the_sequences_it_never_saw(tmp_pat
         training = [n for n in seqs if n not in fold["held_out"]]
         assert set(chosen["scores"]) == set(training)  # judged on the other fold only
         # the held-out score is the chosen config's, scored independently from its stored runs
-        store = ResultStore(tmp_path / "out/jobs/otb" / chosen["key"])
+        store = ResultStore(tmp_path / "out/trials" / chosen["key"])
         held = [seqs[n] for n in fold["held_out"]]
         again = evaluate({"t": store.load(held)}, held)
         assert fold["held_out_auc"] == pytest.approx(np.mean([r["auc"] for r in again.per_sequence]))
@@ -253,13 +266,13 @@ def test_a_rerun_resumes_and_more_trials_extend_the_studies(tmp_path, data, caps
     spec = write(tmp_path / "s.yaml", SPEC.replace("trials: 3", "trials: 2"))
     out = tmp_path / "out"
     assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1"]) == 0
-    first = {p.relative_to(out): p.read_bytes() for p in out.glob("trials/*/*.json")}
+    first = {p.relative_to(out): p.read_bytes() for p in records(out)}
     assert len(first) == 3 * 2
     (out / "trials/fold2/0001.json").unlink()  # as a kill before the trial was recorded
     damaged = json.loads((out / "trials/fold1/0001.json").read_text())  # an edited record is run again
     (out / "trials/fold1/0001.json").write_text(json.dumps({**damaged, "params": {"solver.iterations": 99}}))
     assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1", "--trials", "3"]) == 0
-    again = {p.relative_to(out): p.read_bytes() for p in out.glob("trials/*/*.json")}
+    again = {p.relative_to(out): p.read_bytes() for p in records(out)}
     assert len(again) == 3 * 3
     assert {k: again[k] for k in first} == first  # the same trials, the lost one redone the same
     capsys.readouterr()
@@ -277,9 +290,9 @@ def test_experiments_on_the_command_line_replace_the_specs_and_are_recorded(tmp_
     assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1", "--experiments", "ope"]) == 0
     rec = json.loads((out / "trials/all/0000.json").read_text())
     seqs = load_dataset("otb", data)
-    scored = evaluate({"t": ResultStore(out / "jobs/otb" / rec["key"]).load(seqs)}, seqs)
+    scored = evaluate({"t": ResultStore(out / "trials" / rec["key"]).load(seqs)}, seqs)
     assert rec["value"] == pytest.approx(np.mean([r["auc"] for r in scored.per_sequence]))
-    assert not (out / "jobs/otb" / rec["key"] / "tre").exists()  # the spec's TRE was not run
+    assert not (out / "trials" / rec["key"] / "tre").exists()  # the spec's TRE was not run
     capsys.readouterr()
     assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1"]) != 0  # the spec's tre
     assert "these differ: experiments" in capsys.readouterr().err
@@ -296,7 +309,7 @@ def test_a_search_killed_with_sigkill_resumes_to_the_same_result(tmp_path, data)
     proc = subprocess.Popen([*cmd, "--out", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         deadline = time.monotonic() + 120
-        while len(done_sidecars(out)) < 3 and proc.poll() is None and time.monotonic() < deadline:
+        while len(trial_runs(out)) < 3 and proc.poll() is None and time.monotonic() < deadline:
             time.sleep(0.01)
         proc.send_signal(signal.SIGKILL)  # mid-trial: some of its runs stored, its record not written
     finally:
@@ -304,7 +317,40 @@ def test_a_search_killed_with_sigkill_resumes_to_the_same_result(tmp_path, data)
         proc.wait()
     assert proc.returncode == -signal.SIGKILL and not (out / "summary.json").exists()
     subprocess.run([*cmd, "--out", str(out)], check=True, capture_output=True, timeout=300)
-    for path in (tmp_path / "whole").glob("trials/*/*.json"):
+    for path in records(tmp_path / "whole"):
         assert (out / path.relative_to(tmp_path / "whole")).read_bytes() == path.read_bytes(), path
     whole, again = (json.loads((d / "summary.json").read_text()) for d in (tmp_path / "whole", out))
     assert again == {**whole, "spec": again["spec"]}
+
+
+def test_trials_of_one_config_share_their_runs_and_a_baseline_has_its_own_folder(tmp_path, data, monkeypatch,
+                                                                                   capsys):
+    from test_evaluation import DriftTracker  # a fake tracker: the runs it makes are counted
+
+    from dcfkit.autosearch.evaluation import Evaluator
+    from dcfkit.running import runner
+
+    made = []
+    monkeypatch.setattr(runner, "_warm_up", lambda task: None)
+    monkeypatch.setattr(runner, "load_dcfkit_tracker", lambda config: made.append(config) or DriftTracker(config))
+    out, names = tmp_path / "out", ["seqA", "seqB"]
+    evaluator = Evaluator(out, "otb", load_dataset("otb", data), ["ope"], jobs=1, baselines=["KCF"])
+    config = load_config("kcf")
+    first = evaluator.scores(config, names)
+    assert len(made) == 2 and sorted(p.name for p in (out / "trials" / evaluator.key(config)).glob("*.txt")) == [
+        "seqA.txt", "seqB.txt"]  # OUT/trials/<run key>/
+    assert evaluator.scores({**config, "name": "trial 7"}, names) == first and len(made) == 2  # its runs reused
+    assert evaluator.scores(config, names, baseline="KCF") == first and len(made) == 4
+    assert sorted(p.name for p in (out / "baselines" / "KCF").glob("*.txt")) == ["seqA.txt", "seqB.txt"]
+    assert cli.main(["compare", str(out / "trials" / evaluator.key(config)), str(out / "baselines" / "KCF"),
+                     "--dataset", "otb", "--root", str(data)]) == 0  # eval's layout: compare reads it
+
+
+def test_a_search_warns_once_of_runs_in_the_old_layout(tmp_path, data, caplog):
+    spec = load_search_spec(write(tmp_path / "s.yaml", SPEC.replace("trials: 3", "trials: 1")))
+    (tmp_path / "out" / "jobs" / "otb").mkdir(parents=True)  # as dcfkit 0.10 kept a search's runs
+    with caplog.at_level("WARNING"):
+        Search(spec, tmp_path / "out", {"jobs": 1}).run()
+    said = [r.getMessage() for r in caplog.records if "old layout" in r.getMessage()]
+    assert len(said) == 1 and "OUT/trials/<run key>/, OUT/baselines/<name>/" in said[0]
+    assert (tmp_path / "out" / "baselines" / "KCF").is_dir()

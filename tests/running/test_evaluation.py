@@ -21,7 +21,7 @@ from dcfkit.datasets import DatasetError, Sequence, load_dataset
 from dcfkit.errors import ConfigError, DcfkitError
 from dcfkit.integrations.opencv import OpenCVUnavailable, available_opencv_trackers, opencv_tracker
 from dcfkit.registry import PluginWarning
-from dcfkit.running import evaluation, runner
+from dcfkit.running import runner
 from dcfkit.store import provenance, results
 from dcfkit.store import files as store_files
 from dcfkit.running.evaluation import run_one_pass
@@ -271,8 +271,11 @@ def test_default_trackers_are_warmed_up_once_per_process_and_config(tmp_path, se
 
 def test_compiled_code_is_warmed_up_before_the_progress_bar_starts(tmp_path, seqs, monkeypatch):
     """A first run that compiles numba's kernels made the first time-left estimate ten times too
-    long: one throw-away run per solver comes before eval's bar (ablate's _run calls the same)."""
+    long: one throw-away run per solver comes before eval's bar (every run plan's execute does it)."""
     import tqdm.auto
+
+    from dcfkit.running.plan import Entry, RunPlan
+    from dcfkit.running.progress import FrameBar
 
     events = []
     monkeypatch.setattr(runner, "_warmed_up", set())
@@ -281,12 +284,12 @@ def test_compiled_code_is_warmed_up_before_the_progress_bar_starts(tmp_path, seq
     real_bar = tqdm.auto.tqdm
     monkeypatch.setattr(tqdm.auto, "tqdm", lambda *a, **k: events.append("bar") or real_bar(*a, **k))
     configs = [{**CONFIG, "solver": {"name": name}, "drift": d} for name, d in (("a", 1.0), ("a", 2.0), ("b", 3.0))]
-    (tmp_path / "x").mkdir()
-    tasks = [runner.RunTask(c, s, tmp_path / "x", provenance.run_key(c)) for c in configs for s in seqs]
-    evaluation._run({"tracker": "t", "done": [], "failed": {}}, tasks, 1, True, provenance.dcfkit_version())
+    plan = RunPlan([Entry(f"t{i}", c) for i, c in enumerate(configs)], seqs, "ope", tmp_path)
+    plan.run("dcfkit eval", progress=FrameBar("t"))
     first_bar = events.index("bar")
     assert events[:first_bar] == [("tracker", {"name": "a"}), ("tracker", {"name": "b"})]  # one per solver
-    assert events.count("bar") == 1 and len(events) == 1 + 2 + 1 + len(tasks)  # drift 2.0: its own warm-up, later
+    tasks = len(configs) * len(seqs)
+    assert events.count("bar") == 1 and len(events) == 1 + 2 + 1 + tasks  # drift 2.0: its own warm-up, later
 
 
 def test_crash_mid_sequence_leaves_no_partial_result(tmp_path, seqs):

@@ -195,7 +195,8 @@ variants:
     latex = (tmp_path / "out" / "summary.tex").read_text()  # the variants compared, as a paper's table
     assert latex.startswith("\\begin{table*}") and r"\caption{Ablation tre. Experiment TRE (" in latex
     assert "Variant & Mean [CI] & $\\Delta$ [CI] & $p$ & W/T/L" in latex and "difference from kcf" in latex
-    assert len(list((tmp_path / "out" / "jobs").glob(f"otb/*/tre/seqA_{runs:03d}.json"))) == 2
+    assert len(list((tmp_path / "out").glob(f"*/tre/seqA_{runs:03d}.json"))) == 2
+    assert (tmp_path / "out" / "kcf" / "tre" / f"seqA_{runs:03d}.json").is_file()  # OUT/<variant>/tre/, as eval's
     bad = write_spec(tmp_path / "bad.yaml", "name: x\ndataset: otb\nexperiment: reset\nvariants: {k: kcf}\n")
     with pytest.raises(ConfigError, match=r"bad.yaml: experiment: expected one of ope, tre, sre, got 'reset' "
                                           r"\(reset runs: dcfkit eval --experiment reset"):

@@ -3,15 +3,13 @@ from __future__ import annotations
 
 import io
 import sys
-import types
 
 import pytest
 from test_evaluation import CONFIG, Counter, seqs  # noqa: F401  (seqs: a fixture)
 
-from dcfkit.ablation import run as ablation_run
-from dcfkit.running import runner
-from dcfkit.store import provenance
 from dcfkit.running.evaluation import run_one_pass
+from dcfkit.running.plan import Entry, RunPlan
+from dcfkit.running.progress import RunBar
 
 
 class Terminal(io.StringIO):
@@ -20,14 +18,10 @@ class Terminal(io.StringIO):
 
 
 def ablate(tmp_path, seqs):  # noqa: F811
-    """ablate's runner on three fake runs (its bar counts runs)."""
-    key = provenance.run_key(CONFIG)
-    tasks = [runner.RunTask(CONFIG, s, tmp_path / "abl", key, Counter()) for s in seqs]
-    (tmp_path / "abl").mkdir(exist_ok=True)
-    result = {"done": [], "failed": {}}
-    ablation_run._run(types.SimpleNamespace(name="spec"), result, tasks, len(tasks), {key: ["v"]}, 1, "local", None,
-                      True, provenance.dcfkit_version())
-    assert len(result["done"]) == len(seqs)
+    """ablate's bar (it counts runs) on a plan of three fake runs."""
+    plan = RunPlan([Entry("v", CONFIG, Counter())], seqs, "ope", tmp_path / "abl")
+    plan.run("dcfkit ablate", progress=RunBar("spec", True, lambda shared: ["v"]))
+    assert len(plan.entries[0].done) == len(seqs)
 
 
 def evaluate(tmp_path, seqs):  # noqa: F811

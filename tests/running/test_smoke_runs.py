@@ -39,7 +39,8 @@ def test_an_ablation_smoke_run(data, tmp_path, capsys):
     (tmp_path / "spec.yaml").write_text("name: smoke\ndataset: {name: otb, root: data}\nvariants: {k: kcf}\n")
     assert cli.main(["ablate", str(tmp_path / "spec.yaml"), "--out", str(tmp_path / "out"), "--max-frames", "3",
                      "--no-progress", "--jobs", "1"]) == 0
-    (sidecar,) = [p for p in (tmp_path / "out" / "jobs").rglob("seqA.json")]
+    (sidecar,) = [p for p in (tmp_path / "out").rglob("seqA.json")]
+    assert sidecar == tmp_path / "out" / "k" / "seqA.json"  # the variant's folder, as eval's tracker folders
     assert json.loads(sidecar.read_text())["frames"] == 3
 
 
