@@ -1,6 +1,6 @@
 """Scoring one config on some sequences for a search: its runs made (or found) by a run plan
 (:mod:`dcfkit.running.plan`), then scored per sequence. A trial's config is stored as
-``OUT/trials/<run key>/[<experiment>/]``, so every trial of one config (and the fold's choice
+``OUT/runs/<run key>/[<experiment>/]``, so every trial of one config (and the fold's choice
 scored on its held-out fold) shares its runs; a baseline's as ``OUT/baselines/<name>/``; both
 in the layout ``dcfkit report`` and ``dcfkit compare`` read (docs/search.md, "Resuming")."""
 from __future__ import annotations
@@ -20,7 +20,7 @@ from dcfkit.store.results import ResultStore
 
 log = logging.getLogger(__name__)
 
-TRIALS, BASELINES = "trials", "baselines"  # OUT/trials/<run key>/, OUT/baselines/<name>/
+TRIALS, BASELINES = "runs", "baselines"  # OUT/runs/<run key>/, OUT/baselines/<name>/ (OUT/trials/ holds the studies)
 
 
 class Evaluator:

@@ -262,7 +262,7 @@ class Search:
     def run(self) -> dict:
         """Every study, then the held-out scores and the comparison (:mod:`dcfkit.autosearch.summary`)."""
         ensure_writable(self.out, ("search.json",), "the search")
-        warn_old_layout(self.out, "dcfkit search", "OUT/trials/<run key>/, OUT/baselines/<name>/")
+        warn_old_layout(self.out, "dcfkit search", "OUT/runs/<run key>/, OUT/baselines/<name>/")
         with exclusive(self.out / ".lock", "dcfkit search", f"to {self.out}"):
             self.check_record()
             studies = {study: self.run_study(study) for study in self.studies()}

@@ -62,8 +62,8 @@ def records(out: Path) -> list[Path]:
 
 
 def trial_runs(out: Path) -> list[Path]:
-    """The sidecars of the trials' finished runs, OUT/trials/<run key>/<sequence>.json."""
-    return [p for p in out.glob("trials/*/*.json") if p.parent.name not in STUDIES]
+    """The sidecars of the trials' finished runs, OUT/runs/<run key>/<sequence>.json."""
+    return list(out.glob("runs/*/*.json"))
 
 
 def write(path: Path, text: str) -> Path:
@@ -251,7 +251,7 @@ def test_a_search_scores_each_folds_choice_on_the_sequences_it_never_saw(tmp_pat
         training = [n for n in seqs if n not in fold["held_out"]]
         assert set(chosen["scores"]) == set(training)  # judged on the other fold only
         # the held-out score is the chosen config's, scored independently from its stored runs
-        store = ResultStore(tmp_path / "out/trials" / chosen["key"])
+        store = ResultStore(tmp_path / "out/runs" / chosen["key"])
         held = [seqs[n] for n in fold["held_out"]]
         again = evaluate({"t": store.load(held)}, held)
         assert fold["held_out_auc"] == pytest.approx(np.mean([r["auc"] for r in again.per_sequence]))
@@ -290,9 +290,9 @@ def test_experiments_on_the_command_line_replace_the_specs_and_are_recorded(tmp_
     assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1", "--experiments", "ope"]) == 0
     rec = json.loads((out / "trials/all/0000.json").read_text())
     seqs = load_dataset("otb", data)
-    scored = evaluate({"t": ResultStore(out / "trials" / rec["key"]).load(seqs)}, seqs)
+    scored = evaluate({"t": ResultStore(out / "runs" / rec["key"]).load(seqs)}, seqs)
     assert rec["value"] == pytest.approx(np.mean([r["auc"] for r in scored.per_sequence]))
-    assert not (out / "trials" / rec["key"] / "tre").exists()  # the spec's TRE was not run
+    assert not (out / "runs" / rec["key"] / "tre").exists()  # the spec's TRE was not run
     capsys.readouterr()
     assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1"]) != 0  # the spec's tre
     assert "these differ: experiments" in capsys.readouterr().err
@@ -337,12 +337,12 @@ def test_trials_of_one_config_share_their_runs_and_a_baseline_has_its_own_folder
     evaluator = Evaluator(out, "otb", load_dataset("otb", data), ["ope"], jobs=1, baselines=["KCF"])
     config = load_config("kcf")
     first = evaluator.scores(config, names)
-    assert len(made) == 2 and sorted(p.name for p in (out / "trials" / evaluator.key(config)).glob("*.txt")) == [
-        "seqA.txt", "seqB.txt"]  # OUT/trials/<run key>/
+    assert len(made) == 2 and sorted(p.name for p in (out / "runs" / evaluator.key(config)).glob("*.txt")) == [
+        "seqA.txt", "seqB.txt"]  # OUT/runs/<run key>/
     assert evaluator.scores({**config, "name": "trial 7"}, names) == first and len(made) == 2  # its runs reused
     assert evaluator.scores(config, names, baseline="KCF") == first and len(made) == 4
     assert sorted(p.name for p in (out / "baselines" / "KCF").glob("*.txt")) == ["seqA.txt", "seqB.txt"]
-    assert cli.main(["compare", str(out / "trials" / evaluator.key(config)), str(out / "baselines" / "KCF"),
+    assert cli.main(["compare", str(out / "runs" / evaluator.key(config)), str(out / "baselines" / "KCF"),
                      "--dataset", "otb", "--root", str(data)]) == 0  # eval's layout: compare reads it
 
 
@@ -352,5 +352,5 @@ def test_a_search_warns_once_of_runs_in_the_old_layout(tmp_path, data, caplog):
     with caplog.at_level("WARNING"):
         Search(spec, tmp_path / "out", {"jobs": 1}).run()
     said = [r.getMessage() for r in caplog.records if "old layout" in r.getMessage()]
-    assert len(said) == 1 and "OUT/trials/<run key>/, OUT/baselines/<name>/" in said[0]
+    assert len(said) == 1 and "OUT/runs/<run key>/, OUT/baselines/<name>/" in said[0]
     assert (tmp_path / "out" / "baselines" / "KCF").is_dir()

@@ -109,7 +109,7 @@ def test_cut_runs_are_never_taken_for_whole_ones_nor_replace_them(tmp_path):
     cut = [s.head(3) for s in whole]
     config = load_config("kcf")
     Evaluator(tmp_path / "cut", "otb", cut, ["ope"], jobs=1).scores(config, ["seqA", "seqB"])
-    runs = sorted((tmp_path / "cut").glob("trials/*/*.json"))
+    runs = sorted((tmp_path / "cut").glob("runs/*/*.json"))
     assert [json.loads(p.read_text())["frames"] for p in runs] == [3, 3]
     evaluator = Evaluator(tmp_path / "cut", "otb", whole, ["ope"], jobs=1)  # the same store, whole sequences
     evaluator.run([config], ["seqA", "seqB"])  # the cut runs are not taken: the whole ones are made
