@@ -43,7 +43,7 @@ class HookSpecs:
 # What a plugin may raise at import or registration and be skipped for: anything it raises
 # itself, an Exception or not (sys.exit(), raise KeyboardInterrupt, its own BaseException
 # subclass, GeneratorExit), since one broken plugin must not end every command; an interrupt
-# that a signal raised while it ran (Ctrl-C; SIGTERM, see dcfkit.experiments.loop) goes on.
+# that a signal raised while it ran (Ctrl-C; SIGTERM, see dcfkit.signals) goes on.
 PLUGIN_FAULTS = (BaseException,)
 INTERRUPTS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
 
