@@ -20,7 +20,7 @@ from dcfkit.store.results import ResultStore
 
 log = logging.getLogger(__name__)
 
-TRIALS, BASELINES = "runs", "baselines"  # OUT/runs/<run key>/, OUT/baselines/<name>/ (OUT/trials/ holds the studies)
+TRIAL_RUNS, BASELINES = "runs", "baselines"  # OUT/runs/<run key>/, OUT/baselines/<name>/ (OUT/trials/: the studies)
 
 
 class Evaluator:
@@ -50,7 +50,7 @@ class Evaluator:
     def _where(self, config: Mapping, baseline: str | None) -> tuple[Path, str]:
         """(the folder of the plan, the entry's name) of a trial's ``config``, or of the named ``baseline``."""
         if baseline is None:
-            return self.out / TRIALS, self.key(config)
+            return self.out / TRIAL_RUNS, self.key(config)
         return self.out / BASELINES, self.baselines.get(baseline) or folder_names([baseline])[baseline]
 
     def run(self, configs: Iterable[dict], names: list[str], baseline: str | None = None) -> list[str]:
