@@ -7,6 +7,7 @@ from typing import Any
 from dcfkit.errors import ConfigError, shown
 from dcfkit.experiments import EXPERIMENTS, get_experiment
 
+
 def ablation_experiments() -> tuple[str, ...]:
     """The experiments an ablation can run: those whose runs OTB's measures score, which its summary reads."""
     return tuple(name for name, e in EXPERIMENTS.items() if e.scoring == "otb")

@@ -14,7 +14,6 @@ reports (docs/architecture.md, "Where to add")."""
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 from typing import Callable, Iterable, Mapping
 
 from dcfkit.datasets import Sequence
@@ -24,9 +23,9 @@ from dcfkit.running.checks import check_first_boxes, check_same_dataset, say_oth
 from dcfkit.running.layout import store_folder
 from dcfkit.running.progress import Progress
 from dcfkit.running.runner import RunTask, execute, warm_up_compiled
+from dcfkit.store import provenance
 from dcfkit.store.claims import claimed_folders
 from dcfkit.store.files import ensure_writable, make_dir, remove_temporary_files
-from dcfkit.store import provenance
 from dcfkit.store.results import ResultStore
 
 

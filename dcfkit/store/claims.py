@@ -103,6 +103,8 @@ class _Owner:
         _remove(*sorted(self.made, key=lambda path: path.suffix != CLAIMS))
         for handle in self.held:
             handle.close()
+
+
 def _check_claims(locks: Path, names: set[str], command: str, what: Callable[[str], str]) -> None:
     """Raise if an owner in ``locks`` that is alive, or whose lock cannot be read (another
     user's, or something else in its place), claims one of ``names``; remove dead ones' claims."""

@@ -60,7 +60,6 @@ def test_head_keeps_a_sequence_whole_or_cuts_it():
         seq.head(0)
 
 
-
 def test_a_smoke_run_reported_without_its_cut_says_so_once(data, tmp_path, capsys):
     """dcfkit <= 0.9 warned once per result file, then said to report fewer trackers."""
     base = ["--dataset", "otb", "--root", str(data), "--no-progress"]
