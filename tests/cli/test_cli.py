@@ -197,6 +197,7 @@ def test_video_writer_draws_points_in_the_colour_of_their_tracker(tmp_path):
 
 TERMINATED_AT_FRAME_4 = """
 import os, signal, sys
+signal.signal(getattr(signal, sys.argv[1]), signal.SIG_DFL)  # as a terminal starts it, whoever started the suite
 import dcfkit.cli.track as track_command
 real = track_command.open_source
 

@@ -74,7 +74,9 @@ def test_a_non_box_is_a_failure_naming_the_frame():
 @pytest.mark.parametrize("signame", ["SIGTERM", "SIGHUP"])
 def test_termination_signals_interrupt_the_block_like_ctrl_c(signame):
     signum = getattr(signal, signame)
-    before = signal.getsignal(signum)
+    # the signal's default action, whoever started the suite (nohup ignores SIGHUP, and an
+    # ignored signal stays ignored: the next test)
+    before = signal.signal(signum, signal.SIG_DFL)
     done = []
 
     def frames():
@@ -83,11 +85,14 @@ def test_termination_signals_interrupt_the_block_like_ctrl_c(signame):
                 os.kill(os.getpid(), signum)
             yield image
 
-    with pytest.raises(Interrupted) as caught:
-        with interrupt_on_termination():
-            done.extend(steps(Stepper(), frames(), (1, 2, 3, 4)))
-    assert isinstance(caught.value, KeyboardInterrupt) and caught.value.signum == signum
-    assert len(done) == 2 and signal.getsignal(signum) == before
+    try:
+        with pytest.raises(Interrupted) as caught:
+            with interrupt_on_termination():
+                done.extend(steps(Stepper(), frames(), (1, 2, 3, 4)))
+        assert isinstance(caught.value, KeyboardInterrupt) and caught.value.signum == signum
+        assert len(done) == 2 and signal.getsignal(signum) == signal.SIG_DFL
+    finally:
+        signal.signal(signum, before)
 
 
 def test_an_ignored_sighup_stays_ignored_as_under_nohup():
