@@ -21,9 +21,8 @@ from dcfkit.analysis.tables import format_rows, statistics_lines
 from dcfkit.datasets import DatasetError, Sequence, scored_sequences
 from dcfkit.errors import ConfigError, clip
 from dcfkit.experiments import EXPERIMENTS
-from dcfkit.experiments.vot import RULES, SKIP, get_rule
+from dcfkit.experiments.vot import RULES, SKIP, get_rule, next_start
 from dcfkit.store.files import atomic_write, ensure_writable
-from dcfkit.experiments.vot import next_start
 from dcfkit.store.results import ResultStore
 
 log = logging.getLogger(__name__)

@@ -44,12 +44,9 @@ EXPERIMENTS: dict[str, Experiment] = {e.name: e for e in (
 def get_experiment(experiment: str | Experiment, protocol: str | None = None) -> Experiment:
     """The :class:`Experiment` named ``experiment`` (an Experiment passes through), bound to the
     rule ``protocol`` names if it is one of the experiment's own (:meth:`Experiment.bind`)."""
-    if isinstance(experiment, Experiment):
-        return experiment.bind(protocol) if protocol is not None else experiment
-    try:
-        found = EXPERIMENTS[str(experiment).lower()]
-    except KeyError:
-        raise DcfkitError(f"unknown experiment {shown(experiment)}; one of: {', '.join(EXPERIMENTS)}") from None
+    found = experiment if isinstance(experiment, Experiment) else EXPERIMENTS.get(str(experiment).lower())
+    if found is None:
+        raise DcfkitError(f"unknown experiment {shown(experiment)}; one of: {', '.join(EXPERIMENTS)}")
     return found.bind(protocol) if protocol is not None else found
 
 

@@ -24,9 +24,9 @@ class Experiment:
     ``plan(sequence)`` gives a sequence's runs and those left out (:class:`Plan`); ``folder`` is
     the sub-folder of a tracker's results that holds them (``""``: the tracker's folder);
     ``first_box``: whether the runs need frame 1's ground truth; ``pooled``: whether a
-    sequence's score pools several runs; ``scoring``: which of analysis's scorings reads its
-    runs (``"otb"``: OTB's success and precision; ``"reset"``: VOT's accuracy, failures and
-    EAO; :mod:`dcfkit.analysis.scorings`)."""
+    sequence's score pools several runs; ``scoring``: which scoring reads its runs (``"otb"``:
+    OTB's success and precision, :func:`dcfkit.analysis.scoring.evaluate`; ``"reset"``: VOT's
+    accuracy, failures and EAO, :mod:`dcfkit.analysis.reset_report`)."""
 
     name: str
     title: str

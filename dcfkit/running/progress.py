@@ -13,7 +13,10 @@ class Progress:
     """No bar: each hook does nothing. ``start(tasks, total)`` is called before the first run with
     the runs to track and the plan's distinct runs, ``frame()`` after each frame tracked in this
     process, ``result(shared, result)`` as each run ends (``shared``: a
-    :class:`~dcfkit.running.plan.Shared`), ``close()`` at the end, whatever happened."""
+    :class:`~dcfkit.running.plan.Shared`), ``close()`` at the end, whatever happened: it closes
+    the ``bar`` a subclass's ``start`` made."""
+
+    bar = None
 
     def start(self, tasks: list, total: int) -> None:
         pass
@@ -25,7 +28,8 @@ class Progress:
         pass
 
     def close(self) -> None:
-        pass
+        if self.bar is not None:
+            self.bar.close()
 
 
 def _bar(show: bool, tasks: list, **options):
@@ -40,7 +44,7 @@ class FrameBar(Progress):
     logged as a warning."""
 
     def __init__(self, desc: str, show: bool = True):
-        self.desc, self.show, self.bar, self.frames = desc, show, None, 0
+        self.desc, self.show, self.frames = desc, show, 0
 
     def start(self, tasks: list, total: int) -> None:
         self.bar = _bar(self.show, tasks, total=sum(len(t.seq) for t in tasks), unit="frame", desc=self.desc)
@@ -55,10 +59,6 @@ class FrameBar(Progress):
         self.bar.set_postfix_str(shared.task.seq.name, refresh=False)
         self.bar.update(self.frames - self.bar.n)  # a failed run skips its rest
 
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
-
 
 class RunBar(Progress):
     """``ablate``'s bar: the plan's distinct runs, those done before counted at the start, named
@@ -66,7 +66,7 @@ class RunBar(Progress):
     ``FAILED`` line written above the bar."""
 
     def __init__(self, desc: str, show: bool, label: Callable[[object], list[str]]):
-        self.desc, self.show, self.label, self.bar = desc, show, label, None
+        self.desc, self.show, self.label = desc, show, label
 
     def start(self, tasks: list, total: int) -> None:
         self.bar = _bar(self.show, tasks, total=total, initial=total - len(tasks), unit="job", desc=self.desc)
@@ -77,7 +77,3 @@ class RunBar(Progress):
             self.bar.write(f"FAILED {', '.join(names)}: {result['error']}")
         self.bar.set_postfix_str(f"{names[0]} / {shared.task.seq.name}", refresh=False)
         self.bar.update(1)
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
