@@ -12,7 +12,6 @@ import contextlib
 import dataclasses
 import importlib.metadata
 import os
-import signal
 import warnings
 from typing import Any, Callable, Mapping
 
@@ -22,7 +21,7 @@ from dcfkit.components.base import Component, Contract, base_of, check_contract_
 from dcfkit.contracts import checked
 from dcfkit.errors import ConfigError, DcfkitError, DcfkitWarning, RegistryError, clip, describe_error, shown
 from dcfkit.params import check_schema, closest, parse_params
-from dcfkit.signals import handlers_replaced
+from dcfkit.signals import INTERRUPTS, handlers_replaced
 
 PROJECT = "dcfkit"
 DATASET = "dataset"  # the kind of the benchmark layouts plugins register (an Entry's cls is the Layout)
@@ -45,7 +44,6 @@ class HookSpecs:
 # subclass, GeneratorExit), since one broken plugin must not end every command; an interrupt
 # that a signal raised while it ran (Ctrl-C; SIGTERM, see dcfkit.signals) goes on.
 PLUGIN_FAULTS = (BaseException,)
-INTERRUPTS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
 
 
 @contextlib.contextmanager
