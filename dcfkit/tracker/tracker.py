@@ -27,7 +27,7 @@ from dcfkit.config import load_config
 from dcfkit.config.slots import SLOTS, build
 from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.contracts import naming_the_frame
-from dcfkit.errors import InputError, TrackingError
+from dcfkit.errors import ConfigError, InputError, TrackingError
 from dcfkit.numerics.fft import make_fft
 from dcfkit.numerics.patches import (
     box_to_centre_size,
@@ -49,10 +49,15 @@ from dcfkit.tracker.checks import (
 )
 from dcfkit.tracker.confidence import Confidence
 from dcfkit.tracker.geometry import Geometry, geometry, hann2d, reported_box
+from dcfkit.tracker.loops import continuous_loop
 
 
 class Tracker:
     """A DCF tracker assembled from components (see :func:`dcfkit.load_tracker`)."""
+
+    def __new__(cls, config: Mapping[str, Any], *args: Any, **kwargs: Any):
+        """A config whose solver learns on the continuous domain (ECO's) gets that loop."""
+        return super().__new__((continuous_loop(config) or cls) if cls is Tracker else cls)
 
     def __init__(self, config: Mapping[str, Any]):
         """``config``: as :func:`dcfkit.load_config` resolved it. Each slot of
@@ -63,6 +68,8 @@ class Tracker:
         self.params = TrackerParams(**config["tracker"])
         for slot in SLOTS:
             setattr(self, slot.name, build(slot, registry, config, self.name))
+        if self.memory is not None and type(self) is Tracker:
+            raise ConfigError(f"{self.name}: memory: solver '{self.solver.name}' keeps its own model")
         check_terms(self)
         check_spectra(self)
         self.fft = make_fft(self.params.fft_backend, full=self.params.spectra == "full")
@@ -143,11 +150,11 @@ class Tracker:
         sigma = np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * self.params.output_sigma_factor
         self.base_label = gaussian_label(g.filter_size, sigma)
         self.base_label.setflags(write=False)  # every frame's label starts from it
-        regularizers = [r for r in (self.spatial, self.temporal) if r is not None]
-        for component in (*self.features, self.label, self.solver, *regularizers):  # a new target: nothing kept
+        optional = [r for r in (self.spatial, self.temporal, self.schedule) if r is not None]
+        for component in (*self.features, self.label, self.solver, *optional):  # a new target: nothing kept
             component.reset()
         target = Target(self.image_size, g.filter_size, g.target_cells, g.cell_size, scale, float(sigma))
-        for component in (*self.features, self.label, self.solver, *regularizers, self.search, self.scale_estimator):
+        for component in (*self.features, self.label, self.solver, *optional, self.search, self.scale_estimator):
             component.start(target)
         self.w2 = read_only(self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
                              else np.zeros(g.filter_size, np.float32))
@@ -212,6 +219,8 @@ class Tracker:
         """Give the detection to the components that adapt to it: the solver, and the spatial
         regularizer, whose w² it returns is used from this frame on."""
         self.solver.observe(detection)
+        if self.schedule is not None:
+            self.schedule.observe(detection)
         if self.spatial is not None:
             self.w2 = read_only(self.spatial.adapt(self.w2, detection))
 
@@ -239,7 +248,10 @@ class Tracker:
         if theta == np.inf and detection is None:
             raise TrackingError(f"frame {self.frame}: temporal regularizer '{self.temporal.name}' returned θ = inf "
                                 f"on the first frame, where there is no filter to keep")
-        if theta != np.inf:  # inf: the temporal term holds the filter where it is
+        due = self.schedule is None or self.schedule.due(self.frame)  # sparse updates: not every frame
+        if not due and detection is None:
+            raise TrackingError(f"frame 1: schedule '{self.schedule.name}' skips the first frame")
+        if theta != np.inf and due:  # inf: the temporal term holds the filter where it is
             self.hf = self.solver.train(xf, yf, self.w2, theta, self.fft)  # Eqs. (9)-(11)
         step = self.geometry.cell_size * self.scale
         self.last_distractors = (self.position[None, ::-1] + offsets[:, ::-1] * step) if len(offsets) else \
