@@ -27,7 +27,7 @@ from dcfkit.config import load_config
 from dcfkit.config.slots import SLOTS, build
 from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.contracts import naming_the_frame
-from dcfkit.errors import ConfigError, InputError, TrackingError
+from dcfkit.errors import InputError, TrackingError
 from dcfkit.numerics.fft import make_fft
 from dcfkit.numerics.patches import (
     box_to_centre_size,
@@ -48,16 +48,12 @@ from dcfkit.tracker.checks import (
     read_only,
 )
 from dcfkit.tracker.confidence import Confidence
+from dcfkit.tracker.continuous import continuous_loop
 from dcfkit.tracker.geometry import Geometry, geometry, hann2d, reported_box
-from dcfkit.tracker.loops import continuous_loop
 
 
 class Tracker:
     """A DCF tracker assembled from components (see :func:`dcfkit.load_tracker`)."""
-
-    def __new__(cls, config: Mapping[str, Any], *args: Any, **kwargs: Any):
-        """A config whose solver learns on the continuous domain (ECO's) gets that loop."""
-        return super().__new__((continuous_loop(config) or cls) if cls is Tracker else cls)
 
     def __init__(self, config: Mapping[str, Any]):
         """``config``: as :func:`dcfkit.load_config` resolved it. Each slot of
@@ -68,8 +64,7 @@ class Tracker:
         self.params = TrackerParams(**config["tracker"])
         for slot in SLOTS:
             setattr(self, slot.name, build(slot, registry, config, self.name))
-        if self.memory is not None and type(self) is Tracker:
-            raise ConfigError(f"{self.name}: memory: solver '{self.solver.name}' keeps its own model")
+        self.loop = continuous_loop(self)  # ECO's solver learns on the continuous domain: its own loop
         check_terms(self)
         check_spectra(self)
         self.fft = make_fft(self.params.fft_backend, full=self.params.spectra == "full")
@@ -124,6 +119,8 @@ class Tracker:
     @naming_the_frame(lambda tracker: 1)
     def init(self, image: np.ndarray, box) -> None:
         """Frame 1: learn the first filter at ``box`` (x, y, w, h)."""
+        if self.loop is not None:
+            return self.loop.init(image, box)
         image = check_image(image, 1)
         box = check_box(box, image.shape)
         centre, target = box_to_centre_size(box)
@@ -171,6 +168,8 @@ class Tracker:
         """Frame t > 1: locate the target, return its box (x, y, w, h), and learn from it."""
         if self.frame == 0:
             raise TrackingError("update() called before init()")
+        if self.loop is not None:
+            return self.loop.update(image)
         self.frame += 1  # every frame given counts, rejected ones too: numbers match the caller's video
         image = check_image(image, self.frame)
         if image.shape[:2] != self.image_size:
@@ -280,6 +279,8 @@ class Tracker:
     @property
     def box(self) -> tuple[float, float, float, float]:
         """Current (x, y, w, h), 0-based pixels (``tracker.box_output``)."""
+        if self.loop is not None:
+            return self.loop.box()
         return reported_box(self.position, self.geometry.base_target * self.scale, self.params.box_output)
 
 

@@ -7,7 +7,7 @@ from dcfkit.analysis.metrics import score_sequence
 from dcfkit.config import load_config
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.errors import ConfigError, TrackingError
-from dcfkit.tracker.continuous import ContinuousTracker
+from dcfkit.tracker.continuous import ContinuousLoop
 from dcfkit.tracker.tracker import Tracker
 
 
@@ -24,16 +24,16 @@ def run(tracker, frames, box):
 @pytest.mark.parametrize("config", ["configs/eco_hc.yaml", "configs/reference/eco_hc.yaml"])
 def test_eco_hc_tracks_the_synthetic_moving_target(config, sequence, request):
     tracker = dcfkit.load_tracker(request.config.rootpath / config)
-    assert isinstance(tracker, ContinuousTracker)
+    assert isinstance(tracker.loop, ContinuousLoop)
     boxes = run(tracker, sequence.frames, sequence.ground_truth[0])
     scores = score_sequence(boxes, sequence.ground_truth)
     assert scores["precision"] >= 0.95
     assert scores["auc"] >= 0.6
     # two blocks: fHOG at cell 6 compressed to 10 channels, Color Names at cell 4 to 3; the
     # finer block is the output grid
-    blocks = tracker.layout.blocks
+    blocks = tracker.loop.layout.blocks
     assert [(b.cell, b.dim) for b in blocks] == [(4, 3), (6, 10)]
-    assert tracker.layout.output == blocks[0].filter_size
+    assert tracker.loop.layout.output == blocks[0].filter_size
     assert all(n % 2 == 1 for b in blocks for n in b.filter_size)
     assert [p.shape for p in tracker.solver.projections] == [(10, 3), (31, 10)]
     assert tracker.memory.count == len(sequence.frames) - 1 or tracker.memory.count == 30
@@ -50,14 +50,14 @@ def test_a_gray_sequence_leaves_colour_names_out(sequence, request):
     frames = [f.mean(axis=2).astype(np.uint8) for f in sequence.frames[:8]]
     tracker = dcfkit.load_tracker(request.config.rootpath / "configs/eco_hc.yaml")
     boxes = run(tracker, frames, sequence.ground_truth[0])
-    assert [b.feature.name for b in tracker.layout.blocks] == ["fhog"]
+    assert [b.feature.name for b in tracker.loop.layout.blocks] == ["fhog"]
     assert score_sequence(boxes, sequence.ground_truth[:8])["precision"] >= 0.9
 
 
 def test_configs_without_the_new_slots_resolve_as_before():
     config = load_config("strcf")
     assert "memory" not in config and "schedule" not in config
-    assert type(Tracker(config)) is Tracker
+    assert Tracker(config).loop is None
 
 
 def test_a_memory_is_refused_by_the_discrete_loop_and_required_by_eco():

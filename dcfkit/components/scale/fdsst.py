@@ -68,7 +68,8 @@ class FDSST(ScaleEstimator):
         target = np.round(self.base_target * scale, 9)  # the first frame's box in pixels
         area = float(np.prod(target))
         factor = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
-        self.model_size = np.maximum(np.floor(target * factor), 8).astype(int)
+        # at least 8 px (the authors') and 2 cells, which fhog needs
+        self.model_size = np.maximum(np.floor(target * factor), max(8, 2 * p.cell_size)).astype(int)
         self.num = self.den = None
         self._learn(image, centre, scale)
 

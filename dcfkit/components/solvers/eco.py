@@ -34,21 +34,23 @@ class ECOParams:
                                  "direction's decay (the memory's own rate should match)", gt=0, lt=1)
     interpolation_a: float = param(-0.75, "a of the cubic interpolation kernel", ge=-2, le=0)
     interpolation_centering: bool = param(True, "centre the kernel on each feature sample")
-    projection_reg: float = param(1e-7, "λ of ‖P‖² (Eq. 6)", ge=0, le=1e6)
-    init_gn_iterations: int = param(10, "Gauss-Newton steps on the first frame", ge=1, le=1000)
+    projection_reg: float = param(1e-7, "λ of ‖P‖² (Eq. 6)", ge=0, le=1e3)
+    init_gn_iterations: int = param(10, "Gauss-Newton steps on the first frame", ge=1, le=50)
     init_cg_iterations: int = param(150, "CG iterations on the first frame, over all Gauss-Newton steps",
-                                    ge=1, le=100000)
-    cg_iterations: int = param(5, "CG iterations per later training", ge=1, le=1000)
-    cg_forgetting_rate: float = param(50.0, "the last direction is kept with weight (1 - γ)^rate (inf: dropped)",
-                                      ge=0)
+                                    ge=1, le=2000)
+    cg_iterations: int = param(5, "CG iterations per later training", ge=1, le=50)
+    cg_forgetting_rate: float = param(50.0, "CG's last direction is kept with weight (1 - γ)^rate (large: dropped)",
+                                      ge=0, le=1e6)
     fletcher_reeves: bool = param(False, "β by Fletcher-Reeves (else Polak-Ribière) after the first frame")
     precond_data_param: float = param(0.75, "weight of a channel's own energy in the preconditioner", ge=0, le=1)
     precond_reg_param: float = param(0.25, "weight of the regularization in the preconditioner", ge=0, le=1)
-    precond_proj_param: float = param(40.0, "weight of P's part of the first frame's preconditioner", gt=0)
+    precond_proj_param: float = param(40.0, "weight of P's part of the first frame's preconditioner",
+                                      ge=1e-6, le=1e6)
+    # bounded so that w² times the samples' energy stays far inside float32 for any target shape
     reg_window_min: float = param(1e-4, "the spatial regularization's least value (at the target's middle)",
-                                  gt=0, le=1e6)
-    reg_window_edge: float = param(10e-3, "its value at the target's edge", gt=0, le=1e6)
-    reg_window_power: float = param(2.0, "the window's power of the distance from the middle", gt=0, le=10)
+                                  ge=1e-10, le=100)
+    reg_window_edge: float = param(10e-3, "its value at the target's edge", ge=1e-10, le=100)
+    reg_window_power: float = param(2.0, "the window's power of the distance from the middle", gt=0, le=4)
     reg_sparsity_threshold: float = param(0.05, "window DFT coefficients under this x the largest are dropped",
                                           ge=0, lt=1)
 
@@ -106,7 +108,7 @@ class ECO(Solver):
         w = weights.astype(np.float32)
         rhs = [(np.conj(np.einsum("n,ndhw->dhw", w, x)) * y).astype(np.complex64) for x, y in zip(samples, yfs)]
         diag = [preconditioner(e, r, p.precond_data_param, p.precond_reg_param) for e, r in zip(self.energy, regs)]
-        forget = 0.0 if not np.isfinite(p.cg_forgetting_rate) else (1 - rate) ** p.cg_forgetting_rate
+        forget = (1 - rate) ** p.cg_forgetting_rate
         self.filters, self.cg_state = pcg(lambda f: lhs_filter(f, samples, w, regs), rhs,
                                           lambda r: [ri / mi for ri, mi in zip(r, diag)], inner, self.filters,
                                           p.cg_iterations, p.fletcher_reeves, forget, self.cg_state)

@@ -115,8 +115,9 @@ def preconditioner(energy: np.ndarray, reg: np.ndarray, data_param: float, reg_p
     """ECO's diagonal preconditioner of one block from its sample energy |x|² (D, H, Wh):
     (1 - r)(d e + (1 - d) mean_D e) + r Σ reg²."""
     reg_energy = float(np.sum(reg.astype(np.float64) ** 2))
-    return ((1 - reg_param) * (data_param * energy + (1 - data_param) * energy.mean(axis=0))
+    diag = ((1 - reg_param) * (data_param * energy + (1 - data_param) * energy.mean(axis=0))
             + reg_param * reg_energy).astype(np.float32)
+    return np.maximum(diag, np.float32(1e-30))  # a frequency without energy: no division by 0
 
 
 def pcg(apply_a: Callable, b: list, precondition: Callable, dot: Callable, x0: list, iterations: int,
