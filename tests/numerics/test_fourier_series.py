@@ -75,7 +75,8 @@ def brute_force_peak(xf, factor=40):
     h, w = xf.shape
     ys, xs = np.arange(h * factor) / factor, np.arange(w * factor) / factor
     ky, kx = (np.arange(h) - (h - 1) // 2), (np.arange(w) - (w - 1) // 2)
-    values = (np.exp(2j * np.pi * ys[:, None] * ky[None] / h) @ xf @ np.exp(2j * np.pi * kx[:, None] * xs[None] / w)).real
+    left, right = np.exp(2j * np.pi * ys[:, None] * ky[None] / h), np.exp(2j * np.pi * kx[:, None] * xs[None] / w)
+    values = (left @ xf @ right).real
     i, j = np.unravel_index(np.argmax(values), values.shape)
     return ys[i], xs[j]
 

@@ -106,7 +106,8 @@ class ECO(Solver):
         rate = p.learning_rate
         self.energy = [((1 - rate) * e + rate * np.abs(x) ** 2).astype(np.float32) for e, x in zip(self.energy, sample)]
         w = weights.astype(np.float32)
-        rhs = [(np.conj(np.einsum("n,ndhw->dhw", w, x)) * y).astype(np.complex64) for x, y in zip(samples, yfs)]
+        rhs = [(np.conj((w[:, None, None, None] * x).sum(axis=0)) * y).astype(np.complex64)
+               for x, y in zip(samples, yfs)]
         diag = [preconditioner(e, r, p.precond_data_param, p.precond_reg_param) for e, r in zip(self.energy, regs)]
         forget = (1 - rate) ** p.cg_forgetting_rate
         self.filters, self.cg_state = pcg(lambda f: lhs_filter(f, samples, w, regs), rhs,
@@ -118,7 +119,7 @@ class ECO(Solver):
         (S, D, H, W) full centred spectra, projected), summed over blocks on the ``output`` grid."""
         out = np.zeros((samples[0].shape[0],) + tuple(output), np.complex64)
         for x, f in zip(samples, self.filters):
-            padded_into_full(out, np.einsum("dhw,sdhw->shw", full(f), x))
+            padded_into_full(out, (full(f)[None] * x).sum(axis=1))
         return out
 
 

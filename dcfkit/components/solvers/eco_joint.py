@@ -21,7 +21,8 @@ from dcfkit.numerics.fourier_series import symmetrize, window_of
 
 def project(x: np.ndarray, p: np.ndarray) -> np.ndarray:
     """(..., C, H, W) -> (..., D, H, W): the channels mixed by P (C, D)."""
-    return np.einsum("...chw,cd->...dhw", x, p.astype(x.real.dtype)).astype(x.dtype, copy=False)
+    mixed = np.tensordot(x, p.astype(x.real.dtype), axes=([-3], [0]))  # (..., H, W, D), one matrix product
+    return np.moveaxis(mixed, -1, -3).astype(x.dtype, copy=False)
 
 
 def pca_projection(x: np.ndarray, dim: int) -> np.ndarray:
@@ -35,7 +36,8 @@ def pca_projection(x: np.ndarray, dim: int) -> np.ndarray:
 
 def _data_grad(xh: np.ndarray, g: np.ndarray) -> np.ndarray:
     """2 Re Σ_{kx<0} conj(x_c) g_d -> (C, D): the ΔP part of Xᴴ applied to (D, H, Wh) g."""
-    return 2 * np.einsum("chw,dhw->cd", xh[..., :-1], g[..., :-1]).real
+    c, d = xh.shape[0], g.shape[0]
+    return 2 * (xh[..., :-1].reshape(c, -1) @ g[..., :-1].reshape(d, -1).T).real
 
 
 def _summed(parts: Sequence[np.ndarray], shape) -> np.ndarray:
@@ -50,8 +52,8 @@ def _lhs(v: list, k: int, xs, zs, f0, reg, lam: float) -> list:
     """The Gauss-Newton normal equations' left side for v = [f_1..f_K, ΔP_1..ΔP_K]."""
     f, dp = v[:k], v[k:]
     shape = output_shape(f)
-    sh = _summed([np.einsum("dhw,dhw->hw", z, fi) for z, fi in zip(zs, f)], shape)
-    bp = _summed([np.einsum("dhw,dhw->hw", project(x, d), g) for x, d, g in zip(xs, dp, f0)], shape)
+    sh = _summed([(z * fi).sum(axis=0) for z, fi in zip(zs, f)], shape)
+    bp = _summed([(project(x, d) * g).sum(axis=0) for x, d, g in zip(xs, dp, f0)], shape)
     out_f, out_p = [], []
     for x, z, fi, g, r, d in zip(xs, zs, f, f0, reg, dp):
         win = window_of(shape, fi.shape)

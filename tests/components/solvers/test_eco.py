@@ -107,7 +107,7 @@ def test_cg_converges_to_the_dense_solution_of_the_normal_equations():
                np.stack([hermitian_half(rng, 1, 5, 5) for _ in range(3)])]
     weights = np.array([0.5, 0.3, 0.2], np.float32)
     reg = [regularization_filter((35, 35), (10, 10), 0.2, 1.0, 2, 0.05)] * 2
-    labels = [fs.half(fs.centred_dft(rng.standard_normal((7, 7)))), fs.half(fs.centred_dft(rng.standard_normal((5, 5))))]
+    labels = [fs.half(fs.centred_dft(rng.standard_normal((n, n)))) for n in (7, 5)]
     rhs = [np.conj(np.einsum("n,ndhw->dhw", weights, x)) * y for x, y in zip(samples, labels)]
     op = lambda f: lhs_filter([np.asarray(b, np.complex64) for b in f], samples, weights, reg)  # noqa: E731
     template = [np.zeros((2, 7, 4)), np.zeros((1, 5, 3))]
