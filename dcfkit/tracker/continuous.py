@@ -53,6 +53,9 @@ class ContinuousLoop:
         if len(s.cell_sizes) != len(tracker.features):
             raise ConfigError(f"{tracker.name}: solver.cell_sizes has {len(s.cell_sizes)} entries for "
                               f"{len(tracker.features)} features: one per feature, in their order")
+        for skip in ("gray_skip", "colour_skip"):
+            if all(f.name in getattr(s, skip) for f in tracker.features):
+                raise ConfigError(f"{tracker.name}: solver.{skip} leaves out every feature")
         for f, d in zip(tracker.features, s.compressed_dims):
             if d > f.channels():
                 raise ConfigError(f"{tracker.name}: solver.compressed_dims: {d} for feature '{f.name}', which has "
@@ -61,9 +64,10 @@ class ContinuousLoop:
     def _active(self, colour: bool) -> list:
         """The features used on this sequence (ECO's useForGray), with their parameters."""
         s = self.t.solver.params
-        keep = [colour or f.name not in s.gray_skip for f in self.t.features]
+        keep = [f.name not in (s.colour_skip if colour else s.gray_skip) for f in self.t.features]
         if not any(keep):
-            raise InputError("frame 1: every feature is in solver.gray_skip, and the sequence is gray")
+            raise InputError(f"frame 1: every feature is in solver.{'colour' if colour else 'gray'}_skip, and the "
+                             f"sequence is {'colour' if colour else 'gray'}")
         pick = dataclasses.replace(s, cell_sizes=tuple(c for c, k in zip(s.cell_sizes, keep) if k),
                                    compressed_dims=tuple(d for d, k in zip(s.compressed_dims, keep) if k))
         return [f for f, k in zip(self.t.features, keep) if k], pick

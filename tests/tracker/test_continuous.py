@@ -46,12 +46,24 @@ def test_eco_hc_is_deterministic(sequence, request):
         run(dcfkit.load_tracker(path), frames, sequence.ground_truth[0])
 
 
-def test_a_gray_sequence_leaves_colour_names_out(sequence, request):
+def test_a_gray_sequence_takes_the_intensity_table_in_place_of_colour_names(sequence, request, tmp_path):
     frames = [f.mean(axis=2).astype(np.uint8) for f in sequence.frames[:8]]
-    tracker = dcfkit.load_tracker(request.config.rootpath / "configs/eco_hc.yaml")
+    path = request.config.rootpath / "configs/eco_hc.yaml"
+    tracker = dcfkit.load_tracker(path)
     boxes = run(tracker, frames, sequence.ground_truth[0])
     assert [b.feature.name for b in tracker.loop.layout.blocks] == ["fhog"]
     assert score_sequence(boxes, sequence.ground_truth[:8])["precision"] >= 0.9
+    # with a gray-level table (ECO's intensityChannelNorm6 is such a 256x5 one) as a third feature
+    np.save(tmp_path / "table.npy", np.random.default_rng(0).random((256, 5)).astype(np.float32))
+    three = {"features": [{"name": "fhog"}, {"name": "colornames"},
+                          {"name": "intensity_table", "table_path": str(tmp_path / "table.npy")}],
+             "solver.cell_sizes": [6, 4, 4], "solver.compressed_dims": [10, 3, 3]}
+    tracker = dcfkit.load_tracker(path, overrides=three)
+    boxes = run(tracker, frames, sequence.ground_truth[0])
+    assert [(b.feature.name, b.dim) for b in tracker.loop.layout.blocks] == [("intensity_table", 3), ("fhog", 10)]
+    assert score_sequence(boxes, sequence.ground_truth[:8])["precision"] >= 0.9
+    tracker.init(sequence.frames[0], sequence.ground_truth[0])  # a colour sequence: Color Names, no table
+    assert [b.feature.name for b in tracker.loop.layout.blocks] == ["colornames", "fhog"]
 
 
 def test_configs_without_the_new_slots_resolve_as_before():

@@ -30,6 +30,8 @@ class ECOParams:
     cell_sizes: tuple[int, ...] = param((6, 4), "cell size (pixels) of each feature, in the order of features")
     compressed_dims: tuple[int, ...] = param((10, 3), "channels each feature is projected to (its P's columns)")
     gray_skip: tuple[str, ...] = param(("colornames",), "features left out on gray sequences (ECO's useForGray)")
+    colour_skip: tuple[str, ...] = param(("intensity_table",), "features left out on colour sequences (ECO's "
+                                         "useForColor)")
     learning_rate: float = param(0.009, "γ: rate of the preconditioner's sample energy and of the CG "
                                  "direction's decay (the memory's own rate should match)", gt=0, lt=1)
     interpolation_a: float = param(-0.75, "a of the cubic interpolation kernel", ge=-2, le=0)
