@@ -23,6 +23,7 @@ import numpy as np
 from dcfkit.components.base import Target
 from dcfkit.components.scale.base import scale_limits
 from dcfkit.components.solvers.eco_joint import pca_projection, project
+from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.errors import ConfigError, InputError, TrackingError
 from dcfkit.numerics import fourier_series as fs
 from dcfkit.numerics.patches import box_to_centre_size, centre_size_to_box, round_half_away
@@ -41,12 +42,23 @@ def continuous_loop(tracker) -> "ContinuousLoop | None":
     return None
 
 
+# tracker keys of the discrete loop that the continuous one has no use for: ECO samples, windows,
+# finds the peak and moves its own way, on half spectra of its blocks
+UNUSED = ("sampling", "window", "peak", "translation", "training_sample", "init_position", "init_area",
+          "cell_selection_thresh", "spectra", "fft_backend")
+
+
 class ContinuousLoop:
     """ECO's loop over the components of ``tracker`` (see the module docstring)."""
 
     def __init__(self, tracker):
         self.t = tracker
         s = tracker.solver.params
+        default = TrackerParams()
+        for key in UNUSED:
+            if getattr(tracker.params, key) != getattr(default, key):
+                raise ConfigError(f"{tracker.name}: tracker.{key}: solver '{tracker.solver.name}' runs in the "
+                                  f"continuous loop, which does not use it (keys it ignores: {', '.join(UNUSED)})")
         if tracker.memory is None:
             raise ConfigError(f"{tracker.name}: solver '{tracker.solver.name}' learns from a memory of samples: "
                               f"add one, e.g. memory: {{name: gmm}}")
