@@ -23,10 +23,12 @@ F32 = np.float32
 
 
 def inner_products(stored: list[np.ndarray], sample) -> np.ndarray:
-    """(N,) float32: 2 Re <slot n, sample> summed over blocks."""
+    """(N,) float32: 2 Re <slot n, sample> summed over blocks (numpy's own sums, not a BLAS
+    product, whose order depends on the processor and the number of threads)."""
     total = np.zeros(stored[0].shape[0], F32)
     for store, block in zip(stored, sample):
-        total += F32(2) * (store.reshape(store.shape[0], -1) @ np.conj(np.ravel(block))).real.astype(F32)
+        flat, b = store.reshape(store.shape[0], -1), np.ravel(block)
+        total += F32(2) * (flat.real * b.real + flat.imag * b.imag).sum(axis=1, dtype=F32)  # Re(x conj(b))
     return total
 
 

@@ -21,8 +21,8 @@ from dcfkit.numerics.fourier_series import symmetrize, window_of
 
 def project(x: np.ndarray, p: np.ndarray) -> np.ndarray:
     """(..., C, H, W) -> (..., D, H, W): the channels mixed by P (C, D)."""
-    mixed = np.tensordot(x, p.astype(x.real.dtype), axes=([-3], [0]))  # (..., H, W, D), one matrix product
-    return np.moveaxis(mixed, -1, -3).astype(x.dtype, copy=False)
+    # einsum, not a BLAS product: its sums' order would depend on the processor and the threads
+    return np.einsum("...chw,cd->...dhw", x, p.astype(x.real.dtype)).astype(x.dtype, copy=False)
 
 
 def pca_projection(x: np.ndarray, dim: int) -> np.ndarray:
@@ -36,8 +36,7 @@ def pca_projection(x: np.ndarray, dim: int) -> np.ndarray:
 
 def _data_grad(xh: np.ndarray, g: np.ndarray) -> np.ndarray:
     """2 Re Σ_{kx<0} conj(x_c) g_d -> (C, D): the ΔP part of Xᴴ applied to (D, H, Wh) g."""
-    c, d = xh.shape[0], g.shape[0]
-    return 2 * (xh[..., :-1].reshape(c, -1) @ g[..., :-1].reshape(d, -1).T).real
+    return 2 * np.einsum("chw,dhw->cd", xh[..., :-1], g[..., :-1]).real
 
 
 def _summed(parts: Sequence[np.ndarray], shape) -> np.ndarray:
