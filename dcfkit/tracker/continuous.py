@@ -65,6 +65,9 @@ class ContinuousLoop:
         if len(s.cell_sizes) != len(tracker.features):
             raise ConfigError(f"{tracker.name}: solver.cell_sizes has {len(s.cell_sizes)} entries for "
                               f"{len(tracker.features)} features: one per feature, in their order")
+        if tracker.label.name != "gaussian":  # the label is the Gaussian's Fourier series (tracker.output_sigma_factor)
+            raise ConfigError(f"{tracker.name}: label: the continuous loop's label is a Gaussian's Fourier series; "
+                              f"'{tracker.label.name}' would be ignored (use label: {{name: gaussian}})")
         for skip in ("gray_skip", "colour_skip"):
             if all(f.name in getattr(s, skip) for f in tracker.features):
                 raise ConfigError(f"{tracker.name}: solver.{skip} leaves out every feature")

@@ -79,6 +79,8 @@ def test_a_memory_is_refused_by_the_discrete_loop_and_required_by_eco():
         dcfkit.load_tracker("eco_hc", overrides={"memory": None})
     with pytest.raises(ConfigError, match="spatial"):
         dcfkit.load_tracker("eco_hc", overrides={"regularizers.spatial": {"name": "box"}})
+    with pytest.raises(ConfigError, match="label: the continuous loop's label is a Gaussian's"):
+        dcfkit.load_tracker("eco_hc", overrides={"label": {"name": "distractor_repressed"}})
     with pytest.raises(ConfigError, match="tracker.sampling: solver 'eco' runs in the continuous loop"):
         dcfkit.load_tracker("eco_hc", overrides={"tracker.sampling": "whole_pixel"})
 

@@ -12,7 +12,7 @@ from dcfkit.components.solvers.eco_cg import (
     pcg,
     regularization_filter,
 )
-from dcfkit.components.solvers.eco_joint import _dot_joint, _lhs, pca_projection, project, train_joint
+from dcfkit.components.solvers.eco_joint import _dot_joint, pca_projection, project, train_joint
 from dcfkit.numerics import fourier_series as fs
 
 
