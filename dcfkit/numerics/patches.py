@@ -42,6 +42,12 @@ def cropper(shape, centre, region) -> Callable[[np.ndarray], np.ndarray]:
     return _cropper_at(shape, _origin(centre[0], rh), _origin(centre[1], rw), rh, rw)
 
 
+def pixel_cropper(shape, y0: int, x0: int, rh: int, rw: int) -> Callable[[np.ndarray], np.ndarray]:
+    """Rows y0..y0+rh-1 and columns x0..x0+rw-1 (0-based) of images of ``shape``, outside
+    pixels replicating the edge (for crops whose first pixel a caller decides, as ECO's)."""
+    return _cropper_at(shape, y0, x0, rh, rw)
+
+
 def _cropper_at(shape, y0: int, x0: int, rh: int, rw: int) -> Callable[[np.ndarray], np.ndarray]:
     """Rows y0..y0+rh-1 and columns x0..x0+rw-1, outside pixels replicating the edge."""
     height, width = shape[:2]

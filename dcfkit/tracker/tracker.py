@@ -48,6 +48,7 @@ from dcfkit.tracker.checks import (
     read_only,
 )
 from dcfkit.tracker.confidence import Confidence
+from dcfkit.tracker.continuous import continuous_loop
 from dcfkit.tracker.geometry import Geometry, geometry, hann2d, reported_box
 
 
@@ -63,6 +64,7 @@ class Tracker:
         self.params = TrackerParams(**config["tracker"])
         for slot in SLOTS:
             setattr(self, slot.name, build(slot, registry, config, self.name))
+        self.loop = continuous_loop(self)  # ECO's solver learns on the continuous domain: its own loop
         check_terms(self)
         check_spectra(self)
         self.fft = make_fft(self.params.fft_backend, full=self.params.spectra == "full")
@@ -117,6 +119,8 @@ class Tracker:
     @naming_the_frame(lambda tracker: 1)
     def init(self, image: np.ndarray, box) -> None:
         """Frame 1: learn the first filter at ``box`` (x, y, w, h)."""
+        if self.loop is not None:
+            return self.loop.init(image, box)
         image = check_image(image, 1)
         box = check_box(box, image.shape)
         centre, target = box_to_centre_size(box)
@@ -143,11 +147,11 @@ class Tracker:
         sigma = np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * self.params.output_sigma_factor
         self.base_label = gaussian_label(g.filter_size, sigma)
         self.base_label.setflags(write=False)  # every frame's label starts from it
-        regularizers = [r for r in (self.spatial, self.temporal) if r is not None]
-        for component in (*self.features, self.label, self.solver, *regularizers):  # a new target: nothing kept
+        optional = [r for r in (self.spatial, self.temporal, self.schedule) if r is not None]
+        for component in (*self.features, self.label, self.solver, *optional):  # a new target: nothing kept
             component.reset()
         target = Target(self.image_size, g.filter_size, g.target_cells, g.cell_size, scale, float(sigma))
-        for component in (*self.features, self.label, self.solver, *regularizers, self.search, self.scale_estimator):
+        for component in (*self.features, self.label, self.solver, *optional, self.search, self.scale_estimator):
             component.start(target)
         self.w2 = read_only(self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
                              else np.zeros(g.filter_size, np.float32))
@@ -164,6 +168,8 @@ class Tracker:
         """Frame t > 1: locate the target, return its box (x, y, w, h), and learn from it."""
         if self.frame == 0:
             raise TrackingError("update() called before init()")
+        if self.loop is not None:
+            return self.loop.update(image)
         self.frame += 1  # every frame given counts, rejected ones too: numbers match the caller's video
         image = check_image(image, self.frame)
         if image.shape[:2] != self.image_size:
@@ -212,6 +218,8 @@ class Tracker:
         """Give the detection to the components that adapt to it: the solver, and the spatial
         regularizer, whose w² it returns is used from this frame on."""
         self.solver.observe(detection)
+        if self.schedule is not None:
+            self.schedule.observe(detection)
         if self.spatial is not None:
             self.w2 = read_only(self.spatial.adapt(self.w2, detection))
 
@@ -239,7 +247,10 @@ class Tracker:
         if theta == np.inf and detection is None:
             raise TrackingError(f"frame {self.frame}: temporal regularizer '{self.temporal.name}' returned θ = inf "
                                 f"on the first frame, where there is no filter to keep")
-        if theta != np.inf:  # inf: the temporal term holds the filter where it is
+        due = self.schedule is None or self.schedule.due(self.frame)  # sparse updates: not every frame
+        if not due and detection is None:
+            raise TrackingError(f"frame 1: schedule '{self.schedule.name}' skips the first frame")
+        if theta != np.inf and due:  # inf: the temporal term holds the filter where it is
             self.hf = self.solver.train(xf, yf, self.w2, theta, self.fft)  # Eqs. (9)-(11)
         step = self.geometry.cell_size * self.scale
         self.last_distractors = (self.position[None, ::-1] + offsets[:, ::-1] * step) if len(offsets) else \
@@ -268,6 +279,8 @@ class Tracker:
     @property
     def box(self) -> tuple[float, float, float, float]:
         """Current (x, y, w, h), 0-based pixels (``tracker.box_output``)."""
+        if self.loop is not None:
+            return self.loop.box()
         return reported_box(self.position, self.geometry.base_target * self.scale, self.params.box_output)
 
 

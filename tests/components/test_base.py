@@ -48,6 +48,11 @@ def slot_override(kind: str, cls: type, params: dict) -> dict:
         return {"features": [spec]}
     if kind == "regularizer":
         return {f"regularizers.{cls.role}": spec}
+    if kind == "memory" or getattr(cls, "loop", None) == "continuous":  # ECO's: one feature block, a memory
+        solver = spec if kind == "solver" else {"name": "eco"}
+        solver = {"cell_sizes": (4,), "compressed_dims": (1,), **solver}
+        return {"solver": solver, "memory": spec if kind == "memory" else {"name": "gmm"},
+                "regularizers.spatial": None, "regularizers.temporal": None}
     if kind == "solver":  # without the regularizers it has no term for (KCF's, DSST's), which the tracker refuses
         return {kind: spec, **{f"regularizers.{role}": None for role in ("spatial", "temporal") if role not in cls.terms}}
     return {kind: spec}
@@ -72,6 +77,9 @@ def values_of(field: dataclasses.Field, annotation) -> st.SearchStrategy:
                          st.floats(-100, 100))
     if annotation is str:
         return st.one_of(st.sampled_from(PATHS), st.text(max_size=12))
+    if typing.get_origin(annotation) is tuple:  # tuple[X, ...]: a few of X's values
+        item = values_of(dataclasses.field(), typing.get_args(annotation)[0])
+        return st.lists(item, max_size=3).map(tuple)
     raise AssertionError(f"no strategy for {annotation!r}: add one (the built-ins' Params grew a new type)")
 
 

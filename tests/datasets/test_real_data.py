@@ -7,7 +7,8 @@ both lose the trucks at their occlusion and wakeboard7's rider, DSST wakeboard10
 DSST's boat1 centre drifts 15-25 px off the 155x319 px boat; OpenCV's KCF scores 0.405). 0.8
 ships the authors' details (docs/results.md, "Defaults decided by evidence"): DR²Track 0.959,
 STRCF 0.962, BACF 0.721 (the authors' BACF loses both trucks here), and the floors follow
-the lowest measured. Six sequences are few: a last-bit change in a feature moved a
+the lowest measured. ECO-HC 0.825 (2026-11-29, issue 40: it loses truck4_1 at the occlusion,
+as its authors' code does under Octave). Six sequences are few: a last-bit change in a feature moved a
 tracker's mean by up to ±0.05 (measured), hence the margins, and no test of the ranking between
 trackers.
 """
@@ -18,7 +19,8 @@ import dcfkit
 from dcfkit.analysis.metrics import average, score_sequence
 from dcfkit.datasets import load_dataset
 
-FLOORS = {"dr2track": 0.88, "strcf": 0.81, "bacf": 0.64, "kcf": 0.48, "dsst": 0.27}  # measured minus ~0.08
+FLOORS = {"dr2track": 0.88, "strcf": 0.81, "bacf": 0.64, "kcf": 0.48, "dsst": 0.27,  # measured minus ~0.08
+          "eco_hc": 0.75}
 
 
 @pytest.fixture(scope="module")

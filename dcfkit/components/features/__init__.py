@@ -11,8 +11,9 @@ from dcfkit.components.features.base import MAX_FEATURE_VALUE, Feature, cell_ave
 from dcfkit.components.features.colornames import ColorNames
 from dcfkit.components.features.fhog import FHOG, fhog
 from dcfkit.components.features.gray import MATLAB_GRAY_WEIGHTS, Gray
+from dcfkit.components.features.intensity import IntensityTable
 
-BUILTIN = (Gray, FHOG, ColorNames)
+BUILTIN = (Gray, FHOG, ColorNames, IntensityTable)
 
-__all__ = ["BUILTIN", "ColorNames", "FHOG", "Feature", "Gray", "MATLAB_GRAY_WEIGHTS", "MAX_FEATURE_VALUE",
+__all__ = ["BUILTIN", "ColorNames", "FHOG", "Feature", "Gray", "IntensityTable", "MATLAB_GRAY_WEIGHTS", "MAX_FEATURE_VALUE",
            "cell_average", "extract_stack", "fhog"]

@@ -10,7 +10,10 @@
 * :mod:`.kernels` -- the ADMM's per-frequency arithmetic, compiled (numba) on first use;
 * :mod:`.kcf` -- ``kernel_ridge``: KCF's kernelized ridge regression (Gaussian, linear or
   polynomial kernel);
-* :mod:`.dsst` -- ``ridge``: DSST's multichannel ridge regression in closed form.
+* :mod:`.dsst` -- ``ridge``: DSST's multichannel ridge regression in closed form;
+* :mod:`.eco` -- ``eco``: ECO's factorised convolution (:mod:`.eco_joint`: the first frame's
+  Gauss-Newton; :mod:`.eco_cg`: conjugate gradient and the regularization filter), run by
+  the continuous loop (:mod:`dcfkit.tracker.continuous`).
 """
 from __future__ import annotations
 
@@ -18,6 +21,7 @@ from dcfkit.components.solvers.arcf import ADMMArcf, ARCFParams
 from dcfkit.components.solvers.autotrack import ADMMAutoTrack, AutoTrackParams
 from dcfkit.components.solvers.base import Solver
 from dcfkit.components.solvers.dsst import Ridge, RidgeParams
+from dcfkit.components.solvers.eco import ECO, ECOParams
 from dcfkit.components.solvers.kcf import KernelParams, KernelRidge, kernel_correlation
 from dcfkit.components.solvers.strcf_bacf import (
     ADMMBacf,
@@ -30,8 +34,8 @@ from dcfkit.components.solvers.strcf_bacf import (
     sherman_morrison_solve,
 )
 
-BUILTIN = (ADMMStrcf, ADMMBacf, ADMMArcf, ADMMAutoTrack, KernelRidge, Ridge)
+BUILTIN = (ADMMStrcf, ADMMBacf, ADMMArcf, ADMMAutoTrack, KernelRidge, Ridge, ECO)
 
 __all__ = ["ADMMArcf", "ADMMAutoTrack", "ADMMBacf", "ADMMParams", "ADMMStrcf", "ARCFParams", "AutoTrackParams",
-           "BACFParams", "BUILTIN", "KernelParams", "KernelRidge", "Ridge", "RidgeParams", "Solver", "admm",
+           "BACFParams", "BUILTIN", "ECO", "ECOParams", "KernelParams", "KernelRidge", "Ridge", "RidgeParams", "Solver", "admm",
            "kernel_correlation", "penalties", "schedule_problem", "sherman_morrison_solve"]
