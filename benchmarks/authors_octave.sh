@@ -110,6 +110,10 @@ port_gradientmex() {
   portable_estimates "$1"
   (cd "$1" && mkoctfile --mex -O2 -DMATLAB_MEX_FILE -o gradientMex.mex gradientMex.cpp)
 }
+# a checkout named by an environment variable ($1 its folder, $2 the variable, $3 the repository)
+checkout() {
+  [ -d "$1" ] || { echo "no checkout of $3 at $1: set $2 to one"; exit 1; }
+}
 # the portability patches the copies share (gradientMex folder, mexResize.mex path, mtimesx
 # folder, shim folder)
 port_lineage() {
@@ -140,17 +144,19 @@ case $TRK in
     port_lineage "$C/feature" "$C/utils/mexResize.mex" "$C/utils" "$C/utils" ;;
   eco_hc)
     C=$BUILD/code; P=$C/external_libs/pdollar_toolbox/channels; M=$C/external_libs/mtimesx
+    checkout "${ECO_CODE:-$REF/ECO}" ECO_CODE martin-danelljan/ECO
     rm -rf "$C"; cp -r "${ECO_CODE:-$REF/ECO}" "$C"; rm -rf "$C/.git"; mkdir -p "$P"
     cp "$REF"/DR2Track/DR2Track1/feature/{fhog.m,gradientMex.cpp,sse.hpp,wrappers.hpp} "$P/"
     port_gradientmex "$P"
     rm -f "$C"/external_libs/mexResize/mexResize.mex*
     build_mexresize "$C/external_libs/mexResize/mexResize.mex"
     (cd "$M" && mkoctfile --mex -O2 -DDEFINEUNIX -DMWSIZE_MAX -DmxCreateSharedDataCopy=mxDuplicateArray \
-       -o mtimesx.mex mtimesx.c -lblas 2>/dev/null)
+       -o mtimesx.mex mtimesx.c -lblas > build.log 2>&1) || { cat "$M/build.log"; exit 1; }  # its many warnings
     mv "$M/mtimesx.m" "$M/mtimesx_mex_help.txt"
     cp "$REF"/octave/{hann.m,ifft2.m,gather.m} "$HERE/octave/shims/ifft.m" "$C/utils/" ;;
   csrdcf)
     C=$BUILD/code; S=$C/mex_src/segmentation; O=$C/octave_shims
+    checkout "${CSR_CODE:-$REF/csr-dcf}" CSR_CODE alanlukezic/csr-dcf
     rm -rf "$C"; cp -r "${CSR_CODE:-$REF/csr-dcf}" "$C"; rm -rf "$C/.git"; mkdir -p "$C/mex" "$O"
     port_gradientmex "$C/mex_src/hog"; mv "$C/mex_src/hog/gradientMex.mex" "$C/mex/"
     sed -i 's|^#include <opencv2/opencv.hpp>|#include <opencv2/core.hpp>\n#include <opencv2/imgproc.hpp>|' \
