@@ -2,17 +2,22 @@
 # Optional parity tool: runs the authors' own MATLAB code, STRCF (run_STRCF.m, hand-crafted:
 # gray + fHOG + CN), DR²Track (IROS version, DR2Track1), BACF (the ARCF repository's
 # tracker_HOG.m with its aberrance term off, which is BACF_optimized.m), ARCF-HC (run_ARCF.m:
-# gray + fHOG + CN, tracker_HOGCN.m) or AutoTrack (run_AutoTrack.m, AutoTrack_optimized.m),
-# under GNU Octave on one dataset's sequences, and writes their boxes for comparison with dcfkit.
+# gray + fHOG + CN, tracker_HOGCN.m), AutoTrack (run_AutoTrack.m, AutoTrack_optimized.m), ECO-HC
+# (runfiles/testing_ECO_HC.m, implementation/tracker.m) or CSR-DCF (read_default_csr_parameters.m,
+# create_csr_tracker.m, track_csr_tracker.m) under GNU Octave on one dataset's sequences, and
+# writes their boxes for comparison with dcfkit.
 #
-#   bash benchmarks/authors_octave.sh {strcf|dr2track|bacf|arcf|autotrack} DATASET_ROOT OUT_DIR [sequence ...]
+#   bash benchmarks/authors_octave.sh {strcf|dr2track|bacf|arcf|autotrack|eco_hc|csrdcf} DATASET_ROOT OUT_DIR [sequence ...]
 #
 # DATASET_ROOT is read by dcfkit.datasets (UAV123, UAV123@10fps, UAV123@20L, DTB70, UAVDT, OTB
 # layouts; DATASET=otb names the layout where two fit, as the validation set's OUT/all). Writes OUT_DIR/<DATASET>/<sequence>.txt (1-based x,y,w,h, one '%.4f' line per frame)
 # and OUT_DIR/<DATASET>/<tracker>_fps.tsv (the fps the authors' code reports, wall seconds).
 # Needs: apt-get install -y octave liboctave-dev octave-image libopencv-imgproc-dev
-# The authors' code comes from $DCFKIT_REFERENCE (default: ../shared/reference next to the repo)
-# and is built into $AUTHORS_BUILD (default: a new temp dir); it is never copied into dcfkit.
+# The authors' code comes from $DCFKIT_REFERENCE (default: ../shared/reference next to the repo),
+# ECO's from $ECO_CODE (default $DCFKIT_REFERENCE/ECO: a checkout of martin-danelljan/ECO, checked
+# at 27e8ae5) and CSR-DCF's from $CSR_CODE (default $DCFKIT_REFERENCE/csr-dcf: alanlukezic/csr-dcf,
+# checked at 469959d), and is built into $AUTHORS_BUILD (default: a new temp dir); it is never
+# copied into dcfkit.
 # What the built copy changes, only for portability (algorithms and parameters untouched):
 #  - gradientMex.cpp (Piotr's toolbox) gets Octave's 64-bit mwSize and <cstdlib>/<cstddef>;
 #  - mexResize is dcfkit's stand-in benchmarks/octave/mexResize.cpp (OpenCV resize per channel,
@@ -46,13 +51,39 @@
 #    which every processor computes alike. With SSE_ESTIMATES=sse_cpu the processor's own
 #    instructions and the C library's acosf stay, as in a MATLAB run on this machine (dcfkit's
 #    'sse_cpu'): their values differ between processor families (docs/architecture.md).
+#  - ECO-HC: its pdollar_toolbox submodule is empty, so fhog.m and gradientMex.cpp/sse.hpp/
+#    wrappers.hpp come from DR2Track1/feature into external_libs/pdollar_toolbox/channels (the same
+#    toolbox files: get_fhog.m and the scale filter call fhog(I, binSize[, nOrients]), which that
+#    fhog.m serves with the same gradientMex calls); the prebuilt mexResize.mex* are replaced by
+#    dcfkit's stand-in; mtimesx is their own mtimesx.c built by mkoctfile against Octave's BLAS,
+#    without OpenMP, with -DMWSIZE_MAX (Octave's 64-bit mwSize) and mxCreateSharedDataCopy (a
+#    MATLAB-internal call Octave lacks) = mxDuplicateArray (a copy of the same values); hann,
+#    ifft2 and gather shims into utils/ (cifft2's 'symmetric' input is conjugate-symmetric: ECO
+#    completes it with full_fourier_coeff), with benchmarks/octave/shims/ifft.m for the scale
+#    filter's ifft(.., 'symmetric') (MATLAB's rule: the completion of the first half); authors_run.m
+#    takes testing_ECO_HC.m's settings and sets params.visualization = 0. The HC setting uses no
+#    matconvnet (its empty submodule).
+#  - CSR-DCF: its mex files are built as compile.m does, into mex/: mex_src/hog/gradientMex.cpp
+#    (the toolbox file: the patches above) and mex_segment, mex_extractforeground,
+#    mex_extractbackground against OpenCV 4's core and imgproc (opencv2/opencv.hpp, which needs
+#    every module, becomes core.hpp + imgproc.hpp; <map> and <vector> are included; CV_USRTYPE1,
+#    gone from OpenCV 4, is its 2.4 value 7: no caller passes it). OpenCV 4's bit-exact 8-bit
+#    bilinear cv::resize (segment.cpp's ROI) may differ from 2.4's by one grey level. MATLAB
+#    functions: imresize is dcfkit's benchmarks/octave/shims/imresize.m (MATLAB's algorithm;
+#    Octave's does not normalise the antialiasing weights, resizes columns first and rounds
+#    integer images from single), hann the shim above, and strel a copy of Octave's image
+#    package's @strel whose disk takes N = 0 below radius 3, as MATLAB's does (the package
+#    refuses the default N = 4 of strel('disk', 1)). authors_run.m runs demo_csr.m's loop
+#    without its display and reinitialisation: create_csr_tracker on the first frame with the
+#    1-based box, track_csr_tracker on the others; fps = frames / seconds inside those calls.
 set -euo pipefail
 # Octave's BLAS (OpenBLAS) picks its kernels by processor, and they sum in different orders
 # (rgb2gray's product differs in the last bit on a quarter of the pixels between Haswell and
 # SkylakeX kernels): one kernel everywhere keeps the runs the same on every x86-64 machine with AVX2
 export OPENBLAS_CORETYPE=${OPENBLAS_CORETYPE:-Haswell}
-[ $# -ge 3 ] || { sed -n '2,12p' "$0"; exit 2; }
-case $1 in strcf|dr2track|bacf|arcf|autotrack) ;; *) echo "tracker must be strcf, dr2track, bacf, arcf or autotrack"; exit 2 ;; esac
+[ $# -ge 3 ] || { sed -n '2,14p' "$0"; exit 2; }
+case $1 in strcf|dr2track|bacf|arcf|autotrack|eco_hc|csrdcf) ;;
+  *) echo "tracker must be strcf, dr2track, bacf, arcf, autotrack, eco_hc or csrdcf"; exit 2 ;; esac
 TRK=$1; ROOT=$(cd "$2" && pwd); mkdir -p "$3"; OUT=$(cd "$3" && pwd); shift 3
 HERE=$(cd "$(dirname "$0")" && pwd)
 REF=$(cd "${DCFKIT_REFERENCE:-$HERE/../../shared/reference}" && pwd)
@@ -72,13 +103,21 @@ portable_estimates() {
   grep -q dcfkit_estimates::rsqrt "$1/sse.hpp" && grep -q 'acos(double(' "$1/gradientMex.cpp" \
     || { echo "could not put the portable estimates into $1"; exit 1; }
 }
-# the portability patches the copies share (gradientMex folder, mexResize.mex path, mtimesx
-# folder, shim folder)
-port_lineage() {
+# Piotr's gradientMex, ported and built in its folder $1
+port_gradientmex() {
   sed -i '1i #include <cstdlib>\n#include <cstddef>' "$1/wrappers.hpp"
   sed -i 's/const int dims\[3\]={h,w,d}, n=h\*w\*d;/const mwSize dims[3]={(mwSize)h,(mwSize)w,(mwSize)d}; const int n=h*w*d;/; s/  const int \*dims; int nDims;/  const mwSize *dims; int nDims;/' "$1/gradientMex.cpp"
   portable_estimates "$1"
   (cd "$1" && mkoctfile --mex -O2 -DMATLAB_MEX_FILE -o gradientMex.mex gradientMex.cpp)
+}
+# a checkout named by an environment variable ($1 its folder, $2 the variable, $3 the repository)
+checkout() {
+  [ -d "$1" ] || { echo "no checkout of $3 at $1: set $2 to one"; exit 1; }
+}
+# the portability patches the copies share (gradientMex folder, mexResize.mex path, mtimesx
+# folder, shim folder)
+port_lineage() {
+  port_gradientmex "$1"
   build_mexresize "$2"
   mv "$3/mtimesx.m" "$3/mtimesx_mex_help.txt"
   cp "$REF"/octave/{hann.m,ifft2.m,gather.m,mtimesx.m} "$4/"
@@ -103,6 +142,35 @@ case $TRK in
     C=$BUILD/code; rm -rf "$C"; cp -r "$REF/AutoTrack" "$C"
     cp "$REF"/DR2Track/DR2Track1/feature/{sse.hpp,wrappers.hpp} "$C/feature/"
     port_lineage "$C/feature" "$C/utils/mexResize.mex" "$C/utils" "$C/utils" ;;
+  eco_hc)
+    C=$BUILD/code; P=$C/external_libs/pdollar_toolbox/channels; M=$C/external_libs/mtimesx
+    checkout "${ECO_CODE:-$REF/ECO}" ECO_CODE martin-danelljan/ECO
+    rm -rf "$C"; cp -r "${ECO_CODE:-$REF/ECO}" "$C"; rm -rf "$C/.git"; mkdir -p "$P"
+    cp "$REF"/DR2Track/DR2Track1/feature/{fhog.m,gradientMex.cpp,sse.hpp,wrappers.hpp} "$P/"
+    port_gradientmex "$P"
+    rm -f "$C"/external_libs/mexResize/mexResize.mex*
+    build_mexresize "$C/external_libs/mexResize/mexResize.mex"
+    (cd "$M" && mkoctfile --mex -O2 -DDEFINEUNIX -DMWSIZE_MAX -DmxCreateSharedDataCopy=mxDuplicateArray \
+       -o mtimesx.mex mtimesx.c -lblas > build.log 2>&1) || { cat "$M/build.log"; exit 1; }  # its many warnings
+    mv "$M/mtimesx.m" "$M/mtimesx_mex_help.txt"
+    cp "$REF"/octave/{hann.m,ifft2.m,gather.m} "$HERE/octave/shims/ifft.m" "$C/utils/" ;;
+  csrdcf)
+    C=$BUILD/code; S=$C/mex_src/segmentation; O=$C/octave_shims
+    checkout "${CSR_CODE:-$REF/csr-dcf}" CSR_CODE alanlukezic/csr-dcf
+    rm -rf "$C"; cp -r "${CSR_CODE:-$REF/csr-dcf}" "$C"; rm -rf "$C/.git"; mkdir -p "$C/mex" "$O"
+    port_gradientmex "$C/mex_src/hog"; mv "$C/mex_src/hog/gradientMex.mex" "$C/mex/"
+    sed -i 's|^#include <opencv2/opencv.hpp>|#include <opencv2/core.hpp>\n#include <opencv2/imgproc.hpp>|' \
+      "$S"/*.cpp "$S/mex_utils.hpp" "$S/src/segment.h"
+    sed -i '1i #include <map>\n#include <vector>' "$S/mex_utils.hpp"
+    sed -i 's|(depth==CV_USRTYPE1)|(depth==7 /* CV_USRTYPE1 of OpenCV 2.4 */)|' "$S/mex_utils.hpp"
+    for f in mex_segment mex_extractforeground mex_extractbackground; do
+      (cd "$S" && mkoctfile --mex -O2 -Isrc -I/usr/include/opencv4 -o "$C/mex/$f.mex" "$f.cpp" src/segment.cpp \
+         -lopencv_imgproc -lopencv_core)
+    done
+    cp "$REF/octave/hann.m" "$HERE/octave/shims/imresize.m" "$O/"
+    cp -r "$(octave --no-gui -q --eval "pkg load image; disp(fileparts(which('strel')))" 2>/dev/null | tail -1)" "$O/"
+    sed -i 's|^      ## TODO implement approximation by periodic lines|      if (radius < 3) n = 0; endif  # as MATLAB: no decomposition below radius 3\n&|' "$O/@strel/strel.m"
+    grep -q 'if (radius < 3) n = 0;' "$O/@strel/strel.m" || { echo "could not patch the image package's strel"; exit 1; } ;;
 esac
 # frame lists and 1-based first boxes, from dcfkit's own dataset loader
 DS=$(PYTHONPATH="$HERE/..${PYTHONPATH:+:$PYTHONPATH}" python3 - "$ROOT" "$BUILD/seqs" "$@" <<'EOF'

@@ -103,3 +103,28 @@ def test_authors_octave(tmp_path, synthetic_uav123):
     boxes = (tmp_path / "out" / "UAV123_10fps" / "wakeboard7.txt").read_text().splitlines()
     assert len(boxes) == 67 and all(len(line.split(",")) == 4 for line in boxes)
 
+
+
+def _authors_source(variable: str, folder: str) -> Path | None:
+    """Where authors_octave.sh finds ECO's or CSR-DCF's checkout ($ECO_CODE / $CSR_CODE, else
+    $DCFKIT_REFERENCE/<folder>), or None."""
+    reference = Path(os.environ.get("DCFKIT_REFERENCE") or ROOT.parent / "shared" / "reference")
+    code = Path(os.environ.get(variable) or reference / folder)
+    return code if code.is_dir() and (reference / "DR2Track").is_dir() else None
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("octave") is None, reason="GNU Octave is not installed (apt-get install octave)")
+@pytest.mark.parametrize("tracker, variable, folder", [("eco_hc", "ECO_CODE", "ECO"), ("csrdcf", "CSR_CODE", "csr-dcf")])
+def test_authors_octave_builds_and_runs_eco_and_csr(tmp_path, synthetic_uav123, tracker, variable, folder):
+    """ECO-HC and CSR-DCF: the mex files build (their mtimesx, the segmentation mex against
+    OpenCV 4) and a sequence runs to one box per frame, with the fps the run reports."""
+    if _authors_source(variable, folder) is None:
+        pytest.skip(f"no checkout of the authors' code (${variable}) or no DCFKIT_REFERENCE")
+    done = subprocess.run(["bash", str(BENCHMARKS / "authors_octave.sh"), tracker, str(synthetic_uav123),
+                           str(tmp_path / "out"), "wakeboard7"], capture_output=True, text=True, timeout=1200)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    boxes = (tmp_path / "out" / "UAV123_10fps" / "wakeboard7.txt").read_text().splitlines()
+    assert len(boxes) == 67 and all(len(line.split(",")) == 4 for line in boxes)
+    fps = (tmp_path / "out" / "UAV123_10fps" / f"{tracker}_fps.tsv").read_text().splitlines()[1].split("\t")
+    assert fps[0] == "wakeboard7" and float(fps[2]) > 0
