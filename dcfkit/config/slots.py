@@ -54,6 +54,9 @@ SLOTS = (
     Slot("solver", "solver", "solver", required=True, help="how the filter is trained"),
     Slot("search", "search", "search", default="fixed", help="where the next frame is searched"),
     Slot("scale_estimator", "scale", "scale", default="pyramid", help="how the scale is estimated"),
+    Slot("mask", "mask", "mask", help="a spatial mask learnt each frame, outside which the filter is zero"),
+    Slot("channel_weights", "channel_weights", "channel_weights",
+         help="how much each feature channel's response counts at detection"),
 )
 
 KINDS = tuple(dict.fromkeys(s.kind for s in SLOTS))  # the kinds of the components the slots take
@@ -86,7 +89,7 @@ def build(slot: Slot, registry: Registry, config: Mapping, tracker: str) -> list
     """What ``slot`` holds in the resolved ``config`` of ``tracker``, each component built once:
     a list (``many``), one, or None (an absent role)."""
     where, found = f"{tracker}: {slot.key}", specs(slot, config)
-    if not found and slot.role is None:
+    if not found and (slot.required or slot.default is not None):
         raise ConfigError(f"{where}: missing (a Tracker takes a config that dcfkit.load_config resolved)")
     if slot.many:
         return [registry.build(slot.kind, spec, f"{where}[{i}]") for i, spec in enumerate(found)]
@@ -127,6 +130,8 @@ def _resolve_slot(registry: Registry, slot: Slot, data: Mapping, origin: str) ->
         raw = _group(data, slot.top, origin).get(slot.role)
         return None if raw is None else _spec(registry, slot, raw, where)
     raw = data.get(slot.key, slot.default)
+    if raw is None and not slot.required and slot.default is None:  # an optional slot given none
+        return None
     if not slot.many:
         return _spec(registry, slot, raw, where)
     if not isinstance(raw, list) or not raw:
@@ -154,6 +159,8 @@ def resolve(data: Mapping, origin: str) -> dict:
     out["tracker"] = dataclasses.asdict(parse_params(TrackerParams, data.get("tracker"), f"{origin}: tracker"))
     for slot in SLOTS:
         spec = _resolve_slot(registry, slot, data, origin)
+        if spec is None and slot.role is None:  # an optional slot left empty: absent, as configs before it
+            continue
         if slot.role is None:
             out[slot.key] = spec
         else:

@@ -34,6 +34,8 @@ def geometry(p: TrackerParams, target: np.ndarray, area_of: np.ndarray | None = 
     size the search area is computed from (default ``target``; DR²Track's code takes the
     annotation's size before its floor, ``tracker.init_area: given``)."""
     cell, low, high = p.cell_size, p.min_image_sample_size, p.max_image_sample_size
+    if p.search_area_shape == "padded_square":
+        return _padded_square(p, target)
     area = float(np.prod((target if area_of is None else area_of) * p.search_area_scale))
     if p.cell_selection_thresh > 0 and area / cell**2 < p.cell_selection_thresh * high / cell**2:
         smaller = min(cell, max(1, int(np.ceil(np.sqrt(area / (p.cell_selection_thresh * high / cell**2))))))
@@ -51,6 +53,31 @@ def geometry(p: TrackerParams, target: np.ndarray, area_of: np.ndarray | None = 
     target_cells = tuple(float(v) for v in base_target / cell)
     geom = Geometry(base_target, cells * cell, (int(cells[0]), int(cells[1])), target_cells, cell)
     return geom, float(scale)
+
+
+def _padded_square(p: TrackerParams, target: np.ndarray) -> tuple[Geometry, float]:
+    """CSR-DCF's template (create_csr_tracker.m): a square of side the mean of floor(size +
+    padding √(wh)), rescaled to at most ``max_image_sample_size`` (at least the smallest),
+    floored, in whole cells (floored), with cells of min(cell_size, ceil(wh / cell_area))."""
+    cell = p.cell_size
+    if p.cell_area > 0:
+        cell = min(cell, max(1, int(np.ceil(np.prod(target) / p.cell_area))))
+    side = float(np.mean(np.floor(target + (p.search_area_scale - 1) * np.sqrt(np.prod(target)))))
+    ratio = min(1.0, float(np.sqrt(p.max_image_sample_size / side**2)))
+    ratio = max(ratio, float(np.sqrt(p.min_image_sample_size / side**2)))
+    cells = max(int(np.floor(np.floor(ratio * side) / cell)), 4)
+    base_target = target * ratio
+    geom = Geometry(base_target, np.array([cells * cell] * 2), (cells, cells),
+                    tuple(float(v) for v in base_target / cell), cell)
+    return geom, 1.0 / ratio
+
+
+def label_sigma(p: TrackerParams, g: Geometry) -> float:
+    """The label's σ in cells: ``tracker.output_sigma`` if set (CSR-DCF's fixed y_sigma), else
+    ``output_sigma_factor`` times the square root of the target's whole cells."""
+    if p.output_sigma > 0:
+        return float(p.output_sigma)
+    return float(np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * p.output_sigma_factor)
 
 
 def reported_box(centre: np.ndarray, size: np.ndarray, convention: str) -> tuple[float, float, float, float]:

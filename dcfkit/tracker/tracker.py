@@ -36,7 +36,7 @@ from dcfkit.numerics.patches import (
     sampler,
     whole_pixel_sampler,
 )
-from dcfkit.numerics.response import newton_peak, response_spectra, shift_spectrum, subpixel_peak
+from dcfkit.numerics.response import newton_peak, parabola_peak, response_spectra, shift_spectrum, subpixel_peak
 from dcfkit.registry import get_registry
 from dcfkit.tracker.checks import (
     check_box,
@@ -48,7 +48,8 @@ from dcfkit.tracker.checks import (
     read_only,
 )
 from dcfkit.tracker.confidence import Confidence
-from dcfkit.tracker.geometry import Geometry, geometry, hann2d, reported_box
+from dcfkit.tracker.geometry import Geometry, geometry, hann2d, label_sigma, reported_box
+from dcfkit.tracker.learnt import channel_maps, learn_channels, masked_w2
 
 
 class Tracker:
@@ -140,14 +141,14 @@ class Tracker:
         self.image_size = image.shape[:2]
         self.geometry, self.scale, self.limits = g, scale, limits
         self.window = hann2d(g.filter_size, interior=self.params.window == "hann_interior")
-        sigma = np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * self.params.output_sigma_factor
+        sigma = label_sigma(self.params, g)
         self.base_label = gaussian_label(g.filter_size, sigma)
         self.base_label.setflags(write=False)  # every frame's label starts from it
-        regularizers = [r for r in (self.spatial, self.temporal) if r is not None]
-        for component in (*self.features, self.label, self.solver, *regularizers):  # a new target: nothing kept
+        optional = [c for c in (self.spatial, self.temporal, self.mask, self.channel_weights) if c is not None]
+        for component in (*self.features, self.label, self.solver, *optional):  # a new target: nothing kept
             component.reset()
         target = Target(self.image_size, g.filter_size, g.target_cells, g.cell_size, scale, float(sigma))
-        for component in (*self.features, self.label, self.solver, *regularizers, self.search, self.scale_estimator):
+        for component in (*self.features, self.label, self.solver, *optional, self.search, self.scale_estimator):
             component.start(target)
         self.w2 = read_only(self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
                              else np.zeros(g.filter_size, np.float32))
@@ -200,18 +201,24 @@ class Tracker:
             sy, sx = (self.position - centre) / (g.cell_size * self.scale)
             xf = shift_spectrum(samples[best], sy, sx, g.filter_size, self.fft.full)
         detection = Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells, (dy, dx))
-        self._observe(detection)
+        self._observe(detection, best)
         self._train(image, detection, xf)
         return self.box
 
     def _response(self, samples: np.ndarray) -> np.ndarray:
         """The solver's (S, H, W) response maps of the (S, C, H, Wr) search samples."""
+        if self.channel_weights is not None:  # each channel's map weighted (CSR-DCF's channel reliability)
+            self._channel_maps = channel_maps(self, samples)
+            return self.channel_weights.combine(self._channel_maps)
         return self.solver.response(self.hf, samples, self.geometry.filter_size, self.fft)
 
-    def _observe(self, detection: Detection) -> None:
-        """Give the detection to the components that adapt to it: the solver, and the spatial
-        regularizer, whose w² it returns is used from this frame on."""
+    def _observe(self, detection: Detection, best: int = 0) -> None:
+        """Give the detection to the components that adapt to it: the solver, the spatial
+        regularizer, whose w² it returns is used from this frame on, and the channel weights
+        (the channel maps of the ``best`` search scale)."""
         self.solver.observe(detection)
+        if self.channel_weights is not None:
+            self.channel_weights.observe(self._channel_maps[best])
         if self.spatial is not None:
             self.w2 = read_only(self.spatial.adapt(self.w2, detection))
 
@@ -227,6 +234,8 @@ class Tracker:
             best, dy, dx, _ = newton_peak(maps, self.params.newton_iterations, spectra)
             return best, dy, dx
         best = int(np.argmax(maps.reshape(len(maps), -1).max(axis=1)))
+        if self.params.peak == "parabola":  # CSR-DCF's: a parabola through each axis's neighbours
+            return (best, *parabola_peak(maps[best]))
         dy, dx, _ = subpixel_peak(maps[best], self.params.newton_iterations)
         return best, dy, dx
 
@@ -240,7 +249,10 @@ class Tracker:
             raise TrackingError(f"frame {self.frame}: temporal regularizer '{self.temporal.name}' returned θ = inf "
                                 f"on the first frame, where there is no filter to keep")
         if theta != np.inf:  # inf: the temporal term holds the filter where it is
-            self.hf = self.solver.train(xf, yf, self.w2, theta, self.fft)  # Eqs. (9)-(11)
+            w2 = self.w2 if self.mask is None else masked_w2(self, image)  # a mask: inf outside it
+            self.hf = self.solver.train(xf, yf, w2, theta, self.fft)  # Eqs. (9)-(11)
+            if self.channel_weights is not None:
+                learn_channels(self, xf)
         step = self.geometry.cell_size * self.scale
         self.last_distractors = (self.position[None, ::-1] + offsets[:, ::-1] * step) if len(offsets) else \
             np.zeros((0, 2))

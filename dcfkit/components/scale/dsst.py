@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import cv2
 import numpy as np
 
 from dcfkit.components.features.fhog import ARITHMETICS, fhog
@@ -32,11 +33,14 @@ class DSST(ScaleEstimator):
         cell_size: int = param(4, "fHOG cell size of the scale samples", ge=1, le=16)
         model_size: str = param("base_target", "size of a scale sample: 'base_target' the target at the search "
                                 "patch's resolution (at least 2x2 cells), 'image_target' its size in image pixels "
-                                "(the authors' init_scale: floored; at least 2 cells, where theirs allows 2 px)",
-                                choices=("base_target", "image_target"))
+                                "(the authors' init_scale: floored; at least 2 cells, where theirs allows 2 px), "
+                                "'square' floor(√model_max_area) on each side (CSR-DCF's: its square template "
+                                "shrunk to that area)", choices=("base_target", "image_target", "square"))
         sampling: str = param("working_patch", "'working_patch': the largest region cut once and each scale "
                               "resampled from it; 'whole_pixel': each scale cropped in whole pixels and resized "
-                              "(the authors' get_scale_sample)", choices=("working_patch", "whole_pixel"))
+                              "(the authors' get_scale_sample); 'whole_pixel_bilinear' the same around the pixel "
+                              "nearest the centre, resized bilinearly (CSR-DCF's get_scale_subwindow, whose centre is "
+                              "half a pixel from dcfkit's)", choices=("working_patch", "whole_pixel", "whole_pixel_bilinear"))
         window: str = param("hann_interior", "window over the scales: 'hann_interior' hann(S+2) without its zero "
                             "ends, or 'hann' hann(S) (the authors')", choices=("hann_interior", "hann"))
         channel_order: str = param("bgr", "colour channel order deciding fHOG's ties (see fhog.channel_order)",
@@ -68,7 +72,10 @@ class DSST(ScaleEstimator):
         area = float(np.prod(target))
         shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
         # at least 2 cells, which fhog needs (init_scale allows 2 px: a side under 8 px differs)
-        self.model_size = np.maximum((np.floor if authors else np.round)(target * shrink),
+        if p.model_size == "square":
+            target = np.full(2, np.sqrt(p.model_max_area))
+            shrink = 1.0
+        self.model_size = np.maximum((np.floor if authors or p.model_size == "square" else np.round)(target * shrink),
                                      2 * p.cell_size).astype(int)
         # the working patch and its resampling to each scale keep their geometry every frame
         span = self.factors[-1] / self.factors[0]
@@ -87,10 +94,14 @@ class DSST(ScaleEstimator):
         small working patch (fine enough for the smallest scale); every scale sample is resized
         from it. 'whole_pixel': floor(target x scale) whole pixels per scale, resized."""
         which = range(len(self.factors)) if which is None else which
-        if self.params.sampling == "whole_pixel":
+        if self.params.sampling != "working_patch":
+            bilinear = self.params.sampling == "whole_pixel_bilinear"
+            at = np.asarray(centre, float) + (0.5 if bilinear else 0.0)
+            size = (int(self.model_size[1]), int(self.model_size[0]))
             patches = np.stack([
-                resize_auto(whole_pixel_crop(image, centre, np.maximum(np.floor(self.base_target * (scale * f)), 2)),
-                            self.model_size) for f in self.factors[list(which)]])
+                (cv2.resize(crop, size) if bilinear else resize_auto(crop, self.model_size))
+                for crop in (whole_pixel_crop(image, at, np.maximum(np.floor(self.base_target * (scale * f)), 2))
+                             for f in self.factors[list(which)])])
         else:
             work = sample(image, centre, self.base_target * scale * self.factors[-1], self.work_size)
             patches = np.stack([self.resamplers[i](work) for i in which])

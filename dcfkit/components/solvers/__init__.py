@@ -10,13 +10,15 @@
 * :mod:`.kernels` -- the ADMM's per-frequency arithmetic, compiled (numba) on first use;
 * :mod:`.kcf` -- ``kernel_ridge``: KCF's kernelized ridge regression (Gaussian, linear or
   polynomial kernel);
-* :mod:`.dsst` -- ``ridge``: DSST's multichannel ridge regression in closed form.
+* :mod:`.dsst` -- ``ridge``: DSST's multichannel ridge regression in closed form;
+* :mod:`.csr` -- ``admm_csr``: CSR-DCF's per-channel filter constrained to a mask.
 """
 from __future__ import annotations
 
 from dcfkit.components.solvers.arcf import ADMMArcf, ARCFParams
 from dcfkit.components.solvers.autotrack import ADMMAutoTrack, AutoTrackParams
 from dcfkit.components.solvers.base import Solver
+from dcfkit.components.solvers.csr import ADMMCsr, CSRParams, csr_filter
 from dcfkit.components.solvers.dsst import Ridge, RidgeParams
 from dcfkit.components.solvers.kcf import KernelParams, KernelRidge, kernel_correlation
 from dcfkit.components.solvers.strcf_bacf import (
@@ -30,8 +32,9 @@ from dcfkit.components.solvers.strcf_bacf import (
     sherman_morrison_solve,
 )
 
-BUILTIN = (ADMMStrcf, ADMMBacf, ADMMArcf, ADMMAutoTrack, KernelRidge, Ridge)
+BUILTIN = (ADMMStrcf, ADMMBacf, ADMMArcf, ADMMAutoTrack, KernelRidge, Ridge, ADMMCsr)
 
-__all__ = ["ADMMArcf", "ADMMAutoTrack", "ADMMBacf", "ADMMParams", "ADMMStrcf", "ARCFParams", "AutoTrackParams",
-           "BACFParams", "BUILTIN", "KernelParams", "KernelRidge", "Ridge", "RidgeParams", "Solver", "admm",
-           "kernel_correlation", "penalties", "schedule_problem", "sherman_morrison_solve"]
+__all__ = ["ADMMArcf", "ADMMAutoTrack", "ADMMBacf", "ADMMCsr", "ADMMParams", "ADMMStrcf", "ARCFParams",
+           "AutoTrackParams", "BACFParams", "BUILTIN", "CSRParams", "KernelParams", "KernelRidge", "Ridge", "RidgeParams",
+           "Solver", "admm", "csr_filter", "kernel_correlation", "penalties", "schedule_problem",
+           "sherman_morrison_solve"]

@@ -1,0 +1,151 @@
+"""CSR-DCF's spatial reliability map (Lukežič et al., CVPR 2017, Sec. 3.1), as the authors'
+``create_csr_tracker.m`` and ``track_csr_tracker.m`` learn it each frame."""
+from __future__ import annotations
+
+import dataclasses
+
+import cv2
+import numpy as np
+
+from dcfkit.components.base import Target
+from dcfkit.components.masks.base import Mask
+from dcfkit.components.masks.segmentation import background_histogram, foreground_histogram, hsv255, \
+    location_prior, posterior
+from dcfkit.numerics.patches import round_half_away, whole_pixel_cropper
+from dcfkit.params import param
+
+GRAY_SUM = 10  # create_csr_tracker: a frame whose channels differ from their mean by less in sum is gray
+
+
+def box_mask(shape: tuple[int, int], target_cells: tuple[float, float]) -> np.ndarray:
+    """The authors' fallback ``target_dummy_mask``: floor(target cells) + 1 cells from 1-based
+    ⌊(n - target) / 2⌋ (one cell above and left of the middle), (H, W) bool."""
+    mask = np.zeros(shape, bool)
+    spans = []
+    for n, extent in zip(shape, target_cells):
+        extent = int(np.floor(extent))
+        start = max(int(np.floor((n - extent) / 2)) - 1, 0)
+        spans.append(slice(start, start + extent + 1))
+    mask[spans[0], spans[1]] = True
+    return mask
+
+
+def nearest_resize(mask: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """MATLAB's ``imresize(mask, shape, 'nearest')``: output cell i takes input ⌊(i + ½) n / m⌋
+    (OpenCV's nearest takes ⌊i n / m⌋)."""
+    rows = ((np.arange(shape[0]) + 0.5) * mask.shape[0] / shape[0]).astype(int)
+    cols = ((np.arange(shape[1]) + 0.5) * mask.shape[1] / shape[1]).astype(int)
+    return mask[np.ix_(rows, cols)]
+
+
+def disk(radius: int) -> np.ndarray:
+    """MATLAB's ``strel('disk', r)`` for the small radii used: the cells within r (uint8)."""
+    r = np.arange(-radius, radius + 1)
+    return (r[:, None] ** 2 + r[None, :] ** 2 <= radius**2).astype(np.uint8)
+
+
+class CSRSegmentation(Mask):
+    """CSR-DCF's spatial reliability: colour histograms of target and surroundings, a spatial
+    prior, an MRF-smoothed posterior, binarised on the filter grid (Lukežič et al. 2017)."""
+
+    name = "csr_segmentation"
+
+    @dataclasses.dataclass(frozen=True)
+    class Params:
+        n_bins: int = param(16, "histogram bins per colour channel", ge=2, le=64)
+        colour_space: str = param("hsv", "'hsv' (MATLAB's rgb2hsv on 0..255) or 'bgr'", choices=("hsv", "bgr"))
+        learning_rate: float = param(0.04, "weight of each frame's histograms in the colour model (hist_lr)",
+                                     gt=0, le=1)
+        threshold: float = param(0.5, "the posterior, over its maximum, above which a pixel is the target",
+                                 ge=0, lt=1)
+        min_area: float = param(0.05, "a mask smaller than this fraction of the box mask is replaced by the box "
+                                "mask (mask_normal)", ge=0, le=1)
+        dilation: int = param(1, "radius (cells) of the disk the mask is dilated by (0: none)", ge=0, le=10)
+        histogram_box: str = param("previous_scale", "the box the histograms are taken from: 'previous_scale' "
+                                   "the new centre with the scale before this frame's scale update (the "
+                                   "authors' region), or 'current'", choices=("previous_scale", "current"))
+
+    def reset(self) -> None:
+        self.hist_fg = self.hist_bg = self.last_target = None
+        self.colour = True
+        self.box = None
+
+    def start(self, target: Target) -> None:
+        self.box = box_mask(target.filter_size, target.target_cells)
+
+    def make(self, image, centre, target, region, shape):
+        first = self.hist_fg is None and self.last_target is None
+        if first:
+            self.colour = image.ndim == 3 and not _gray(image)
+        box = self.box if self.box is not None and self.box.shape == tuple(shape) else \
+            box_mask(shape, (1.0, 1.0))
+        if not self.colour:  # the authors: no segmentation on a gray sequence
+            self.last_target = np.asarray(target, float)
+            return box.copy()
+        hist_size = target if first or self.params.histogram_box == "current" else self.last_target
+        self.last_target = np.asarray(target, float)
+        self._learn_histograms(image, centre, np.asarray(hist_size, float))
+        soft = self._posterior(image, centre, np.asarray(target, float), np.floor(region).astype(int))
+        if first:  # the first mask stays within the given box
+            soft = soft * _within(soft.shape, round_half_away(target).astype(int))
+        peak = soft.max()
+        hard = soft / (peak if peak > 0 else 1.0) > self.params.threshold
+        mask = nearest_resize(hard, tuple(shape))
+        if mask.sum() < box.sum() * self.params.min_area:
+            return box.copy()
+        if self.params.dilation:
+            mask = cv2.dilate(mask.astype(np.uint8), disk(self.params.dilation)).astype(bool)
+        return mask
+
+    def _learn_histograms(self, image, centre, size) -> None:
+        """The target box (the authors' round([c - s/2, c + s/2]) - 1, c 1-based) and the ring
+        of half its size around it, their histograms averaged into the colour model."""
+        height, width = image.shape[:2]
+        c = np.asarray(centre, float) + 1.5  # the authors' 1-based centre (dcfkit's is x + (w-1)/2)
+        (y1, x1), (y2, x2) = (round_half_away(c - size / 2) - 1).astype(int), (round_half_away(c + size / 2)
+                                                                                - 1).astype(int)
+        x1, x2 = (min(max(v, 0), width - 1) for v in (x1, x2))
+        y1, y2 = (min(max(v, 0), height - 1) for v in (y1, y2))
+        dx, dy = (x2 - x1 + 1) // 2, (y2 - y1 + 1) // 2
+        ox1, ox2 = max(x1 - dx, 0), min(x2 + dx + 1, width - 1)
+        oy1, oy2 = max(y1 - dy, 0), min(y2 + dy + 1, height - 1)
+        pixels = self._colours(image[oy1:max(oy2, y2) + 1, ox1:max(ox2, x2) + 1])
+        inner = (x1 - ox1, y1 - oy1, x2 - ox1, y2 - oy1)
+        fg = foreground_histogram(pixels, inner, self.params.n_bins)
+        bg = background_histogram(pixels, inner, (0, 0, ox2 - ox1, oy2 - oy1), self.params.n_bins)
+        if self.hist_fg is None:
+            self.hist_fg, self.hist_bg = fg, bg
+        else:
+            rate = self.params.learning_rate
+            self.hist_fg = (1 - rate) * self.hist_fg + rate * fg
+            self.hist_bg = (1 - rate) * self.hist_bg + rate * bg
+
+    def _posterior(self, image, centre, target, size) -> np.ndarray:
+        """The foreground posterior over the region's whole pixels around the authors' ⌊c⌋ (get_patch),
+        zero outside the image, (h, w) float32."""
+        size = np.maximum(size, 2)
+        c = np.asarray(centre, float) + 0.5  # whole_pixel_cropper's ⌊c⌋ is then the authors' ⌊c⌋ - 1
+        patch = whole_pixel_cropper(image.shape, c, size)(image)
+        rows = np.floor(c[0]).astype(int) + 1 - size[0] // 2 + np.arange(size[0])
+        cols = np.floor(c[1]).astype(int) + 1 - size[1] // 2 + np.arange(size[1])
+        valid = ((rows >= 0) & (rows < image.shape[0]))[:, None] & ((cols >= 0) & (cols < image.shape[1]))[None, :]
+        prior = location_prior(tuple(size), target)
+        soft = posterior(self._colours(patch), self.hist_fg, self.hist_bg, prior, self.params.n_bins)
+        return soft * valid
+
+    def _colours(self, bgr: np.ndarray) -> np.ndarray:
+        return hsv255(bgr) if self.params.colour_space == "hsv" else bgr
+
+
+def _gray(image: np.ndarray) -> bool:
+    """create_csr_tracker's test: the channels' summed deviation from their mean below 10."""
+    deviation = image.astype(np.float32) - image.mean(axis=2, dtype=np.float32, keepdims=True)
+    return float(np.abs(deviation).sum()) < GRAY_SUM
+
+
+def _within(shape: tuple[int, int], box: np.ndarray) -> np.ndarray:
+    """The authors' ``init_mask_padded``: ones over ``box`` (h, w) from 1-based ⌊n/2 - b/2⌋."""
+    out = np.zeros(shape, np.float32)
+    y0, x0 = (max(int(np.floor(n / 2 - b / 2)) - 1, 0) for n, b in zip(shape, box))
+    out[y0:y0 + int(box[0]), x0:x0 + int(box[1])] = 1
+    return out

@@ -1,0 +1,127 @@
+"""CSR-DCF's segmentation (Lukežič et al., CVPR 2017, Sec. 3.1): colour histograms of the
+target and its surroundings, a spatial prior, and the posteriors smoothed by the Markov random
+field of Kristan et al. (ACCV 2014), as the authors' ``segment.cpp`` computes them.
+
+Every function is pure numpy/OpenCV on small arrays: a histogram is ``n_bins³`` float64
+values, its bin of a pixel ``Σ_d n_bins^(2-d) ⌊n_bins v_d / 256⌋`` over the three channels.
+"""
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+EPANECHNIKOV = 2.0 / 3.14  # the authors' kernel profile constant (it cancels in every normalisation)
+P_BACKGROUND = 5.0 / 3.0  # segment.cpp's prior of the background relative to the foreground
+MAX_ITERATIONS, TOLERANCE = 50, 0.1  # the MRF's iterations and its stop on the mean log-likelihood
+
+
+def hsv255(bgr: np.ndarray) -> np.ndarray:
+    """(H, W, 3) uint8 BGR -> (H, W, 3) uint8 HSV, each channel on 0..255 as MATLAB's
+    ``rgb2hsv(img) * 255`` rounded (OpenCV's 8-bit hue runs to 180 or wraps at 256)."""
+    hsv = cv2.cvtColor(bgr.astype(np.float32) * np.float32(1 / 255), cv2.COLOR_BGR2HSV)
+    hsv *= np.array([255 / 360, 255, 255], np.float32)
+    return np.rint(hsv).clip(0, 255).astype(np.uint8)
+
+
+def bins(pixels: np.ndarray, n_bins: int) -> np.ndarray:
+    """The histogram bin of every pixel of (..., 3) uint8 -> (...) int64."""
+    q = pixels.astype(np.int64) * n_bins // 256
+    return (q[..., 0] * n_bins + q[..., 1]) * n_bins + q[..., 2]
+
+
+def foreground_histogram(pixels: np.ndarray, box: tuple[int, int, int, int], n_bins: int) -> np.ndarray:
+    """Histogram of the box (x1, y1, x2, y2), inclusive pixel indices of ``pixels``, each pixel
+    weighted by an Epanechnikov kernel on the box (extractForegroundHistogram); sums to 1."""
+    x1, y1, x2, y2 = box
+    ys, xs = np.mgrid[y1:y2 + 1, x1:x2 + 1]
+    kw, kh = 1.0 / (0.5 * (x2 - x1) * 1.4142 + 1), 1.0 / (0.5 * (y2 - y1) * 1.4142 + 1)
+    d = ((x1 + (x2 - x1) / 2.0 - xs) * kw) ** 2 + ((y1 + (y2 - y1) / 2.0 - ys) * kh) ** 2
+    weights = np.where(d <= 1, EPANECHNIKOV * (1 - d), 0.0)
+    hist = np.bincount(bins(pixels[y1:y2 + 1, x1:x2 + 1], n_bins).ravel(), weights.ravel(), n_bins**3)
+    return hist / max(hist.sum(), np.finfo(float).tiny)
+
+
+def background_histogram(pixels: np.ndarray, box: tuple[int, int, int, int], outer: tuple[int, int, int, int],
+                         n_bins: int) -> np.ndarray:
+    """Histogram of the ``outer`` rows and columns [x1, x2) x [y1, y2) but the ``box``
+    (inclusive), unweighted (extractBackGroundHistogram); sums to 1."""
+    ox1, oy1, ox2, oy2 = outer
+    x1, y1, x2, y2 = box
+    ring = np.ones((oy2 - oy1, ox2 - ox1), bool)
+    ring[max(y1 - oy1, 0):max(y2 + 1 - oy1, 0), max(x1 - ox1, 0):max(x2 + 1 - ox1, 0)] = False
+    hist = np.bincount(bins(pixels[oy1:oy2, ox1:ox2][ring], n_bins), minlength=n_bins**3).astype(float)
+    return hist / max(hist.sum(), 1.0)
+
+
+def location_prior(shape: tuple[int, int], target: np.ndarray) -> np.ndarray:
+    """The foreground prior over a patch of ``shape`` (h, w) pixels (get_location_prior): an
+    Epanechnikov kernel of the target's smaller side, centred, scaled to peak 1 and clipped
+    to [0.5, 0.9]; the background's is 1 minus it. (h, w) float64."""
+    h, w = shape
+    k = 1.0 / (0.5 * float(np.min(target)) * 1.4142 + 1)
+    dy = (np.arange(1, h + 1) - (1 + 0.5 * (h - 1))) * k
+    dx = (np.arange(1, w + 1) - (1 + 0.5 * (w - 1))) * k
+    d = dy[:, None] ** 2 + dx[None, :] ** 2
+    prior = np.where(d > 1, 0.0, EPANECHNIKOV * (1 - d))
+    return np.clip(prior / prior.max(), 0.5, 0.9)
+
+
+def mrf_kernels(width: int) -> tuple[np.ndarray, np.ndarray]:
+    """The MRF's neighbourhood: a Gaussian of half-size ⌊3 width / 50 + 0.5⌋ (at least 1), σ a
+    third of it, its centre 0 and the rest summing to 1 (λ), and the same with centre 1 (λ₂)."""
+    half = max(1, int(np.floor(width * 3.0 / 50.0 + 0.5)))
+    r = np.arange(-half, half + 1, dtype=float)
+    std2 = (half / 3.0) ** 2
+    lam = np.exp(-(r[:, None] ** 2 + r[None, :] ** 2) / (2 * std2)) / (2 * np.pi * std2)
+    lam[half, half] = 0.0
+    lam /= lam.sum()
+    lam2 = lam.copy()
+    lam2[half, half] = 1.0
+    return lam, lam2
+
+
+def regularised(prob_o: np.ndarray, prior_o: np.ndarray) -> np.ndarray:
+    """The MRF smoothing of segment.cpp's getRegularizedSegmentation (Kristan et al., ACCV 2014):
+    from the foreground posterior and prior (h, w) float64, the smoothed foreground
+    probability Q_o, iterated until the mean log-likelihood moves less than 0.1 (at most 50).
+    Foreground and background are filtered together, as the channels of one image."""
+    lam, lam2 = mrf_kernels(prob_o.shape[1])
+    eps = np.finfo(float).eps
+    prob = np.dstack([prob_o, 1.0 - prob_o])
+    prior = np.dstack([prior_o, 1.0 - prior_o])
+    reflect = cv2.BORDER_REFLECT
+    log_like = np.finfo(float).max
+    for _ in range(MAX_ITERATIONS):
+        p_i = prior * prob + eps
+        s_q = cv2.filter2D(np.dstack([prior, p_i]), -1, lam, borderType=reflect) * np.dstack([prior, p_i])
+        s_q[..., :2] /= s_q[..., :2].sum(axis=2, keepdims=True)  # S_i, normalised over o and b
+        s_q[..., 2:] /= s_q[..., 2:].sum(axis=2, keepdims=True)  # Q_i
+        sums = cv2.filter2D(s_q, -1, lam2, borderType=reflect)  # S_sum (o, b), Q_sum (o, b)
+        prior = (sums[..., 2:] + sums[..., :2]) * 0.25
+        prior /= prior.sum(axis=2, keepdims=True)
+        new = -np.log(sums[..., 2:]).sum() / (2 * prob_o.size)
+        if abs(log_like - new) < TOLERANCE:
+            break
+        log_like = new
+    return sums[..., 2]
+
+
+def posterior(patch: np.ndarray, hist_fg: np.ndarray, hist_bg: np.ndarray, prior: np.ndarray,
+              n_bins: int) -> np.ndarray:
+    """segment.cpp's computePosteriors: the (h, w, 3) uint8 patch (and its prior) shrunk to about
+    1000 pixels, each pixel's likelihoods from the histograms times the priors, Bayes' rule
+    with the background 5/3 as likely, the MRF, and the foreground probability resized back:
+    (h, w) float32. Where neither histogram has the pixel's colour (the authors' 0/0), 0.5."""
+    h, w = patch.shape[:2]
+    factor = min(1.0, float(np.sqrt(1000.0 / max((w - 1) * (h - 1), 1))))
+    size = (max(int((w - 1) * factor), 1), max(int((h - 1) * factor), 1))  # cv::Size truncates
+    small = cv2.resize(patch, size)
+    prior_o = cv2.resize(prior, size)
+    index = bins(small, n_bins)
+    fg = hist_fg[index] * prior_o
+    bg = hist_bg[index] * (1.0 - prior_o)
+    p_o = 1.0 / (P_BACKGROUND + 1)
+    den = p_o * fg + P_BACKGROUND * bg
+    prob_o = np.divide(p_o * fg, den, out=np.full_like(fg, 0.5), where=den > 0)
+    q_o = regularised(prob_o, prior_o)
+    return cv2.resize(q_o, (w, h)).astype(np.float32)
