@@ -9,9 +9,8 @@ import numpy as np
 
 from dcfkit.components.base import Target
 from dcfkit.components.masks.base import Mask
-from dcfkit.components.masks.segmentation import background_histogram, foreground_histogram, hsv255, \
-    location_prior, posterior
-from dcfkit.numerics.patches import round_half_away, whole_pixel_cropper
+from dcfkit.components.masks.segmentation import background_histogram, foreground_histogram, hsv255, posterior
+from dcfkit.numerics.patches import round_half_away
 from dcfkit.params import param
 
 GRAY_SUM = 10  # create_csr_tracker: a frame whose channels differ from their mean by less in sum is gray
@@ -124,14 +123,20 @@ class CSRSegmentation(Mask):
         """The foreground posterior over the region's whole pixels around the authors' ⌊c⌋ (get_patch),
         zero outside the image, (h, w) float32."""
         size = np.maximum(size, 2)
-        c = np.asarray(centre, float) + 0.5  # whole_pixel_cropper's ⌊c⌋ is then the authors' ⌊c⌋ - 1
-        patch = whole_pixel_cropper(image.shape, c, size)(image)
-        rows = np.floor(c[0]).astype(int) + 1 - size[0] // 2 + np.arange(size[0])
-        cols = np.floor(c[1]).astype(int) + 1 - size[1] // 2 + np.arange(size[1])
-        valid = ((rows >= 0) & (rows < image.shape[0]))[:, None] & ((cols >= 0) & (cols < image.shape[1]))[None, :]
-        prior = location_prior(tuple(size), target)
-        soft = posterior(self._colours(patch), self.hist_fg, self.hist_bg, prior, self.params.n_bins)
-        return soft * valid
+        # the authors' 1-based floor(c) + (1:h) - floor(h/2), their c being dcfkit's centre + 1.5
+        firsts = [int(np.floor(np.asarray(centre, float)[a] + 0.5)) + 1 - size[a] // 2 for a in range(2)]
+        rows, cols = (np.clip(f + np.arange(n), 0, image.shape[a] - 1) for a, (f, n) in enumerate(zip(firsts, size)))
+
+        def pixels(r, c):  # the patch's colours at its rows r x columns c, edges replicated
+            return self._colours(image[np.ix_(rows[r], cols[c])])
+
+        soft = posterior(pixels, (int(size[0]), int(size[1])), self.hist_fg, self.hist_bg, target, self.params.n_bins)
+        for axis, first in enumerate(firsts):  # zero where the patch is beyond the image (valid_pixels_mask)
+            inside = slice(max(-first, 0), max(image.shape[axis] - first, 0))
+            view = np.moveaxis(soft, axis, 0)
+            view[:inside.start] = 0
+            view[inside.stop:] = 0
+        return soft
 
     def _colours(self, bgr: np.ndarray) -> np.ndarray:
         return hsv255(bgr) if self.params.colour_space == "hsv" else bgr

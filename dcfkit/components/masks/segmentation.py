@@ -18,14 +18,13 @@ MAX_ITERATIONS, TOLERANCE = 50, 0.1  # the MRF's iterations and its stop on the 
 def hsv255(bgr: np.ndarray) -> np.ndarray:
     """(H, W, 3) uint8 BGR -> (H, W, 3) uint8 HSV, each channel on 0..255 as MATLAB's
     ``rgb2hsv(img) * 255`` rounded (OpenCV's 8-bit hue runs to 180 or wraps at 256)."""
-    hsv = cv2.cvtColor(bgr.astype(np.float32) * np.float32(1 / 255), cv2.COLOR_BGR2HSV)
-    hsv *= np.array([255 / 360, 255, 255], np.float32)
-    return np.rint(hsv).clip(0, 255).astype(np.uint8)
+    hsv = cv2.cvtColor(bgr.astype(np.float32), cv2.COLOR_BGR2HSV)  # H in degrees, S in [0, 1], V in 0..255
+    return cv2.convertScaleAbs(cv2.multiply(hsv, (255 / 360, 255, 1, 0)))  # rounded (to even), saturated
 
 
 def bins(pixels: np.ndarray, n_bins: int) -> np.ndarray:
     """The histogram bin of every pixel of (..., 3) uint8 -> (...) int64."""
-    q = pixels.astype(np.int64) * n_bins // 256
+    q = pixels.astype(np.int32) * n_bins // 256
     return (q[..., 0] * n_bins + q[..., 1]) * n_bins + q[..., 2]
 
 
@@ -47,23 +46,32 @@ def background_histogram(pixels: np.ndarray, box: tuple[int, int, int, int], out
     (inclusive), unweighted (extractBackGroundHistogram); sums to 1."""
     ox1, oy1, ox2, oy2 = outer
     x1, y1, x2, y2 = box
-    ring = np.ones((oy2 - oy1, ox2 - ox1), bool)
-    ring[max(y1 - oy1, 0):max(y2 + 1 - oy1, 0), max(x1 - ox1, 0):max(x2 + 1 - ox1, 0)] = False
-    hist = np.bincount(bins(pixels[oy1:oy2, ox1:ox2][ring], n_bins), minlength=n_bins**3).astype(float)
-    return hist / max(hist.sum(), 1.0)
+    ring = np.ones((max(oy2 - oy1, 0), max(ox2 - ox1, 0)), np.uint8)
+    ring[max(y1 - oy1, 0):max(y2 + 1 - oy1, 0), max(x1 - ox1, 0):max(x2 + 1 - ox1, 0)] = 0
+    if not ring.any():
+        return np.zeros(n_bins**3)
+    # OpenCV's uniform bins over [0, 256): bin ⌊n_bins v / 256⌋ of each channel, channel 0 first
+    hist = cv2.calcHist([np.ascontiguousarray(pixels[oy1:oy2, ox1:ox2])], [0, 1, 2], ring, [n_bins] * 3,
+                        [0, 256] * 3).ravel().astype(float)
+    return hist / hist.sum()
 
 
-def location_prior(shape: tuple[int, int], target: np.ndarray) -> np.ndarray:
+def location_prior(shape: tuple[int, int], target: np.ndarray, rows=None, cols=None) -> np.ndarray:
     """The foreground prior over a patch of ``shape`` (h, w) pixels (get_location_prior): an
     Epanechnikov kernel of the target's smaller side, centred, scaled to peak 1 and clipped
-    to [0.5, 0.9]; the background's is 1 minus it. (h, w) float64."""
+    to [0.5, 0.9]; the background's is 1 minus it. (h, w) float64, or only at ``rows`` x ``cols``."""
     h, w = shape
     k = 1.0 / (0.5 * float(np.min(target)) * 1.4142 + 1)
     dy = (np.arange(1, h + 1) - (1 + 0.5 * (h - 1))) * k
     dx = (np.arange(1, w + 1) - (1 + 0.5 * (w - 1))) * k
-    d = dy[:, None] ** 2 + dx[None, :] ** 2
-    prior = np.where(d > 1, 0.0, EPANECHNIKOV * (1 - d))
-    return np.clip(prior / prior.max(), 0.5, 0.9)
+    peak = 1.0 - (np.min(dy * dy) + np.min(dx * dx))
+    if rows is not None:
+        dy, dx = dy[rows], dx[cols]
+    d = np.add.outer(dy * dy, dx * dx)
+    # the profile (1 - d) over its peak, 0 beyond d = 1 (raised to 0.5 by the clip all the same)
+    np.subtract(1.0, d, out=d)
+    d *= 1.0 / peak
+    return np.clip(d, 0.5, 0.9, out=d)
 
 
 def mrf_kernels(width: int) -> tuple[np.ndarray, np.ndarray]:
@@ -88,17 +96,21 @@ def regularised(prob_o: np.ndarray, prior_o: np.ndarray) -> np.ndarray:
     lam, lam2 = mrf_kernels(prob_o.shape[1])
     eps = np.finfo(float).eps
     prob = np.dstack([prob_o, 1.0 - prob_o])
-    prior = np.dstack([prior_o, 1.0 - prior_o])
+    # the four maps filtered together: the priors (o, b) and the likelihoods P_I (o, b)
+    state = np.dstack([prior_o, 1.0 - prior_o, prior_o, prior_o])
+    prior, p_i = state[..., :2], state[..., 2:]
     reflect = cv2.BORDER_REFLECT
     log_like = np.finfo(float).max
     for _ in range(MAX_ITERATIONS):
-        p_i = prior * prob + eps
-        s_q = cv2.filter2D(np.dstack([prior, p_i]), -1, lam, borderType=reflect) * np.dstack([prior, p_i])
-        s_q[..., :2] /= s_q[..., :2].sum(axis=2, keepdims=True)  # S_i, normalised over o and b
-        s_q[..., 2:] /= s_q[..., 2:].sum(axis=2, keepdims=True)  # Q_i
+        np.multiply(prior, prob, out=p_i)
+        p_i += eps
+        s_q = cv2.filter2D(state, -1, lam, borderType=reflect)
+        s_q *= state
+        s_q[..., :2] /= (s_q[..., 0] + s_q[..., 1])[..., None]  # S_i, normalised over o and b
+        s_q[..., 2:] /= (s_q[..., 2] + s_q[..., 3])[..., None]  # Q_i
         sums = cv2.filter2D(s_q, -1, lam2, borderType=reflect)  # S_sum (o, b), Q_sum (o, b)
-        prior = (sums[..., 2:] + sums[..., :2]) * 0.25
-        prior /= prior.sum(axis=2, keepdims=True)
+        np.add(sums[..., 2:], sums[..., :2], out=prior)
+        prior /= (prior[..., 0] + prior[..., 1])[..., None]  # the 0.25 cancels here
         new = -np.log(sums[..., 2:]).sum() / (2 * prob_o.size)
         if abs(log_like - new) < TOLERANCE:
             break
@@ -106,17 +118,52 @@ def regularised(prob_o: np.ndarray, prior_o: np.ndarray) -> np.ndarray:
     return sums[..., 2]
 
 
-def posterior(patch: np.ndarray, hist_fg: np.ndarray, hist_bg: np.ndarray, prior: np.ndarray,
-              n_bins: int) -> np.ndarray:
-    """segment.cpp's computePosteriors: the (h, w, 3) uint8 patch (and its prior) shrunk to about
-    1000 pixels, each pixel's likelihoods from the histograms times the priors, Bayes' rule
-    with the background 5/3 as likely, the MRF, and the foreground probability resized back:
-    (h, w) float32. Where neither histogram has the pixel's colour (the authors' 0/0), 0.5."""
-    h, w = patch.shape[:2]
+def linear_taps(n_in: int, n_out: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """OpenCV's INTER_LINEAR resampling of ``n_in`` pixels to ``n_out``: for each output pixel
+    its two source pixels and the second's weight (``cv::resize``'s geometry: pixel centres
+    aligned, the borders clamped)."""
+    f = (np.arange(n_out) + 0.5) * (n_in / n_out) - 0.5
+    i0 = np.floor(f).astype(np.int64)
+    w = f - i0
+    low, high = i0 < 0, i0 >= n_in - 1
+    w[low | high] = 0.0
+    i0 = np.clip(i0, 0, n_in - 1)
+    return i0, np.minimum(i0 + 1, n_in - 1), w
+
+
+def bilinear(read, taps_y, taps_x) -> np.ndarray:
+    """The bilinear resampling of a map that ``read(rows, cols)`` gives only where it is needed
+    ((len(rows), len(cols)[, C]) float), float64: the four source pixels of each output pixel."""
+    (y0, y1, wy), (x0, x1, wx) = taps_y, taps_x
+    top_left = read(y0, x0)
+    extra = (1,) * (top_left.ndim - 2)  # a colour axis
+    wy, wx = wy.reshape(-1, 1, *extra), wx.reshape(1, -1, *extra)
+    top = top_left * (1 - wx) + read(y0, x1) * wx
+    bottom = read(y1, x0) * (1 - wx) + read(y1, x1) * wx
+    return top * (1 - wy) + bottom * wy
+
+
+def small_size(h: int, w: int) -> tuple[int, int]:
+    """segment.cpp's working size (w, h): the patch less one pixel each way, shrunk to about 1000
+    pixels (never enlarged), truncated as cv::Size truncates."""
     factor = min(1.0, float(np.sqrt(1000.0 / max((w - 1) * (h - 1), 1))))
-    size = (max(int((w - 1) * factor), 1), max(int((h - 1) * factor), 1))  # cv::Size truncates
-    small = cv2.resize(patch, size)
-    prior_o = cv2.resize(prior, size)
+    return max(int((w - 1) * factor), 1), max(int((h - 1) * factor), 1)
+
+
+def posterior(pixels, shape: tuple[int, int], hist_fg: np.ndarray, hist_bg: np.ndarray, target: np.ndarray,
+              n_bins: int) -> np.ndarray:
+    """segment.cpp's computePosteriors on a patch of ``shape`` (h, w) that ``pixels(rows, cols)``
+    reads ((n, m, 3) uint8 colours): the patch and the :func:`location_prior` of the ``target``
+    size shrunk to about 1000 pixels (bilinearly, each read only at the pixels the shrinking
+    takes: :func:`bilinear`), each pixel's likelihoods from the histograms times the priors,
+    Bayes' rule with the background 5/3 as likely, the MRF, and the foreground probability
+    resized back: (h, w) float32. Where neither histogram has the pixel's colour (the
+    authors' 0/0), 0.5."""
+    h, w = shape
+    size = small_size(h, w)
+    taps = linear_taps(h, size[1]), linear_taps(w, size[0])
+    small = np.rint(bilinear(lambda r, c: pixels(r, c).astype(np.float32), *taps)).astype(np.uint8)
+    prior_o = bilinear(lambda r, c: location_prior((h, w), target, r, c), *taps)
     index = bins(small, n_bins)
     fg = hist_fg[index] * prior_o
     bg = hist_bg[index] * (1.0 - prior_o)

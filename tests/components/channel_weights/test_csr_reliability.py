@@ -43,7 +43,10 @@ def brute_regional_maxima(r):
 def test_regional_maxima_match_a_flood_fill(seed):
     rng = np.random.default_rng(seed)
     r = rng.integers(0, 4, (9, 11)).astype(np.float32)  # few levels: plateaus, and plateaus next to higher ones
-    np.testing.assert_array_equal(regional_maxima(r), brute_regional_maxima(r))
+    stack = np.stack([r, r[::-1], np.zeros_like(r)])
+    got = regional_maxima(stack)
+    for c in range(3):
+        np.testing.assert_array_equal(got[c], brute_regional_maxima(stack[c]))
 
 
 def test_detection_reliability_by_hand():

@@ -6,7 +6,8 @@ import pytest
 import dcfkit
 from dcfkit.components.base import Target
 from dcfkit.components.masks import CSRSegmentation, Mask, box_mask
-from dcfkit.components.masks.segmentation import bins, foreground_histogram, posterior, regularised
+from dcfkit.components.masks.segmentation import (bilinear, bins, foreground_histogram, linear_taps, posterior,
+                                                  regularised)
 from dcfkit.contracts import ContractViolation
 from dcfkit.errors import ConfigError, RegistryError
 from dcfkit.registry import Registry
@@ -65,9 +66,20 @@ def test_the_posterior_of_two_colours():
     hist_fg[bins(np.array(RED, np.uint8), 16)] = 1
     hist_bg = np.zeros(16**3)
     hist_bg[bins(np.array(BLUE, np.uint8), 16)] = 1
-    p = posterior(patch, hist_fg, hist_bg, np.full((40, 60), 0.5), 16)
+    p = posterior(lambda r, c: patch[np.ix_(r, c)], (40, 60), hist_fg, hist_bg, np.array([40.0, 60.0]), 16)
     assert p.shape == (40, 60) and p.dtype == np.float32
     assert (p[:, :25] > 0.9).all() and (p[:, 35:] < 0.1).all()
+
+
+def test_bilinear_reads_what_opencv_resizes():
+    rng = np.random.default_rng(2)
+    image = rng.random((37, 53))
+    taps = linear_taps(37, 11), linear_taps(53, 16)
+    np.testing.assert_allclose(bilinear(lambda r, c: image[np.ix_(r, c)], *taps),
+                               cv2.resize(image, (16, 11)), atol=1e-12)
+    colour = rng.integers(0, 256, (37, 53, 3), dtype=np.uint8)
+    ours = np.rint(bilinear(lambda r, c: colour[np.ix_(r, c)].astype(float), *taps))
+    assert np.abs(ours - cv2.resize(colour, (16, 11))).max() <= 1  # OpenCV's 8-bit fixed point: within a level
 
 
 def test_the_mrf_removes_isolated_pixels():
