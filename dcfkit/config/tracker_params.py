@@ -62,6 +62,8 @@ class TrackerParams:
                             "'half_size' x = cx - w/2 with the size rounded (DR²Track's rect_position); "
                             "'floor_half' x = cx - floor(w/2) with the size floored (BACF's)",
                             choices=("exact", "rounded", "half_size", "floor_half"))
+    box_scale: str = param("current", "the reported box's size: at the scale 'current', or 'previous' the scale before "
+                           "this frame's scale update (CSR-DCF's region)", choices=("current", "previous"))
     newton_iterations: int = param(5, "Newton steps refining the response peak", ge=0, le=100)
     cell_selection_thresh: float = param(0.0, "BACF's small-target rule: if the search area holds fewer than this "
                                          "fraction of max_image_sample_size / cell_size² cells, use cells of "

@@ -140,6 +140,7 @@ class Tracker:
         self.frame = 1
         self.image_size = image.shape[:2]
         self.geometry, self.scale, self.limits = g, scale, limits
+        self.box_scale = scale  # the reported box's (tracker.box_scale)
         self.window = hann2d(g.filter_size, interior=self.params.window == "hann_interior")
         sigma = label_sigma(self.params, g)
         self.base_label = gaussian_label(g.filter_size, sigma)
@@ -191,7 +192,9 @@ class Tracker:
         if p.translation == "whole_pixel":
             move = round_half_away(move)
         self.position = self._clamp(centre + move, image.shape)
+        self.box_scale = self.scale if p.box_scale == "previous" else None  # CSR-DCF's region: the old scale
         self.scale = float(self.scale_estimator.update(image, self.position, self.scale * factors[best]))
+        self.box_scale = self.box_scale or self.scale
         self.search.observe(self.position)  # Eq. (13)
         peak = np.unravel_index(int(np.argmax(maps[best])), g.filter_size)
         self.last_response = np.fft.fftshift(maps[best])
@@ -213,9 +216,8 @@ class Tracker:
         return self.solver.response(self.hf, samples, self.geometry.filter_size, self.fft)
 
     def _observe(self, detection: Detection, best: int = 0) -> None:
-        """Give the detection to the components that adapt to it: the solver, the spatial
-        regularizer, whose w² it returns is used from this frame on, and the channel weights
-        (the channel maps of the ``best`` search scale)."""
+        """Give the detection to the components that adapt to it: the solver, the spatial regularizer,
+        whose w² it returns is used from this frame on, the channel weights (``best`` scale's maps)."""
         self.solver.observe(detection)
         if self.channel_weights is not None:
             self.channel_weights.observe(self._channel_maps[best])
@@ -280,7 +282,7 @@ class Tracker:
     @property
     def box(self) -> tuple[float, float, float, float]:
         """Current (x, y, w, h), 0-based pixels (``tracker.box_output``)."""
-        return reported_box(self.position, self.geometry.base_target * self.scale, self.params.box_output)
+        return reported_box(self.position, self.geometry.base_target * self.box_scale, self.params.box_output)
 
 
 def load_tracker(config: str | Mapping[str, Any], **overrides: Any) -> Tracker:
