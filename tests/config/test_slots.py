@@ -39,16 +39,18 @@ def test_the_tracker_builds_each_component_once(made):
     assert [f.name for f in tracker.features] == ["gray", "fhog", "colornames"]
 
 
-def test_every_slot_is_a_tracker_attribute_of_its_kind():
-    config = load_config("dr2track")
+@pytest.mark.parametrize("name", ["dr2track", "csrdcf"])  # between them every slot filled
+def test_every_slot_is_a_tracker_attribute_of_its_kind(name):
+    config = load_config(name)
     tracker = Tracker(config)
+    built = []
     for slot in SLOTS:
         held = getattr(tracker, slot.name)
-        for component in held if slot.many else [held]:
+        held = held if slot.many else [] if held is None and (slot.role or slot.default is None) else [held]
+        for component in held:
             assert component.kind == slot.kind, slot
-    assert sorted(components(config)) == sorted((c.kind, c.name) for slot in SLOTS
-                                                for held in [getattr(tracker, slot.name)]
-                                                for c in (held if slot.many else [held]))
+        built += held
+    assert sorted(components(config)) == sorted((c.kind, c.name) for c in built)
 
 
 def test_an_absent_role_builds_nothing_and_a_missing_slot_is_named():
@@ -72,5 +74,9 @@ def test_the_readers_follow_the_table():
         if slot.default is not None:
             assert f"| `{slot.key}` | `{slot.default}` |" in reference
     resolved = load_config({"features": ["gray"], "label": "gaussian", "solver": "ridge"})
-    assert list(resolved) == ["name", "tracker", *TOP_LEVEL[4:]]  # then each slot's key in table order
+    optional = ("mask", "channel_weights")  # slots whose absence is none: left out, as before they existed
+    assert list(resolved) == ["name", "tracker", *(k for k in TOP_LEVEL[4:] if k not in optional)]  # table order
+    masked = load_config({"features": ["gray"], "label": "gaussian", "solver": "admm_csr", "mask": "csr_segmentation",
+                          "channel_weights": "csr_reliability"})
+    assert list(masked) == ["name", "tracker", *TOP_LEVEL[4:]]
     assert {s.key: resolved[s.key]["name"] for s in SLOTS if s.default} == {"search": "fixed", "scale": "pyramid"}

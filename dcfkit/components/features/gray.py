@@ -21,8 +21,9 @@ class Gray(Feature):
     @dataclasses.dataclass(frozen=True)
     class Params:
         conversion: str = param("opencv", "'opencv': cv2's BGR2GRAY, rounded to whole gray levels; 'matlab': "
-                                "rgb2gray of the unrounded values, as the authors' get_colorspace",
-                                choices=("opencv", "matlab"))
+                                "rgb2gray of the unrounded values, as the authors' get_colorspace; 'csr': CSR-DCF's "
+                                "uint8 arithmetic, single((gray / 255) - 0.5) on a uint8 image: 1 where the cell's "
+                                "whole gray level is at least 128, else 0", choices=("opencv", "matlab", "csr"))
 
     def channels(self) -> int:
         return 1
@@ -35,6 +36,8 @@ class Gray(Feature):
             gray = (pixels[..., 0] * b + pixels[..., 1] * g) + pixels[..., 2] * r
         else:
             gray = cv2.cvtColor(patch, cv2.COLOR_BGR2GRAY).astype(np.float32)
+        if self.params.conversion == "csr":  # uint8 / 255 rounds to 0 or 1; uint8 - 0.5 rounds back (to 0 or 1)
+            return (np.rint(cell_average(gray, cell_size)) >= 128).astype(np.float32)[None]
         gray *= 1.0 / 255.0
         gray -= 0.5
         return cell_average(gray, cell_size)[None]

@@ -28,3 +28,13 @@ def test_gray_opencv_conversion_rounds_to_whole_levels():
     patch = np.full((8, 8, 3), (30, 200, 90), np.uint8)
     got = Gray().extract(patch, 4)
     np.testing.assert_allclose(got, round(0.299 * 90 + 0.587 * 200 + 0.114 * 30) / 255 - 0.5, atol=2e-7)
+
+
+def test_gray_csr_conversion_is_matlabs_uint8_arithmetic():
+    # get_csr_features: single((gray_patch / 255) - 0.5) of a uint8 patch. uint8 / 255 rounds to 0
+    # (levels 0..127) or 1 (128..255); uint8(0) - 0.5 rounds to -1 and saturates at 0, uint8(1) - 0.5
+    # rounds to 1: the channel is 1 where the level is at least 128, else 0
+    levels = np.array([[0, 127, 128, 255]], np.uint8)
+    patch = np.repeat(levels[..., None], 3, axis=2)  # gray pixels: every conversion gives the level
+    out = Gray(Gray.Params(conversion="csr")).extract(patch, 1)
+    np.testing.assert_array_equal(out[0], [[0, 0, 1, 1]])
