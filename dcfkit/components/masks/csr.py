@@ -9,7 +9,8 @@ import numpy as np
 
 from dcfkit.components.base import Target
 from dcfkit.components.masks.base import Mask
-from dcfkit.components.masks.segmentation import background_histogram, foreground_histogram, hsv255, posterior
+from dcfkit.components.masks.segmentation import background_histogram, foreground_histogram, hsv255, on_grid, \
+    posterior
 from dcfkit.numerics.patches import round_half_away
 from dcfkit.params import param
 
@@ -27,14 +28,6 @@ def box_mask(shape: tuple[int, int], target_cells: tuple[float, float]) -> np.nd
         spans.append(slice(start, start + extent + 1))
     mask[spans[0], spans[1]] = True
     return mask
-
-
-def nearest_resize(mask: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
-    """MATLAB's ``imresize(mask, shape, 'nearest')``: output cell i takes input ⌊(i + ½) n / m⌋
-    (OpenCV's nearest takes ⌊i n / m⌋)."""
-    rows = ((np.arange(shape[0]) + 0.5) * mask.shape[0] / shape[0]).astype(int)
-    cols = ((np.arange(shape[1]) + 0.5) * mask.shape[1] / shape[1]).astype(int)
-    return mask[np.ix_(rows, cols)]
 
 
 def disk(radius: int) -> np.ndarray:
@@ -84,12 +77,8 @@ class CSRSegmentation(Mask):
         hist_size = target if first or self.params.histogram_box == "current" else self.last_target
         self.last_target = np.asarray(target, float)
         self._learn_histograms(image, centre, np.asarray(hist_size, float))
-        soft = self._posterior(image, centre, np.asarray(target, float), np.floor(region).astype(int))
-        if first:  # the first mask stays within the given box
-            soft = soft * _within(soft.shape, round_half_away(target).astype(int))
-        peak = soft.max()
-        hard = soft / (peak if peak > 0 else 1.0) > self.params.threshold
-        mask = nearest_resize(hard, tuple(shape))
+        mask = self._segment(image, centre, np.asarray(target, float), np.floor(region).astype(int), tuple(shape),
+                             first)
         if mask.sum() < box.sum() * self.params.min_area:
             return box.copy()
         if self.params.dilation:
@@ -119,9 +108,9 @@ class CSRSegmentation(Mask):
             self.hist_fg = (1 - rate) * self.hist_fg + rate * fg
             self.hist_bg = (1 - rate) * self.hist_bg + rate * bg
 
-    def _posterior(self, image, centre, target, size) -> np.ndarray:
-        """The foreground posterior over the region's whole pixels around the authors' ⌊c⌋ (get_patch),
-        zero outside the image, (h, w) float32."""
+    def _segment(self, image, centre, target, size, grid, first) -> np.ndarray:
+        """The binarised foreground posterior over the region's whole pixels around the authors' ⌊c⌋
+        (get_patch), zero outside the image (and the first frame's box), on the filter ``grid``."""
         size = np.maximum(size, 2)
         # the authors' 1-based floor(c) + (1:h) - floor(h/2), their c being dcfkit's centre + 1.5
         firsts = [int(np.floor(np.asarray(centre, float)[a] + 0.5)) + 1 - size[a] // 2 for a in range(2)]
@@ -130,13 +119,15 @@ class CSRSegmentation(Mask):
         def pixels(r, c):  # the patch's colours at its rows r x columns c, edges replicated
             return self._colours(image[np.ix_(rows[r], cols[c])])
 
-        soft = posterior(pixels, (int(size[0]), int(size[1])), self.hist_fg, self.hist_bg, target, self.params.n_bins)
-        for axis, first in enumerate(firsts):  # zero where the patch is beyond the image (valid_pixels_mask)
-            inside = slice(max(-first, 0), max(image.shape[axis] - first, 0))
-            view = np.moveaxis(soft, axis, 0)
-            view[:inside.start] = 0
-            view[inside.stop:] = 0
-        return soft
+        size = (int(size[0]), int(size[1]))
+        q = posterior(pixels, size, self.hist_fg, self.hist_bg, target, self.params.n_bins)
+        # the authors' valid_pixels_mask (the patch on the image), and on the first frame init_mask_padded
+        keep = [(max(-f, 0), min(max(image.shape[a] - f, 0), n)) for a, (f, n) in enumerate(zip(firsts, size))]
+        if first:  # ones over the given box from 1-based floor(n/2 - b/2)
+            for a, (n, b) in enumerate(zip(size, round_half_away(target).astype(int))):
+                start = max(int(np.floor(n / 2 - b / 2)) - 1, 0)
+                keep[a] = (max(keep[a][0], start), min(keep[a][1], start + int(b)))
+        return on_grid(q, size, tuple(keep), grid, self.params.threshold)
 
     def _colours(self, bgr: np.ndarray) -> np.ndarray:
         return hsv255(bgr) if self.params.colour_space == "hsv" else bgr
@@ -146,11 +137,3 @@ def _gray(image: np.ndarray) -> bool:
     """create_csr_tracker's test: the channels' summed deviation from their mean below 10."""
     deviation = image.astype(np.float32) - image.mean(axis=2, dtype=np.float32, keepdims=True)
     return float(np.abs(deviation).sum()) < GRAY_SUM
-
-
-def _within(shape: tuple[int, int], box: np.ndarray) -> np.ndarray:
-    """The authors' ``init_mask_padded``: ones over ``box`` (h, w) from 1-based ⌊n/2 - b/2⌋."""
-    out = np.zeros(shape, np.float32)
-    y0, x0 = (max(int(np.floor(n / 2 - b / 2)) - 1, 0) for n, b in zip(shape, box))
-    out[y0:y0 + int(box[0]), x0:x0 + int(box[1])] = 1
-    return out

@@ -156,9 +156,9 @@ def posterior(pixels, shape: tuple[int, int], hist_fg: np.ndarray, hist_bg: np.n
     reads ((n, m, 3) uint8 colours): the patch and the :func:`location_prior` of the ``target``
     size shrunk to about 1000 pixels (bilinearly, each read only at the pixels the shrinking
     takes: :func:`bilinear`), each pixel's likelihoods from the histograms times the priors,
-    Bayes' rule with the background 5/3 as likely, the MRF, and the foreground probability
-    resized back: (h, w) float32. Where neither histogram has the pixel's colour (the
-    authors' 0/0), 0.5."""
+    Bayes' rule with the background 5/3 as likely, and the MRF: the foreground probability at
+    that small size (:func:`on_grid` takes it to the filter grid). Where neither histogram has
+    the pixel's colour (the authors' 0/0), 0.5."""
     h, w = shape
     size = small_size(h, w)
     taps = linear_taps(h, size[1]), linear_taps(w, size[0])
@@ -170,5 +170,32 @@ def posterior(pixels, shape: tuple[int, int], hist_fg: np.ndarray, hist_bg: np.n
     p_o = 1.0 / (P_BACKGROUND + 1)
     den = p_o * fg + P_BACKGROUND * bg
     prob_o = np.divide(p_o * fg, den, out=np.full_like(fg, 0.5), where=den > 0)
-    q_o = regularised(prob_o, prior_o)
-    return cv2.resize(q_o, (w, h)).astype(np.float32)
+    return regularised(prob_o, prior_o)
+
+
+def _extremes(first_tap: np.ndarray, lo: int, hi: int) -> np.ndarray:
+    """The output pixels lo..hi-1 that are the first or last to read their source pixel: where
+    a bilinear resize takes its extreme values (it is linear in each weight between them)."""
+    taps = first_tap[lo:hi]
+    change = taps[1:] != taps[:-1]
+    return np.arange(lo, hi)[np.r_[True, change] | np.r_[change, True]]
+
+
+def on_grid(q: np.ndarray, size: tuple[int, int], keep: tuple[tuple[int, int], tuple[int, int]],
+            grid: tuple[int, int], threshold: float) -> np.ndarray:
+    """The authors' mask of segment.cpp's small foreground probability ``q``: resized (bilinear)
+    to the patch's ``size`` (h, w), zero outside the rows and columns ``keep`` ((r0, r1), (c0, c1)),
+    divided by its maximum, above ``threshold``, then ``imresize(.., grid, 'nearest')``: (grid)
+    bool. Computed at the patch pixels 'nearest' reads, and the maximum at the pixels where the
+    bilinear resize takes its extremes (:func:`_extremes`), never at the patch's full size."""
+    taps = linear_taps(q.shape[0], size[0]), linear_taps(q.shape[1], size[1])
+
+    def at(rows, cols):  # the resized map at rows x cols
+        return bilinear(lambda r, c: q[np.ix_(r, c)], *((t[0][i], t[1][i], t[2][i]) for t, i in zip(taps, (rows, cols))))
+
+    (r0, r1), (c0, c1) = keep
+    peak = float(at(_extremes(taps[0][0], r0, r1), _extremes(taps[1][0], c0, c1)).max()) if r1 > r0 and c1 > c0 else 0
+    rows, cols = (((np.arange(g) + 0.5) * n / g).astype(int) for g, n in zip(grid, size))  # MATLAB's 'nearest'
+    values = at(rows, cols).astype(np.float32)  # the mex's single
+    values *= ((rows >= r0) & (rows < r1))[:, None] & ((cols >= c0) & (cols < c1))[None, :]
+    return values / np.float32(peak if peak > 0 else 1.0) > threshold

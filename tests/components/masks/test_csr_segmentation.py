@@ -6,8 +6,8 @@ import pytest
 import dcfkit
 from dcfkit.components.base import Target
 from dcfkit.components.masks import CSRSegmentation, Mask, box_mask
-from dcfkit.components.masks.segmentation import (bilinear, bins, foreground_histogram, linear_taps, posterior,
-                                                  regularised)
+from dcfkit.components.masks.segmentation import (bilinear, bins, foreground_histogram, linear_taps, on_grid,
+                                                  posterior, regularised)
 from dcfkit.contracts import ContractViolation
 from dcfkit.errors import ConfigError, RegistryError
 from dcfkit.registry import Registry
@@ -66,9 +66,24 @@ def test_the_posterior_of_two_colours():
     hist_fg[bins(np.array(RED, np.uint8), 16)] = 1
     hist_bg = np.zeros(16**3)
     hist_bg[bins(np.array(BLUE, np.uint8), 16)] = 1
-    p = posterior(lambda r, c: patch[np.ix_(r, c)], (40, 60), hist_fg, hist_bg, np.array([40.0, 60.0]), 16)
-    assert p.shape == (40, 60) and p.dtype == np.float32
-    assert (p[:, :25] > 0.9).all() and (p[:, 35:] < 0.1).all()
+    q = posterior(lambda r, c: patch[np.ix_(r, c)], (40, 60), hist_fg, hist_bg, np.array([40.0, 60.0]), 16)
+    assert q.shape == (25, 38)  # segment.cpp's working size: (59, 39) shrunk to about 1000 pixels
+    assert (q[:, :14] > 0.9).all() and (q[:, 24:] < 0.1).all()
+
+
+@pytest.mark.parametrize("keep", [((0, 90), (0, 70)), ((10, 90), (0, 55)), ((30, 40), (20, 30)), ((5, 5), (0, 70))])
+def test_on_grid_is_the_full_size_resize_masked_binarised_and_sampled(keep):
+    rng = np.random.default_rng(4)
+    q = cv2.GaussianBlur(rng.random((23, 31)), (5, 5), 2)
+    full = cv2.resize(q, (70, 90))  # the mex's resize back to the patch (w, h) = (70, 90)
+    inside = np.zeros_like(full)
+    (r0, r1), (c0, c1) = keep
+    inside[r0:r1, c0:c1] = 1
+    soft = (full * inside).astype(np.float32)
+    peak = soft.max() if soft.max() > 0 else 1
+    hard = soft / peak > 0.5
+    rows, cols = [int((i + 0.5) * 90 / 20) for i in range(20)], [int((j + 0.5) * 70 / 16) for j in range(16)]
+    np.testing.assert_array_equal(on_grid(q, (90, 70), keep, (20, 16), 0.5), hard[np.ix_(rows, cols)])
 
 
 def test_bilinear_reads_what_opencv_resizes():
