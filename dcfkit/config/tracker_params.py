@@ -43,6 +43,9 @@ class TrackerParams:
                           "bilinearly mapped onto the sample grid; 'whole_pixel': the authors' get_pixels, whole "
                           "pixels around round(centre), then OpenCV's resize (bilinear when the width grows, else "
                           "area)", choices=("subpixel", "whole_pixel"))
+    resize: str = param("auto", "how 'padded_square' whole-pixel samples are resized: 'auto' OpenCV's (bilinear when "
+                        "the width grows, else area), 'matlab_bicubic' MATLAB's imresize (CSR-DCF's)",
+                        choices=("auto", "matlab_bicubic"))
     window: str = param("hann_interior", "cosine window of the features: 'hann_interior' hann(n+2) without its zero "
                         "ends (DR²Track's code), 'hann' hann(n) with them (STRCF's and BACF's)",
                         choices=("hann_interior", "hann"))
@@ -51,7 +54,9 @@ class TrackerParams:
                       "steps, the scale with the highest refined value); 'parabola' CSR-DCF's parabola through the "
                       "grid maximum's neighbours on each axis", choices=("bounded_newton", "newton", "parabola"))
     translation: str = param("exact", "'exact', or 'whole_pixel': the displacement rounded to whole image pixels "
-                             "(BACF's and DR²Track's translation_vec)", choices=("exact", "whole_pixel"))
+                             "(BACF's and DR²Track's translation_vec), or 'exact_centre': with sampling 'whole_pixel', "
+                             "the move added to the exact centre, not to the whole pixel the patch is cut around "
+                             "(CSR-DCF's c + d)", choices=("exact", "whole_pixel", "exact_centre"))
     scale_limits: str = param("exact", "the smallest and largest scale: 'exact' the ratios themselves (the search "
                               "region keeps 5 cells, the target fits the image); 'step_powers' those rounded "
                               "inwards to whole powers of the scale estimator's step, as the authors' STRCF, BACF, "

@@ -166,7 +166,7 @@ def check_dsst_copies(tracker, shape, centre: np.ndarray, target: np.ndarray) ->
     d = tracker.scale_estimator.params
     span = d.step ** (d.n_scales - 1)
     region = np.maximum(np.floor(target * span ** 0.5), 2)
-    if d.sampling == "whole_pixel":
+    if d.sampling != "working_patch":  # whole pixels of each scale
         cropper(shape, centre, region)
     else:
         sampler(shape, centre, region, np.full(2, np.ceil(2 * d.cell_size * span)))

@@ -6,7 +6,7 @@ import dataclasses
 import numpy as np
 
 from dcfkit.config.tracker_params import TrackerParams
-from dcfkit.numerics.patches import centre_size_to_box, round_half_away
+from dcfkit.numerics.patches import centre_size_to_box, round_half_away, sampler, whole_pixel_sampler
 
 
 def hann2d(shape: tuple[int, int], interior: bool = True) -> np.ndarray:
@@ -26,6 +26,10 @@ class Geometry:
     filter_size: tuple[int, int]  # (H, W) in cells
     target_cells: tuple[float, float]
     cell_size: int               # pixels per cell (tracker.cell_size, or smaller for a small target)
+    # CSR-DCF's template ('padded_square'): its side at scale 1 and the whole pixels it is resized to,
+    # of which sample_size is the top-left corner; None: sample_size is the region
+    template: float | None = None
+    resized: int | None = None
 
 
 def geometry(p: TrackerParams, target: np.ndarray, area_of: np.ndarray | None = None) -> tuple[Geometry, float]:
@@ -65,11 +69,23 @@ def _padded_square(p: TrackerParams, target: np.ndarray) -> tuple[Geometry, floa
     side = float(np.mean(np.floor(target + (p.search_area_scale - 1) * np.sqrt(np.prod(target)))))
     ratio = min(1.0, float(np.sqrt(p.max_image_sample_size / side**2)))
     ratio = max(ratio, float(np.sqrt(p.min_image_sample_size / side**2)))
-    cells = max(int(np.floor(np.floor(ratio * side) / cell)), 4)
+    resized = int(np.floor(ratio * side))
+    cells = max(resized // cell, 4)
     base_target = target * ratio
     geom = Geometry(base_target, np.array([cells * cell] * 2), (cells, cells),
-                    tuple(float(v) for v in base_target / cell), cell)
+                    tuple(float(v) for v in base_target / cell), cell, side * ratio, max(resized, cells * cell))
     return geom, 1.0 / ratio
+
+
+def patch_sampler(p: TrackerParams, g: Geometry, shape, centre: np.ndarray, scale: float):
+    """The search patch's sampler at ``centre`` and ``scale`` for images of ``shape``
+    (``tracker.sampling``; an InputError if its copy would be over the image budget)."""
+    if p.sampling != "whole_pixel":
+        return sampler(shape, centre, g.sample_size * scale, g.sample_size)
+    if g.template is not None:  # CSR-DCF's template: floor(scale x side) pixels, resized, then whole cells
+        return whole_pixel_sampler(shape, round_half_away(centre), np.full(2, g.template * scale), g.sample_size,
+                                   p.resize, (g.resized, g.resized))
+    return whole_pixel_sampler(shape, round_half_away(centre), g.sample_size * scale, g.sample_size)
 
 
 def label_sigma(p: TrackerParams, g: Geometry) -> float:

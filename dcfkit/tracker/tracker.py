@@ -29,13 +29,7 @@ from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.contracts import naming_the_frame
 from dcfkit.errors import InputError, TrackingError
 from dcfkit.numerics.fft import make_fft
-from dcfkit.numerics.patches import (
-    box_to_centre_size,
-    centre_size_to_box,
-    round_half_away,
-    sampler,
-    whole_pixel_sampler,
-)
+from dcfkit.numerics.patches import box_to_centre_size, centre_size_to_box, round_half_away
 from dcfkit.numerics.response import newton_peak, parabola_peak, response_spectra, shift_spectrum, subpixel_peak
 from dcfkit.registry import get_registry
 from dcfkit.tracker.checks import (
@@ -48,7 +42,7 @@ from dcfkit.tracker.checks import (
     read_only,
 )
 from dcfkit.tracker.confidence import Confidence
-from dcfkit.tracker.geometry import Geometry, geometry, hann2d, label_sigma, reported_box
+from dcfkit.tracker.geometry import Geometry, geometry, hann2d, label_sigma, patch_sampler, reported_box
 from dcfkit.tracker.learnt import channel_maps, learn_channels, masked_w2
 
 
@@ -88,10 +82,7 @@ class Tracker:
     def _sampler(self, shape, centre: np.ndarray, scale: float, g: Geometry | None = None):
         """:meth:`_patch`'s geometry, built without touching an image (an InputError if its copy
         would be over the image budget)."""
-        g = g or self.geometry
-        if self.params.sampling == "whole_pixel":
-            return whole_pixel_sampler(shape, round_half_away(centre), g.sample_size * scale, g.sample_size)
-        return sampler(shape, centre, g.sample_size * scale, g.sample_size)
+        return patch_sampler(self.params, g or self.geometry, shape, centre, scale)
 
     def _spectrum(self, patch: np.ndarray) -> np.ndarray:
         """(C, H, Wr) complex64 spectrum of the windowed features of a search patch."""
@@ -173,7 +164,7 @@ class Tracker:
                              f"sequence's first frame was {self.image_size[1]}x{self.image_size[0]}")
         g, p = self.geometry, self.params
         centre = self._clamp(np.array(self.search.centre(), dtype=float), image.shape)  # Eq. (14); a copy
-        if p.sampling == "whole_pixel":  # the patch is centred on a whole pixel, and so are displacements
+        if p.sampling == "whole_pixel" and p.translation != "exact_centre":  # the patch on a whole pixel, and moves
             centre = round_half_away(centre)
         factors = np.array(self.scale_estimator.search_factors(), dtype=float)  # copies: a plugin may change its own
         if self._blank(image[::4, ::4]) is not None:  # a dropped frame: hold, learn nothing

@@ -53,6 +53,10 @@ class CSRSegmentation(Mask):
         min_area: float = param(0.05, "a mask smaller than this fraction of the box mask is replaced by the box "
                                 "mask (mask_normal)", ge=0, le=1)
         dilation: int = param(1, "radius (cells) of the disk the mask is dilated by (0: none)", ge=0, le=10)
+        unseen_colour: str = param("neutral", "a pixel whose colour neither histogram holds: 'neutral' posterior "
+                                   "0.5, or 'discard' the frame's segmentation, which takes the box mask (the "
+                                   "authors': their 0/0 is a NaN that their MRF spreads over the whole patch)",
+                                   choices=("neutral", "discard"))
         histogram_box: str = param("previous_scale", "the box the histograms are taken from: 'previous_scale' "
                                    "the new centre with the scale before this frame's scale update (the "
                                    "authors' region), or 'current'", choices=("previous_scale", "current"))
@@ -79,7 +83,7 @@ class CSRSegmentation(Mask):
         self._learn_histograms(image, centre, np.asarray(hist_size, float))
         mask = self._segment(image, centre, np.asarray(target, float), np.floor(region).astype(int), tuple(shape),
                              first)
-        if mask.sum() < box.sum() * self.params.min_area:
+        if mask is None or mask.sum() < box.sum() * self.params.min_area:
             return box.copy()
         if self.params.dilation:
             mask = cv2.dilate(mask.astype(np.uint8), disk(self.params.dilation)).astype(bool)
@@ -110,7 +114,8 @@ class CSRSegmentation(Mask):
 
     def _segment(self, image, centre, target, size, grid, first) -> np.ndarray:
         """The binarised foreground posterior over the region's whole pixels around the authors' ⌊c⌋
-        (get_patch), zero outside the image (and the first frame's box), on the filter ``grid``."""
+        (get_patch), zero outside the image (and the first frame's box), on the filter ``grid``; None
+        if the posterior was discarded."""
         size = np.maximum(size, 2)
         # the authors' 1-based floor(c) + (1:h) - floor(h/2), their c being dcfkit's centre + 1.5
         firsts = [int(np.floor(np.asarray(centre, float)[a] + 0.5)) + 1 - size[a] // 2 for a in range(2)]
@@ -120,7 +125,9 @@ class CSRSegmentation(Mask):
             return self._colours(image[np.ix_(rows[r], cols[c])])
 
         size = (int(size[0]), int(size[1]))
-        q = posterior(pixels, size, self.hist_fg, self.hist_bg, target, self.params.n_bins)
+        q = posterior(pixels, size, self.hist_fg, self.hist_bg, target, self.params.n_bins, self.params.unseen_colour)
+        if q is None:
+            return None
         # the authors' valid_pixels_mask (the patch on the image), and on the first frame init_mask_padded
         keep = [(max(-f, 0), min(max(image.shape[a] - f, 0), n)) for a, (f, n) in enumerate(zip(firsts, size))]
         if first:  # ones over the given box from 1-based floor(n/2 - b/2)

@@ -151,14 +151,15 @@ def small_size(h: int, w: int) -> tuple[int, int]:
 
 
 def posterior(pixels, shape: tuple[int, int], hist_fg: np.ndarray, hist_bg: np.ndarray, target: np.ndarray,
-              n_bins: int) -> np.ndarray:
+              n_bins: int, unseen: str = "neutral") -> np.ndarray | None:
     """segment.cpp's computePosteriors on a patch of ``shape`` (h, w) that ``pixels(rows, cols)``
     reads ((n, m, 3) uint8 colours): the patch and the :func:`location_prior` of the ``target``
     size shrunk to about 1000 pixels (bilinearly, each read only at the pixels the shrinking
     takes: :func:`bilinear`), each pixel's likelihoods from the histograms times the priors,
     Bayes' rule with the background 5/3 as likely, and the MRF: the foreground probability at
     that small size (:func:`on_grid` takes it to the filter grid). Where neither histogram has
-    the pixel's colour (the authors' 0/0), 0.5."""
+    the pixel's colour, 0.5 (``unseen`` 'neutral'), or None ('discard': the authors' 0/0, a NaN
+    that their MRF, which then runs all its iterations, spreads over the whole patch)."""
     h, w = shape
     size = small_size(h, w)
     taps = linear_taps(h, size[1]), linear_taps(w, size[0])
@@ -169,6 +170,8 @@ def posterior(pixels, shape: tuple[int, int], hist_fg: np.ndarray, hist_bg: np.n
     bg = hist_bg[index] * (1.0 - prior_o)
     p_o = 1.0 / (P_BACKGROUND + 1)
     den = p_o * fg + P_BACKGROUND * bg
+    if unseen == "discard" and not den.all():
+        return None
     prob_o = np.divide(p_o * fg, den, out=np.full_like(fg, 0.5), where=den > 0)
     return regularised(prob_o, prior_o)
 

@@ -3,11 +3,11 @@ from __future__ import annotations
 
 import dataclasses
 
-import cv2
 import numpy as np
 
 from dcfkit.components.features.fhog import ARITHMETICS, fhog
 from dcfkit.components.scale.base import MAX_SCALES, MIN_LAM, ScaleEstimator, check_span, scale_factors
+from dcfkit.numerics.imresize import imresize
 from dcfkit.numerics.patches import resize_auto, sample, sampler, whole_pixel_crop
 from dcfkit.params import param
 
@@ -40,7 +40,8 @@ class DSST(ScaleEstimator):
                               "resampled from it; 'whole_pixel': each scale cropped in whole pixels and resized "
                               "(the authors' get_scale_sample); 'whole_pixel_bilinear' the same around the pixel "
                               "nearest the centre, resized bilinearly (CSR-DCF's get_scale_subwindow, whose centre is "
-                              "half a pixel from dcfkit's)", choices=("working_patch", "whole_pixel", "whole_pixel_bilinear"))
+                              "half a pixel from dcfkit's; MATLAB's imresize 'bilinear' without antialiasing)",
+                              choices=("working_patch", "whole_pixel", "whole_pixel_bilinear"))
         window: str = param("hann_interior", "window over the scales: 'hann_interior' hann(S+2) without its zero "
                             "ends, or 'hann' hann(S) (the authors')", choices=("hann_interior", "hann"))
         channel_order: str = param("bgr", "colour channel order deciding fHOG's ties (see fhog.channel_order)",
@@ -97,9 +98,8 @@ class DSST(ScaleEstimator):
         if self.params.sampling != "working_patch":
             bilinear = self.params.sampling == "whole_pixel_bilinear"
             at = np.asarray(centre, float) + (0.5 if bilinear else 0.0)
-            size = (int(self.model_size[1]), int(self.model_size[0]))
             patches = np.stack([
-                (cv2.resize(crop, size) if bilinear else resize_auto(crop, self.model_size))
+                (imresize(crop, self.model_size, bilinear=True) if bilinear else resize_auto(crop, self.model_size))
                 for crop in (whole_pixel_crop(image, at, np.maximum(np.floor(self.base_target * (scale * f)), 2))
                              for f in self.factors[list(which)])])
         else:
