@@ -168,8 +168,9 @@ def whole_pixel_sampler(shape, centre, region, out, resize: str = "auto",
                         resized=None) -> Callable[[np.ndarray], np.ndarray]:
     """:func:`whole_pixel_sample` with its geometry worked out once, for images of ``shape``.
     ``resize`` 'matlab_bicubic': MATLAB's ``imresize`` instead of :func:`resize_auto`; with
-    ``resized`` (h, w), the crop is resized to it and ``out`` is its top-left corner (CSR-DCF's
-    template, whose remainder beyond whole cells fhog drops), and ``region`` is floored."""
+    ``resized`` (h, w), ``region`` is floored and the crop resized to ``resized`` instead of
+    ``out`` (CSR-DCF's template, which may exceed ``out``'s whole cells by less than a cell: the
+    features take the whole cells, fhog with the remainder's gradients, as theirs)."""
     if resized is None:
         size = [int(v) if v >= 1 else 2 for v in round_half_away(region)]
     else:
@@ -177,9 +178,9 @@ def whole_pixel_sampler(shape, centre, region, out, resize: str = "auto",
     cut = whole_pixel_cropper(shape, centre, size)
     if resize == "auto" and resized is None:
         return lambda image: resize_auto(cut(image), out)
-    to, (oh, ow) = (out if resized is None else resized), (int(out[0]), int(out[1]))
+    to = out if resized is None else resized
     scale = imresize if resize == "matlab_bicubic" else resize_auto
-    return lambda image: scale(cut(image), (int(to[0]), int(to[1])))[:oh, :ow]
+    return lambda image: scale(cut(image), (int(to[0]), int(to[1])))
 
 
 def _blocks_outside(start: int, n: int, k: int, size: int) -> tuple[int, int]:

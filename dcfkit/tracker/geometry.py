@@ -26,9 +26,11 @@ class Geometry:
     filter_size: tuple[int, int]  # (H, W) in cells
     target_cells: tuple[float, float]
     cell_size: int               # pixels per cell (tracker.cell_size, or smaller for a small target)
-    # CSR-DCF's template ('padded_square'): its side at scale 1 and the whole pixels it is resized to,
-    # of which sample_size is the top-left corner; None: sample_size is the region
+    # CSR-DCF's template ('padded_square'): its side in image pixels at the first scale, that scale,
+    # and the whole pixels it is resized to, of which sample_size is the top-left corner; None:
+    # sample_size is the region
     template: float | None = None
+    template_scale: float | None = None
     resized: int | None = None
 
 
@@ -73,7 +75,7 @@ def _padded_square(p: TrackerParams, target: np.ndarray) -> tuple[Geometry, floa
     cells = max(resized // cell, 4)
     base_target = target * ratio
     geom = Geometry(base_target, np.array([cells * cell] * 2), (cells, cells),
-                    tuple(float(v) for v in base_target / cell), cell, side * ratio, max(resized, cells * cell))
+                    tuple(float(v) for v in base_target / cell), cell, side, 1.0 / ratio, max(resized, cells * cell))
     return geom, 1.0 / ratio
 
 
@@ -82,9 +84,11 @@ def patch_sampler(p: TrackerParams, g: Geometry, shape, centre: np.ndarray, scal
     (``tracker.sampling``; an InputError if its copy would be over the image budget)."""
     if p.sampling != "whole_pixel":
         return sampler(shape, centre, g.sample_size * scale, g.sample_size)
-    if g.template is not None:  # CSR-DCF's template: floor(scale x side) pixels, resized, then whole cells
-        return whole_pixel_sampler(shape, round_half_away(centre), np.full(2, g.template * scale), g.sample_size,
-                                   p.resize, (g.resized, g.resized))
+    if g.template is not None:  # CSR-DCF's template: floor(side x their scale) pixels, resized, then whole cells
+        # their scale starts at exactly 1 (scale / template_scale is 1.0 then, not a rounding of it)
+        region = np.full(2, g.template * (scale / g.template_scale))
+        return whole_pixel_sampler(shape, round_half_away(centre), region, g.sample_size, p.resize,
+                                   (g.resized, g.resized))
     return whole_pixel_sampler(shape, round_half_away(centre), g.sample_size * scale, g.sample_size)
 
 

@@ -16,10 +16,30 @@ MAX_ITERATIONS, TOLERANCE = 50, 0.1  # the MRF's iterations and its stop on the 
 
 
 def hsv255(bgr: np.ndarray) -> np.ndarray:
-    """(H, W, 3) uint8 BGR -> (H, W, 3) uint8 HSV, each channel on 0..255 as MATLAB's
-    ``rgb2hsv(img) * 255`` rounded (OpenCV's 8-bit hue runs to 180 or wraps at 256)."""
-    hsv = cv2.cvtColor(bgr.astype(np.float32), cv2.COLOR_BGR2HSV)  # H in degrees, S in [0, 1], V in 0..255
-    return cv2.convertScaleAbs(cv2.multiply(hsv, (255 / 360, 255, 1, 0)))  # rounded (to even), saturated
+    """(H, W, 3) uint8 BGR -> (H, W, 3) uint8 HSV on 0..255: ``rgb2hsv(img) * 255`` as the authors'
+    mex reads it (rounded to even): Octave's rgb2hsv in double, its operations in its order, red
+    winning ties with green and blue, green with blue. (OpenCV's 8-bit hue runs to 180 or wraps.)"""
+    x = bgr.astype(np.float64)
+    x /= 255  # im2double
+    b, g, r = x[..., 0], x[..., 1], x[..., 2]
+    low, v = np.minimum(np.minimum(b, g), r), np.maximum(np.maximum(b, g), r)
+    red, green = v == r, v == g
+    gray = low == v
+    d = v - low
+    d[gray] = 1.0
+    num = np.where(red, g - b, np.where(green, b - r, r - g))
+    num *= 1 / 6
+    num /= d
+    h = np.where(red, 0.0, np.where(green, 1 / 3, 2 / 3))
+    h += num  # 2/3 + 1/6 * (r - g) ./ (v - s), and so on
+    h[gray] = 0.0
+    h[h < 0] += 1
+    sat = low / np.where(gray, 1.0, v)
+    np.subtract(1.0, sat, out=sat)
+    sat[gray] = 0.0
+    out = np.stack([h, sat, v], axis=2)
+    out *= 255
+    return np.rint(out, out=out).astype(np.uint8)
 
 
 def bins(pixels: np.ndarray, n_bins: int) -> np.ndarray:

@@ -84,6 +84,8 @@ class DSST(ScaleEstimator):
         middle = (self.work_size - 1) / 2
         self.resamplers = [sampler(self.work_size, middle, self.work_size * (f / self.factors[-1]), self.model_size)
                            for f in self.factors]
+        # CSR-DCF's get_scale_subwindow: floor(target_sz x their scale x factor), their scale 1 at first
+        self.scale0, self.target0 = scale, np.round(self.base_target * scale, 9)
         self.num = self.den = None
         self._learn(np.fft.fft(self._samples(image, centre, scale), axis=1))
 
@@ -100,7 +102,7 @@ class DSST(ScaleEstimator):
             at = np.asarray(centre, float) + (0.5 if bilinear else 0.0)
             patches = np.stack([
                 (imresize(crop, self.model_size, bilinear=True) if bilinear else resize_auto(crop, self.model_size))
-                for crop in (whole_pixel_crop(image, at, np.maximum(np.floor(self.base_target * (scale * f)), 2))
+                for crop in (whole_pixel_crop(image, at, np.maximum(np.floor(self._scaled(scale, f, bilinear)), 2))
                              for f in self.factors[list(which)])])
         else:
             work = sample(image, centre, self.base_target * scale * self.factors[-1], self.work_size)
@@ -109,6 +111,14 @@ class DSST(ScaleEstimator):
                      arithmetic=self.params.fhog_arithmetic)
         feats = feats.reshape(len(patches), -1).T
         return feats * self.window[None, list(which)] if windowed else feats
+
+    def _scaled(self, scale: float, factor: float, csr: bool) -> np.ndarray:
+        """The target at ``scale`` times ``factor``, in image pixels: CSR-DCF's target_sz times
+        their scale factor (a product of the factors chosen) times ``factor`` (``csr``), else
+        base_target x scale x factor."""
+        if csr:
+            return self.target0 * ((scale / self.scale0) * factor)
+        return self.base_target * (scale * factor)
 
     def _learn(self, xsf: np.ndarray) -> None:
         """Update the scale model with the (D, S) spectrum of the scale samples."""
