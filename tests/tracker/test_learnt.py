@@ -46,3 +46,19 @@ def test_the_padded_square_template_by_hand():
     # a 15 x 20 target: ceil(300 / 400) = 1 pixel per cell
     g, _ = geometry(p, np.array([15.0, 20.0]))
     assert g.cell_size == 1 and g.filter_size[0] == int(np.mean(np.floor(np.array([15, 20]) + 3 * np.sqrt(300))))
+
+
+def test_csr_moves_from_the_exact_centre_and_reports_the_box_at_the_old_scale(sequence):
+    # track_csr_tracker: c = tracker.c + d although the patch is cut around floor(c), and
+    # region = [c - currentScaleFactor * base_target_sz / 2, ...] before the scale update
+    tracker = dcfkit.load_tracker("csrdcf")
+    tracker.init(sequence.frames[0], sequence.ground_truth[0])
+    peaks, find = [], tracker._peak
+    tracker._peak = lambda maps, samples: peaks.append(find(maps, samples)) or peaks[-1]
+    for frame in sequence.frames[1:6]:
+        before, scale = tracker.position.copy(), tracker.scale
+        box = tracker.update(frame)
+        _, dy, dx = peaks[-1]
+        step = tracker.geometry.cell_size * scale
+        np.testing.assert_allclose(tracker.position, before + np.array([dy, dx]) * step)
+        assert box[2:] == pytest.approx(tuple(tracker.geometry.base_target[::-1] * scale))

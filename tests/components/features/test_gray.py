@@ -38,3 +38,18 @@ def test_gray_csr_conversion_is_matlabs_uint8_arithmetic():
     patch = np.repeat(levels[..., None], 3, axis=2)  # gray pixels: every conversion gives the level
     out = Gray(Gray.Params(conversion="csr")).extract(patch, 1)
     np.testing.assert_array_equal(out[0], [[0, 0, 1, 1]])
+
+
+def test_gray_matlab_bicubic_pooling_resizes_the_uint8_gray_map():
+    # get_csr_features: imresize(rgb2gray(im), out_size) of the uint8 patch, then / 255 - 0.5
+    import cv2  # only this test
+
+    from dcfkit.numerics.imresize import imresize
+
+    rng = np.random.default_rng(3)
+    patch = rng.integers(0, 256, (24, 20, 3), dtype=np.uint8)
+    out = Gray(Gray.Params(pooling="matlab_bicubic")).extract(patch, 4)
+    cells = imresize(cv2.cvtColor(patch, cv2.COLOR_BGR2GRAY), (6, 5)).astype(np.float32)
+    np.testing.assert_allclose(out[0], cells / 255 - 0.5, atol=1e-6)
+    binary = Gray(Gray.Params(conversion="csr", pooling="matlab_bicubic")).extract(patch, 4)
+    np.testing.assert_array_equal(binary[0], (cells >= 128).astype(np.float32))

@@ -6,7 +6,7 @@ import pytest
 import dcfkit
 from dcfkit.components.base import Target
 from dcfkit.components.masks import CSRSegmentation, Mask, box_mask
-from dcfkit.components.masks.segmentation import (bilinear, bins, foreground_histogram, linear_taps, on_grid,
+from dcfkit.components.masks.segmentation import (bilinear, bins, foreground_histogram, hsv255, linear_taps, on_grid,
                                                   posterior, regularised)
 from dcfkit.contracts import ContractViolation
 from dcfkit.errors import ConfigError, RegistryError
@@ -145,3 +145,27 @@ def test_a_mask_needs_a_solver_with_a_spatial_term_and_configs_without_one_are_u
     assert dcfkit.load_tracker("strcf").mask is None
     with pytest.raises(ConfigError, match="solver 'kernel_ridge' has no spatial term.*mask"):
         dcfkit.load_tracker("kcf", overrides={"mask": {"name": "csr_segmentation"}})
+
+
+@pytest.mark.parametrize("rgb, hsv", [
+    ((255, 0, 0), (0, 255, 255)),        # red: h 0
+    ((0, 255, 0), (85, 255, 255)),       # green: h 1/3 of 255
+    ((0, 0, 255), (170, 255, 255)),      # blue: h 2/3
+    ((255, 0, 255), (212, 255, 255)),    # magenta: red ties blue, red wins: 1/6 (0 - 255)/255 + 1 = 5/6 -> 212.5 -> 212 (even)
+    ((77, 77, 77), (0, 0, 77)),          # gray: no hue, no saturation
+    ((200, 100, 50), (14, 191, 200)),    # h = 1/6 (100 - 50) / 150 = 1/18 -> 14.17; s = 1 - 50/200 = 0.75 -> 191.25
+])
+def test_hsv_is_rgb2hsv_times_255_rounded_to_even(rgb, hsv):
+    bgr = np.array([[rgb[::-1]]], np.uint8)
+    np.testing.assert_array_equal(hsv255(bgr)[0, 0], hsv)
+
+
+def test_an_unseen_colour_discards_the_frame_as_the_authors_nan_does():
+    image, (x, y, w, h) = disk_scene()
+    image[5:15, 5:15] = (0, 255, 0)  # a green square far from the box: in neither histogram, inside the patch
+    centre = np.array([y + (h - 1) / 2, x + (w - 1) / 2])
+    args = (image, centre, np.array([h, w], float), np.array([240.0, 300.0]), (40, 40))
+    neutral = start(CSRSegmentation()).make(*args)
+    discard = start(CSRSegmentation(CSRSegmentation.Params(unseen_colour="discard"))).make(*args)
+    np.testing.assert_array_equal(discard, box_mask((40, 40), (10.25, 10.25)))
+    assert not np.array_equal(neutral, discard)
