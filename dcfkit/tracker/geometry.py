@@ -33,6 +33,13 @@ class Geometry:
     template_scale: float | None = None
     resized: int | None = None
 
+    def region(self, scale: float) -> np.ndarray:
+        """The (h, w) image pixels the sample covers at ``scale`` (CSR-DCF's template: its side
+        times their scale, exactly 1.0 at the first scale)."""
+        if self.template is None:
+            return self.sample_size * scale
+        return np.full(2, self.template * (scale / self.template_scale))
+
 
 def geometry(p: TrackerParams, target: np.ndarray, area_of: np.ndarray | None = None) -> tuple[Geometry, float]:
     """STRCF's init_size, in its arithmetic (a floor of a size decides a sample's pixels), with
@@ -85,9 +92,7 @@ def patch_sampler(p: TrackerParams, g: Geometry, shape, centre: np.ndarray, scal
     if p.sampling != "whole_pixel":
         return sampler(shape, centre, g.sample_size * scale, g.sample_size)
     if g.template is not None:  # CSR-DCF's template: floor(side x their scale) pixels, resized, then whole cells
-        # their scale starts at exactly 1 (scale / template_scale is 1.0 then, not a rounding of it)
-        region = np.full(2, g.template * (scale / g.template_scale))
-        return whole_pixel_sampler(shape, round_half_away(centre), region, g.sample_size, p.resize,
+        return whole_pixel_sampler(shape, round_half_away(centre), g.region(scale), g.sample_size, p.resize,
                                    (g.resized, g.resized))
     return whole_pixel_sampler(shape, round_half_away(centre), g.sample_size * scale, g.sample_size)
 

@@ -17,8 +17,8 @@ def masked_w2(tracker, image: np.ndarray) -> np.ndarray:
     """The w² this frame's filter is trained with: the spatial regularizer's, ``inf`` outside the
     mask the mask component makes from the frame at the tracker's position and scale."""
     g = tracker.geometry
-    mask = tracker.mask.make(image, tracker.position.copy(), g.base_target * tracker.scale,
-                             g.sample_size * tracker.scale, g.filter_size)
+    mask = tracker.mask.make(image, tracker.position.copy(), g.base_target * tracker.scale, g.region(tracker.scale),
+                             g.filter_size)
     return read_only(np.where(mask, tracker.w2, np.float32(np.inf)).astype(np.float32, copy=False))
 
 
