@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import cv2
 import numpy as np
 
 from dcfkit.components.features.fhog import ARITHMETICS, fhog
@@ -42,6 +43,9 @@ class DSST(ScaleEstimator):
                               "nearest the centre, resized bilinearly (CSR-DCF's get_scale_subwindow, whose centre is "
                               "half a pixel from dcfkit's; MATLAB's imresize 'bilinear' without antialiasing)",
                               choices=("working_patch", "whole_pixel", "whole_pixel_bilinear"))
+        bilinear: str = param("opencv", "the resize of 'whole_pixel_bilinear': 'opencv' cv2's bilinear (8-bit fixed "
+                              "point), or 'matlab' imresize's (in double, rounded; the authors', slower)",
+                              choices=("opencv", "matlab"))
         window: str = param("hann_interior", "window over the scales: 'hann_interior' hann(S+2) without its zero "
                             "ends, or 'hann' hann(S) (the authors')", choices=("hann_interior", "hann"))
         channel_order: str = param("bgr", "colour channel order deciding fHOG's ties (see fhog.channel_order)",
@@ -101,7 +105,7 @@ class DSST(ScaleEstimator):
             bilinear = self.params.sampling == "whole_pixel_bilinear"
             at = np.asarray(centre, float) + (0.5 if bilinear else 0.0)
             patches = np.stack([
-                (imresize(crop, self.model_size, bilinear=True) if bilinear else resize_auto(crop, self.model_size))
+                (self._bilinear(crop) if bilinear else resize_auto(crop, self.model_size))
                 for crop in (whole_pixel_crop(image, at, np.maximum(np.floor(self._scaled(scale, f, bilinear)), 2))
                              for f in self.factors[list(which)])])
         else:
@@ -111,6 +115,12 @@ class DSST(ScaleEstimator):
                      arithmetic=self.params.fhog_arithmetic)
         feats = feats.reshape(len(patches), -1).T
         return feats * self.window[None, list(which)] if windowed else feats
+
+    def _bilinear(self, crop: np.ndarray) -> np.ndarray:
+        """``crop`` resized bilinearly, without antialiasing, to the scale sample's size."""
+        if self.params.bilinear == "matlab":
+            return imresize(crop, self.model_size, bilinear=True)
+        return cv2.resize(crop, (int(self.model_size[1]), int(self.model_size[0])), interpolation=cv2.INTER_LINEAR)
 
     def _scaled(self, scale: float, factor: float, csr: bool) -> np.ndarray:
         """The target at ``scale`` times ``factor``, in image pixels: CSR-DCF's target_sz times
