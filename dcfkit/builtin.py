@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import pluggy
 
-from dcfkit.components import features, labels, memory, regularizers, scale, schedule, search, solvers
+from dcfkit.components import (
+    channel_weights, features, labels, masks, memory, regularizers, scale, schedule, search, solvers,
+)
 from dcfkit.datasets.layout import new_layout
 
 # dcfkit.registry.hookimpl, made here too: this module, which the registry loads, imports nothing of it
@@ -14,6 +16,6 @@ hookimpl = pluggy.HookimplMarker("dcfkit")
 @hookimpl
 def dcfkit_register_components(registry):
     registry.accept_layouts(new_layout)
-    for family in (features, labels, regularizers, solvers, search, scale, memory, schedule):
+    for family in (features, labels, regularizers, solvers, search, scale, memory, schedule, masks, channel_weights):
         for cls in family.BUILTIN:
             registry.register(cls)

@@ -9,6 +9,7 @@ import pytest
 
 from dcfkit.cli import components, main
 from dcfkit.cli import docs as docs_gen
+from dcfkit.config.slots import KINDS
 from dcfkit.params import fields, param
 from dcfkit.registry import build_registry, get_registry
 
@@ -27,7 +28,7 @@ def test_committed_reference_docs_are_current(file_name):
 def test_config_reference_documents_every_key_and_every_parameter():
     text = docs_gen.config_reference()
     registry = build_registry(external=False)
-    for kind in ("feature", "label", "regularizer", "solver", "search", "scale"):
+    for kind in KINDS:
         for name in registry.names(kind):
             assert f"#### {kind} `{name}`" in text
             for f in fields(registry.entry(kind, name).cls.Params):

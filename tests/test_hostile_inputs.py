@@ -28,7 +28,7 @@ from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.datasets.video import open_source
 from dcfkit.errors import ConfigError, DcfkitError, InputError
 
-CONFIGS = ("strcf", "bacf", "dr2track", "kcf", "dsst")
+CONFIGS = ("strcf", "bacf", "dr2track", "kcf", "dsst", "csrdcf")
 SEQUENCE = make_sequence(n_frames=2, size=(72, 96), target=(10, 14), distractor=False)
 _TRACKERS: dict[str, dcfkit.Tracker] = {}
 

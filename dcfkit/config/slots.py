@@ -57,6 +57,9 @@ SLOTS = (
     Slot("memory", "memory", "memory", help="the training samples kept and their weights (absent: none; "
          "the continuous loop's solvers need one)"),
     Slot("schedule", "schedule", "schedule", help="on which frames the filter is trained (absent: every frame)"),
+    Slot("mask", "mask", "mask", help="a spatial mask learnt each frame, outside which the filter is zero"),
+    Slot("channel_weights", "channel_weights", "channel_weights",
+         help="how much each feature channel's response counts at detection"),
 )
 
 KINDS = tuple(dict.fromkeys(s.kind for s in SLOTS))  # the kinds of the components the slots take
@@ -159,6 +162,8 @@ def resolve(data: Mapping, origin: str) -> dict:
     out["tracker"] = dataclasses.asdict(parse_params(TrackerParams, data.get("tracker"), f"{origin}: tracker"))
     for slot in SLOTS:
         spec = _resolve_slot(registry, slot, data, origin)
+        if spec is None and slot.role is None:  # an optional slot left empty: absent, as configs before it
+            continue
         if slot.role is None:
             if spec is not None or slot.required or slot.default is not None:  # an empty optional slot: no key
                 out[slot.key] = spec

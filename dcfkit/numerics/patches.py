@@ -10,6 +10,8 @@ from typing import Callable
 import cv2
 import numpy as np
 
+from dcfkit.numerics.imresize import imresize
+
 from dcfkit.errors import InputError
 from dcfkit.limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
@@ -168,11 +170,23 @@ def whole_pixel_sample(image: np.ndarray, centre, region, out) -> np.ndarray:
     return whole_pixel_sampler(image.shape, centre, region, out)(image)
 
 
-def whole_pixel_sampler(shape, centre, region, out) -> Callable[[np.ndarray], np.ndarray]:
-    """:func:`whole_pixel_sample` with its geometry worked out once, for images of ``shape``."""
-    size = [int(v) if v >= 1 else 2 for v in round_half_away(region)]
+def whole_pixel_sampler(shape, centre, region, out, resize: str = "auto",
+                        resized=None) -> Callable[[np.ndarray], np.ndarray]:
+    """:func:`whole_pixel_sample` with its geometry worked out once, for images of ``shape``.
+    ``resize`` 'matlab_bicubic': MATLAB's ``imresize`` instead of :func:`resize_auto`; with
+    ``resized`` (h, w), ``region`` is floored and the crop resized to ``resized`` instead of
+    ``out`` (CSR-DCF's template, which may exceed ``out``'s whole cells by less than a cell: the
+    features take the whole cells, fhog with the remainder's gradients, as theirs)."""
+    if resized is None:
+        size = [int(v) if v >= 1 else 2 for v in round_half_away(region)]
+    else:
+        size = [int(v) if v >= 1 else 2 for v in np.floor(region)]
     cut = whole_pixel_cropper(shape, centre, size)
-    return lambda image: resize_auto(cut(image), out)
+    if resize == "auto" and resized is None:
+        return lambda image: resize_auto(cut(image), out)
+    to = out if resized is None else resized
+    scale = imresize if resize == "matlab_bicubic" else resize_auto
+    return lambda image: scale(cut(image), (int(to[0]), int(to[1])))
 
 
 def _blocks_outside(start: int, n: int, k: int, size: int) -> tuple[int, int]:

@@ -150,3 +150,27 @@ def shift_spectrum(xf: np.ndarray, dy: float, dx: float, shape: tuple[int, int],
     kx = ((_signed_frequencies(shape[1]) / shape[1]) if full else np.fft.rfftfreq(shape[1]))[None, :]
     phase = np.exp(2j * np.pi * (ky * dy + kx * dx)).astype(np.complex64)
     return multiply(xf, phase)
+
+
+def channel_responses(hf: np.ndarray, sf: np.ndarray, shape: tuple[int, int], fft) -> np.ndarray:
+    """Eq. (12) per channel, unsummed: (C, H, Wr) filter and (..., C, H, Wr) samples ->
+    (..., C, H, W) float32 (CSR-DCF's ``response_chann``)."""
+    return np.real(fft.irfft2(hf.conj() * sf, shape)).astype(np.float32, copy=False)
+
+
+def parabola_peak(r: np.ndarray) -> tuple[float, float]:
+    """CSR-DCF's peak of a circular (H, W) map: the grid maximum (the first in column-major
+    order, as MATLAB's ``find``), each axis refined by the parabola through it and its two
+    neighbours (0.5 (p₊ - p₋) / (2 p₀ - p₊ - p₋), 0 if not finite), then wrapped to a signed
+    (dy, dx) offset (beyond half the grid: negative)."""
+    h, w = r.shape
+    flat = int(np.argmax(r.T))
+    row, col = flat % h, flat // h
+    out = []
+    for index, size, line in ((row, h, r[:, col]), (col, w, r[row, :])):
+        before, here, after = (float(line[(index + k) % size]) for k in (-1, 0, 1))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            delta = 0.5 * (after - before) / (2 * here - after - before)
+        offset = index + (delta if np.isfinite(delta) else 0.0)
+        out.append(offset - size if offset + 1 > size / 2 else offset)
+    return out[0], out[1]

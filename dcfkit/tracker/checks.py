@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from dcfkit.components.scale.dsst import DSST
+from dcfkit.components.solvers.base import Solver
 from dcfkit.config.slots import SLOTS
 from dcfkit.contracts import ContractViolation
 from dcfkit.errors import ConfigError, InputError, shown
@@ -70,13 +71,22 @@ def read_only(w2: np.ndarray) -> np.ndarray:
 
 
 def check_terms(tracker) -> None:
-    """ConfigError if a regularizer is configured that the solver has no term for (``Solver.terms``):
-    it would be ignored."""
+    """ConfigError if a regularizer or a mask is configured that the solver has no term for
+    (``Solver.terms``): it would be ignored; or channel weights with a solver whose response is
+    not the linear correlation (KCF's kernel), whose channels cannot be weighted."""
     for slot in SLOTS:
         regularizer = getattr(tracker, slot.name) if slot.role is not None else None
         if regularizer is not None and slot.role not in tracker.solver.terms:
             raise ConfigError(f"{tracker.name}: solver '{tracker.solver.name}' has no {slot.role} term, so "
                               f"{slot.key} '{regularizer.name}' would be ignored: set {slot.key}: null")
+    if tracker.mask is not None and "spatial" not in tracker.solver.terms:
+        raise ConfigError(f"{tracker.name}: solver '{tracker.solver.name}' has no spatial term, so mask "
+                          f"'{tracker.mask.name}' would be ignored: set mask: null")
+    linear = type(tracker.solver).response is Solver.response
+    if tracker.channel_weights is not None and not linear:
+        raise ConfigError(f"{tracker.name}: channel_weights '{tracker.channel_weights.name}' weight the channels "
+                          f"of a linear filter's response; solver '{tracker.solver.name}' has its own response: "
+                          f"set channel_weights: null")
 
 
 def check_spectra(tracker) -> None:
@@ -156,7 +166,7 @@ def check_dsst_copies(tracker, shape, centre: np.ndarray, target: np.ndarray) ->
     d = tracker.scale_estimator.params
     span = d.step ** (d.n_scales - 1)
     region = np.maximum(np.floor(target * span ** 0.5), 2)
-    if d.sampling == "whole_pixel":
+    if d.sampling != "working_patch":  # whole pixels of each scale
         cropper(shape, centre, region)
     else:
         sampler(shape, centre, region, np.full(2, np.ceil(2 * d.cell_size * span)))

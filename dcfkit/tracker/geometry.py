@@ -6,7 +6,7 @@ import dataclasses
 import numpy as np
 
 from dcfkit.config.tracker_params import TrackerParams
-from dcfkit.numerics.patches import centre_size_to_box, round_half_away
+from dcfkit.numerics.patches import centre_size_to_box, round_half_away, sampler, whole_pixel_sampler
 
 
 def hann2d(shape: tuple[int, int], interior: bool = True) -> np.ndarray:
@@ -26,6 +26,19 @@ class Geometry:
     filter_size: tuple[int, int]  # (H, W) in cells
     target_cells: tuple[float, float]
     cell_size: int               # pixels per cell (tracker.cell_size, or smaller for a small target)
+    # CSR-DCF's template ('padded_square'): its side in image pixels at the first scale, that scale,
+    # and the whole pixels it is resized to, of which sample_size is the top-left corner; None:
+    # sample_size is the region
+    template: float | None = None
+    template_scale: float | None = None
+    resized: int | None = None
+
+    def region(self, scale: float) -> np.ndarray:
+        """The (h, w) image pixels the sample covers at ``scale`` (CSR-DCF's template: its side
+        times their scale, exactly 1.0 at the first scale)."""
+        if self.template is None:
+            return self.sample_size * scale
+        return np.full(2, self.template * (scale / self.template_scale))
 
 
 def geometry(p: TrackerParams, target: np.ndarray, area_of: np.ndarray | None = None) -> tuple[Geometry, float]:
@@ -34,6 +47,8 @@ def geometry(p: TrackerParams, target: np.ndarray, area_of: np.ndarray | None = 
     size the search area is computed from (default ``target``; DR²Track's code takes the
     annotation's size before its floor, ``tracker.init_area: given``)."""
     cell, low, high = p.cell_size, p.min_image_sample_size, p.max_image_sample_size
+    if p.search_area_shape == "padded_square":
+        return _padded_square(p, target)
     area = float(np.prod((target if area_of is None else area_of) * p.search_area_scale))
     if p.cell_selection_thresh > 0 and area / cell**2 < p.cell_selection_thresh * high / cell**2:
         smaller = min(cell, max(1, int(np.ceil(np.sqrt(area / (p.cell_selection_thresh * high / cell**2))))))
@@ -51,6 +66,43 @@ def geometry(p: TrackerParams, target: np.ndarray, area_of: np.ndarray | None = 
     target_cells = tuple(float(v) for v in base_target / cell)
     geom = Geometry(base_target, cells * cell, (int(cells[0]), int(cells[1])), target_cells, cell)
     return geom, float(scale)
+
+
+def _padded_square(p: TrackerParams, target: np.ndarray) -> tuple[Geometry, float]:
+    """CSR-DCF's template (create_csr_tracker.m): a square of side the mean of floor(size +
+    padding √(wh)), rescaled to at most ``max_image_sample_size`` (at least the smallest),
+    floored, in whole cells (floored), with cells of min(cell_size, ceil(wh / cell_area))."""
+    cell = p.cell_size
+    if p.cell_area > 0:
+        cell = min(cell, max(1, int(np.ceil(np.prod(target) / p.cell_area))))
+    side = float(np.mean(np.floor(target + (p.search_area_scale - 1) * np.sqrt(np.prod(target)))))
+    ratio = min(1.0, float(np.sqrt(p.max_image_sample_size / side**2)))
+    ratio = max(ratio, float(np.sqrt(p.min_image_sample_size / side**2)))
+    resized = int(np.floor(ratio * side))
+    cells = max(resized // cell, 4)
+    base_target = target * ratio
+    geom = Geometry(base_target, np.array([cells * cell] * 2), (cells, cells),
+                    tuple(float(v) for v in base_target / cell), cell, side, 1.0 / ratio, max(resized, cells * cell))
+    return geom, 1.0 / ratio
+
+
+def patch_sampler(p: TrackerParams, g: Geometry, shape, centre: np.ndarray, scale: float):
+    """The search patch's sampler at ``centre`` and ``scale`` for images of ``shape``
+    (``tracker.sampling``; an InputError if its copy would be over the image budget)."""
+    if p.sampling != "whole_pixel":
+        return sampler(shape, centre, g.sample_size * scale, g.sample_size)
+    if g.template is not None:  # CSR-DCF's template: floor(side x their scale) pixels, resized, then whole cells
+        return whole_pixel_sampler(shape, round_half_away(centre), g.region(scale), g.sample_size, p.resize,
+                                   (g.resized, g.resized))
+    return whole_pixel_sampler(shape, round_half_away(centre), g.sample_size * scale, g.sample_size)
+
+
+def label_sigma(p: TrackerParams, g: Geometry) -> float:
+    """The label's σ in cells: ``tracker.output_sigma`` if set (CSR-DCF's fixed y_sigma), else
+    ``output_sigma_factor`` times the square root of the target's whole cells."""
+    if p.output_sigma > 0:
+        return float(p.output_sigma)
+    return float(np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * p.output_sigma_factor)
 
 
 def reported_box(centre: np.ndarray, size: np.ndarray, convention: str) -> tuple[float, float, float, float]:

@@ -29,14 +29,8 @@ from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.contracts import naming_the_frame
 from dcfkit.errors import InputError, TrackingError
 from dcfkit.numerics.fft import make_fft
-from dcfkit.numerics.patches import (
-    box_to_centre_size,
-    centre_size_to_box,
-    round_half_away,
-    sampler,
-    whole_pixel_sampler,
-)
-from dcfkit.numerics.response import newton_peak, response_spectra, shift_spectrum, subpixel_peak
+from dcfkit.numerics.patches import box_to_centre_size, centre_size_to_box, round_half_away
+from dcfkit.numerics.response import newton_peak, parabola_peak, response_spectra, shift_spectrum, subpixel_peak
 from dcfkit.registry import get_registry
 from dcfkit.tracker.checks import (
     check_box,
@@ -49,7 +43,8 @@ from dcfkit.tracker.checks import (
 )
 from dcfkit.tracker.confidence import Confidence
 from dcfkit.tracker.continuous import continuous_loop
-from dcfkit.tracker.geometry import Geometry, geometry, hann2d, reported_box
+from dcfkit.tracker.geometry import Geometry, geometry, hann2d, label_sigma, patch_sampler, reported_box
+from dcfkit.tracker.learnt import channel_maps, learn_channels, masked_w2
 
 
 class Tracker:
@@ -89,10 +84,7 @@ class Tracker:
     def _sampler(self, shape, centre: np.ndarray, scale: float, g: Geometry | None = None):
         """:meth:`_patch`'s geometry, built without touching an image (an InputError if its copy
         would be over the image budget)."""
-        g = g or self.geometry
-        if self.params.sampling == "whole_pixel":
-            return whole_pixel_sampler(shape, round_half_away(centre), g.sample_size * scale, g.sample_size)
-        return sampler(shape, centre, g.sample_size * scale, g.sample_size)
+        return patch_sampler(self.params, g or self.geometry, shape, centre, scale)
 
     def _spectrum(self, patch: np.ndarray) -> np.ndarray:
         """(C, H, Wr) complex64 spectrum of the windowed features of a search patch."""
@@ -143,11 +135,13 @@ class Tracker:
         self.frame = 1
         self.image_size = image.shape[:2]
         self.geometry, self.scale, self.limits = g, scale, limits
+        self.box_scale = scale  # the reported box's (tracker.box_scale)
         self.window = hann2d(g.filter_size, interior=self.params.window == "hann_interior")
-        sigma = np.sqrt(np.prod(np.floor(np.asarray(g.target_cells)).clip(1))) * self.params.output_sigma_factor
+        sigma = label_sigma(self.params, g)
         self.base_label = gaussian_label(g.filter_size, sigma)
         self.base_label.setflags(write=False)  # every frame's label starts from it
-        optional = [r for r in (self.spatial, self.temporal, self.schedule) if r is not None]
+        optional = [c for c in (self.spatial, self.temporal, self.schedule, self.mask, self.channel_weights)
+                    if c is not None]
         for component in (*self.features, self.label, self.solver, *optional):  # a new target: nothing kept
             component.reset()
         target = Target(self.image_size, g.filter_size, g.target_cells, g.cell_size, scale, float(sigma))
@@ -177,7 +171,7 @@ class Tracker:
                              f"sequence's first frame was {self.image_size[1]}x{self.image_size[0]}")
         g, p = self.geometry, self.params
         centre = self._clamp(np.array(self.search.centre(), dtype=float), image.shape)  # Eq. (14); a copy
-        if p.sampling == "whole_pixel":  # the patch is centred on a whole pixel, and so are displacements
+        if p.sampling == "whole_pixel" and p.translation != "exact_centre":  # the patch on a whole pixel, and moves
             centre = round_half_away(centre)
         factors = np.array(self.scale_estimator.search_factors(), dtype=float)  # copies: a plugin may change its own
         if self._blank(image[::4, ::4]) is not None:  # a dropped frame: hold, learn nothing
@@ -196,7 +190,9 @@ class Tracker:
         if p.translation == "whole_pixel":
             move = round_half_away(move)
         self.position = self._clamp(centre + move, image.shape)
+        self.box_scale = self.scale if p.box_scale == "previous" else None  # CSR-DCF's region: the old scale
         self.scale = float(self.scale_estimator.update(image, self.position, self.scale * factors[best]))
+        self.box_scale = self.box_scale or self.scale
         self.search.observe(self.position)  # Eq. (13)
         peak = np.unravel_index(int(np.argmax(maps[best])), g.filter_size)
         self.last_response = np.fft.fftshift(maps[best])
@@ -206,20 +202,25 @@ class Tracker:
             sy, sx = (self.position - centre) / (g.cell_size * self.scale)
             xf = shift_spectrum(samples[best], sy, sx, g.filter_size, self.fft.full)
         detection = Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells, (dy, dx))
-        self._observe(detection)
+        self._observe(detection, best)
         self._train(image, detection, xf)
         return self.box
 
     def _response(self, samples: np.ndarray) -> np.ndarray:
         """The solver's (S, H, W) response maps of the (S, C, H, Wr) search samples."""
+        if self.channel_weights is not None:  # each channel's map weighted (CSR-DCF's channel reliability)
+            self._channel_maps = channel_maps(self, samples)
+            return self.channel_weights.combine(self._channel_maps)
         return self.solver.response(self.hf, samples, self.geometry.filter_size, self.fft)
 
-    def _observe(self, detection: Detection) -> None:
-        """Give the detection to the components that adapt to it: the solver, and the spatial
-        regularizer, whose w² it returns is used from this frame on."""
+    def _observe(self, detection: Detection, best: int = 0) -> None:
+        """Give the detection to the components that adapt to it: the solver, the spatial regularizer,
+        whose w² it returns is used from this frame on, the channel weights (``best`` scale's maps)."""
         self.solver.observe(detection)
         if self.schedule is not None:
             self.schedule.observe(detection)
+        if self.channel_weights is not None:
+            self.channel_weights.observe(self._channel_maps[best])
         if self.spatial is not None:
             self.w2 = read_only(self.spatial.adapt(self.w2, detection))
 
@@ -235,6 +236,8 @@ class Tracker:
             best, dy, dx, _ = newton_peak(maps, self.params.newton_iterations, spectra)
             return best, dy, dx
         best = int(np.argmax(maps.reshape(len(maps), -1).max(axis=1)))
+        if self.params.peak == "parabola":  # CSR-DCF's: a parabola through each axis's neighbours
+            return (best, *parabola_peak(maps[best]))
         dy, dx, _ = subpixel_peak(maps[best], self.params.newton_iterations)
         return best, dy, dx
 
@@ -251,7 +254,10 @@ class Tracker:
         if not due and detection is None:
             raise TrackingError(f"frame 1: schedule '{self.schedule.name}' skips the first frame")
         if theta != np.inf and due:  # inf: the temporal term holds the filter where it is
-            self.hf = self.solver.train(xf, yf, self.w2, theta, self.fft)  # Eqs. (9)-(11)
+            w2 = self.w2 if self.mask is None else masked_w2(self, image)  # a mask: inf outside it
+            self.hf = self.solver.train(xf, yf, w2, theta, self.fft)  # Eqs. (9)-(11)
+            if self.channel_weights is not None:
+                learn_channels(self, xf)
         step = self.geometry.cell_size * self.scale
         self.last_distractors = (self.position[None, ::-1] + offsets[:, ::-1] * step) if len(offsets) else \
             np.zeros((0, 2))
@@ -281,7 +287,7 @@ class Tracker:
         """Current (x, y, w, h), 0-based pixels (``tracker.box_output``)."""
         if self.loop is not None:
             return self.loop.box()
-        return reported_box(self.position, self.geometry.base_target * self.scale, self.params.box_output)
+        return reported_box(self.position, self.geometry.base_target * self.box_scale, self.params.box_output)
 
 
 def load_tracker(config: str | Mapping[str, Any], **overrides: Any) -> Tracker:

@@ -39,10 +39,11 @@ def test_the_tracker_builds_each_component_once(made):
     assert [f.name for f in tracker.features] == ["gray", "fhog", "colornames"]
 
 
-@pytest.mark.parametrize("name", ["dr2track", "eco_hc"])
+@pytest.mark.parametrize("name", ["dr2track", "eco_hc", "csrdcf"])  # between them every slot filled
 def test_every_slot_is_a_tracker_attribute_of_its_kind(name):
     config = load_config(name)
     tracker = Tracker(config)
+    built = []
     for slot in SLOTS:
         held = getattr(tracker, slot.name)
         assert held is not None or not (slot.required or slot.default), slot  # only an optional slot is empty
@@ -74,7 +75,11 @@ def test_the_readers_follow_the_table():
         if slot.default is not None:
             assert f"| `{slot.key}` | `{slot.default}` |" in reference
     resolved = load_config({"features": ["gray"], "label": "gaussian", "solver": "ridge"})
-    # then each slot's key in table order; an optional slot left empty (memory, schedule) has none
+    # then each slot's key in table order; an optional slot left empty (memory, schedule, mask,
+    # channel_weights) has none, as before it existed
     kept = dict.fromkeys(s.top for s in SLOTS if s.required or s.default or s.role)
-    assert list(resolved) == ["name", "tracker", *kept] and "memory" not in kept
+    assert list(resolved) == ["name", "tracker", *kept] and "memory" not in kept and "mask" not in kept
+    masked = load_config({"features": ["gray"], "label": "gaussian", "solver": "admm_csr", "mask": "csr_segmentation",
+                          "channel_weights": "csr_reliability"})
+    assert list(masked) == ["name", "tracker", *kept, "mask", "channel_weights"]
     assert {s.key: resolved[s.key]["name"] for s in SLOTS if s.default} == {"search": "fixed", "scale": "pyramid"}

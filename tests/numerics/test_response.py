@@ -327,3 +327,17 @@ def test_newton_peak_refines_on_the_spectra_it_is_given():
     assert best == ref_best and (dy, dx) == (pytest.approx(ref_dy, abs=1e-9), pytest.approx(ref_dx, abs=1e-9))
     assert value == pytest.approx(ref_value, rel=1e-9)
     assert (dy, dx) != pytest.approx(newton_peak(maps, 5)[1:3], abs=1e-6)
+
+
+def test_parabola_peak_by_hand():
+    from dcfkit.numerics.response import parabola_peak  # only this test
+
+    r = np.zeros((8, 10), np.float32)
+    r[6, 2], r[5, 2], r[7, 2] = 1.0, 0.5, 0.7  # rows: a parabola through 0.5, 1, 0.7
+    r[6, 1], r[6, 3] = 0.2, 0.6
+    dy, dx = parabola_peak(r)
+    assert dy == pytest.approx(6 + 0.5 * (0.7 - 0.5) / (2 - 0.7 - 0.5) - 8)  # 6.125 > 4: wrapped
+    assert dx == pytest.approx(2 + 0.5 * (0.6 - 0.2) / (2 - 0.6 - 0.2))
+    flat = np.zeros((5, 5), np.float32)
+    flat[0, 0] = 1.0
+    assert parabola_peak(flat) == (0.0, 0.0)

@@ -15,7 +15,7 @@ from dcfkit.numerics.patches import round_half_away
 from dcfkit.numerics.response import shift_spectrum
 from dcfkit.tracker.geometry import reported_box
 
-CONFIGS = ["strcf", "bacf", "dr2track", "kcf", "dsst", "configs/ablations/dr2track_no_dr.yaml",
+CONFIGS = ["strcf", "bacf", "dr2track", "kcf", "dsst", "csrdcf", "configs/ablations/dr2track_no_dr.yaml",
            "configs/ablations/dr2track_no_ma.yaml"]
 
 

@@ -41,7 +41,8 @@ class Feature(Component, declares="feature"):
         raise NotImplementedError
 
     def extract(self, patch: np.ndarray, cell_size: int) -> np.ndarray:
-        """(H, W, 3) uint8 BGR, sides multiples of ``cell_size`` -> (C, H/cell, W/cell) float32, finite."""
+        """(H, W, 3) uint8 BGR, sides multiples of ``cell_size`` (CSR-DCF's template: up to a cell more,
+        left out) -> (C, H // cell, W // cell) float32, finite."""
         raise NotImplementedError
 
     def reset(self) -> None:

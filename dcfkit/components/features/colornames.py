@@ -19,6 +19,7 @@ import numpy as np
 
 from dcfkit.components.features.base import Feature
 from dcfkit.errors import ConfigError, clip, shown
+from dcfkit.numerics.imresize import imresize
 from dcfkit.opencv_check import contrib_advice
 from dcfkit.params import param
 
@@ -153,6 +154,9 @@ class ColorNames(Feature):
     @dataclasses.dataclass(frozen=True)
     class Params:
         table_path: str = param("", "a .npy/.mat CN table; empty: read it from the installed OpenCV")
+        pooling: str = param("cells", "each cell's value: 'cells' the mean of its pixels, 'matlab_bicubic' MATLAB's "
+                             "imresize of the map to the cell grid (CSR-DCF's get_csr_features)",
+                             choices=("cells", "matlab_bicubic"))
 
         def validate(self):
             return table_path_problem(self.table_path) if self.table_path else None
@@ -164,6 +168,10 @@ class ColorNames(Feature):
         from dcfkit.components.features.kernels import colornames_cells  # numba, compiled on first use
 
         table = load_table(self.params.table_path)
+        if self.params.pooling == "matlab_bicubic":  # each pixel's names, then the map resized
+            names = table[table_index(np.ascontiguousarray(patch))].astype(np.float64)
+            cells = imresize(names, (patch.shape[0] // cell_size, patch.shape[1] // cell_size))
+            return np.ascontiguousarray(cells.transpose(2, 0, 1), np.float32)
         out = np.empty((table.shape[1], patch.shape[0] // cell_size, patch.shape[1] // cell_size), np.float32)
         colornames_cells(np.ascontiguousarray(patch), table, cell_size, out)
         return out

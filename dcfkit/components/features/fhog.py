@@ -311,6 +311,8 @@ class FHOG(Feature):
         arithmetic: str = param("exact", "'exact' square roots and arctan, or the estimates and acos table of "
                                 "Piotr's compiled gradientMex that the authors' MATLAB runs: 'sse' the same on every "
                                 "machine, 'sse_cpu' this processor's (x86 only)", choices=ARITHMETICS)
+        output: str = param("all", "channels kept: 'all', or 'signed' the 2 n_orients contrast-sensitive ones only "
+                            "(CSR-DCF's get_csr_features)", choices=("all", "signed"))
 
         def validate(self):
             """gradientMex's arithmetic only with soft_orientation false."""
@@ -319,9 +321,10 @@ class FHOG(Feature):
                         "set soft_orientation false")
 
     def channels(self) -> int:
-        return 3 * self.params.n_orients + 4
+        return (2 if self.params.output == "signed" else 3) * self.params.n_orients + 4 * (self.params.output == "all")
 
     def extract(self, patch, cell_size):
         p = self.params
-        return fhog(patch, cell_size=cell_size, n_orients=p.n_orients, clip=p.clip, soft_orientation=p.soft_orientation,
-                    channel_order=p.channel_order, arithmetic=p.arithmetic)
+        out = fhog(patch, cell_size=cell_size, n_orients=p.n_orients, clip=p.clip, soft_orientation=p.soft_orientation,
+                   channel_order=p.channel_order, arithmetic=p.arithmetic)
+        return out if p.output == "all" else out[:2 * p.n_orients]

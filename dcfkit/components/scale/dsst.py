@@ -3,10 +3,12 @@ from __future__ import annotations
 
 import dataclasses
 
+import cv2
 import numpy as np
 
 from dcfkit.components.features.fhog import ARITHMETICS, fhog
 from dcfkit.components.scale.base import MAX_SCALES, MIN_LAM, ScaleEstimator, check_span, scale_factors
+from dcfkit.numerics.imresize import imresize
 from dcfkit.numerics.patches import resize_auto, sample, sampler, whole_pixel_crop
 from dcfkit.params import param
 
@@ -32,11 +34,18 @@ class DSST(ScaleEstimator):
         cell_size: int = param(4, "fHOG cell size of the scale samples", ge=1, le=16)
         model_size: str = param("base_target", "size of a scale sample: 'base_target' the target at the search "
                                 "patch's resolution (at least 2x2 cells), 'image_target' its size in image pixels "
-                                "(the authors' init_scale: floored; at least 2 cells, where theirs allows 2 px)",
-                                choices=("base_target", "image_target"))
+                                "(the authors' init_scale: floored; at least 2 cells, where theirs allows 2 px), "
+                                "'square' floor(√model_max_area) on each side (CSR-DCF's: its square template "
+                                "shrunk to that area)", choices=("base_target", "image_target", "square"))
         sampling: str = param("working_patch", "'working_patch': the largest region cut once and each scale "
                               "resampled from it; 'whole_pixel': each scale cropped in whole pixels and resized "
-                              "(the authors' get_scale_sample)", choices=("working_patch", "whole_pixel"))
+                              "(the authors' get_scale_sample); 'whole_pixel_bilinear' the same around the pixel "
+                              "nearest the centre, resized bilinearly (CSR-DCF's get_scale_subwindow, whose centre is "
+                              "half a pixel from dcfkit's; MATLAB's imresize 'bilinear' without antialiasing)",
+                              choices=("working_patch", "whole_pixel", "whole_pixel_bilinear"))
+        bilinear: str = param("opencv", "the resize of 'whole_pixel_bilinear': 'opencv' cv2's bilinear (8-bit fixed "
+                              "point), or 'matlab' imresize's (in double, rounded; the authors', slower)",
+                              choices=("opencv", "matlab"))
         window: str = param("hann_interior", "window over the scales: 'hann_interior' hann(S+2) without its zero "
                             "ends, or 'hann' hann(S) (the authors')", choices=("hann_interior", "hann"))
         channel_order: str = param("bgr", "colour channel order deciding fHOG's ties (see fhog.channel_order)",
@@ -68,7 +77,10 @@ class DSST(ScaleEstimator):
         area = float(np.prod(target))
         shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
         # at least 2 cells, which fhog needs (init_scale allows 2 px: a side under 8 px differs)
-        self.model_size = np.maximum((np.floor if authors else np.round)(target * shrink),
+        if p.model_size == "square":
+            target = np.full(2, np.sqrt(p.model_max_area))
+            shrink = 1.0
+        self.model_size = np.maximum((np.floor if authors or p.model_size == "square" else np.round)(target * shrink),
                                      2 * p.cell_size).astype(int)
         # the working patch and its resampling to each scale keep their geometry every frame
         span = self.factors[-1] / self.factors[0]
@@ -76,6 +88,8 @@ class DSST(ScaleEstimator):
         middle = (self.work_size - 1) / 2
         self.resamplers = [sampler(self.work_size, middle, self.work_size * (f / self.factors[-1]), self.model_size)
                            for f in self.factors]
+        # CSR-DCF's get_scale_subwindow: floor(target_sz x their scale x factor), their scale 1 at first
+        self.scale0, self.target0 = scale, np.round(self.base_target * scale, 9)
         self.num = self.den = None
         self._learn(np.fft.fft(self._samples(image, centre, scale), axis=1))
 
@@ -87,10 +101,13 @@ class DSST(ScaleEstimator):
         small working patch (fine enough for the smallest scale); every scale sample is resized
         from it. 'whole_pixel': floor(target x scale) whole pixels per scale, resized."""
         which = range(len(self.factors)) if which is None else which
-        if self.params.sampling == "whole_pixel":
+        if self.params.sampling != "working_patch":
+            bilinear = self.params.sampling == "whole_pixel_bilinear"
+            at = np.asarray(centre, float) + (0.5 if bilinear else 0.0)
             patches = np.stack([
-                resize_auto(whole_pixel_crop(image, centre, np.maximum(np.floor(self.base_target * (scale * f)), 2)),
-                            self.model_size) for f in self.factors[list(which)]])
+                (self._bilinear(crop) if bilinear else resize_auto(crop, self.model_size))
+                for crop in (whole_pixel_crop(image, at, np.maximum(np.floor(self._scaled(scale, f, bilinear)), 2))
+                             for f in self.factors[list(which)])])
         else:
             work = sample(image, centre, self.base_target * scale * self.factors[-1], self.work_size)
             patches = np.stack([self.resamplers[i](work) for i in which])
@@ -98,6 +115,20 @@ class DSST(ScaleEstimator):
                      arithmetic=self.params.fhog_arithmetic)
         feats = feats.reshape(len(patches), -1).T
         return feats * self.window[None, list(which)] if windowed else feats
+
+    def _bilinear(self, crop: np.ndarray) -> np.ndarray:
+        """``crop`` resized bilinearly, without antialiasing, to the scale sample's size."""
+        if self.params.bilinear == "matlab":
+            return imresize(crop, self.model_size, bilinear=True)
+        return cv2.resize(crop, (int(self.model_size[1]), int(self.model_size[0])), interpolation=cv2.INTER_LINEAR)
+
+    def _scaled(self, scale: float, factor: float, csr: bool) -> np.ndarray:
+        """The target at ``scale`` times ``factor``, in image pixels: CSR-DCF's target_sz times
+        their scale factor (a product of the factors chosen) times ``factor`` (``csr``), else
+        base_target x scale x factor."""
+        if csr:
+            return self.target0 * ((scale / self.scale0) * factor)
+        return self.base_target * (scale * factor)
 
     def _learn(self, xsf: np.ndarray) -> None:
         """Update the scale model with the (D, S) spectrum of the scale samples."""

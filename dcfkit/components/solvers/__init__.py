@@ -14,12 +14,14 @@
 * :mod:`.eco` -- ``eco``: ECO's factorised convolution (:mod:`.eco_joint`: the first frame's
   Gauss-Newton; :mod:`.eco_cg`: conjugate gradient and the regularization filter), run by
   the continuous loop (:mod:`dcfkit.tracker.continuous`).
+* :mod:`.csr` -- ``admm_csr``: CSR-DCF's per-channel filter constrained to a mask.
 """
 from __future__ import annotations
 
 from dcfkit.components.solvers.arcf import ADMMArcf, ARCFParams
 from dcfkit.components.solvers.autotrack import ADMMAutoTrack, AutoTrackParams
 from dcfkit.components.solvers.base import Solver
+from dcfkit.components.solvers.csr import ADMMCsr, CSRParams, csr_filter
 from dcfkit.components.solvers.dsst import Ridge, RidgeParams
 from dcfkit.components.solvers.eco import ECO, ECOParams
 from dcfkit.components.solvers.kcf import KernelParams, KernelRidge, kernel_correlation
@@ -34,8 +36,9 @@ from dcfkit.components.solvers.strcf_bacf import (
     sherman_morrison_solve,
 )
 
-BUILTIN = (ADMMStrcf, ADMMBacf, ADMMArcf, ADMMAutoTrack, KernelRidge, Ridge, ECO)
+BUILTIN = (ADMMStrcf, ADMMBacf, ADMMArcf, ADMMAutoTrack, KernelRidge, Ridge, ECO, ADMMCsr)
 
-__all__ = ["ADMMArcf", "ADMMAutoTrack", "ADMMBacf", "ADMMParams", "ADMMStrcf", "ARCFParams", "AutoTrackParams",
-           "BACFParams", "BUILTIN", "ECO", "ECOParams", "KernelParams", "KernelRidge", "Ridge", "RidgeParams", "Solver", "admm",
-           "kernel_correlation", "penalties", "schedule_problem", "sherman_morrison_solve"]
+__all__ = ["ADMMArcf", "ADMMAutoTrack", "ADMMBacf", "ADMMCsr", "ADMMParams", "ADMMStrcf", "ARCFParams",
+           "AutoTrackParams", "BACFParams", "BUILTIN", "CSRParams", "ECO", "ECOParams", "KernelParams",
+           "KernelRidge", "Ridge", "RidgeParams", "Solver", "admm", "csr_filter", "kernel_correlation",
+           "penalties", "schedule_problem", "sherman_morrison_solve"]

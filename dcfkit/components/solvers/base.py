@@ -39,6 +39,9 @@ class Solver(Component, declares="solver"):
     terms: tuple[str, ...] = ("spatial", "temporal")
     # whether train and response also work on whole complex spectra (tracker.spectra: full)
     full_spectra: bool = False
+    # the filter of the last train's sample alone, before any average over frames (CSR-DCF's
+    # H_new, which channel weights learn from); None: the filter train returned
+    frame_filter: np.ndarray | None = None
     contract = Contract(required={"reset": (), "train": ("xf", "yf", "w2", "theta", "fft")},
                         optional={"response": ("hf", "samples", "shape", "fft"), "observe": ("detection",)},
                         # a response that is not finite is the tracker's to say: the filter overflowed

@@ -6,7 +6,7 @@ the samples of a memory (Eq. 9, :mod:`.eco_cg`).
 
 This solver does not fit the discrete loop's ``train(xf, yf, w2, theta, fft)``: its samples
 are per-block Fourier series, not one grid's spectrum. A config naming it is run by
-:class:`dcfkit.tracker.continuous.ContinuousTracker`, which calls :meth:`ECO.learn_first`,
+:class:`dcfkit.tracker.continuous.ContinuousLoop`, which calls :meth:`ECO.learn_first`,
 :meth:`ECO.learn` and :meth:`ECO.scores`.
 """
 from __future__ import annotations
@@ -71,7 +71,7 @@ class ECO(Solver):
 
     name = "eco"
     terms: tuple[str, ...] = ()
-    loop = "continuous"  # dcfkit.tracker.loops: configs naming it run in dcfkit.tracker.continuous
+    loop = "continuous"  # configs naming it run in dcfkit.tracker.continuous (continuous_loop)
     Params = ECOParams
 
     def reset(self) -> None:

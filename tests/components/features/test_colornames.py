@@ -70,3 +70,16 @@ def test_gray_feature_is_centred_cell_mean():
     # rows and columns beyond the last whole cell are left out, as fhog and Color Names do
     np.testing.assert_allclose(cell_average(np.arange(20, dtype=np.float32).reshape(4, 5), 2),
                                [[3.0, 5.0], [13.0, 15.0]])
+
+
+def test_matlab_bicubic_pooling_resizes_each_pixels_names():
+    # get_csr_features: imresize(im2c(single(im), w2c, -2), out_size); im2c looks each pixel up
+    from dcfkit.numerics.imresize import imresize  # only this test
+
+    rng = np.random.default_rng(5)
+    patch = rng.integers(0, 256, (16, 12, 3), dtype=np.uint8)
+    table = cn.load_table("")
+    names = np.array([[table[int(p[2]) // 8 + 32 * (int(p[1]) // 8) + 1024 * (int(p[0]) // 8)] for p in row]
+                      for row in patch], np.float64)
+    out = ColorNames(ColorNames.Params(pooling="matlab_bicubic")).extract(patch, 4)
+    np.testing.assert_allclose(out, imresize(names, (4, 3)).transpose(2, 0, 1), atol=1e-6)

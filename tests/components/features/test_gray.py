@@ -28,3 +28,28 @@ def test_gray_opencv_conversion_rounds_to_whole_levels():
     patch = np.full((8, 8, 3), (30, 200, 90), np.uint8)
     got = Gray().extract(patch, 4)
     np.testing.assert_allclose(got, round(0.299 * 90 + 0.587 * 200 + 0.114 * 30) / 255 - 0.5, atol=2e-7)
+
+
+def test_gray_csr_conversion_is_matlabs_uint8_arithmetic():
+    # get_csr_features: single((gray_patch / 255) - 0.5) of a uint8 patch. uint8 / 255 rounds to 0
+    # (levels 0..127) or 1 (128..255); uint8(0) - 0.5 rounds to -1 and saturates at 0, uint8(1) - 0.5
+    # rounds to 1: the channel is 1 where the level is at least 128, else 0
+    levels = np.array([[0, 127, 128, 255]], np.uint8)
+    patch = np.repeat(levels[..., None], 3, axis=2)  # gray pixels: every conversion gives the level
+    out = Gray(Gray.Params(conversion="csr")).extract(patch, 1)
+    np.testing.assert_array_equal(out[0], [[0, 0, 1, 1]])
+
+
+def test_gray_matlab_bicubic_pooling_resizes_the_uint8_gray_map():
+    # get_csr_features: imresize(rgb2gray(im), out_size) of the uint8 patch, then / 255 - 0.5
+    import cv2  # only this test
+
+    from dcfkit.numerics.imresize import imresize
+
+    rng = np.random.default_rng(3)
+    patch = rng.integers(0, 256, (24, 20, 3), dtype=np.uint8)
+    out = Gray(Gray.Params(pooling="matlab_bicubic")).extract(patch, 4)
+    cells = imresize(cv2.cvtColor(patch, cv2.COLOR_BGR2GRAY), (6, 5)).astype(np.float32)
+    np.testing.assert_allclose(out[0], cells / 255 - 0.5, atol=1e-6)
+    binary = Gray(Gray.Params(conversion="csr", pooling="matlab_bicubic")).extract(patch, 4)
+    np.testing.assert_array_equal(binary[0], (cells >= 128).astype(np.float32))
