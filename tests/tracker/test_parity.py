@@ -164,6 +164,15 @@ def test_eco_hc_reference_is_within_the_bar_of_the_authors_code(shared_data, run
     assert next(row for row in rows if row["sequence"] == "wakeboard10")["iou"] == 1.0
 
 
+
+def test_csrdcf_reference_is_within_the_bar_of_the_authors_code(shared_data, runs):
+    """Issue 40: CSR-DCF's preset against alanlukezic/csr-dcf under Octave (measured 2026-11-29:
+    |ΔAUC| <= 0.005, mean IoU 0.938-0.999; wakeboard7's boxes part at frame 58, where a scale
+    product returning to 1 puts the crop a pixel apart, docs/reference.md "CSR-DCF")."""
+    rows = compare_preset("csrdcf", *UAV, None, OCTAVE_RUNS / "CSR-DCF" / "UAV123_10fps", shared_data, runs)
+    assert_within_the_bar(rows)
+    assert sum(row["diverges_at"] is None for row in rows) >= 5, rows
+
 # Another x86-64 platform (docs/architecture.md, "Same boxes on every machine"), whatever this
 # one is: numpy's loops without AVX2 and AVX-512, OpenBLAS's SSE3 kernel, OpenCV's SSE2 paths,
 # numba compiled for a generic x86-64, glibc's math without FMA, libjpeg-turbo without SIMD
