@@ -3,6 +3,9 @@
     python benchmarks/speed.py [--root ../shared/data/UAV123_10fps] [--configs strcf,bacf,dr2track]
         [--passes 3] [--json speed.json]
 
+A config may be a shipped name, a YAML path, or ``opencv:CSRT`` (``opencv:KCF``, ``opencv:MOSSE``):
+OpenCV's tracker timed the same way in the same run, as a yardstick.
+
 Run single-threaded (the script sets OMP/OPENBLAS/MKL threads to 1 before numpy loads).
 Frames are decoded one at a time outside the timer; only init/update are timed. Runs the
 UAV123@10fps sequences and a synthetic sequence of the same 1280x720 frame size. Prints
@@ -27,6 +30,7 @@ import numpy as np  # noqa: E402
 import dcfkit  # noqa: E402
 from dcfkit.datasets.synthetic import make_sequence  # noqa: E402
 from dcfkit.experiments.loop import track as run_track  # noqa: E402
+from dcfkit.integrations.opencv import opencv_tracker  # noqa: E402
 
 cv2.setNumThreads(1)
 SYNTHETIC = "synthetic_720p"
@@ -59,7 +63,11 @@ frame = cv2.imread(sys.argv[2]) if sys.argv[2] else numpy.random.default_rng(0).
 box = [float(v) for v in sys.argv[3].split(",")]
 start = time.perf_counter()
 import dcfkit
-tracker = dcfkit.load_tracker(sys.argv[1])
+if sys.argv[1].lower().startswith("opencv:"):
+    from dcfkit.integrations.opencv import opencv_tracker
+    tracker = opencv_tracker(sys.argv[1].partition(":")[2])()
+else:
+    tracker = dcfkit.load_tracker(sys.argv[1])
 loaded = time.perf_counter()
 tracker.init(frame, box)
 tracker.update(frame)
@@ -75,9 +83,16 @@ def first_frame_fresh(config: str, image: str, box) -> tuple[float, float]:
     return float(out[0]), float(out[1])
 
 
+def make_tracker(config: str):
+    """A dcfkit tracker, or OpenCV's for ``opencv:NAME``."""
+    if config.lower().startswith("opencv:"):
+        return opencv_tracker(config.partition(":")[2])()
+    return dcfkit.load_tracker(config)
+
+
 def track(config: str, frame_at, n_frames: int, box) -> tuple[float, float]:
     """(fps of update over frames 2..n, seconds of init), decoding excluded."""
-    times = run_track(dcfkit.load_tracker(config), (frame_at(i) for i in range(n_frames)), box).times
+    times = run_track(make_tracker(config), (frame_at(i) for i in range(n_frames)), box).times
     return (n_frames - 1) / float(times[1:].sum()), float(times[0])
 
 

@@ -54,9 +54,13 @@ def test_stages(tmp_path):
 
 @pytest.mark.slow
 def test_speed(tmp_path):
-    out = run("speed.py", "--root", str(tmp_path / "none"), "--configs", "kcf", "--passes", "1", "--json", "speed.json",
-              "--synthetic-frames", "4", tmp_path=tmp_path)
+    from dcfkit.integrations.opencv import available_opencv_trackers  # reason: only this test asks
+
+    configs = ["kcf"] + (["opencv:CSRT"] if "CSRT" in available_opencv_trackers() else [])  # the yardstick
+    out = run("speed.py", "--root", str(tmp_path / "none"), "--configs", ",".join(configs), "--passes", "1",
+              "--json", "speed.json", "--synthetic-frames", "4", tmp_path=tmp_path)
     assert "synthetic frames only" in out and "first frame in a fresh process" in out
+    assert all(f"synthetic_720p {config}" in out for config in configs), out
     assert (tmp_path / "speed.json").is_file()
 
 
