@@ -152,8 +152,7 @@ class Tracker:
         self.search.reset(centre)
         self.scale_estimator.init(image, centre, g.base_target, self.scale, self.limits)
         self.position = centre
-        self.last_response, self.last_search_box = None, None
-        self.last_distractors = np.zeros((0, 2))
+        self.last_response, self.last_search_box, self.last_distractors = None, None, np.zeros((0, 2))
         self.held_frames = []
         self._train(image, None, self._spectrum(patch))  # m^1: the patch checked above
 
