@@ -45,7 +45,26 @@ def continuous_loop(tracker) -> "ContinuousLoop | None":
 # tracker keys of the discrete loop that the continuous one has no use for: ECO samples, windows,
 # finds the peak and moves its own way, on half spectra of its blocks
 UNUSED = ("sampling", "window", "peak", "translation", "training_sample", "init_position", "init_area",
-          "cell_selection_thresh", "spectra", "fft_backend")
+          "cell_selection_thresh", "spectra", "fft_backend", "output_sigma", "cell_area", "box_scale", "resize")
+
+
+def refuse_unused(tracker) -> None:
+    """ConfigError naming a tracker key or component the continuous loop would silently ignore:
+    a discrete-loop key changed from its default (``UNUSED``), ``search_area_shape: padded_square``,
+    channel weights or a mask (ECO's filter has neither)."""
+    default, solver = TrackerParams(), tracker.solver.name
+    for key in UNUSED:
+        if getattr(tracker.params, key) != getattr(default, key):
+            raise ConfigError(f"{tracker.name}: tracker.{key}: solver '{solver}' runs in the "
+                              f"continuous loop, which does not use it (keys it ignores: {', '.join(UNUSED)})")
+    if tracker.params.search_area_shape == "padded_square":
+        raise ConfigError(f"{tracker.name}: tracker.search_area_shape: 'padded_square' is the discrete loop's "
+                          f"(CSR-DCF's); solver '{solver}' runs in the continuous loop: use square or proportional")
+    for slot in ("channel_weights", "mask"):
+        component = getattr(tracker, slot)
+        if component is not None:
+            raise ConfigError(f"{tracker.name}: {slot} '{component.name}': solver '{solver}' runs in the "
+                              f"continuous loop, which would ignore it: set {slot}: null")
 
 
 class ContinuousLoop:
@@ -54,11 +73,7 @@ class ContinuousLoop:
     def __init__(self, tracker):
         self.t = tracker
         s = tracker.solver.params
-        default = TrackerParams()
-        for key in UNUSED:
-            if getattr(tracker.params, key) != getattr(default, key):
-                raise ConfigError(f"{tracker.name}: tracker.{key}: solver '{tracker.solver.name}' runs in the "
-                                  f"continuous loop, which does not use it (keys it ignores: {', '.join(UNUSED)})")
+        refuse_unused(tracker)
         if tracker.memory is None:
             raise ConfigError(f"{tracker.name}: solver '{tracker.solver.name}' learns from a memory of samples: "
                               f"add one, e.g. memory: {{name: gmm}}")
@@ -69,6 +84,11 @@ class ContinuousLoop:
             raise ConfigError(f"{tracker.name}: label: the continuous loop's label is a Gaussian's Fourier series; "
                               f"'{tracker.label.name}' would be ignored (use label: {{name: gaussian}})")
         for skip in ("gray_skip", "colour_skip"):
+            # the defaults name ECO's features, whichever a config has; names given must be its own
+            unknown = [n for n in getattr(s, skip) if n not in {f.name for f in tracker.features}]
+            if unknown and getattr(s, skip) != getattr(type(s)(), skip):
+                raise ConfigError(f"{tracker.name}: solver.{skip}: {', '.join(map(repr, unknown))} is not one of the "
+                                  f"config's features ({', '.join(f.name for f in tracker.features)})")
             if all(f.name in getattr(s, skip) for f in tracker.features):
                 raise ConfigError(f"{tracker.name}: solver.{skip} leaves out every feature")
         for f, d in zip(tracker.features, s.compressed_dims):

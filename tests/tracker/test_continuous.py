@@ -5,6 +5,7 @@ import pytest
 import dcfkit
 from dcfkit.analysis.metrics import score_sequence
 from dcfkit.config import load_config
+from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.errors import ConfigError, TrackingError
 from dcfkit.tracker.continuous import ContinuousLoop
@@ -103,3 +104,30 @@ def test_a_schedule_gates_the_discrete_loops_training(sequence):
     tracker.solver.train = train
     run(tracker, sequence.frames[:12], sequence.ground_truth[0])
     assert trained == [1, 2, 5, 8, 11]
+
+
+@pytest.mark.parametrize("key, value", [("output_sigma", 1.0), ("cell_area", 100), ("box_scale", "previous"),
+                                        ("resize", "matlab_bicubic")])
+def test_the_continuous_loop_refuses_the_discrete_loops_csr_keys(key, value):
+    default = getattr(TrackerParams(), key)
+    assert value != default
+    with pytest.raises(ConfigError, match=f"tracker.{key}: solver 'eco' runs in the continuous loop"):
+        dcfkit.load_tracker("eco_hc", overrides={f"tracker.{key}": value})
+
+
+def test_the_continuous_loop_refuses_a_padded_square_search_area():
+    with pytest.raises(ConfigError, match="tracker.search_area_shape: 'padded_square'"):
+        dcfkit.load_tracker("eco_hc", overrides={"tracker.search_area_shape": "padded_square"})
+
+
+@pytest.mark.parametrize("slot", ["channel_weights", "mask"])
+def test_the_continuous_loop_refuses_channel_weights_and_masks(slot):
+    name = load_config("csrdcf")[slot]["name"]
+    with pytest.raises(ConfigError, match=f"{slot} '{name}': solver 'eco' runs in the continuous loop"):
+        dcfkit.load_tracker("eco_hc", overrides={slot: {"name": name}})
+
+
+@pytest.mark.parametrize("skip", ["gray_skip", "colour_skip"])
+def test_skipped_feature_names_must_be_the_configs(skip):
+    with pytest.raises(ConfigError, match=f"solver.{skip}: 'colournames' is not one of the config's features"):
+        dcfkit.load_tracker("eco_hc", overrides={f"solver.{skip}": ["colournames"]})
