@@ -21,6 +21,7 @@ import dataclasses
 import numpy as np
 
 from dcfkit.components.base import Target
+from dcfkit.components.labels.base import Detection
 from dcfkit.components.scale.base import scale_limits
 from dcfkit.components.solvers.eco_joint import pca_projection, project
 from dcfkit.config.tracker_params import TrackerParams
@@ -28,7 +29,7 @@ from dcfkit.errors import ConfigError, InputError, TrackingError
 from dcfkit.numerics import fourier_series as fs
 from dcfkit.numerics.patches import box_to_centre_size, centre_size_to_box, round_half_away
 from dcfkit.tracker.blocks import extract, layout, sample_patch
-from dcfkit.tracker.checks import check_box, check_image
+from dcfkit.tracker.checks import check_blank_first, check_box, check_image, first_due
 from dcfkit.tracker.geometry import Geometry, reported_box
 
 
@@ -151,18 +152,22 @@ class ContinuousLoop:
         gray = image if image.ndim == 2 else image[..., 2]
         features, s = self._active(colour)
         lay = layout(self.t.params, s, target, features)
-        self.colour, self.layout = colour, lay
         image = image if colour else gray
         step = self.t._limit_step()
         limits = scale_limits(lay.base_target, lay.support, image.shape, step=step)
-        self._start(image, centre, lay, limits)
         pos = centre + 1  # ECO's 1-based position
         sample_pos = round_half_away(pos)
-        maps = [m[0] for m in self._samples(image, sample_pos, [self.t.scale])]
+        # checked before any state changes: a failed init leaves the tracker as it was
+        patch = sample_patch(image, sample_pos, lay.support * lay.scale, lay.support)
+        check_blank_first(self.t, patch, centre, image.shape)
+        first_due(self.t)
+        self.colour, self.layout = colour, lay
+        self._start(image, centre, lay, limits)
+        maps = extract(lay.blocks, patch)
         xs = self._shifted([fs.half(x) for x in self._spectra(maps)], pos, sample_pos, self.t.scale)
         projections = [pca_projection(x, b.dim) for x, b in zip(maps, lay.blocks)]
         self.t.memory.insert([project(x, p) for x, p in zip(xs, projections)])
-        if self.t.schedule is not None and not self.t.schedule.due(1):
+        if self.t.schedule is not None and not self.t.schedule.due(1):  # first_due asked a copy: changed its mind
             raise TrackingError(f"frame 1: schedule '{self.t.schedule.name}' skips the first frame, where the filter "
                                 f"must be learnt")
         labels, regs = [b.label for b in lay.blocks], [b.reg for b in lay.blocks]
@@ -200,10 +205,15 @@ class ContinuousLoop:
         self.t.position = pos
         self.t.scale = float(self.t.scale_estimator.update(image, pos - 1, detect_scale))
         self.t.search.observe(pos - 1)
-        self.t.last_response = np.fft.fftshift(fs.sample(scores[best]))
+        grid = fs.sample(scores[best])
+        self.t.last_response = np.fft.fftshift(grid)
         self.t.last_search_box = centre_size_to_box(sample_pos - 1, lay.support * detect_scale)
         sample = self._shifted([fs.half(x[best]) for x in spectra], pos, sample_pos, detect_scale)
         self.t.memory.insert(sample)
+        if self.t.schedule is not None:  # the detection on the output grid, as the discrete loop gives it
+            peak = np.unravel_index(int(np.argmax(grid)), grid.shape)
+            self.t.schedule.observe(Detection(grid.astype(np.float32), (int(peak[0]), int(peak[1])),
+                                              self.t.geometry.target_cells, (float(dy), float(dx))))
         if self.t.schedule is None or self.t.schedule.due(self.t.frame):
             self.t.solver.learn(sample, self.t.memory.samples, self.t.memory.weights, [b.label for b in blocks],
                                 [b.reg for b in blocks])
