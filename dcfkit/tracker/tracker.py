@@ -142,7 +142,7 @@ class Tracker:
                     if c is not None]
         for component in (*self.features, self.label, self.solver, *optional):  # a new target: nothing kept
             component.reset()
-        target = Target(self.image_size, g.filter_size, g.target_cells, g.cell_size, scale, float(sigma))
+        target = Target(self.image_size, g.filter_size, g.target_cells, g.cell_size, scale, float(sigma), g.template)
         for component in (*self.features, self.label, self.solver, *optional, self.search, self.scale_estimator):
             component.start(target)
         self.w2 = read_only(self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
