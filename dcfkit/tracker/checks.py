@@ -98,6 +98,20 @@ def check_spectra(tracker) -> None:
                           f"works on half spectra: set tracker.spectra: half")
 
 
+def check_sampling(tracker) -> None:
+    """ConfigError for keys only whole-pixel sampling reads: ``search_area_shape: padded_square``
+    (CSR-DCF's template, cropped in whole pixels) and ``resize`` (how that template is resized)."""
+    p = tracker.params
+    if p.search_area_shape == "padded_square" and p.sampling != "whole_pixel":
+        raise ConfigError(f"{tracker.name}: tracker.search_area_shape 'padded_square' (CSR-DCF's template) is "
+                          f"cropped in whole pixels; tracker.sampling '{p.sampling}' would ignore the template: "
+                          f"set tracker.sampling: whole_pixel")
+    if p.resize != "auto" and not (p.sampling == "whole_pixel" and p.search_area_shape == "padded_square"):
+        raise ConfigError(f"{tracker.name}: tracker.resize '{p.resize}' resizes the padded_square template's "
+                          f"whole-pixel samples; with tracker.sampling '{p.sampling}' and search_area_shape "
+                          f"'{p.search_area_shape}' it would be ignored: set tracker.resize: auto")
+
+
 def search_scales(tracker) -> np.ndarray:
     """The relative scales of the search samples (one sample each per frame)."""
     try:

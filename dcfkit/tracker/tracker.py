@@ -38,6 +38,7 @@ from dcfkit.tracker.checks import (
     check_config_budget,
     check_first_frame,
     check_image,
+    check_sampling,
     check_spectra,
     check_terms,
     first_due,
@@ -64,6 +65,7 @@ class Tracker:
         self.loop = continuous_loop(self)  # ECO's solver learns on the continuous domain: its own loop
         check_terms(self)
         check_spectra(self)
+        check_sampling(self)
         self.fft = make_fft(self.params.fft_backend, full=self.params.spectra == "full")
         self.frame = 0
         # diagnostics of the last frame: the response map (cells, centred: fftshift), the image box
