@@ -203,10 +203,14 @@ def check_blank_first(tracker, patch: np.ndarray, centre: np.ndarray, shape) -> 
 def first_due(tracker) -> None:
     """TrackingError if the schedule, reset for a new target, would skip frame 1, where the
     first filter must be learnt. A copy is asked: the schedule itself is untouched, so a
-    refused init leaves the tracker as it was, and it is asked once per frame as before."""
+    refused init leaves the tracker as it was, and it is asked once per frame as before (a
+    schedule that cannot be copied is only asked by the loop, after the state changed)."""
     if tracker.schedule is None:
         return
-    probe = copy.deepcopy(tracker.schedule)
+    try:
+        probe = copy.deepcopy(tracker.schedule)
+    except Exception:  # a plugin's state that cannot be copied: the loops still ask it, later
+        return
     probe.reset()
     if not probe.due(1):
         raise TrackingError(f"frame 1: schedule '{tracker.schedule.name}' skips the first frame, where the filter "
