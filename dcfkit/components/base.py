@@ -31,7 +31,9 @@ class Target:
     ``image_size``: frame 1's ``(H, W)`` pixels; ``filter_size``: the ``(H, W)`` cells of the
     filter, the label and the response; ``target_cells``: the target in cells; ``cell_size``:
     pixels per cell (the config's, or smaller for a small target); ``scale``: pixels of the
-    image per pixel of the resampled patch; ``sigma``: the base label's σ in cells (Eq. 1)."""
+    image per pixel of the resampled patch; ``sigma``: the base label's σ in cells (Eq. 1);
+    ``template``: CSR-DCF's square template's side in image pixels (``tracker.search_area_shape:
+    padded_square``), else None."""
 
     image_size: tuple[int, int]
     filter_size: tuple[int, int]
@@ -39,6 +41,7 @@ class Target:
     cell_size: int
     scale: float
     sigma: float
+    template: float | None = None
 
 
 class Component:

@@ -97,14 +97,6 @@ def symmetrize(hf: np.ndarray) -> np.ndarray:
     return hf
 
 
-def padded_into(target: np.ndarray, block: np.ndarray) -> None:
-    """Add the half spectrum ``block`` into the larger ``target`` at the same frequencies
-    (both centred; the frequency-0 column is the last of each)."""
-    py = (target.shape[-2] - block.shape[-2]) // 2
-    px = target.shape[-1] - block.shape[-1]
-    target[..., py:target.shape[-2] - py, px:] += block
-
-
 def window_of(target_shape, block_shape) -> tuple[slice, slice]:
     """The slices of a larger half spectrum that hold a block's frequencies."""
     py = (target_shape[-2] - block_shape[-2]) // 2

@@ -119,8 +119,8 @@ def sample_patch(image: np.ndarray, pos: np.ndarray, region: np.ndarray, out: np
 
 
 def extract(blocks: list[Block], patch: np.ndarray) -> list[np.ndarray]:
-    """Each block's (C, h, w) float32 map of ``patch``, scaled to mean square 1 per channel
-    (ECO-HC's normalize_power 2, normalize_size, normalize_dim)."""
+    """Each block's (C, h, w) float32 map of ``patch``, scaled to mean square 1 over the whole
+    block, all channels together (ECO-HC's normalize_power 2, normalize_size, normalize_dim)."""
     if patch.ndim == 2:
         patch = cv2.cvtColor(patch, cv2.COLOR_GRAY2BGR)
     out = []

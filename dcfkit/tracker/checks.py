@@ -3,6 +3,7 @@ image and the first box, that every configured term is used, and that a frame's 
 within the memory budgets of :mod:`dcfkit.limits` (docs/hardening.md)."""
 from __future__ import annotations
 
+import copy
 from typing import Any
 
 import numpy as np
@@ -11,7 +12,7 @@ from dcfkit.components.scale.dsst import DSST
 from dcfkit.components.solvers.base import Solver
 from dcfkit.config.slots import SLOTS
 from dcfkit.contracts import ContractViolation
-from dcfkit.errors import ConfigError, InputError, shown
+from dcfkit.errors import ConfigError, InputError, TrackingError, shown
 from dcfkit.limits import SAMPLE_PIXELS_VARIABLE, sample_budget
 from dcfkit.numerics.patches import cropper, sampler
 from dcfkit.tracker.geometry import Geometry
@@ -97,6 +98,20 @@ def check_spectra(tracker) -> None:
                           f"works on half spectra: set tracker.spectra: half")
 
 
+def check_sampling(tracker) -> None:
+    """ConfigError for keys only whole-pixel sampling reads: ``search_area_shape: padded_square``
+    (CSR-DCF's template, cropped in whole pixels) and ``resize`` (how that template is resized)."""
+    p = tracker.params
+    if p.search_area_shape == "padded_square" and p.sampling != "whole_pixel":
+        raise ConfigError(f"{tracker.name}: tracker.search_area_shape 'padded_square' (CSR-DCF's template) is "
+                          f"cropped in whole pixels; tracker.sampling '{p.sampling}' would ignore the template: "
+                          f"set tracker.sampling: whole_pixel")
+    if p.resize != "auto" and not (p.sampling == "whole_pixel" and p.search_area_shape == "padded_square"):
+        raise ConfigError(f"{tracker.name}: tracker.resize '{p.resize}' resizes the padded_square template's "
+                          f"whole-pixel samples; with tracker.sampling '{p.sampling}' and search_area_shape "
+                          f"'{p.search_area_shape}' it would be ignored: set tracker.resize: auto")
+
+
 def search_scales(tracker) -> np.ndarray:
     """The relative scales of the search samples (one sample each per frame)."""
     try:
@@ -170,3 +185,33 @@ def check_dsst_copies(tracker, shape, centre: np.ndarray, target: np.ndarray) ->
         cropper(shape, centre, region)
     else:
         sampler(shape, centre, region, np.full(2, np.ceil(2 * d.cell_size * span)))
+
+
+def check_blank_first(tracker, patch: np.ndarray, centre: np.ndarray, shape) -> None:
+    """InputError if the first frame's search ``patch`` is blank (``tracker.blank_std``):
+    there is nothing to learn. ``centre`` is the 0-based (y, x) box centre."""
+    std = tracker._blank(patch)
+    if std is None:
+        return
+    outside = not (0 <= centre[0] < shape[0] and 0 <= centre[1] < shape[1])
+    raise InputError(f"frame 1: the search area around the initial box is blank (standard deviation "
+                     f"{std:.2f} < tracker.blank_std {tracker.params.blank_std:g}); nothing to learn"
+                     + (f" (the box centre (x={centre[1]:g}, y={centre[0]:g}) is outside the "
+                        f"{shape[1]}x{shape[0]} image)" if outside else ""))
+
+
+def first_due(tracker) -> None:
+    """TrackingError if the schedule, reset for a new target, would skip frame 1, where the
+    first filter must be learnt. A copy is asked: the schedule itself is untouched, so a
+    refused init leaves the tracker as it was, and it is asked once per frame as before (a
+    schedule that cannot be copied is only asked by the loop, after the state changed)."""
+    if tracker.schedule is None:
+        return
+    try:
+        probe = copy.deepcopy(tracker.schedule)
+    except Exception:  # a plugin's state that cannot be copied: the loops still ask it, later
+        return
+    probe.reset()
+    if not probe.due(1):
+        raise TrackingError(f"frame 1: schedule '{tracker.schedule.name}' skips the first frame, where the filter "
+                            f"must be learnt")

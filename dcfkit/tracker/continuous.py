@@ -21,6 +21,7 @@ import dataclasses
 import numpy as np
 
 from dcfkit.components.base import Target
+from dcfkit.components.labels.base import Detection
 from dcfkit.components.scale.base import scale_limits
 from dcfkit.components.solvers.eco_joint import pca_projection, project
 from dcfkit.config.tracker_params import TrackerParams
@@ -28,7 +29,7 @@ from dcfkit.errors import ConfigError, InputError, TrackingError
 from dcfkit.numerics import fourier_series as fs
 from dcfkit.numerics.patches import box_to_centre_size, centre_size_to_box, round_half_away
 from dcfkit.tracker.blocks import extract, layout, sample_patch
-from dcfkit.tracker.checks import check_box, check_image
+from dcfkit.tracker.checks import check_blank_first, check_box, check_image, first_due
 from dcfkit.tracker.geometry import Geometry, reported_box
 
 
@@ -45,7 +46,26 @@ def continuous_loop(tracker) -> "ContinuousLoop | None":
 # tracker keys of the discrete loop that the continuous one has no use for: ECO samples, windows,
 # finds the peak and moves its own way, on half spectra of its blocks
 UNUSED = ("sampling", "window", "peak", "translation", "training_sample", "init_position", "init_area",
-          "cell_selection_thresh", "spectra", "fft_backend")
+          "cell_selection_thresh", "spectra", "fft_backend", "output_sigma", "cell_area", "box_scale", "resize")
+
+
+def refuse_unused(tracker) -> None:
+    """ConfigError naming a tracker key or component the continuous loop would silently ignore:
+    a discrete-loop key changed from its default (``UNUSED``), ``search_area_shape: padded_square``,
+    channel weights or a mask (ECO's filter has neither)."""
+    default, solver = TrackerParams(), tracker.solver.name
+    for key in UNUSED:
+        if getattr(tracker.params, key) != getattr(default, key):
+            raise ConfigError(f"{tracker.name}: tracker.{key}: solver '{solver}' runs in the "
+                              f"continuous loop, which does not use it (keys it ignores: {', '.join(UNUSED)})")
+    if tracker.params.search_area_shape == "padded_square":
+        raise ConfigError(f"{tracker.name}: tracker.search_area_shape: 'padded_square' is the discrete loop's "
+                          f"(CSR-DCF's); solver '{solver}' runs in the continuous loop: use square or proportional")
+    for slot in ("channel_weights", "mask"):
+        component = getattr(tracker, slot)
+        if component is not None:
+            raise ConfigError(f"{tracker.name}: {slot} '{component.name}': solver '{solver}' runs in the "
+                              f"continuous loop, which would ignore it: set {slot}: null")
 
 
 class ContinuousLoop:
@@ -54,11 +74,7 @@ class ContinuousLoop:
     def __init__(self, tracker):
         self.t = tracker
         s = tracker.solver.params
-        default = TrackerParams()
-        for key in UNUSED:
-            if getattr(tracker.params, key) != getattr(default, key):
-                raise ConfigError(f"{tracker.name}: tracker.{key}: solver '{tracker.solver.name}' runs in the "
-                                  f"continuous loop, which does not use it (keys it ignores: {', '.join(UNUSED)})")
+        refuse_unused(tracker)
         if tracker.memory is None:
             raise ConfigError(f"{tracker.name}: solver '{tracker.solver.name}' learns from a memory of samples: "
                               f"add one, e.g. memory: {{name: gmm}}")
@@ -69,6 +85,11 @@ class ContinuousLoop:
             raise ConfigError(f"{tracker.name}: label: the continuous loop's label is a Gaussian's Fourier series; "
                               f"'{tracker.label.name}' would be ignored (use label: {{name: gaussian}})")
         for skip in ("gray_skip", "colour_skip"):
+            # the defaults name ECO's features, whichever a config has; names given must be its own
+            unknown = [n for n in getattr(s, skip) if n not in {f.name for f in tracker.features}]
+            if unknown and getattr(s, skip) != getattr(type(s)(), skip):
+                raise ConfigError(f"{tracker.name}: solver.{skip}: {', '.join(map(repr, unknown))} is not one of the "
+                                  f"config's features ({', '.join(f.name for f in tracker.features)})")
             if all(f.name in getattr(s, skip) for f in tracker.features):
                 raise ConfigError(f"{tracker.name}: solver.{skip} leaves out every feature")
         for f, d in zip(tracker.features, s.compressed_dims):
@@ -131,18 +152,22 @@ class ContinuousLoop:
         gray = image if image.ndim == 2 else image[..., 2]
         features, s = self._active(colour)
         lay = layout(self.t.params, s, target, features)
-        self.colour, self.layout = colour, lay
         image = image if colour else gray
         step = self.t._limit_step()
         limits = scale_limits(lay.base_target, lay.support, image.shape, step=step)
-        self._start(image, centre, lay, limits)
         pos = centre + 1  # ECO's 1-based position
         sample_pos = round_half_away(pos)
-        maps = [m[0] for m in self._samples(image, sample_pos, [self.t.scale])]
+        # checked before any state changes: a failed init leaves the tracker as it was
+        patch = sample_patch(image, sample_pos, lay.support * lay.scale, lay.support)
+        check_blank_first(self.t, patch, centre, image.shape)
+        first_due(self.t)
+        self.colour, self.layout = colour, lay
+        self._start(image, centre, lay, limits)
+        maps = extract(lay.blocks, patch)
         xs = self._shifted([fs.half(x) for x in self._spectra(maps)], pos, sample_pos, self.t.scale)
         projections = [pca_projection(x, b.dim) for x, b in zip(maps, lay.blocks)]
         self.t.memory.insert([project(x, p) for x, p in zip(xs, projections)])
-        if self.t.schedule is not None and not self.t.schedule.due(1):
+        if self.t.schedule is not None and not self.t.schedule.due(1):  # first_due asked a copy: changed its mind
             raise TrackingError(f"frame 1: schedule '{self.t.schedule.name}' skips the first frame, where the filter "
                                 f"must be learnt")
         labels, regs = [b.label for b in lay.blocks], [b.reg for b in lay.blocks]
@@ -180,10 +205,15 @@ class ContinuousLoop:
         self.t.position = pos
         self.t.scale = float(self.t.scale_estimator.update(image, pos - 1, detect_scale))
         self.t.search.observe(pos - 1)
-        self.t.last_response = np.fft.fftshift(fs.sample(scores[best]))
+        grid = fs.sample(scores[best])
+        self.t.last_response = np.fft.fftshift(grid)
         self.t.last_search_box = centre_size_to_box(sample_pos - 1, lay.support * detect_scale)
         sample = self._shifted([fs.half(x[best]) for x in spectra], pos, sample_pos, detect_scale)
         self.t.memory.insert(sample)
+        if self.t.schedule is not None:  # the detection on the output grid, as the discrete loop gives it
+            peak = np.unravel_index(int(np.argmax(grid)), grid.shape)
+            self.t.schedule.observe(Detection(grid.astype(np.float32), (int(peak[0]), int(peak[1])),
+                                              self.t.geometry.target_cells, (float(dy), float(dx))))
         if self.t.schedule is None or self.t.schedule.due(self.t.frame):
             self.t.solver.learn(sample, self.t.memory.samples, self.t.memory.weights, [b.label for b in blocks],
                                 [b.reg for b in blocks])

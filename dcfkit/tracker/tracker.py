@@ -33,12 +33,15 @@ from dcfkit.numerics.patches import box_to_centre_size, centre_size_to_box, roun
 from dcfkit.numerics.response import newton_peak, parabola_peak, response_spectra, shift_spectrum, subpixel_peak
 from dcfkit.registry import get_registry
 from dcfkit.tracker.checks import (
+    check_blank_first,
     check_box,
     check_config_budget,
     check_first_frame,
     check_image,
+    check_sampling,
     check_spectra,
     check_terms,
+    first_due,
     read_only,
 )
 from dcfkit.tracker.confidence import Confidence
@@ -62,6 +65,7 @@ class Tracker:
         self.loop = continuous_loop(self)  # ECO's solver learns on the continuous domain: its own loop
         check_terms(self)
         check_spectra(self)
+        check_sampling(self)
         self.fft = make_fft(self.params.fft_backend, full=self.params.spectra == "full")
         self.frame = 0
         # diagnostics of the last frame: the response map (cells, centred: fftshift), the image box
@@ -125,13 +129,9 @@ class Tracker:
         scale = float(np.clip(scale, *limits))
         check_first_frame(self, image.shape, centre, g, scale, box)
         patch = self._patch(image, centre, scale, g)
-        std = self._blank(patch)
-        if std is not None:  # checked before any state changes: a failed init leaves the tracker as it was
-            outside = not (0 <= centre[0] < image.shape[0] and 0 <= centre[1] < image.shape[1])
-            raise InputError(f"frame 1: the search area around the initial box is blank (standard deviation "
-                             f"{std:.2f} < tracker.blank_std {self.params.blank_std:g}); nothing to learn"
-                             + (f" (the box centre (x={centre[1]:g}, y={centre[0]:g}) is outside the "
-                                f"{image.shape[1]}x{image.shape[0]} image)" if outside else ""))
+        # checked before any state changes: a failed init leaves the tracker as it was
+        check_blank_first(self, patch, centre, image.shape)
+        first_due(self)  # a copy of the schedule, reset, asked about frame 1
         self.frame = 1
         self.image_size = image.shape[:2]
         self.geometry, self.scale, self.limits = g, scale, limits
@@ -144,7 +144,7 @@ class Tracker:
                     if c is not None]
         for component in (*self.features, self.label, self.solver, *optional):  # a new target: nothing kept
             component.reset()
-        target = Target(self.image_size, g.filter_size, g.target_cells, g.cell_size, scale, float(sigma))
+        target = Target(self.image_size, g.filter_size, g.target_cells, g.cell_size, scale, float(sigma), g.template)
         for component in (*self.features, self.label, self.solver, *optional, self.search, self.scale_estimator):
             component.start(target)
         self.w2 = read_only(self.spatial.weights_squared(g.filter_size, g.target_cells) if self.spatial is not None
@@ -250,7 +250,7 @@ class Tracker:
             raise TrackingError(f"frame {self.frame}: temporal regularizer '{self.temporal.name}' returned θ = inf "
                                 f"on the first frame, where there is no filter to keep")
         due = self.schedule is None or self.schedule.due(self.frame)  # sparse updates: not every frame
-        if not due and detection is None:
+        if not due and detection is None:  # first_due asked a copy: only a schedule that changed its mind
             raise TrackingError(f"frame 1: schedule '{self.schedule.name}' skips the first frame")
         if theta != np.inf and due:  # inf: the temporal term holds the filter where it is
             w2 = self.w2 if self.mask is None else masked_w2(self, image)  # a mask: inf outside it

@@ -1,12 +1,16 @@
 """The continuous loop (ECO-HC) end to end, and the hooks that choose and feed it."""
+import types
+
 import numpy as np
 import pytest
 
 import dcfkit
 from dcfkit.analysis.metrics import score_sequence
 from dcfkit.config import load_config
+from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.datasets.synthetic import make_sequence
-from dcfkit.errors import ConfigError, TrackingError
+from dcfkit.components.schedule.sparse import Sparse
+from dcfkit.errors import ConfigError, InputError, TrackingError
 from dcfkit.tracker.continuous import ContinuousLoop
 from dcfkit.tracker.tracker import Tracker
 
@@ -103,3 +107,78 @@ def test_a_schedule_gates_the_discrete_loops_training(sequence):
     tracker.solver.train = train
     run(tracker, sequence.frames[:12], sequence.ground_truth[0])
     assert trained == [1, 2, 5, 8, 11]
+
+
+@pytest.mark.parametrize("key, value", [("output_sigma", 1.0), ("cell_area", 100), ("box_scale", "previous"),
+                                        ("resize", "matlab_bicubic")])
+def test_the_continuous_loop_refuses_the_discrete_loops_csr_keys(key, value):
+    default = getattr(TrackerParams(), key)
+    assert value != default
+    with pytest.raises(ConfigError, match=f"tracker.{key}: solver 'eco' runs in the continuous loop"):
+        dcfkit.load_tracker("eco_hc", overrides={f"tracker.{key}": value})
+
+
+def test_the_continuous_loop_refuses_a_padded_square_search_area():
+    with pytest.raises(ConfigError, match="tracker.search_area_shape: 'padded_square'"):
+        dcfkit.load_tracker("eco_hc", overrides={"tracker.search_area_shape": "padded_square"})
+
+
+@pytest.mark.parametrize("slot", ["channel_weights", "mask"])
+def test_the_continuous_loop_refuses_channel_weights_and_masks(slot):
+    name = load_config("csrdcf")[slot]["name"]
+    with pytest.raises(ConfigError, match=f"{slot} '{name}': solver 'eco' runs in the continuous loop"):
+        dcfkit.load_tracker("eco_hc", overrides={slot: {"name": name}})
+
+
+@pytest.mark.parametrize("skip", ["gray_skip", "colour_skip"])
+def test_skipped_feature_names_must_be_the_configs(skip):
+    with pytest.raises(ConfigError, match=f"solver.{skip}: 'colournames' is not one of the config's features"):
+        dcfkit.load_tracker("eco_hc", overrides={f"solver.{skip}": ["colournames"]})
+
+
+def test_a_black_first_frame_is_refused_by_the_continuous_loop_and_changes_nothing(sequence):
+    black, box = np.zeros_like(sequence.frames[0]), sequence.ground_truth[0]
+    fresh = dcfkit.load_tracker("eco_hc")
+    with pytest.raises(InputError, match=r"frame 1: the search area around the initial box is blank"):
+        fresh.init(black, box)
+    with pytest.raises(TrackingError, match="before init"):
+        fresh.update(sequence.frames[1])
+    tracking, reference = dcfkit.load_tracker("eco_hc"), dcfkit.load_tracker("eco_hc")
+    run(tracking, sequence.frames[:5], box)
+    run(reference, sequence.frames[:5], box)
+    with pytest.raises(InputError):
+        tracking.init(black, (box[0], box[1], box[2] * 2, box[3] * 2))
+    assert [tracking.update(f) for f in sequence.frames[5:8]] == [reference.update(f) for f in sequence.frames[5:8]]
+
+
+def _skips_first(schedule, frame):
+    """ECO's sparse schedule's due(), but not learning on frame 1."""
+    return frame != 1 and Sparse.due(schedule, frame)
+
+
+@pytest.mark.parametrize("config", ["eco_hc", "strcf"])
+def test_a_schedule_refusing_frame_1_leaves_the_tracker_as_it_was(config, sequence):
+    box = sequence.ground_truth[0]
+    overrides = {"schedule": {"name": "sparse", "gap": 2, "after_frame": 2}}
+    tracking, reference = (dcfkit.load_tracker(config, overrides=overrides) for _ in range(2))
+    run(tracking, sequence.frames[:5], box)
+    run(reference, sequence.frames[:5], box)
+    due = tracking.schedule.due
+    tracking.schedule.due = types.MethodType(_skips_first, tracking.schedule)
+    with pytest.raises(TrackingError, match="skips the first frame"):
+        tracking.init(sequence.frames[5], (box[0] + 3, box[1], box[2] * 1.5, box[3] * 1.5))
+    tracking.schedule.due = due
+    assert [tracking.update(f) for f in sequence.frames[5:9]] == [reference.update(f) for f in sequence.frames[5:9]]
+
+
+def test_the_continuous_loop_gives_the_schedule_each_detection(sequence):
+    tracker = dcfkit.load_tracker("eco_hc")
+    seen = []
+    tracker.schedule.observe = seen.append
+    run(tracker, sequence.frames[:6], sequence.ground_truth[0])
+    assert len(seen) == 5
+    output = tracker.loop.layout.output
+    for d in seen:
+        assert d.response.shape == tuple(output) and d.response.dtype == np.float32
+        assert d.response[d.peak] == d.response.max()
+        assert d.target_cells == tracker.geometry.target_cells and len(d.offset) == 2

@@ -609,3 +609,17 @@ def test_whole_spectra_keep_the_complex_filter_of_dr2tracks_code():
     filt = np.fft.ifft2(full.hf)
     assert np.abs(filt.imag).max() > 1e-4 * np.abs(filt.real).max()
     np.testing.assert_allclose([b for b, _ in boxes], [b for _, b in boxes], atol=1.0)
+
+
+
+@pytest.mark.parametrize("config, overrides, match", [
+    ("csrdcf", {"tracker.sampling": "subpixel"},
+     "tracker.search_area_shape 'padded_square' .* tracker.sampling 'subpixel' would ignore"),
+    ("reference/csrdcf", {"tracker.search_area_shape": "square"},
+     "tracker.resize 'matlab_bicubic' .* search_area_shape 'square' it would be ignored"),
+    ("reference/csrdcf", {"tracker.sampling": "subpixel", "tracker.resize": "matlab_bicubic"},
+     "tracker.search_area_shape 'padded_square'"),
+])
+def test_padded_square_and_resize_need_whole_pixel_sampling(config, overrides, match, request):
+    with pytest.raises(ConfigError, match=match):
+        dcfkit.load_tracker(request.config.rootpath / f"configs/{config}.yaml", overrides=overrides)

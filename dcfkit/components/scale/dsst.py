@@ -35,8 +35,9 @@ class DSST(ScaleEstimator):
         model_size: str = param("base_target", "size of a scale sample: 'base_target' the target at the search "
                                 "patch's resolution (at least 2x2 cells), 'image_target' its size in image pixels "
                                 "(the authors' init_scale: floored; at least 2 cells, where theirs allows 2 px), "
-                                "'square' floor(√model_max_area) on each side (CSR-DCF's: its square template "
-                                "shrunk to that area)", choices=("base_target", "image_target", "square"))
+                                "'square' CSR-DCF's square template (tracker.search_area_shape padded_square) "
+                                "shrunk to at most model_max_area, floored: floor(√model_max_area) a side unless the "
+                                "template is smaller (without a template, that side)", choices=("base_target", "image_target", "square"))
         sampling: str = param("working_patch", "'working_patch': the largest region cut once and each scale "
                               "resampled from it; 'whole_pixel': each scale cropped in whole pixels and resized "
                               "(the authors' get_scale_sample); 'whole_pixel_bilinear' the same around the pixel "
@@ -60,6 +61,11 @@ class DSST(ScaleEstimator):
             """step ** ((n_scales - 1) / 2) <= 10: the scales span at most x10 each way."""
             return check_span(self.n_scales, self.step)
 
+    template = None  # CSR-DCF's template side (image pixels), from start()
+
+    def start(self, target) -> None:
+        self.template = target.template
+
     def init(self, image, centre, base_target, scale, limits):
         super().init(image, centre, base_target, scale, limits)
         p = self.params
@@ -77,9 +83,9 @@ class DSST(ScaleEstimator):
         area = float(np.prod(target))
         shrink = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
         # at least 2 cells, which fhog needs (init_scale allows 2 px: a side under 8 px differs)
-        if p.model_size == "square":
-            target = np.full(2, np.sqrt(p.model_max_area))
-            shrink = 1.0
+        if p.model_size == "square":  # create_csr_tracker.m's scale_model_sz
+            side = self.template if self.template is not None else np.sqrt(p.model_max_area)
+            target, shrink = np.full(2, side), min(1.0, float(np.sqrt(p.model_max_area / side**2)))
         self.model_size = np.maximum((np.floor if authors or p.model_size == "square" else np.round)(target * shrink),
                                      2 * p.cell_size).astype(int)
         # the working patch and its resampling to each scale keep their geometry every frame

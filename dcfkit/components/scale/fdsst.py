@@ -115,7 +115,12 @@ class FDSST(ScaleEstimator):
         ids = [(best - 1) % len(response), best, (best + 1) % len(response)]
         xs = self.interp_factors[ids]
         poly = np.linalg.solve(np.stack([xs**2, xs, np.ones(3)], axis=1), response[ids])
-        return float(-poly[1] / (2 * poly[0]))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            peak = -poly[1] / (2 * poly[0])
+        # a flat or convex response (a uniform target) has no maximum: keep the grid's best
+        if not (poly[0] < 0 and np.isfinite(peak)):
+            return float(self.interp_factors[best])
+        return float(peak)
 
     def update(self, image, centre, scale):
         new_scale = float(np.clip(scale * self._change(image, centre, scale), *self.limits))

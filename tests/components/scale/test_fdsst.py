@@ -31,3 +31,14 @@ def test_a_zoom_about_the_target_is_found(zoom):
     warp = np.array([[zoom, 0, (1 - zoom) * 199.5], [0, zoom, (1 - zoom) * 199.5]])
     zoomed = cv2.warpAffine(image, warp, (400, 400), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT)
     assert scale.update(zoomed, centre, 1.0) == pytest.approx(zoom, abs=0.015)
+
+
+def test_a_uniform_target_keeps_a_finite_scale():
+    # a flat response has no parabola maximum (poly[0] == 0 gave NaN and a crash next frame)
+    image = np.full((200, 200, 3), 128, np.uint8)
+    centre = np.array([99.5, 99.5])
+    scale = FDSST()
+    scale.init(image, centre, np.array([30.0, 40.0]), 1.0, (0.1, 10.0))
+    new = scale.update(image, centre, 1.0)
+    assert np.isfinite(new) and new in scale.interp_factors
+    assert np.isfinite(scale.update(image, centre, new))

@@ -3,6 +3,7 @@ import cv2
 import numpy as np
 import pytest
 
+from dcfkit.components.base import Target
 from dcfkit.components.scale.base import scale_limits
 from dcfkit.components.scale.dsst import DSST
 from dcfkit.components.scale.pyramid import Pyramid
@@ -129,6 +130,24 @@ def test_dsst_model_size_image_target_is_init_scale(monkeypatch, target, model):
     scale = 2.5  # base_target * scale is the target in image pixels
     dsst.init(np.zeros((50, 50, 3), np.uint8), np.array([25.0, 25.0]), np.array(target) / scale, scale, (0.1, 10))
     assert tuple(int(v) for v in dsst.model_size) == model
+
+
+@pytest.mark.parametrize("template, side", [
+    (300.0, 22),   # floor(300 * sqrt(512 / 300²)) = floor(22.63)
+    (23.0, 22),    # 529 > 512: shrunk to floor(22.63)
+    (22.0, 22),    # 484 <= 512: the template itself
+    (15.0, 15),    # a target of about 4 px: floor(15), not 22
+    (12.5, 12),
+    (6.0, 8),      # at least 2 cells, which fhog needs
+    (None, 22),    # no CSR-DCF template: floor(sqrt(512))
+])
+def test_dsst_model_size_square_is_csr_scale_model_sz(monkeypatch, template, side):
+    # create_csr_tracker.m:112-117: floor(template_size * min(1, sqrt(512 / prod(template_size))))
+    dsst = make_dsst(model_size="square")
+    monkeypatch.setattr(dsst, "_samples", lambda *a, **k: np.ones((3, 33)))
+    dsst.start(Target((50, 50), (10, 10), (2.0, 2.0), 4, 1.0, 1.0, template))
+    dsst.init(np.zeros((50, 50, 3), np.uint8), np.array([25.0, 25.0]), np.array([5.0, 4.0]), 1.0, (0.1, 10))
+    assert tuple(int(v) for v in dsst.model_size) == (side, side)
 
 
 def test_dsst_hann_window_has_zero_ends(monkeypatch):
