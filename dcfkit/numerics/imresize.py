@@ -50,7 +50,7 @@ def contributions(n_in: int, n_out: int, bilinear: bool = False) -> tuple[np.nda
 def _along(x: np.ndarray, axis: int, n_out: int, bilinear: bool) -> np.ndarray:
     """One axis resized, in float64, the taps summed in their order (as imresizemex)."""
     index, weights = contributions(x.shape[axis], n_out, bilinear)
-    a = np.moveaxis(x, axis, 0).astype(np.float64)
+    a = np.moveaxis(x, axis, 0)  # not cast whole: only the rows each tap gathers become float64
     shape = (-1,) + (1,) * (a.ndim - 1)
     out = weights[:, 0].reshape(shape) * a[index[:, 0]]
     for j in range(1, index.shape[1]):  # a loop over the kernel's taps, not over pixels
