@@ -10,6 +10,8 @@ import types
 import typing
 from typing import Any, Callable, Mapping
 
+import numpy as np
+
 from dcfkit.errors import ConfigError, RegistryError, shown
 from dcfkit.params import NoParams
 
@@ -19,6 +21,18 @@ _BASES: dict[str, list[type]] = {}  # kind -> its base classes (a regularizer's:
 def kinds() -> tuple[str, ...]:
     """The kinds declared so far, in the order their base classes were defined."""
     return tuple(_BASES)
+
+
+def running_average(model: np.ndarray | None, sample: np.ndarray, rate: float, dtype=None) -> np.ndarray:
+    """A model kept across frames: ``sample`` itself on the first frame (``model`` None), else
+    (1 - η) model + η sample (BACF's and ARCF's sample model, KCF's ``interp_factor``, DSST's
+    Eq. 3, CSR-DCF's histograms and channel weights, ECO's scale model); cast to ``dtype`` if
+    given. Every kind's components keep their models with it."""
+    if model is None:
+        new = np.array(sample, copy=True)
+    else:
+        new = (1 - rate) * model + rate * sample
+    return new if dtype is None else new.astype(dtype, copy=False)
 
 
 @dataclasses.dataclass(frozen=True)

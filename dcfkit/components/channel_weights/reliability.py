@@ -7,6 +7,7 @@ import dataclasses
 import cv2
 import numpy as np
 
+from dcfkit.components.base import running_average
 from dcfkit.components.channel_weights.base import ChannelWeights
 from dcfkit.params import param
 
@@ -80,8 +81,7 @@ class CSRReliability(ChannelWeights):
         if self.weights is None:
             self.weights = fresh
         else:
-            rate = self.params.learning_rate
-            mixed = (1 - rate) * self.weights + rate * fresh
+            mixed = running_average(self.weights, fresh, self.params.learning_rate)
             self.weights = mixed / mixed.sum()
 
     def combine(self, maps):

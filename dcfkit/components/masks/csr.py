@@ -7,7 +7,7 @@ import dataclasses
 import cv2
 import numpy as np
 
-from dcfkit.components.base import Target
+from dcfkit.components.base import Target, running_average
 from dcfkit.components.masks.base import Mask
 from dcfkit.components.masks.segmentation import background_histogram, foreground_histogram, hsv255, on_grid, \
     posterior
@@ -105,12 +105,9 @@ class CSRSegmentation(Mask):
         inner = (x1 - ox1, y1 - oy1, x2 - ox1, y2 - oy1)
         fg = foreground_histogram(pixels, inner, self.params.n_bins)
         bg = background_histogram(pixels, inner, (0, 0, ox2 - ox1, oy2 - oy1), self.params.n_bins)
-        if self.hist_fg is None:
-            self.hist_fg, self.hist_bg = fg, bg
-        else:
-            rate = self.params.learning_rate
-            self.hist_fg = (1 - rate) * self.hist_fg + rate * fg
-            self.hist_bg = (1 - rate) * self.hist_bg + rate * bg
+        rate = self.params.learning_rate
+        self.hist_fg = running_average(self.hist_fg, fg, rate)
+        self.hist_bg = running_average(self.hist_bg, bg, rate)
 
     def _segment(self, image, centre, target, size, grid, first) -> np.ndarray:
         """The binarised foreground posterior over the region's whole pixels around the authors' ⌊c⌋

@@ -5,6 +5,7 @@ import dataclasses
 
 import numpy as np
 
+from dcfkit.components.base import running_average
 from dcfkit.components.memory.base import Memory
 from dcfkit.params import param
 
@@ -30,4 +31,4 @@ class RunningAverage(Memory):
             return
         rate = self.params.learning_rate
         for store, block in zip(self.samples, sample):
-            store[0] = (1 - rate) * store[0] + rate * np.asarray(block)
+            store[0] = running_average(store[0], np.asarray(block), rate)

@@ -6,6 +6,7 @@ import dataclasses
 import cv2
 import numpy as np
 
+from dcfkit.components.base import running_average
 from dcfkit.components.features.fhog import ARITHMETICS, fhog
 from dcfkit.components.scale.base import MAX_SCALES, MIN_LAM, ScaleEstimator, check_span, scale_factors
 from dcfkit.numerics.imresize import imresize
@@ -140,12 +141,8 @@ class DSST(ScaleEstimator):
         """Update the scale model with the (D, S) spectrum of the scale samples."""
         num = self.label_f[None, :] * xsf.conj()
         den = np.einsum("ds,ds->s", xsf, xsf.conj()).real
-        if self.num is None:
-            self.num, self.den = num, den
-        else:
-            lr = self.params.learning_rate
-            self.num = (1 - lr) * self.num + lr * num
-            self.den = (1 - lr) * self.den + lr * den
+        self.num = running_average(self.num, num, self.params.learning_rate)
+        self.den = running_average(self.den, den, self.params.learning_rate)
 
     def update(self, image, centre, scale):
         xs = self._samples(image, centre, scale)

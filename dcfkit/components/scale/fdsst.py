@@ -8,6 +8,7 @@ import dataclasses
 
 import numpy as np
 
+from dcfkit.components.base import running_average
 from dcfkit.components.features.fhog import ARITHMETICS, fhog
 from dcfkit.components.scale.base import MAX_SCALES, MIN_LAM, ScaleEstimator, check_span
 from dcfkit.numerics.patches import resize_auto, whole_pixel_crop
@@ -76,7 +77,7 @@ class FDSST(ScaleEstimator):
         factor = np.sqrt(p.model_max_area / area) if area > p.model_max_area else 1.0
         # at least 8 px (the authors') and 2 cells, which fhog needs
         self.model_size = np.maximum(np.floor(target * factor), max(8, 2 * p.cell_size)).astype(int)
-        self.num = self.den = None
+        self.num = self.den = self.model = None
         self._learn(image, centre, scale)
 
     def _samples(self, image, centre, scale) -> np.ndarray:
@@ -97,7 +98,7 @@ class FDSST(ScaleEstimator):
         denominator."""
         xs = self._samples(image, centre, scale)
         lr = self.params.learning_rate
-        self.model = xs if self.num is None else (1 - lr) * self.model + lr * xs
+        self.model = running_average(self.model, xs, lr)
         self.basis = np.linalg.qr(self.model)[0].T
         basis_den = np.linalg.qr(xs)[0].T
         self.num = self.label_f[None] * np.conj(np.fft.fft(self.window * _times(self.basis, self.model), axis=1))

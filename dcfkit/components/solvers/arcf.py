@@ -25,7 +25,7 @@ import dataclasses
 
 import numpy as np
 
-from dcfkit.components.solvers.base import running_average
+from dcfkit.components.base import running_average
 from dcfkit.components.solvers.strcf_bacf import ADMMBacf, BACFParams, admm
 from dcfkit.numerics.response import response as linear_response
 from dcfkit.params import param

@@ -8,17 +8,6 @@ from dcfkit.contracts import array, finite_arrays
 from dcfkit.numerics.response import response as linear_response
 
 
-def running_average(model: np.ndarray | None, sample: np.ndarray, rate: float, dtype=None) -> np.ndarray:
-    """A model kept across frames: ``sample`` itself on the first frame (``model`` None), else
-    (1 - η) model + η sample (BACF's and ARCF's sample model, KCF's ``interp_factor``, DSST's
-    Eq. 3); cast to ``dtype`` if given."""
-    if model is None:
-        new = np.array(sample, copy=True)
-    else:
-        new = (1 - rate) * model + rate * sample
-    return new if dtype is None else new.astype(dtype, copy=False)
-
-
 class Solver(Component, declares="solver"):
     """Trains the filter of one frame and, optionally, detects with it. State between frames
     lives in the solver instance.

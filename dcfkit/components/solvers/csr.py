@@ -20,7 +20,8 @@ import dataclasses
 
 import numpy as np
 
-from dcfkit.components.solvers.base import Solver, running_average
+from dcfkit.components.base import running_average
+from dcfkit.components.solvers.base import Solver
 from dcfkit.params import param
 
 

@@ -30,7 +30,8 @@ from typing import Callable
 
 import numpy as np
 
-from dcfkit.components.solvers.base import Solver, running_average
+from dcfkit.components.base import running_average
+from dcfkit.components.solvers.base import Solver
 from dcfkit.params import param
 
 
