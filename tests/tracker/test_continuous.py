@@ -10,7 +10,7 @@ from dcfkit.config import load_config
 from dcfkit.config.tracker_params import TrackerParams
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.components.schedule.sparse import Sparse
-from dcfkit.errors import ConfigError, InputError, TrackingError
+from dcfkit.errors import ConfigError, TrackingError
 from dcfkit.tracker.continuous import ContinuousLoop
 from dcfkit.tracker.tracker import Tracker
 
@@ -134,21 +134,6 @@ def test_the_continuous_loop_refuses_channel_weights_and_masks(slot):
 def test_skipped_feature_names_must_be_the_configs(skip):
     with pytest.raises(ConfigError, match=f"solver.{skip}: 'colournames' is not one of the config's features"):
         dcfkit.load_tracker("eco_hc", overrides={f"solver.{skip}": ["colournames"]})
-
-
-def test_a_black_first_frame_is_refused_by_the_continuous_loop_and_changes_nothing(sequence):
-    black, box = np.zeros_like(sequence.frames[0]), sequence.ground_truth[0]
-    fresh = dcfkit.load_tracker("eco_hc")
-    with pytest.raises(InputError, match=r"frame 1: the search area around the initial box is blank"):
-        fresh.init(black, box)
-    with pytest.raises(TrackingError, match="before init"):
-        fresh.update(sequence.frames[1])
-    tracking, reference = dcfkit.load_tracker("eco_hc"), dcfkit.load_tracker("eco_hc")
-    run(tracking, sequence.frames[:5], box)
-    run(reference, sequence.frames[:5], box)
-    with pytest.raises(InputError):
-        tracking.init(black, (box[0], box[1], box[2] * 2, box[3] * 2))
-    assert [tracking.update(f) for f in sequence.frames[5:8]] == [reference.update(f) for f in sequence.frames[5:8]]
 
 
 def _skips_first(schedule, frame):

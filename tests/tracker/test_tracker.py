@@ -247,20 +247,21 @@ def test_a_held_frame_leaves_the_filter_and_scale_unchanged(sequence):
     assert np.array_equal(tracker.hf, hf) and tracker.scale == scale and np.array_equal(tracker.position, position)
 
 
-def test_blank_first_frame_is_a_clear_error_and_changes_nothing(sequence):
-    blank, box = np.full_like(sequence.frames[0], 90), sequence.ground_truth[0]
-    fresh = dcfkit.load_tracker("strcf")
+@pytest.mark.parametrize("config,level", [("strcf", 90), ("eco_hc", 0)])  # the discrete and the continuous loop
+def test_blank_first_frame_is_a_clear_error_and_changes_nothing(sequence, config, level):
+    blank, box = np.full_like(sequence.frames[0], level), sequence.ground_truth[0]
+    fresh = dcfkit.load_tracker(config)
     with pytest.raises(InputError, match=r"frame 1: the search area around the initial box is blank"):
         fresh.init(blank, box)
     with pytest.raises(TrackingError, match="before init"):
         fresh.update(sequence.frames[1])
     # a tracker that was tracking goes on as if the failed init had not happened
-    tracking, reference = dcfkit.load_tracker("strcf"), dcfkit.load_tracker("strcf")
+    tracking, reference = dcfkit.load_tracker(config), dcfkit.load_tracker(config)
     run(tracking, sequence.frames[:5], box)
     run(reference, sequence.frames[:5], box)
     with pytest.raises(InputError):
         tracking.init(blank, (box[0], box[1], box[2] * 2, box[3] * 2))
-    assert tracking.update(sequence.frames[5]) == reference.update(sequence.frames[5])
+    assert [tracking.update(f) for f in sequence.frames[5:8]] == [reference.update(f) for f in sequence.frames[5:8]]
 
 
 class _BadLabel(Label):
