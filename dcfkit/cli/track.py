@@ -46,8 +46,8 @@ def add_track_arguments(p: argparse.ArgumentParser) -> None:
     first.add_argument("--select", action="store_true", help="draw the initial box on the first frame in a window "
                        "(needs a display; the box drawn is printed on stderr)")
     p.add_argument("--one-based", action="store_true", help="--box and --out use 1-based (OTB toolkit) pixels")
-    p.add_argument("--out", help="write one x,y,w,h line per frame here, and beside it OUT.confidence (peak,apce "
-                   "per frame) and OUT.time (seconds per frame) (default: x,y,w,h,peak,apce lines on stdout); each "
+    p.add_argument("--out", help="write one x,y,w,h line per frame here, and beside it OUT.confidence (peak,apce,score "
+                   "per frame) and OUT.time (seconds per frame) (default: x,y,w,h,peak,apce,score lines on stdout); each "
                    "line is written as its frame is tracked")
     p.add_argument("--save-video", help="write an annotated video (.mp4, .avi, .mkv, .mov or .m4v) at the source's "
                    f"frame rate ({DEFAULT_FPS:g} fps for a folder of frames or a video that declares none)")
@@ -138,11 +138,11 @@ def check_out(path: Path, companion: bool) -> None:
 
 class BoxLines:
     """Each frame's box as soon as it is tracked. With ``--out``: the boxes (x,y,w,h, as the
-    toolkits read them), the confidence (peak,apce) and the seconds of each frame, a line a
+    toolkits read them), the confidence (peak,apce,score) and the seconds of each frame, a line a
     frame in three files, opened at the first box (a run that fails before it leaves the files
     of an earlier run) and flushed at each line, so that a run that is killed keeps every frame
-    it tracked. Else one x,y,w,h,peak,apce line a frame on stdout, flushed (frame 1 and held
-    blank frames: nan,nan, they have no response)."""
+    it tracked. Else one x,y,w,h,peak,apce,score line a frame on stdout, flushed (frame 1 and
+    held blank frames: nan,nan,nan, they have no response)."""
 
     def __init__(self, out: Path | None, offset: float):
         self.out, self.offset = out, offset

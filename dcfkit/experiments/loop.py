@@ -24,7 +24,7 @@ OnFrame = Callable[[int, np.ndarray, np.ndarray, object], None]
 class Track:
     """What a run produced: ``boxes`` ``(N, 4)`` 0-based (frame 1: the initial box),
     ``times`` ``(N,)`` tracker seconds per frame (decoding excluded) and ``confidence``
-    ``(N, 2)``, each frame's ``(peak, apce)`` (:mod:`dcfkit.tracker.confidence`; NaN for frame 1, held
+    ``(N, 3)``, each frame's ``(peak, apce, score)`` (:mod:`dcfkit.tracker.confidence`; NaN for frame 1, held
     blank frames and trackers without ``last_confidence``; all NaN if not given)."""
 
     boxes: np.ndarray
@@ -33,7 +33,7 @@ class Track:
 
     def __post_init__(self):
         if self.confidence is None:
-            self.confidence = np.full((len(self.boxes), 2), np.nan)
+            self.confidence = np.full((len(self.boxes), 3), np.nan)
 
     @property
     def fps(self) -> float | None:
@@ -62,13 +62,13 @@ def as_box(value, frame: int) -> np.ndarray:
 @dataclasses.dataclass(frozen=True)
 class Step:
     """One tracked frame: ``index`` 0-based, the ``image``, its 0-based ``box`` ``(4,)``, the
-    tracker's ``seconds`` on it and its ``confidence`` ``(peak, apce)``."""
+    tracker's ``seconds`` on it and its ``confidence`` ``(peak, apce, score)``."""
 
     index: int
     image: np.ndarray
     box: np.ndarray
     seconds: float
-    confidence: tuple[float, float]
+    confidence: tuple[float, float, float]
 
 
 def steps(tracker, frames: Iterable[np.ndarray], init_box) -> Iterator[Step]:
@@ -110,4 +110,4 @@ def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | N
         if on_frame is not None:
             on_frame(step.index, step.image, step.box, tracker)
     return Track(np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(times, dtype=np.float64),
-                 np.array(confidence, dtype=np.float64).reshape(-1, 2))
+                 np.array(confidence, dtype=np.float64).reshape(-1, 3))

@@ -56,7 +56,7 @@ def track_with_resets(make_tracker: Callable[[], object], seq: Sequence, frame: 
     overlap); a start moves on to the next frame whose ground truth is valid and inside the
     image (:func:`next_start`)."""
     n, found = len(seq), get_rule(rule)
-    run = ResetTrack(np.full((n, 4), np.nan), np.full(n, np.nan), np.full((n, 2), np.nan), rule=found.name)
+    run = ResetTrack(np.full((n, 4), np.nan), np.full(n, np.nan), np.full((n, 3), np.nan), rule=found.name)
     due, size = 0, None  # the image size: unknown until a frame is read
     start = next_start(seq.ground_truth, due)
     while start is not None:

@@ -15,8 +15,9 @@ pixels (libtrax's conversion); replies are rectangles.
 Images: ``path`` (read by :func:`dcfkit.datasets.read_frame`, with its checks) and ``memory``
 (``rgb`` or ``gray8``), on the ``color`` channel.
 
-Each reply carries the object's properties ``confidence`` (the response's peak,
-:mod:`dcfkit.tracker.confidence`: VOT's long-term analysis thresholds it) and ``apce``; a frame
+Each reply carries the object's properties ``confidence`` (the presence score of
+:mod:`dcfkit.tracker.confidence`, the response's peak without a reliability component: VOT's
+long-term analysis thresholds it), ``peak`` and ``apce``; a frame
 without a response (the initialising frame, a frame held as blank) has neither.
 
 An error on a frame (an unreadable image, a tracker failure) ends the session: the client is
@@ -196,7 +197,7 @@ def memory_image(array: np.ndarray, what: str) -> np.ndarray:
 
 
 def confidence_properties(tracker) -> dict[str, float]:
-    """``confidence`` (the response's peak) and ``apce`` of the last frame; none on a frame
-    without a response (:func:`dcfkit.tracker.confidence.confidence_of` gives NaN)."""
-    peak, apce = confidence_of(tracker)
-    return {"confidence": peak, "apce": apce} if math.isfinite(peak) else {}
+    """``confidence`` (the presence score), ``peak`` and ``apce`` of the last frame; none on a
+    frame without a response (:func:`dcfkit.tracker.confidence.confidence_of` gives NaN)."""
+    peak, apce, score = confidence_of(tracker)
+    return {"confidence": score, "peak": peak, "apce": apce} if math.isfinite(peak) else {}

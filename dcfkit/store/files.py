@@ -134,8 +134,10 @@ def format_boxes(boxes: np.ndarray, offset: float = 1.0) -> str:
 
 
 def format_confidence(confidence: np.ndarray) -> str:
-    """``(N, 2)`` ``(peak, apce)`` rows as ``peak,apce`` lines, ``%.6g``; NaN as ``nan``."""
-    return "".join("%.6g,%.6g\n" % (p, a) for p, a in np.asarray(confidence, dtype=np.float64).reshape(-1, 2))
+    """``(N, 3)`` ``(peak, apce, score)`` rows (:mod:`dcfkit.tracker.confidence`) as
+    ``peak,apce,score`` lines, ``%.6g``; NaN as ``nan``."""
+    rows = np.asarray(confidence, dtype=np.float64).reshape(-1, 3)
+    return "".join("%.6g,%.6g,%.6g\n" % tuple(row) for row in rows)
 
 
 def format_times(times: np.ndarray) -> str:

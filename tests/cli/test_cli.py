@@ -33,8 +33,8 @@ def test_track_frames_writes_one_box_per_frame(clip, tmp_path, capsys):
     centre = lambda b: b[:, :2] + b[:, 2:] / 2  # noqa: E731
     assert np.hypot(*(centre(boxes) - centre(seq.ground_truth)).T).max() < 10
     assert "12 frames" in capsys.readouterr().err
-    confidence = np.loadtxt(tmp_path / "boxes.txt.confidence", delimiter=",")  # peak,apce beside the boxes
-    assert confidence.shape == (12, 2) and np.isnan(confidence[0]).all() and (confidence[1:, 1] > 1).all()
+    confidence = np.loadtxt(tmp_path / "boxes.txt.confidence", delimiter=",")  # peak,apce,score beside the boxes
+    assert confidence.shape == (12, 3) and np.isnan(confidence[0]).all() and (confidence[1:, 1] > 1).all()
     times = np.loadtxt(tmp_path / "boxes.txt.time")
     assert times.shape == (12,) and (times > 0).all()
 
@@ -43,9 +43,9 @@ def test_track_prints_boxes_and_confidence_on_stdout(clip, capsys):
     seq, frames = clip
     assert cli.main(["track", "strcf", "--frames", str(frames), "--box", box_arg(seq.ground_truth[0])]) == 0
     out = capsys.readouterr().out
-    assert out.splitlines()[0].endswith(",nan,nan")  # frame 1: no response
-    rows = np.loadtxt(out.splitlines(), delimiter=",")  # x,y,w,h,peak,apce
-    assert rows.shape == (12, 6)
+    assert out.splitlines()[0].endswith(",nan,nan,nan")  # frame 1: no response
+    rows = np.loadtxt(out.splitlines(), delimiter=",")  # x,y,w,h,peak,apce,score
+    assert rows.shape == (12, 7)
     np.testing.assert_allclose(rows[0, :4], seq.ground_truth[0])
     assert np.isfinite(rows[1:, 4:]).all() and (rows[1:, 5] > 1).all()
 
@@ -233,6 +233,6 @@ def test_track_keeps_its_boxes_when_terminated(clip, tmp_path, signame):
     assert f"dcfkit track: interrupted ({signame})" in run.stderr and "Traceback" not in run.stderr
     boxes = np.loadtxt(out, delimiter=",")
     assert boxes.shape == (3, 4)  # frames 1-3, tracked before the signal
-    assert np.loadtxt(tmp_path / "partial.txt.confidence", delimiter=",").shape == (3, 2)
+    assert np.loadtxt(tmp_path / "partial.txt.confidence", delimiter=",").shape == (3, 3)
     assert np.loadtxt(tmp_path / "partial.txt.time").shape == (3,)
     np.testing.assert_allclose(boxes[0], seq.ground_truth[0], atol=1e-3)

@@ -130,7 +130,7 @@ def test_boxes_are_printed_as_the_frames_of_a_stream_come(tmp_path):
     finally:
         run.kill()
         stream.close()
-    assert rows.shape == (20, 6)
+    assert rows.shape == (20, 7)
     np.testing.assert_allclose(rows[0, :4], SEQ.ground_truth[0], atol=1e-3)
     assert "the stream ended after frame 20" in err
 
@@ -357,7 +357,7 @@ def test_progress_is_shown_on_a_terminal_and_stdout_holds_only_boxes(stdout_term
     monkeypatch.setattr(sys, "stdout", stdout)
     assert cli.main(["track", "kcf", "--video", path, f"--box={BOX}"]) == 0
     assert "20/20" in stderr.getvalue() and "frame/s" in stderr.getvalue()
-    assert np.loadtxt(stdout.getvalue().splitlines(), delimiter=",").shape == (20, 6)
+    assert np.loadtxt(stdout.getvalue().splitlines(), delimiter=",").shape == (20, 7)
     monkeypatch.setattr(sys, "stderr", Terminal())
     assert cli.main(["track", "kcf", "--video", path, f"--box={BOX}", "--no-progress"]) == 0
     assert sys.stderr.getvalue().startswith("kcf: 20 frames, ")  # no bar

@@ -123,7 +123,8 @@ def test_handshake_then_frames_give_the_boxes_of_the_tracker_run_directly(trax, 
     np.testing.assert_allclose(boxes, expected, atol=1e-3)  # the protocol writes 4 decimals
     assert replies[0][0][1] == {}  # frame 1 has no response, so no confidence
     for ((_, properties),), c in zip(replies[1:], confidence[1:]):
-        assert math.isclose(float(properties["confidence"]), c.peak, rel_tol=1e-12)
+        assert math.isclose(float(properties["confidence"]), c.score, rel_tol=1e-12)
+        assert math.isclose(float(properties["peak"]), c.peak, rel_tol=1e-12)
         assert math.isclose(float(properties["apce"]), c.apce, rel_tol=1e-12)
 
 

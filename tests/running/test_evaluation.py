@@ -115,8 +115,8 @@ def test_result_files_are_one_based_with_sidecar(tmp_path, seqs):
     assert len(meta["times"]) == N_FRAMES and meta["fps"] > 0 and meta["config"] == CONFIG
     times = np.loadtxt(d / "a.time")  # the toolkits' time file: one float a line
     np.testing.assert_allclose(times, meta["times"], atol=1e-8)
-    # DriftTracker has no last_confidence: every line nan,nan
-    assert (d / "a.confidence").read_text() == "nan,nan\n" * N_FRAMES
+    # DriftTracker has no last_confidence: every line nan,nan,nan
+    assert (d / "a.confidence").read_text() == "nan,nan,nan\n" * N_FRAMES
     res = load_results(tmp_path / "out", "drift", seqs)
     np.testing.assert_allclose(res["b"].boxes, gt_boxes())
     assert res["b"].times.shape == (N_FRAMES,) and res["b"].fps > 0

@@ -17,7 +17,8 @@ def test_apce_of_a_single_peak_by_hand():
     r = np.zeros((3, 3))
     r[1, 1] = 4.0  # |4 - 0|² = 16; mean((R - 0)²) = 16 / 9
     assert apce(r) == pytest.approx(9.0)
-    assert Confidence.of(r) == Confidence(4.0, pytest.approx(9.0))
+    assert Confidence.of(r) == Confidence(4.0, pytest.approx(9.0), 4.0)  # no reliability: the peak is the score
+    assert Confidence.of(r, 0.25).score == 0.25
 
 
 def test_apce_of_a_map_with_a_floor_and_a_second_peak_by_hand():
@@ -36,11 +37,11 @@ def test_apce_is_invariant_to_gain_and_offset_and_zero_for_a_flat_map():
 
 
 def test_confidence_is_frozen_and_none_is_nan():
-    assert math.isnan(NO_CONFIDENCE.peak) and math.isnan(NO_CONFIDENCE.apce)
-    assert Confidence.of(None) is NO_CONFIDENCE
+    assert all(math.isnan(v) for v in NO_CONFIDENCE.as_tuple())
+    assert Confidence.of(None) is NO_CONFIDENCE and Confidence.of(None, 2.0) is NO_CONFIDENCE
     with pytest.raises(dataclasses.FrozenInstanceError):
-        Confidence(1.0, 2.0).peak = 3.0
-    assert format_confidence(np.array([[np.nan, np.nan], [0.5, 12.25]])) == "nan,nan\n0.5,12.25\n"
+        Confidence(1.0, 2.0, 1.0).peak = 3.0
+    assert format_confidence(np.array([[np.nan] * 3, [0.5, 12.25, 1.5]])) == "nan,nan,nan\n0.5,12.25,1.5\n"
 
 
 def test_tracker_confidence_is_read_from_its_last_response():
@@ -59,7 +60,8 @@ def test_tracker_confidence_is_read_from_its_last_response():
 def test_track_collects_one_confidence_per_frame_and_keeps_the_boxes():
     seq = make_sequence(n_frames=8, seed=3)
     run = track(load_tracker("strcf"), seq.frames, seq.ground_truth[0])
-    assert run.confidence.shape == (8, 2)
+    assert run.confidence.shape == (8, 3)
+    np.testing.assert_array_equal(run.confidence[:, 2], run.confidence[:, 0])  # no reliability: the peak
     assert np.isnan(run.confidence[0]).all() and np.isfinite(run.confidence[1:]).all()
     tracker = load_tracker("strcf")  # the same tracker, never asked for its confidence
     tracker.init(seq.frames[0], seq.ground_truth[0])
@@ -85,9 +87,9 @@ class BrokenConfidence(NoConfidence):
 def test_trackers_without_a_readable_confidence_give_nan(kind):
     frames = [np.zeros((20, 20), np.uint8)] * 3
     run = track(kind(), frames, (2, 2, 5, 5))
-    assert run.confidence.shape == (3, 2) and np.isnan(run.confidence).all()
+    assert run.confidence.shape == (3, 3) and np.isnan(run.confidence).all()
     assert np.isnan(confidence_of(kind())).all()
-    assert Track(np.zeros((2, 4)), np.zeros(2)).confidence.shape == (2, 2)
+    assert Track(np.zeros((2, 4)), np.zeros(2)).confidence.shape == (2, 3)
 
 
 @pytest.mark.parametrize("config", ["strcf", "kcf", "dr2track"])
@@ -128,7 +130,7 @@ def test_eval_writes_time_and_confidence_files_beside_the_boxes(tmp_path):
     d = tmp_path / "out" / "strcf"
     times, confidence = np.loadtxt(d / "syn.time"), np.loadtxt(d / "syn.confidence", delimiter=",")
     assert times.shape == (10,) and (times > 0).all()
-    assert confidence.shape == (10, 2) and np.isnan(confidence[0]).all() and (confidence[1:, 1] > 1).all()
+    assert confidence.shape == (10, 3) and np.isnan(confidence[0]).all() and (confidence[1:, 1] > 1).all()
     meta = json.loads((d / "syn.json").read_text())
     np.testing.assert_allclose(times, meta["times"], atol=1e-8)
     assert meta["time_sha256"] == checksum((d / "syn.time").read_bytes())
