@@ -5,7 +5,8 @@ from __future__ import annotations
 import pluggy
 
 from dcfkit.components import (
-    channel_weights, features, labels, masks, memory, regularizers, scale, schedule, search, solvers,
+    channel_weights, features, labels, masks, memory, redetect, regularizers, reliability, scale, schedule, search,
+    solvers,
 )
 from dcfkit.datasets.layout import new_layout
 
@@ -16,6 +17,7 @@ hookimpl = pluggy.HookimplMarker("dcfkit")
 @hookimpl
 def dcfkit_register_components(registry):
     registry.accept_layouts(new_layout)
-    for family in (features, labels, regularizers, solvers, search, scale, memory, schedule, masks, channel_weights):
+    for family in (features, labels, regularizers, solvers, search, scale, memory, schedule, masks, channel_weights,
+                   reliability, redetect):
         for cls in family.BUILTIN:
             registry.register(cls)

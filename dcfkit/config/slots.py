@@ -60,6 +60,10 @@ SLOTS = (
     Slot("mask", "mask", "mask", help="a spatial mask learnt each frame, outside which the filter is zero"),
     Slot("channel_weights", "channel_weights", "channel_weights",
          help="how much each feature channel's response counts at detection"),
+    Slot("reliability", "reliability", "reliability", help="how sure each detection is (its score is the presence "
+         "score written per frame; absent: the response's peak, nothing judged)"),
+    Slot("redetect", "redetect", "redetect", help="where to search on a frame the reliability component judges "
+         "lost, and which candidate to take (needs reliability)"),
 )
 
 KINDS = tuple(dict.fromkeys(s.kind for s in SLOTS))  # the kinds of the components the slots take

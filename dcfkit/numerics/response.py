@@ -174,3 +174,11 @@ def parabola_peak(r: np.ndarray) -> tuple[float, float]:
         offset = index + (delta if np.isfinite(delta) else 0.0)
         out.append(offset - size if offset + 1 > size / 2 else offset)
     return out[0], out[1]
+
+
+def apce(response: np.ndarray) -> float:
+    """Wang et al.'s APCE: ``|max - min|² / mean((R - min)²)``; 0 for a flat map."""
+    r = np.asarray(response, dtype=np.float64)
+    low = r.min()
+    energy = float(np.mean((r - low) ** 2))
+    return float((r.max() - low) ** 2 / energy) if energy > 0 else 0.0

@@ -6,6 +6,7 @@ from __future__ import annotations
 import copy
 from typing import Any
 
+import cv2
 import numpy as np
 
 from dcfkit.components.scale.dsst import DSST
@@ -73,8 +74,9 @@ def read_only(w2: np.ndarray) -> np.ndarray:
 
 def check_terms(tracker) -> None:
     """ConfigError if a regularizer or a mask is configured that the solver has no term for
-    (``Solver.terms``): it would be ignored; or channel weights with a solver whose response is
-    not the linear correlation (KCF's kernel), whose channels cannot be weighted."""
+    (``Solver.terms``): it would be ignored; channel weights with a solver whose response is
+    not the linear correlation (KCF's kernel), whose channels cannot be weighted; or a gate or
+    re-detection without the reliability component they act on."""
     for slot in SLOTS:
         regularizer = getattr(tracker, slot.name) if slot.role is not None else None
         if regularizer is not None and slot.role not in tracker.solver.terms:
@@ -88,6 +90,12 @@ def check_terms(tracker) -> None:
         raise ConfigError(f"{tracker.name}: channel_weights '{tracker.channel_weights.name}' weight the channels "
                           f"of a linear filter's response; solver '{tracker.solver.name}' has its own response: "
                           f"set channel_weights: null")
+    gate = tracker.schedule if getattr(tracker.schedule, "needs_reliability", False) else None
+    for key, needs in (("schedule", gate), ("redetect", tracker.redetect)):
+        if needs is not None and tracker.reliability is None:
+            raise ConfigError(f"{tracker.name}: {key} '{needs.name}' acts on the reliability of each detection, "
+                              f"and the config has no reliability component: add one, e.g. reliability: "
+                              f"{{name: lmcf}}")
 
 
 def check_spectra(tracker) -> None:
@@ -190,7 +198,7 @@ def check_dsst_copies(tracker, shape, centre: np.ndarray, target: np.ndarray) ->
 def check_blank_first(tracker, patch: np.ndarray, centre: np.ndarray, shape) -> None:
     """InputError if the first frame's search ``patch`` is blank (``tracker.blank_std``):
     there is nothing to learn. ``centre`` is the 0-based (y, x) box centre."""
-    std = tracker._blank(patch)
+    std = blank(tracker, patch)
     if std is None:
         return
     outside = not (0 <= centre[0] < shape[0] and 0 <= centre[1] < shape[1])
@@ -215,3 +223,10 @@ def first_due(tracker) -> None:
     if not probe.due(1):
         raise TrackingError(f"frame 1: schedule '{tracker.schedule.name}' skips the first frame, where the filter "
                             f"must be learnt")
+
+
+def blank(tracker, pixels: np.ndarray) -> float | None:
+    """The standard deviation of the pixel values (RMS over colour channels) if it is below
+    ``tracker.blank_std``, else None."""
+    std = float(np.sqrt(np.mean(np.square(cv2.meanStdDev(pixels)[1]))))
+    return std if std < tracker.params.blank_std else None

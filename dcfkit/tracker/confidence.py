@@ -16,6 +16,8 @@ import math
 
 import numpy as np
 
+from dcfkit.numerics.response import apce
+
 
 @dataclasses.dataclass(frozen=True)
 class Confidence:
@@ -41,14 +43,6 @@ class Confidence:
 
 
 NO_CONFIDENCE = Confidence(math.nan, math.nan, math.nan)
-
-
-def apce(response: np.ndarray) -> float:
-    """Wang et al.'s APCE: ``|max - min|² / mean((R - min)²)``; 0 for a flat map."""
-    r = np.asarray(response, dtype=np.float64)
-    low = r.min()
-    energy = float(np.mean((r - low) ** 2))
-    return float((r.max() - low) ** 2 / energy) if energy > 0 else 0.0
 
 
 def confidence_of(tracker) -> tuple[float, float, float]:

@@ -29,8 +29,8 @@ from dcfkit.errors import ConfigError, InputError, TrackingError
 from dcfkit.numerics import fourier_series as fs
 from dcfkit.numerics.patches import box_to_centre_size, centre_size_to_box, round_half_away
 from dcfkit.tracker.blocks import extract, layout, sample_patch
-from dcfkit.tracker.checks import check_blank_first, check_box, check_image, first_due
-from dcfkit.tracker.geometry import Geometry, reported_box
+from dcfkit.tracker.checks import blank, check_blank_first, check_box, check_image, first_due
+from dcfkit.tracker.geometry import Geometry, limit_step, reported_box
 
 
 def continuous_loop(tracker) -> "ContinuousLoop | None":
@@ -61,7 +61,7 @@ def refuse_unused(tracker) -> None:
     if tracker.params.search_area_shape == "padded_square":
         raise ConfigError(f"{tracker.name}: tracker.search_area_shape: 'padded_square' is the discrete loop's "
                           f"(CSR-DCF's); solver '{solver}' runs in the continuous loop: use square or proportional")
-    for slot in ("channel_weights", "mask"):
+    for slot in ("channel_weights", "mask", "reliability", "redetect"):
         component = getattr(tracker, slot)
         if component is not None:
             raise ConfigError(f"{tracker.name}: {slot} '{component.name}': solver '{solver}' runs in the "
@@ -153,7 +153,7 @@ class ContinuousLoop:
         features, s = self._active(colour)
         lay = layout(self.t.params, s, target, features)
         image = image if colour else gray
-        step = self.t._limit_step()
+        step = limit_step(self.t)
         limits = scale_limits(lay.base_target, lay.support, image.shape, step=step)
         pos = centre + 1  # ECO's 1-based position
         sample_pos = round_half_away(pos)
@@ -184,7 +184,7 @@ class ContinuousLoop:
                              f"sequence's first frame was {self.t.image_size[1]}x{self.t.image_size[0]}")
         if not self.colour and image.ndim == 3:
             image = image[..., 2]
-        if self.t._blank(image[::4, ::4]) is not None:
+        if blank(self.t, image[::4, ::4]) is not None:
             self.t.last_response, self.t.last_search_box, self.t.last_distractors = None, None, np.zeros((0, 2))
             self.t.held_frames.append(self.t.frame)
             return self.box()

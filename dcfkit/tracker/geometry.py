@@ -122,3 +122,11 @@ def reported_box(centre: np.ndarray, size: np.ndarray, convention: str) -> tuple
         x, y, w, h = round_half_away(np.add(box, (1, 1, 0, 0))) - (1, 1, 0, 0)
         return float(x), float(y), float(max(w, 1.0)), float(max(h, 1.0))
     return box
+
+
+def limit_step(tracker) -> float | None:
+    """The step the scale limits are whole powers of (``tracker.scale_limits``), if any: the
+    scale estimator's, as the authors' codes take their scale search's."""
+    if tracker.params.scale_limits != "step_powers":
+        return None
+    return getattr(getattr(tracker.scale_estimator, "params", None), "step", None)

@@ -2,12 +2,12 @@
 
 Frame 1 (``init``): extract the sample m¹ at the ground truth, train h¹ (θ = 0), V¹ = 0.
 Frame t (``update``): centre the search area (Eq. 14), compute the response (Eq. 12) at each
-search scale, take the peak as p^t, update the scale, extract m^t at p^t, build the label
-(Eq. 3 for the repressed label), train h^t (Eqs. 9–11), and update the velocity (Eq. 13).
-A blank frame (standard deviation of its pixel values below ``tracker.blank_std``: a dropped
-or black video frame) is held: the box stays, nothing is learnt, and the frame number goes
-to ``held_frames``. The whole frame is tested, not the search patch: a dark scene or a
-featureless stretch of sky is tracked as any other frame.
+search scale, take the peak as p^t (re-detected if judged lost: :mod:`.recovery`), update
+the scale, extract m^t at p^t, build the label (Eq. 3 for the repressed label), train h^t
+(Eqs. 9–11), and update the velocity (Eq. 13). A blank frame (standard deviation of its
+pixel values below ``tracker.blank_std``: a dropped or black video frame; the whole frame
+tested, so a dark scene is tracked) is held: the box stays, nothing is learnt, and the frame
+number goes to ``held_frames``.
 
 Images are (H, W, 3) uint8 BGR or (H, W) uint8 gray; boxes are (x, y, w, h) floats,
 0-based pixels. The tracker is deterministic.
@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
-import cv2
 import numpy as np
 
 from dcfkit.components.base import Target
@@ -33,21 +32,16 @@ from dcfkit.numerics.patches import box_to_centre_size, centre_size_to_box, roun
 from dcfkit.numerics.response import newton_peak, parabola_peak, response_spectra, shift_spectrum, subpixel_peak
 from dcfkit.registry import get_registry
 from dcfkit.tracker.checks import (
-    check_blank_first,
-    check_box,
-    check_config_budget,
-    check_first_frame,
-    check_image,
-    check_sampling,
-    check_spectra,
-    check_terms,
-    first_due,
-    read_only,
+    blank, check_blank_first, check_box, check_config_budget, check_first_frame,
+    check_image, check_sampling, check_spectra, check_terms, first_due, read_only,
 )
 from dcfkit.tracker.confidence import Confidence
 from dcfkit.tracker.continuous import continuous_loop
-from dcfkit.tracker.geometry import Geometry, geometry, hann2d, label_sigma, patch_sampler, reported_box
+from dcfkit.tracker.geometry import (
+    Geometry, geometry, hann2d, label_sigma, limit_step, patch_sampler, reported_box,
+)
 from dcfkit.tracker.learnt import channel_maps, learn_channels, masked_w2
+from dcfkit.tracker.recovery import Located, gated, judged, recovered, unreliable
 
 
 class Tracker:
@@ -63,9 +57,8 @@ class Tracker:
         for slot in SLOTS:
             setattr(self, slot.name, build(slot, registry, config, self.name))
         self.loop = continuous_loop(self)  # ECO's solver learns on the continuous domain: its own loop
-        check_terms(self)
-        check_spectra(self)
-        check_sampling(self)
+        for check in (check_terms, check_spectra, check_sampling):
+            check(self)
         self.fft = make_fft(self.params.fft_backend, full=self.params.spectra == "full")
         self.frame = 0
         # diagnostics of the last frame: the response map (cells, centred: fftshift), the image box
@@ -75,6 +68,7 @@ class Tracker:
         self.last_search_box: tuple[float, float, float, float] | None = None
         self.last_distractors = np.zeros((0, 2))
         self.held_frames: list[int] = []  # 1-based numbers of frames held as blank
+        self.last_score: float | None = None  # the reliability score of the last detection
         check_config_budget(self)
 
     def _patch(self, image: np.ndarray, centre: np.ndarray, scale: float, g: Geometry | None = None) -> np.ndarray:
@@ -98,19 +92,6 @@ class Tracker:
     def _sample(self, image: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
         return self._spectrum(self._patch(image, centre, scale))
 
-    def _limit_step(self) -> float | None:
-        """The step the scale limits are whole powers of (``tracker.scale_limits``), if any: the
-        scale estimator's, as the authors' codes take their scale search's."""
-        if self.params.scale_limits != "step_powers":
-            return None
-        return getattr(getattr(self.scale_estimator, "params", None), "step", None)
-
-    def _blank(self, pixels: np.ndarray) -> float | None:
-        """The standard deviation of the pixel values (RMS over colour channels) if it is below
-        ``blank_std``, else None."""
-        std = float(np.sqrt(np.mean(np.square(cv2.meanStdDev(pixels)[1]))))
-        return std if std < self.params.blank_std else None
-
     # -- Algorithm 1 ------------------------------------------------------------------------
     @naming_the_frame(lambda tracker: 1)
     def init(self, image: np.ndarray, box) -> None:
@@ -125,7 +106,7 @@ class Tracker:
             target = np.floor(target)
             centre = np.floor(box[[1, 0]] + np.floor(target / 2))
         g, scale = geometry(self.params, target, given if self.params.init_area == "given" else target)
-        limits = scale_limits(g.base_target, g.sample_size, image.shape, initial=scale, step=self._limit_step())
+        limits = scale_limits(g.base_target, g.sample_size, image.shape, initial=scale, step=limit_step(self))
         scale = float(np.clip(scale, *limits))
         check_first_frame(self, image.shape, centre, g, scale, box)
         patch = self._patch(image, centre, scale, g)
@@ -140,8 +121,8 @@ class Tracker:
         sigma = label_sigma(self.params, g)
         self.base_label = gaussian_label(g.filter_size, sigma)
         self.base_label.setflags(write=False)  # every frame's label starts from it
-        optional = [c for c in (self.spatial, self.temporal, self.schedule, self.mask, self.channel_weights)
-                    if c is not None]
+        optional = [c for c in (self.spatial, self.temporal, self.schedule, self.mask, self.channel_weights,
+                                self.reliability, self.redetect) if c is not None]
         for component in (*self.features, self.label, self.solver, *optional):  # a new target: nothing kept
             component.reset()
         target = Target(self.image_size, g.filter_size, g.target_cells, g.cell_size, scale, float(sigma), g.template)
@@ -173,7 +154,7 @@ class Tracker:
         if p.sampling == "whole_pixel" and p.translation != "exact_centre":  # the patch on a whole pixel, and moves
             centre = round_half_away(centre)
         factors = np.array(self.scale_estimator.search_factors(), dtype=float)  # copies: a plugin may change its own
-        if self._blank(image[::4, ::4]) is not None:  # a dropped frame: hold, learn nothing
+        if blank(self, image[::4, ::4]) is not None:  # a dropped frame: hold, learn nothing
             self.last_response, self.last_search_box, self.last_distractors = None, None, np.zeros((0, 2))
             self.held_frames.append(self.frame)
             return self.box
@@ -184,26 +165,38 @@ class Tracker:
             raise TrackingError(f"frame {self.frame}: the response map is not finite (the filter overflowed: "
                                 f"look for extreme solver, regularizer or label values in the config)")
         best, dy, dx = self._peak(maps, samples)
-        step = g.cell_size * self.scale * factors[best]  # pixels per cell
         move = np.array([dy, dx]) * g.cell_size * self.scale * factors[best]  # not * step: the authors' rounding
         if p.translation == "whole_pixel":
             move = round_half_away(move)
-        self.position = self._clamp(centre + move, image.shape)
-        self.box_scale = self.scale if p.box_scale == "previous" else None  # CSR-DCF's region: the old scale
-        self.scale = float(self.scale_estimator.update(image, self.position, self.scale * factors[best]))
-        self.box_scale = self.box_scale or self.scale
-        self.search.observe(self.position)  # Eq. (13)
         peak = np.unravel_index(int(np.argmax(maps[best])), g.filter_size)
-        self.last_response = np.fft.fftshift(maps[best])
-        self.last_search_box = centre_size_to_box(centre, g.sample_size * step / g.cell_size)
+        detection = judged(self, Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells, (dy, dx)))
+        channel_maps = self._channel_maps[best] if self.channel_weights is not None else None
+        found = Located(self._clamp(centre + move, image.shape), centre, self.scale * factors[best],
+                        g.cell_size * self.scale * factors[best], detection, samples[best], channel_maps)
+        self._settle(image, recovered(self, image, found))
+        return self.box
+
+    def _settle(self, image: np.ndarray, found: Located) -> None:
+        """Place the target where ``found`` says, estimate the scale there, and learn."""
+        g, p = self.geometry, self.params
+        self.position = found.position
+        self.box_scale = self.scale if p.box_scale == "previous" else None  # CSR-DCF's region: the old scale
+        if not gated(self, found.detection):  # a gated frame's scale filter would learn the background too
+            self.scale = float(self.scale_estimator.update(image, self.position, found.scale))
+        self.box_scale = self.box_scale or self.scale
+        if found.jumped:  # re-detected: no motion to extrapolate from
+            self.search.reset(self.position)
+        else:
+            self.search.observe(self.position)  # Eq. (13)
+        self.last_response = np.fft.fftshift(found.detection.response)
+        self.last_search_box = centre_size_to_box(found.centre, g.sample_size * found.step / g.cell_size)
+        self.last_score = found.detection.score
         xf = None
         if p.training_sample == "shift":  # the detection sample, moved to p^t in cells of the new scale
-            sy, sx = (self.position - centre) / (g.cell_size * self.scale)
-            xf = shift_spectrum(samples[best], sy, sx, g.filter_size, self.fft.full)
-        detection = Detection(maps[best], (int(peak[0]), int(peak[1])), g.target_cells, (dy, dx))
-        self._observe(detection, best)
-        self._train(image, detection, xf)
-        return self.box
+            sy, sx = (self.position - found.centre) / (g.cell_size * self.scale)
+            xf = shift_spectrum(found.sample, sy, sx, g.filter_size, self.fft.full)
+        self._observe(found)
+        self._train(image, found.detection, xf)
 
     def _response(self, samples: np.ndarray) -> np.ndarray:
         """The solver's (S, H, W) response maps of the (S, C, H, Wr) search samples."""
@@ -212,14 +205,20 @@ class Tracker:
             return self.channel_weights.combine(self._channel_maps)
         return self.solver.response(self.hf, samples, self.geometry.filter_size, self.fft)
 
-    def _observe(self, detection: Detection, best: int = 0) -> None:
-        """Give the detection to the components that adapt to it: the solver, the spatial regularizer,
-        whose w² it returns is used from this frame on, the channel weights (``best`` scale's maps)."""
+    def _observe(self, found: Located) -> None:
+        """Give the frame's detection to the components that adapt to it: the solver, the
+        schedule, the channel weights, the reliability and re-detection components, and the
+        spatial regularizer, whose w² it returns is used from this frame on."""
+        detection = found.detection
         self.solver.observe(detection)
         if self.schedule is not None:
             self.schedule.observe(detection)
         if self.channel_weights is not None:
-            self.channel_weights.observe(self._channel_maps[best])
+            self.channel_weights.observe(found.channel_maps)
+        if self.reliability is not None:
+            self.reliability.observe(detection, detection.score)
+        if self.redetect is not None:
+            self.redetect.observe(self.position.copy(), not unreliable(detection))
         if self.spatial is not None:
             self.w2 = read_only(self.spatial.adapt(self.w2, detection))
 
@@ -274,12 +273,10 @@ class Tracker:
 
     @property
     def last_confidence(self) -> Confidence:
-        """The last frame's :class:`~dcfkit.tracker.confidence.Confidence`: ``peak`` (max of
-        ``last_response``) and ``apce`` (Wang et al.'s average peak-to-correlation energy, chosen
-        over the PSR because it has no sidelobe window to size in cells). Both NaN after
-        ``init`` and on a held blank frame, which have no response. Read-only: computed from
-        ``last_response`` when asked, it changes nothing the tracker does."""
-        return Confidence.of(self.last_response)
+        """The last frame's :class:`~dcfkit.tracker.confidence.Confidence` (``peak``, ``apce`` and
+        the reliability ``score``), NaN after ``init`` and on a held blank frame, which have no
+        response. Read-only: computed when asked, it changes nothing the tracker does."""
+        return Confidence.of(self.last_response, self.last_score)
 
     @property
     def box(self) -> tuple[float, float, float, float]:

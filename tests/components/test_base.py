@@ -55,6 +55,8 @@ def slot_override(kind: str, cls: type, params: dict) -> dict:
                 "regularizers.spatial": None, "regularizers.temporal": None}
     if kind == "solver":  # without the regularizers it has no term for (KCF's, DSST's), which the tracker refuses
         return {kind: spec, **{f"regularizers.{role}": None for role in ("spatial", "temporal") if role not in cls.terms}}
+    if kind == "redetect" or getattr(cls, "needs_reliability", False):  # they act on a reliability's verdicts
+        return {kind: spec, "reliability": {"name": "lmcf"}}
     return {kind: spec}
 
 

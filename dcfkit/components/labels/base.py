@@ -16,13 +16,15 @@ class Detection:
 
     response: (H, W) float32 response at the chosen scale (circular layout, as computed);
     peak: (row, col) integer index of its maximum; target_cells: (h, w) target size in cells;
-    offset: the sub-cell peak as a signed (dy, dx) offset in cells (None: the grid peak).
+    offset: the sub-cell peak as a signed (dy, dx) offset in cells (None: the grid peak);
+    score: the reliability component's score (≥ 1: reliable; None: the config has none).
     """
 
     response: np.ndarray
     peak: tuple[int, int]
     target_cells: tuple[float, float]
     offset: tuple[float, float] | None = None
+    score: float | None = None
 
 
 def gaussian_label(shape: tuple[int, int], sigma: float) -> np.ndarray:
