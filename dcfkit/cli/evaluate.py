@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from dcfkit.analysis.compare import COLUMNS, compare_folders, counted_lines
+from dcfkit.analysis.longterm_report import long_term_lines, score_long_term
 from dcfkit.analysis.report import json_ready, named_folder, score_and_write
 from dcfkit.analysis.report_html import write_html_report
 from dcfkit.analysis.reset_report import reset_latex, reset_runs, reset_table, write_reset_report
@@ -201,6 +202,8 @@ def run_report(args: argparse.Namespace) -> int:
         for name, without in evaluation.settings["left_out"].items():
             print(f"left out: {name} (no result from {', '.join(without)}; --missing fail scores it as a failure)")
         print("\n" + "\n".join(statistics_lines(evaluation.statistics)))
+        if evaluation.long_term:
+            print("\n" + long_term_lines(evaluation.long_term), end="")
         print(f"\n{len(paths)} files written to {paths[0].parent}")
         if args.html:
             print(f"open {paths[-1]}")
@@ -220,6 +223,7 @@ def _reset_report(args: argparse.Namespace, experiment: Experiment, sequences: l
         for name, without in scores["left_out"].items():
             print(f"left out: {name} (no result from {', '.join(without)})")
         print("\n" + "\n".join(statistics_lines(scores["statistics"])))
+        print("\n" + long_term_lines(score_long_term({}, {}, [], experiment)), end="")
         print(f"\n{len(paths)} files written to {paths[0].parent}")
     return 0
 
