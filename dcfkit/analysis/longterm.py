@@ -7,9 +7,12 @@ tracking" (arXiv:1804.07056, 2018), as the Python vot-toolkit computes them
 github.com/votchallenge/toolkit). A frame's prediction is *present* at threshold τ when its
 confidence is ``>= τ``; a NaN confidence is never present (the toolkit's ``NaN >= τ`` is false).
 
-* Pr(τ): mean IoU over the frames present at τ, the IoU 0 where the ground truth is absent;
-  1 when no frame is present (the toolkit's rule; the paper leaves it undefined).
-* Re(τ): the sum of those IoUs over the number of frames whose ground truth is present.
+* Pr(τ): mean overlap of the frames present at τ, 0 where the ground truth is absent; 1 when no
+  frame is present (the toolkit's rule; the paper leaves it undefined).
+* Re(τ): the sum of those overlaps over the number of frames whose ground truth is present.
+* Overlaps are the toolkit's (rounded boxes bounded by the image, :func:`frame_overlaps`); frame 1
+  is in Re's denominator and never present (:func:`predicted_scores`); a NaN box is never present
+  (the paper's empty prediction; the toolkit would count an empty region of confidence >= τ).
 * Curves are per sequence, then averaged over sequences with equal weight; F(τ) = 2 Pr Re /
   (Pr + Re) of the averaged curves (0 where Pr + Re = 0: the toolkit divides by zero), and the
   score is the maximum of F with the Pr, Re and τ there (the first maximum, i.e. the highest τ,

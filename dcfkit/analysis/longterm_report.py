@@ -42,6 +42,10 @@ LONG_TERM_COLUMNS = ("tracker", "f", "precision", "recall", "threshold", "sequen
 LONG_TERM_FILES = ("longterm.txt", "longterm.md", "longterm.csv", "longterm_curves.csv")
 
 
+class NoConfidence(DatasetError):
+    """A tracker's results have no confidence file (imported or published results): not damage."""
+
+
 def score_long_term(folders: Mapping[str, Path], results: Mapping[str, Mapping], sequences: Seq[Sequence],
                     experiment: str | Experiment = "ope") -> dict:
     """The ``long_term`` record of a report: ``rows`` (best F first: ``f``, ``precision``, ``recall``,
@@ -63,9 +67,10 @@ def score_long_term(folders: Mapping[str, Path], results: Mapping[str, Mapping],
     for tracker, folder in folders.items():
         try:
             read[tracker] = [_read(folder, results[tracker].get(s.name), s) for s in sequences]
-        except DatasetError as exc:
+        except DatasetError as exc:  # the table says why; a damaged file is worth a warning too
             left_out[tracker] = str(exc)
-            log.warning("tracker %r left out of the long-term table: %s", tracker, exc)
+            log.log(logging.INFO if isinstance(exc, NoConfidence) else logging.WARNING,
+                    "no long-term scores for %r: %s", tracker, exc)
     sizes, unread = _image_sizes(sequences) if read else ({}, [])
     rows, curves = [], {}
     for tracker, found in read.items():
@@ -89,7 +94,7 @@ def _read(folder: Path, result, seq: Sequence) -> tuple[np.ndarray, np.ndarray]:
     store = ResultStore(folder)
     path = store.confidence_path(seq.name)
     if not path.is_file():
-        raise DatasetError(f"no {clip(str(path))} (results imported or written without confidences)")
+        raise NoConfidence(f"no {clip(str(path))} (results imported or written without confidences)")
     recorded = (store.sidecar(seq.name) or {}).get("confidence_sha256")
     confidence = read_confidence(path, recorded if isinstance(recorded, str) else None)
     if len(confidence) != len(boxes):
@@ -113,19 +118,21 @@ def _image_sizes(sequences: Seq[Sequence]) -> tuple[dict[str, tuple[int, int]], 
     return sizes, unread
 
 
-def long_term_lines(record: Mapping, fmt: str = "table") -> str:
-    """The long-term table (``table`` or ``markdown``) with what it measures, the trackers left out
-    and why, or the reason it was skipped."""
+def long_term_lines(record: Mapping, fmt: str = "table", brief: bool = False) -> str:
+    """The long-term table (``table`` or ``markdown``) with what it measures, the sequences whose
+    overlaps are not bounded by the image, the trackers without scores and why (``brief``: one line
+    when no tracker has scores), or the reason it was skipped."""
     if "skipped" in record:
         return record["skipped"] + "\n"
+    if brief and not record["rows"]:  # imported or published results only: the reasons are in the files
+        return "long-term measures: no tracker has a confidence file for every sequence scored\n"
     text = MEASURES + "\n\n" + format_rows(record["rows"], fmt, LONG_TERM_COLUMNS)
     if record["unbounded"]:
         names = record["unbounded"]
         text += (f"\noverlaps of {len(names)} sequences are the continuous IoU, not bounded by the image (their frame "
                  f"1 cannot be read): {', '.join(names[:10])}{' ...' if len(names) > 10 else ''}\n")
     if record["left_out"]:
-        text += "\n" + "".join(f"left out of the long-term table: {tracker}: {why}\n"
-                               for tracker, why in record["left_out"].items())
+        text += "\n" + "".join(f"no long-term scores for {tracker}: {why}\n" for tracker, why in record["left_out"].items())
     return text
 
 

@@ -223,7 +223,8 @@ def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | No
 
     ``report_dir`` defaults to :func:`default_report_dir`. Writes ``overall``, ``per_sequence``
     and (when sequences have attributes) ``per_attribute`` tables as ``.txt``, ``.md``, ``.csv``
-    and ``.tex``; ``statistics.txt``; ``report.json`` with all rows and curves; ``precision`` and ``success`` plots
+    and ``.tex``; ``statistics.txt``; ``report.json`` with all rows and curves; for one pass, the long-term
+    ``longterm.txt``, ``.md``, ``.csv`` and ``longterm_curves.csv``; ``precision`` and ``success`` plots
     and ``precision_<ATTR>`` and ``success_<ATTR>`` plots per attribute, each as PNG and SVG. Every file names
     the experiment, the protocol and any ``--max-frames`` cut. ``missing`` is :func:`evaluate`'s: by default the sequences every tracker
     has a result for are scored, the others named. ``experiment`` ``tre`` or ``sre`` scores

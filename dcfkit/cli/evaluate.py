@@ -201,9 +201,9 @@ def run_report(args: argparse.Namespace) -> int:
                   f"decision is close (docs/architecture.md)", file=sys.stderr)
         for name, without in evaluation.settings["left_out"].items():
             print(f"left out: {name} (no result from {', '.join(without)}; --missing fail scores it as a failure)")
-        print("\n" + "\n".join(statistics_lines(evaluation.statistics)))
         if evaluation.long_term:
-            print("\n" + long_term_lines(evaluation.long_term), end="")
+            print("\n" + long_term_lines(evaluation.long_term, brief=True), end="")
+        print("\n" + "\n".join(statistics_lines(evaluation.statistics)))
         print(f"\n{len(paths)} files written to {paths[0].parent}")
         if args.html:
             print(f"open {paths[-1]}")
@@ -222,8 +222,8 @@ def _reset_report(args: argparse.Namespace, experiment: Experiment, sequences: l
     if args.format == "table":
         for name, without in scores["left_out"].items():
             print(f"left out: {name} (no result from {', '.join(without)})")
-        print("\n" + "\n".join(statistics_lines(scores["statistics"])))
         print("\n" + long_term_lines(score_long_term({}, {}, [], experiment)), end="")
+        print("\n" + "\n".join(statistics_lines(scores["statistics"])))
         print(f"\n{len(paths)} files written to {paths[0].parent}")
     return 0
 

@@ -160,8 +160,8 @@ def test_report_writes_the_long_term_table_and_curves(tmp_path, monkeypatch, cap
     assert "long-term measures: tracking precision Pr, recall Re" in out and "continuous IoU" not in out
     row = next(line.split() for line in out.splitlines() if line.startswith("x ") and "0.707" in line)
     assert row == ["x", "0.707", "0.800", "0.633", "0.100", "2", "1"]
-    assert "left out of the long-term table: y: no " in out and "y/a.confidence (results imported" in out
-    assert "left out of the long-term table: z: " in out and "z/a.confidence, line 3: '0.5;1'" in out
+    assert "no long-term scores for y: no " in out and "y/a.confidence (results imported" in out
+    assert "no long-term scores for z: " in out and "z/a.confidence, line 3: '0.5;1'" in out
     report = tmp_path / "out_report"
     record = json.loads((report / "report.json").read_text())["long_term"]
     (x,) = record["rows"]
