@@ -14,10 +14,13 @@ sequence), not total frames / total time, of runs timed alone only (``fps_measur
 :mod:`dcfkit.store.timing`; a note under the text and Markdown tables says whose fps is left
 out and why). A sequence missing from a tracker's results is
 scored as a total failure and counted in the ``missing`` column. :mod:`dcfkit.analysis.report_html`
-adds one self-contained HTML page of it all (``dcfkit report --html``).
+adds one self-contained HTML page of it all (``dcfkit report --html``). Beside the OTB scores, a
+one-pass report has VOT-LT's tracking precision, recall and F of the trackers with confidence
+files (``longterm.*``, ``report.json``'s ``long_term``: :mod:`dcfkit.analysis.longterm_report`).
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -27,6 +30,7 @@ from typing import Sequence as Seq
 
 import numpy as np
 
+from dcfkit.analysis.longterm_report import LONG_TERM_FILES, long_term_files, score_long_term
 from dcfkit.analysis.plots import plot_curves
 from dcfkit.analysis.scoring import Evaluation, evaluate
 from dcfkit.analysis.result_fit import check_results_fit, other_folders
@@ -166,11 +170,13 @@ def report_file_names(sequences: Seq[Sequence]) -> list[str]:
     attributes = sorted({a for s in sequences for a, present in s.attributes.items() if present})
     plots = ["precision", "success"] + [f"{kind}_{a}" for a in attributes for kind in ("precision", "success")]
     return ([f"{t}.{ext}" for t in REPORT_TABLES for _, ext in TABLE_FORMATS] + ["statistics.txt", "report.json", "report.html"]
+            + list(LONG_TERM_FILES)
             + [f"{p}.{ext}" for p in plots for ext in ("png", "svg")])
 
 
 def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
-    """The tables, ``statistics.txt``, ``report.json`` and plots of :func:`write_report` from
+    """The tables, ``statistics.txt``, ``report.json``, the long-term tables and curves
+    (:func:`~dcfkit.analysis.longterm_report.long_term_files`) and plots of :func:`write_report` from
     ``evaluation``, each naming the experiment, the protocol and any ``--max-frames`` cut."""
     paths = []
     protocol = evaluation.protocol.name
@@ -194,6 +200,8 @@ def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
     head = [experiment_line(experiment, cut), evaluation.protocol.describe(), ""]
     text("statistics.txt", "\n".join(head + statistics_lines(evaluation.statistics)) + "\n")
     text("report.json", json.dumps(json_ready(evaluation.as_record()), indent=1) + "\n")
+    if evaluation.long_term:
+        long_term_files(evaluation.long_term, experiment, cut, text)
     run = experiment.upper() + (f", first {cut} frames" if cut is not None else "")
     for kind in ("precision", "success"):
         paths += plot_curves(evaluation.curves, kind, report_dir / kind, title=f"{kind.capitalize()} plots of {run}",
@@ -215,7 +223,8 @@ def write_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | No
 
     ``report_dir`` defaults to :func:`default_report_dir`. Writes ``overall``, ``per_sequence``
     and (when sequences have attributes) ``per_attribute`` tables as ``.txt``, ``.md``, ``.csv``
-    and ``.tex``; ``statistics.txt``; ``report.json`` with all rows and curves; ``precision`` and ``success`` plots
+    and ``.tex``; ``statistics.txt``; ``report.json`` with all rows and curves; for one pass, the long-term
+    ``longterm.txt``, ``.md``, ``.csv`` and ``longterm_curves.csv``; ``precision`` and ``success`` plots
     and ``precision_<ATTR>`` and ``success_<ATTR>`` plots per attribute, each as PNG and SVG. Every file names
     the experiment, the protocol and any ``--max-frames`` cut. ``missing`` is :func:`evaluate`'s: by default the sequences every tracker
     has a result for are scored, the others named. ``experiment`` ``tre`` or ``sre`` scores
@@ -273,5 +282,8 @@ def score_folders(out_dir, sequences: Seq[Sequence], trackers: Iterable[str] | N
         raise DatasetError(f"no tracker results{' of experiment ' + experiment.name if experiment.folder else ''} "
                            f"found under {clip(str(out_dir))}")
     ensure_writable(report_dir, report_file_names(sequences), "the report")  # before the scoring
-    return folders, results, evaluate(results, sequences, include_first, weighting, protocol, missing, experiment,
-                                      by_sequence, baseline)
+    evaluation = evaluate(results, sequences, include_first, weighting, protocol, missing, experiment, by_sequence,
+                          baseline)
+    scored = [s for s in sequences if s.name not in evaluation.settings["left_out"]]
+    long_term = score_long_term(folders, results, scored, experiment)
+    return folders, results, dataclasses.replace(evaluation, long_term=long_term)

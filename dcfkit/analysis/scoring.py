@@ -49,7 +49,9 @@ class Evaluation:
     several when roots were pooled); ``platforms`` tracker -> ``[[platform, sequences], ...]``; ``statistics`` each
     tracker's ranking score and precision with confidence intervals and its paired difference
     from the best (a :class:`~dcfkit.analysis.stats.results.Comparison` of
-    :func:`dcfkit.analysis.statistics.versus_baseline`; ``{}`` without trackers).
+    :func:`dcfkit.analysis.statistics.versus_baseline`; ``{}`` without trackers); ``long_term`` the
+    VOT-LT precision, recall and F a report adds (:func:`dcfkit.analysis.longterm_report.score_long_term`;
+    ``{}`` from :func:`evaluate` alone).
     """
 
     protocol: Protocol
@@ -63,6 +65,7 @@ class Evaluation:
     settings: dict
     platforms: dict
     statistics: Comparison | dict
+    long_term: dict = dataclasses.field(default_factory=dict)
 
     def as_record(self) -> dict:
         """The scores as plain data (``report.json``): the protocol and the experiment as their

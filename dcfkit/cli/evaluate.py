@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from dcfkit.analysis.compare import COLUMNS, compare_folders, counted_lines
+from dcfkit.analysis.longterm_report import long_term_lines, score_long_term
 from dcfkit.analysis.report import json_ready, named_folder, score_and_write
 from dcfkit.analysis.report_html import write_html_report
 from dcfkit.analysis.reset_report import reset_latex, reset_runs, reset_table, write_reset_report
@@ -200,6 +201,8 @@ def run_report(args: argparse.Namespace) -> int:
                   f"decision is close (docs/architecture.md)", file=sys.stderr)
         for name, without in evaluation.settings["left_out"].items():
             print(f"left out: {name} (no result from {', '.join(without)}; --missing fail scores it as a failure)")
+        if evaluation.long_term:
+            print("\n" + long_term_lines(evaluation.long_term, brief=True), end="")
         print("\n" + "\n".join(statistics_lines(evaluation.statistics)))
         print(f"\n{len(paths)} files written to {paths[0].parent}")
         if args.html:
@@ -219,6 +222,7 @@ def _reset_report(args: argparse.Namespace, experiment: Experiment, sequences: l
     if args.format == "table":
         for name, without in scores["left_out"].items():
             print(f"left out: {name} (no result from {', '.join(without)})")
+        print("\n" + long_term_lines(score_long_term({}, {}, [], experiment)), end="")
         print("\n" + "\n".join(statistics_lines(scores["statistics"])))
         print(f"\n{len(paths)} files written to {paths[0].parent}")
     return 0

@@ -334,6 +334,37 @@ def result_files(folder) -> dict[str, Path]:
             or p.with_suffix(SIDECAR_END).is_file()}
 
 
+def read_confidence(path, sha256: str | None = None) -> np.ndarray:
+    """``(N,) float64`` long-term presence scores of a ``<seq>.confidence`` file, one line a frame:
+    column 3 (``score``) of ``peak,apce,score`` lines, else column 1 (``peak``) of the ``peak,apce``
+    lines earlier runs wrote; ``nan`` where the tracker gave none. A :class:`DatasetError` naming the
+    file, and the line, if it cannot be read, differs from the ``sha256`` its sidecar recorded, or a
+    line is not 2 or 3 numbers (as many as the first line's)."""
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise DatasetError(f"cannot read {clip(str(path))}: {exc.strerror}") from None
+    if sha256 is not None and checksum(data) != sha256:
+        raise DatasetError(f"{clip(str(path))} is not the file its run wrote (cut short or edited)")
+    lines = data.decode("utf-8", "replace").split("\n")
+    lines = lines[:-1] if lines[-1] == "" else lines
+    rows, width = [], None
+    for number, line in enumerate(lines, 1):
+        fields = line.split(",")
+        try:
+            if len(fields) not in (2, 3) or len(fields) != (width or len(fields)):
+                raise ValueError
+            values = [float(f) for f in fields]
+        except ValueError:
+            raise DatasetError(f"{clip(str(path))}, line {number}: {shown(line)} is not "
+                               f"{'2 or 3' if width is None else width} comma-separated numbers "
+                               f"(peak,apce,score or peak,apce)") from None
+        rows.append(values[2] if len(values) == 3 else values[0])
+        width = len(fields)
+    return np.array(rows, dtype=np.float64)
+
+
 def import_results(folder) -> dict[str, SequenceResult]:
     """Per-sequence result files of another tracker: ``folder/<sequence>.txt``, 1-based
     ``x,y,w,h`` separated by commas, tabs or spaces. Returns 0-based boxes, no timings."""
