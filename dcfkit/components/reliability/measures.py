@@ -2,8 +2,12 @@
 
 ``lmcf``: LMCF's high-confidence test (Wang et al., "Large Margin Object Tracking with
 Circulant Feature Maps", CVPR 2017, Sec. 3.3): a frame is reliable when its peak F_max and its
-APCE are at least β1 and β2 times their averages over the earlier reliable frames. The score is
-the smaller of the two ratios ``value / (β · average)``, so 1 is the test's boundary.
+APCE are at least β1 and β2 times their historical averages, over every earlier frame. The
+score is the smaller of the two ratios ``value / (β · average)``, so 1 is the test's boundary.
+Averaging the reliable frames alone would let a gate that holds the filter close for good: the
+first frames' peaks, of a filter learnt from one or two samples, set a bar that a filter which
+no longer learns never reaches again; over every frame, a lasting drop lowers the bar until the
+gate opens.
 
 ``psr``: MOSSE's peak-to-sidelobe ratio (Bolme et al., CVPR 2010, Sec. 3.4), ``(peak - μ) /
 σ`` of the map outside a window around the peak, divided by the threshold below which MOSSE
@@ -23,16 +27,16 @@ from dcfkit.numerics.response import apce
 
 
 class LMCF(Reliability):
-    """Peak and APCE against β1 and β2 times their averages over the reliable frames so far."""
+    """Peak and APCE against β1 and β2 times their averages over the frames so far."""
 
     name = "lmcf"
 
     @dataclasses.dataclass(frozen=True)
     class Params:
-        peak_ratio: float = param(0.7, "β1: the peak must reach this fraction of its reliable frames' average "
-                                  "(0: not tested)", ge=0, le=100)
-        apce_ratio: float = param(0.45, "β2: the APCE must reach this fraction of its reliable frames' average "
-                                  "(0: not tested)", ge=0, le=100)
+        peak_ratio: float = param(0.7, "β1: the peak must reach this fraction of its average over the earlier "
+                                  "frames (0: not tested)", ge=0, le=100)
+        apce_ratio: float = param(0.45, "β2: the APCE must reach this fraction of its average over the earlier "
+                                  "frames (0: not tested)", ge=0, le=100)
 
     def __init__(self, params=None):
         super().__init__(params)
@@ -41,7 +45,7 @@ class LMCF(Reliability):
         self.reset()
 
     def reset(self) -> None:
-        self.sums, self.count = np.zeros(2), 0  # of (peak, APCE) over the reliable frames
+        self.sums, self.count = np.zeros(2), 0  # of (peak, APCE) over the frames observed
 
     @staticmethod
     def _measures(detection) -> np.ndarray:
@@ -50,16 +54,15 @@ class LMCF(Reliability):
 
     def score(self, detection) -> float:
         values = self._measures(detection)
-        # no reliable frame yet: the frame is its own average (its ratios are 1 / β)
+        # no frame yet: the frame is its own average (its ratios are 1 / β)
         means = self.sums / self.count if self.count else values
         ratios = [_ratio(v, beta * m) for v, m, beta in zip(values, means, (self.params.peak_ratio,
                                                                              self.params.apce_ratio)) if beta > 0]
         return float(min(ratios))
 
     def observe(self, detection, score: float) -> None:
-        if score >= 1:  # LMCF averages the frames it trusted: a lost stretch must not lower the bar
-            self.sums += self._measures(detection)
-            self.count += 1
+        self.sums += self._measures(detection)
+        self.count += 1
 
 
 def _ratio(value: float, bar: float) -> float:

@@ -37,7 +37,7 @@ def peaked(height, floor=0.0):
     return detection(r)
 
 
-def test_lmcf_scores_against_the_average_of_reliable_frames_by_hand():
+def test_lmcf_scores_against_the_average_of_earlier_frames_by_hand():
     lmcf = LMCF(LMCF.Params(peak_ratio=0.5, apce_ratio=0.5))
     first = peaked(2.0)
     assert lmcf.score(first) == pytest.approx(2.0)  # no history: its own average, 1 / 0.5
@@ -45,11 +45,22 @@ def test_lmcf_scores_against_the_average_of_reliable_frames_by_hand():
     lmcf.observe(peaked(4.0), lmcf.score(peaked(4.0)))  # peak 4 / (0.5 * 2) = 4, APCE 16 / (0.5 * 16) = 2
     # history: peaks 2 and 4 (mean 3), APCE 16 twice; a peak of 1.2 gives 1.2 / 1.5 = 0.8
     assert lmcf.score(peaked(1.2)) == pytest.approx(0.8)
-    lmcf.observe(peaked(1.2), 0.8)  # unreliable: not averaged
-    assert lmcf.score(peaked(1.2)) == pytest.approx(0.8)
     flat = np.zeros((4, 4))
     flat[0, 0], flat[2, 2] = 3.0, 3.0  # two peaks: APCE 9 / (18 / 16) = 8, 8 / (0.5 * 16) = 1; peak 3 / 1.5 = 2
     assert lmcf.score(detection(flat)) == pytest.approx(1.0)
+
+
+def test_a_lasting_drop_lowers_the_bar_until_the_frames_pass_again():
+    lmcf = LMCF(LMCF.Params(peak_ratio=0.5, apce_ratio=0.0))
+    for _ in range(4):
+        lmcf.observe(peaked(4.0), 2.0)
+    scores = []
+    for _ in range(9):  # a lasting drop to a peak of 1: the bar, half the mean, falls towards 0.5
+        scores.append(lmcf.score(peaked(1.0)))
+        lmcf.observe(peaked(1.0), scores[-1])
+    # the mean before the k-th low frame is (16 + k) / (4 + k); score = 1 / (0.5 mean)
+    assert scores == pytest.approx([2 * (4 + k) / (16 + k) for k in range(9)])
+    assert max(scores[:8]) < 1 and scores[8] == pytest.approx(1.0)  # the ninth passes: 24 / 12 = 2
 
 
 def test_lmcf_with_one_measure_off_and_both_off():
