@@ -132,3 +132,32 @@ def test_authors_octave_builds_and_runs_eco_and_csr(tmp_path, synthetic_uav123, 
     assert len(boxes) == 67 and all(len(line.split(",")) == 4 for line in boxes)
     fps = (tmp_path / "out" / "UAV123_10fps" / f"{tracker}_fps.tsv").read_text().splitlines()[1].split("\t")
     assert fps[0] == "wakeboard7" and float(fps[2]) > 0
+
+
+def test_decide_pairs_each_option_with_its_base(tmp_path, capsys):
+    """Hand-made scores: '+ up' wins every sequence by 0.1 (its interval above 0; with 8 sequences
+    the exact two-sided Wilcoxon p is 2/256 = 0.0078, Holm x2 = 0.016 < 0.05: adopted); '+ mixed'
+    wins 4 and loses 4: the base stands."""
+    import csv
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("decide", ROOT / "benchmarks" / "decide.py")
+    decide = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(decide)
+    path = tmp_path / "ope" / "per_sequence.csv"
+    path.parent.mkdir()
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["variant", "sequence", "precision", "auc", "fps", "frames", "status", "protocol"])
+        for i in range(8):
+            base = 0.3 + 0.05 * i
+            w.writerow(["T", f"s{i}", 0, base, 1, 10, "done", "otb"])
+            w.writerow(["T + up", f"s{i}", 0, base + 0.1 + 0.001 * i, 1, 10, "done", "otb"])
+            w.writerow(["T + mixed", f"s{i}", 0, base + (0.05 if i % 2 else -0.05), 1, 10, "done", "otb"])
+    rows = {r["option"]: r for r in decide.decide(decide.read_scores(path, "auc"))}
+    up, mixed = rows["up"], rows["mixed"]
+    assert up["difference"].won == 8 and up["difference"].ci_low > 0
+    assert up["difference"].wilcoxon_p == pytest.approx(2 / 256) and up["holm"] == pytest.approx(4 / 256)
+    assert up["passes"] and not mixed["passes"] and (mixed["difference"].won, mixed["difference"].lost) == (4, 4)
+    assert decide.main([str(path)]) == 0
+    assert "- T + up: adopt" in capsys.readouterr().out
