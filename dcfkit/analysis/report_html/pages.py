@@ -20,10 +20,12 @@ PAGE = "report.html"
 
 def evaluation_sections(evaluation: Mapping, sequences: Seq[Sequence], results: Mapping[str, Mapping],
                         trackers: Seq[str]) -> list[dict]:
-    """The plots, the per-attribute and per-sequence tables and the frames of an evaluation
-    (:func:`dcfkit.analysis.scoring.evaluate`), in page order, for ``trackers``."""
+    """The plots, the long-term measures (when the report scored them), the per-attribute and
+    per-sequence tables and the frames of an evaluation (:func:`dcfkit.analysis.scoring.evaluate`),
+    in page order, for ``trackers``."""
     protocol = evaluation.protocol.name
-    out = [sections.curve_charts(evaluation, trackers), sections.attribute_charts(evaluation, trackers)]
+    out = [sections.curve_charts(evaluation, trackers), sections.attribute_charts(evaluation, trackers),
+           sections.long_term(evaluation.long_term, trackers)]
     if evaluation.per_attribute:
         out.append(sections.table("per-attribute", "Per attribute", evaluation.per_attribute,
                                   columns("per_attribute", protocol), trackers, filterable=True))

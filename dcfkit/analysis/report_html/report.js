@@ -109,11 +109,15 @@
       : {col: se.color, dash: '', key: safeKey(se.key)};
   }
 
+  /* a chart's x values are shared (spec.x), or each series has its own (se.x: a precision-recall
+     curve, whose recall differs per tracker); se.point marks one point of a series */
   function chart(spec) {
     const W = spec.small ? 300 : 400, H = spec.small ? 220 : 290;
     const m = {l: 46, r: 12, t: 10, b: 40};
     const xs = spec.x;
-    const [x0, x1] = spec.xlim || [Math.min(...xs), Math.max(...xs)];
+    const xsOf = (se) => se.x || xs;
+    const allX = xs || spec.series.flatMap((se) => se.x).filter((v) => v !== null);
+    const [x0, x1] = spec.xlim || [Math.min(...allX), Math.max(...allX)];
     const [y0, y1] = spec.ylim || yRange(spec.series);
     const px = (v) => m.l + (v - x0) / ((x1 - x0) || 1) * (W - m.l - m.r);
     const py = (v) => H - m.b - (v - y0) / ((y1 - y0) || 1) * (H - m.t - m.b);
@@ -136,31 +140,41 @@
     }
     const plot = s('g', {}, svg);
     for (const se of [...spec.series].reverse()) {  /* the best drawn last, on top */
-      const st = seriesStyle(se);
+      const st = seriesStyle(se), sx = xsOf(se);
       const g = s('g', {class: 's-' + st.key}, plot);
       if (se.low && se.high) {
         const up = se.high.map((v, i) => v === null ? null : [px(xs[i]), py(v)]).filter(Boolean);
         const down = se.low.map((v, i) => v === null ? null : [px(xs[i]), py(v)]).filter(Boolean).reverse();
         s('polygon', {points: up.concat(down).map((p) => p.join(',')).join(' '), fill: st.col, opacity: 0.15}, g);
       }
-      const pts = se.y.map((v, i) => v === null ? null : [px(xs[i]), py(v)]);
+      const pts = se.y.map((v, i) => v === null || sx[i] === null ? null : [px(sx[i]), py(v)]);
       s('path', {d: linePath(pts), class: 'line', stroke: st.col, 'stroke-dasharray': st.dash}, g);
       if (se.marker) for (const p of pts) if (p) s('circle', {cx: p[0], cy: p[1], r: 3, fill: st.col}, g);
+      if (se.point) s('circle', {cx: px(se.point[0]), cy: py(se.point[1]), r: 4.5, fill: st.col, class: 'point'}, g);
     }
     const guide = s('line', {y1: m.t, y2: H - m.b, class: 'guide', visibility: 'hidden'}, svg);
     const overlay = s('rect', {x: m.l, y: m.t, width: W - m.l - m.r, height: H - m.t - m.b, class: 'overlay'}, svg);
     overlay.addEventListener('pointermove', (event) => {
       const box = svg.getBoundingClientRect();
       const sx = (event.clientX - box.left) * W / box.width;
-      let best = 0;
-      xs.forEach((v, i) => { if (Math.abs(px(v) - sx) < Math.abs(px(xs[best]) - sx)) best = i; });
-      guide.setAttribute('x1', px(xs[best]));
-      guide.setAttribute('x2', px(xs[best]));
+      const nearest = (arr) => {  /* the index of the x nearest the pointer */
+        let best = 0;
+        arr.forEach((v, i) => {
+          if (v !== null && (arr[best] === null || Math.abs(px(v) - sx) < Math.abs(px(arr[best]) - sx))) best = i;
+        });
+        return best;
+      };
+      const best = xs ? nearest(xs) : 0;
+      const gx = xs ? px(xs[best]) : Math.min(Math.max(sx, m.l), W - m.r);
+      guide.setAttribute('x1', gx);
+      guide.setAttribute('x2', gx);
       guide.setAttribute('visibility', 'visible');
-      const rows = spec.series.filter((se) => !hidden.has(safeKey(se.key)) && se.y[best] !== null)
-        .map((se) => [seriesStyle(se).col, se.t !== undefined ? trackers[se.t] : se.label, se.y[best]])
+      const at = (se) => se.x ? nearest(se.x) : best;
+      const rows = spec.series.filter((se) => !hidden.has(safeKey(se.key)) && se.y[at(se)] !== null)
+        .map((se) => [seriesStyle(se).col, se.t !== undefined ? trackers[se.t] : se.label, se.y[at(se)]])
         .sort((a, b) => b[2] - a[2]).map(([c, l, v]) => [c, l, fmt(v, 3)]);
-      const xName = spec.xticks ? (spec.xticks.find((t) => t[0] === xs[best]) || [0, xs[best]])[1] : fmt(xs[best], 2);
+      const xValue = xs ? xs[best] : x0 + (gx - m.l) / (W - m.l - m.r) * (x1 - x0);
+      const xName = spec.xticks ? (spec.xticks.find((t) => t[0] === xValue) || [0, xValue])[1] : fmt(xValue, 2);
       showTip(event, `${spec.xlabel}: ${xName}`, rows);
     });
     overlay.addEventListener('pointerleave', () => { guide.setAttribute('visibility', 'hidden'); hideTip(); });
@@ -339,8 +353,16 @@
     return out;
   }
 
+  /* ---------------------------------------------------------------- groups */
+  /* several parts in one section (a table, another, a chart), each with its own title and note */
+  function group(spec) {
+    return h('div', {class: 'group'}, ...spec.parts.map((part) => h('div', {class: 'part'},
+      part.title ? h('h3', {text: part.title}) : null, part.note ? h('p', {class: 'note', text: part.note}) : null,
+      DRAW[part.kind](part))));
+  }
+
   /* ---------------------------------------------------------------- page */
-  const DRAW = {table: table, charts: charts, gallery: gallery, provenance: provenance};
+  const DRAW = {table: table, charts: charts, gallery: gallery, provenance: provenance, group: group};
   const main = document.getElementById('main');
   const nav = document.getElementById('nav');
   for (const sec of data.sections) {

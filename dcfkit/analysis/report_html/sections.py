@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Iterable, Mapping
 from typing import Sequence as Seq
 
+from dcfkit.analysis.longterm_report import LONG_TERM_COLUMNS, MEASURES
 from dcfkit.analysis.plots import PLOT_STYLE, plot_title
 from dcfkit.analysis.report_html.provenance import folder_provenance
 from dcfkit.analysis.report_html.thumbnails import sequence_thumbnails
@@ -23,13 +24,15 @@ from dcfkit.datasets import ATTRIBUTE_NAMES, Sequence
 COLUMN_LABELS = {**SCORE_LABELS, "norm_precision": "norm. precision", "fps": "fps", "sequences": "sequences",
                  "missing": "missing", "frames": "frames", "failed": "failed", "key": "run key",
                  "name": "attribute name"}
-TEXT_COLUMNS = ("sequence", "attribute", "name", "status", "key", "variant")
+TEXT_COLUMNS = ("sequence", "attribute", "name", "status", "key", "variant", "reason")
+LONG_TERM_LABELS = {"tracker": "tracker", "f": "F", "precision": "Pr", "recall": "Re", "threshold": "\u03c4 at max F",
+                    "sequences": "sequences", "absent": "sequences with absent frames", "reason": "why"}
 
 
-def _column(key: str, tracker_column: str) -> dict:
+def _column(key: str, tracker_column: str, labels: Mapping[str, str] | None = None) -> dict:
     kind = "tracker" if key == tracker_column else "text" if key in TEXT_COLUMNS else "num"
-    digits = 1 if key == "fps" else 0 if key in ("sequences", "missing", "frames", "failed") else 3
-    return {"key": key, "label": COLUMN_LABELS.get(key, key), "type": kind, "digits": digits}
+    digits = 1 if key == "fps" else 0 if key in ("sequences", "missing", "frames", "failed", "absent") else 3
+    return {"key": key, "label": (labels or COLUMN_LABELS).get(key, key), "type": kind, "digits": digits}
 
 
 def count(n: int, noun: str) -> str:
@@ -38,11 +41,13 @@ def count(n: int, noun: str) -> str:
 
 
 def table(section_id: str, title: str, rows: Seq[Mapping], columns: Seq[str], trackers: Seq[str],
-          tracker_column: str = "tracker", filterable: bool = False, note: str = "") -> dict:
-    """A sortable table (``filterable``: with a filter box) of ``rows`` (dicts) in ``columns``;
-    the ``tracker_column`` holds tracker numbers, drawn with their colour."""
+          tracker_column: str = "tracker", filterable: bool = False, note: str = "",
+          labels: Mapping[str, str] | None = None) -> dict:
+    """A sortable table (``filterable``: with a filter box) of ``rows`` (dicts) in ``columns``
+    headed by ``labels`` (default :data:`COLUMN_LABELS`); the ``tracker_column`` holds tracker
+    numbers, drawn with their colour."""
     index = {t: i for i, t in enumerate(trackers)}
-    cols = [_column(c, tracker_column) for c in columns]
+    cols = [_column(c, tracker_column, labels) for c in columns]
     cells = [[index[r[c]] if c == tracker_column else r.get(c) for c in columns] for r in rows]
     return {"kind": "table", "id": section_id, "title": title, "columns": cols, "rows": cells,
             "filter": filterable, "note": note}
@@ -86,6 +91,50 @@ def attribute_charts(evaluation: Mapping, trackers: Seq[str]) -> dict | None:
                           title=f"{ATTRIBUTE_NAMES.get(attr, attr)} ({evaluation.attributes[attr]})")
               for attr, curves in evaluation.attribute_curves.items()]
     return {"kind": "charts", "id": "attribute-plots", "title": "Success plots per attribute", "charts": charts}
+
+
+def long_term(record: Mapping, trackers: Seq[str]) -> dict | None:
+    """The VOT-LT measures of a report (:func:`dcfkit.analysis.longterm_report.score_long_term`): the
+    table, the trackers left out and why, and each tracker's averaged precision-recall curve (Pr
+    against Re over the thresholds) with its maximum F marked; the reason alone for an experiment
+    that has none (TRE, SRE); None without long-term scores."""
+    title = "Long-term measures"
+    if "skipped" in record:
+        return {"kind": "group", "id": "long-term", "title": title, "note": _sentence(record["skipped"]), "parts": []}
+    if not record.get("rows"):
+        return None
+    rows = [{**r, "threshold": r["threshold"] if math.isfinite(r["threshold"]) else str(r["threshold"])}
+            for r in record["rows"]]  # -inf (every frame present) shown as the text table shows it
+    parts = [table("long-term", "", rows, LONG_TERM_COLUMNS, trackers, labels=LONG_TERM_LABELS)]  # the section's
+    if record["left_out"]:
+        parts.append(table("long-term-left-out", "No long-term scores",
+                           [{"tracker": t, "reason": why} for t, why in record["left_out"].items()],
+                           ("tracker", "reason"), trackers, labels=LONG_TERM_LABELS))
+    parts.append({"kind": "charts", "charts": [_precision_recall(record, trackers)],
+                  "note": "Pr and Re averaged over the sequences at each threshold \u03c4; a dot marks each "
+                          "tracker's maximum F, the number after its name."})
+    note = _sentence(MEASURES)
+    if record.get("unbounded"):
+        names = record["unbounded"]
+        note += (f" The overlaps of {count(len(names), 'sequence')} are the continuous IoU, not bounded by the image "
+                 f"(their frame 1 cannot be read): {', '.join(names[:10])}{' ...' if len(names) > 10 else ''}.")
+    return {"kind": "group", "id": "long-term", "title": title, "note": note, "parts": parts}
+
+
+def _sentence(text: str) -> str:
+    return text[:1].upper() + text[1:] + ("" if text.endswith(".") else ".")
+
+
+def _precision_recall(record: Mapping, trackers: Seq[str]) -> dict:
+    """Each tracker's averaged Pr against Re, best F first, its maximum F's point marked."""
+    series = []
+    for row in record["rows"]:
+        t, curve = row["tracker"], record["curves"][row["tracker"]]
+        series.append({"key": f"t{trackers.index(t)}", "t": trackers.index(t), "label": f"{t} [{_score(row['f'])}]",
+                       "x": curve["recall"], "y": curve["precision"], "point": [row["recall"], row["precision"]]})
+    return {"title": "Tracking precision-recall plot of OPE", "xlabel": "Tracking recall (Re)",
+            "ylabel": "Tracking precision (Pr)", "x": None, "xlim": [0, 1], "ylim": [0, 1], "series": series,
+            "small": False}
 
 
 def gallery(sequences: Seq[Sequence], results: Mapping[str, Mapping], trackers: Seq[str],
