@@ -15,7 +15,7 @@ from dcfkit.analysis.stats.columns import DIFFERENCE, LOWER_IS_BETTER, MEAN, hea
 from dcfkit.analysis.stats.results import Comparison
 from dcfkit.protocols import Protocol, get_protocol
 
-__all__ = ["LOWER_IS_BETTER", "comparison_table", "escape", "interval_cell", "latex_table"]
+__all__ = ["LOWER_IS_BETTER", "comparison_table", "escape", "interval_cell", "latex_table", "long_term_table"]
 
 _ESCAPES = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{",
             "}": r"\}", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}",
@@ -90,6 +90,36 @@ def comparison_table(statistics: Comparison, setting: Seq[str], name: str = "Tra
     return _table(caption, "l" * skip + "r" * per * len(keys), head, body, wide=True)
 
 
+#: the headers of the long-term table (:mod:`dcfkit.analysis.longterm_report`), LaTeX already
+LONG_TERM_HEADERS = {"tracker": "Tracker", "f": "F", "precision": "Pr", "recall": "Re", "threshold": r"$\tau$",
+                     "sequences": "Seq.", "absent": "Absent"}
+
+
+def long_term_table(rows: Seq[Mapping], columns: Seq[str], setting: Seq[str], left_out: Seq[str] = ()) -> str:
+    """VOT-LT long-term ``rows`` (F, Pr, Re, the threshold tau at max F, the sequences scored and of
+    them those with absent frames) as a booktabs ``table``, F, Pr and Re marked best bold and second
+    underlined as :func:`latex_table` marks scores; the caption ``setting`` (sentences: the experiment,
+    the measures) and the trackers ``left_out`` (no or unreadable confidence files). Shrunk to the line if wider
+    (graphicx, as the comparison table)."""
+    places = {c: _places([r.get(c) for r in rows]) for c in ("f", "precision", "recall")}
+    body = []
+    for row in rows:
+        cells = []
+        for c in columns:
+            value = row.get(c)
+            text = (rf"${'-' if value < 0 else ''}\infty$" if isinstance(value, float) and math.isinf(value)
+                    else _number(c, value))
+            mark = {1: r"\textbf{%s}", 2: r"\underline{%s}"}.get(places.get(c, {}).get(value))
+            cells.append(mark % text if mark else text)
+        body.append(" & ".join(cells) + r" \\")
+    caption = _sentences(setting) + " Best in bold, second underlined."
+    if left_out:
+        caption += f" Not scored (confidences missing or unreadable): {escape(', '.join(left_out))}."
+    align = "".join("l" if c == "tracker" else "r" for c in columns)
+    head = " & ".join(LONG_TERM_HEADERS.get(c, escape(c)) for c in columns) + r" \\"
+    return _table(caption, align, [head], body, fit=True)  # tracker names may be long
+
+
 def _sentences(parts: Seq[str]) -> str:
     """``parts`` escaped, each a sentence (capitalised, a full stop)."""
     out = []
@@ -103,12 +133,14 @@ def _sentences(parts: Seq[str]) -> str:
 _FIT = r"\resizebox{\ifdim\width>\linewidth\linewidth\else\width\fi}{!}{%"
 
 
-def _table(caption: str, align: str, head: Seq[str], body: Seq[str], wide: bool = False) -> str:
+def _table(caption: str, align: str, head: Seq[str], body: Seq[str], wide: bool = False, fit: bool = False) -> str:
     """A booktabs float; ``wide``: ``table*`` (both columns of a two-column paper), a smaller
     font, narrower column gaps and shrunk to the line if still wider (graphicx), which a
-    comparison's 4 columns per score need."""
-    env, fit, end = ("table*", [r"\small", r"\setlength{\tabcolsep}{3.5pt}"], "}") if wide else ("table", [], "")
-    return "\n".join([rf"\begin{{{env}}}", r"\centering", *fit, rf"\caption{{{caption}}}", *([_FIT] if wide else []),
+    comparison's 4 columns per score need; ``fit``: a ``table`` shrunk to the line if wider."""
+    env, small = ("table*", [r"\small", r"\setlength{\tabcolsep}{3.5pt}"]) if wide else ("table", [])
+    end = "}" if wide or fit else ""
+    return "\n".join([rf"\begin{{{env}}}", r"\centering", *small, rf"\caption{{{caption}}}",
+                      *([_FIT] if wide or fit else []),
                       rf"\begin{{tabular}}{{{align}}}", r"\toprule", *head, r"\midrule", *body, r"\bottomrule",
                       r"\end{tabular}" + end, rf"\end{{{env}}}"]) + "\n"
 

@@ -20,6 +20,7 @@ from typing import Sequence as Seq
 
 import numpy as np
 
+from dcfkit.analysis.latex import long_term_table
 from dcfkit.analysis.longterm import RESOLUTION, frame_overlaps, long_term_scores, predicted_scores
 from dcfkit.analysis.setting import experiment_line
 from dcfkit.analysis.tables import format_rows
@@ -29,7 +30,7 @@ from dcfkit.experiments import Experiment, get_experiment
 from dcfkit.store.results import ResultStore, read_confidence
 
 __all__ = ["LONG_TERM_COLUMNS", "LONG_TERM_FILES", "MEASURES", "long_term_files", "long_term_lines",
-           "score_long_term"]
+           "long_term_output", "score_long_term"]
 
 log = logging.getLogger(__name__)
 
@@ -134,6 +135,22 @@ def long_term_lines(record: Mapping, fmt: str = "table", brief: bool = False) ->
     if record["left_out"]:
         text += "\n" + "".join(f"no long-term scores for {tracker}: {why}\n" for tracker, why in record["left_out"].items())
     return text
+
+
+def long_term_output(record: Mapping, fmt: str, experiment: str | Experiment = "ope",
+                     max_frames: int | None = None) -> str:
+    """The long-term part of ``dcfkit report``'s printed output in ``fmt``: ``table`` and ``markdown``
+    as :func:`long_term_lines` (brief), ``csv`` as ``longterm.csv``, ``latex`` a booktabs table
+    (:func:`dcfkit.analysis.latex.long_term_table`, its caption naming the experiment and the
+    measures). Without a table (a skipped experiment, no tracker with scores) the line saying why,
+    but in LaTeX: nothing (a paper's table takes no notes, as the fps note's rule)."""
+    if fmt in ("table", "markdown") or "skipped" in record or not record["rows"]:
+        return "" if fmt == "latex" else long_term_lines(record, fmt if fmt == "markdown" else "table", brief=True)
+    if fmt == "csv":
+        return format_rows(record["rows"], "csv", LONG_TERM_COLUMNS)
+    setting = [experiment_line(experiment, max_frames), MEASURES,
+               "Absent: of the sequences scored, those with frames whose target is absent"]
+    return long_term_table(record["rows"], LONG_TERM_COLUMNS, setting, list(record["left_out"]))
 
 
 def long_term_files(record: Mapping, experiment: str | Experiment, max_frames: int | None, write) -> None:

@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from dcfkit.analysis.compare import COLUMNS, compare_folders, counted_lines
-from dcfkit.analysis.longterm_report import long_term_lines, score_long_term
+from dcfkit.analysis.longterm_report import long_term_lines, long_term_output, score_long_term
 from dcfkit.analysis.report import json_ready, named_folder, score_and_write
 from dcfkit.analysis.report_html import write_html_report
 from dcfkit.analysis.reset_report import reset_latex, reset_runs, reset_table, write_reset_report
@@ -146,7 +146,8 @@ def add_report_arguments(parser: argparse.ArgumentParser) -> None:
                         help="the tracker whose paired differences (Δ, CI, Wilcoxon p, won/tied/lost) every other "
                              "is compared by, e.g. the one a new component extends (default: the best)")
     parser.add_argument("--format", choices=("table", "markdown", "csv", "latex"), default="table",
-                        help="format of the table printed to stdout; every format names the experiment, the protocol "
+                        help="format of the table printed to stdout, the long-term table after it (csv: on stderr, "
+                             "so that stdout stays one table); every format names the experiment, the protocol "
                              "and a --max-frames cut (latex: a booktabs table a paper can take: each tracker's "
                              "scores with confidence intervals, its difference from the --baseline (default: the best) with "
                              "its interval, "
@@ -192,6 +193,8 @@ def run_report(args: argparse.Namespace) -> int:
           end="")
     if evaluation.settings["fps_note"] and args.format in ("table", "markdown"):
         print(f"\n{evaluation.settings['fps_note']}")
+    if evaluation.long_term and args.format != "table":  # the table format's comes after its notes, below
+        _print_long_term(evaluation.long_term, args.format, experiment, evaluation.settings["max_frames"])
     if args.format == "table":
         for tracker, rows in evaluation.platforms.items():  # ten lines at most: records may differ per sequence
             print(f"{tracker} platform: {'; '.join(counted_lines(dict(rows), sum(n for _, n in rows)))}")
@@ -210,6 +213,17 @@ def run_report(args: argparse.Namespace) -> int:
     return 0
 
 
+def _print_long_term(record: Mapping, fmt: str, experiment: Experiment, max_frames: int | None) -> None:
+    """The long-term table (or why there is none: not in LaTeX) after the OTB one, in ``fmt``;
+    csv's on stderr, so that stdout stays one table (as ``dcfkit compare --format csv`` keeps its
+    notes off stdout)."""
+    text = long_term_output(record, fmt, experiment, max_frames)
+    if fmt == "csv":
+        print(text, end="", file=sys.stderr)
+    elif text:
+        print("\n" + text, end="")
+
+
 def _reset_report(args: argparse.Namespace, experiment: Experiment, sequences: list,
                   trackers: list[str] | None) -> int:
     """``report --experiment reset``: the accuracy, failures and EAO table and the statistics."""
@@ -219,6 +233,8 @@ def _reset_report(args: argparse.Namespace, experiment: Experiment, sequences: l
     scores, paths = write_reset_report(args.out, sequences, trackers, args.report_dir, protocol=args.protocol,
                                        baseline=args.baseline)
     print(reset_latex(scores) if args.format == "latex" else reset_table(scores, "overall", args.format), end="")
+    if args.format != "table":
+        _print_long_term(score_long_term({}, {}, [], experiment), args.format, experiment, None)
     if args.format == "table":
         for name, without in scores["left_out"].items():
             print(f"left out: {name} (no result from {', '.join(without)})")

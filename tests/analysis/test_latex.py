@@ -40,7 +40,7 @@ def check_structure(text: str) -> None:
     known = {"begin", "end", "centering", "caption", "toprule", "midrule", "bottomrule", "cmidrule", "multicolumn",
              "scriptsize", "textbf", "underline", "Delta", "textless", "textgreater", "textbackslash",
              "textasciitilde", "textasciicircum", "small", "setlength", "tabcolsep", "resizebox", "ifdim", "width",
-             "linewidth", "else", "fi"}
+             "linewidth", "else", "fi", "tau", "infty"}
     assert set(re.findall(r"\\([A-Za-z]+)", text)) <= known
     width = len(re.search(r"\\begin\{tabular\}\{(\w+)\}", text).group(1))
     rows = text.split("\\toprule\n")[1].split("\n\\bottomrule")[0].splitlines()

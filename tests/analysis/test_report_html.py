@@ -211,8 +211,8 @@ def check_sorting(page, table: str, rows: list[dict], name: str) -> None:
         assert [value[n] for n in column(page, table, 1)] == sorted(value.values()), f"{label} ascending"
 
 
-def check_plots(page, expected_charts: int) -> None:
-    charts = page.locator("svg.chart")
+def check_plots(page, expected_charts: int, selector: str = "svg.chart") -> None:
+    charts = page.locator(selector)
     assert charts.count() == expected_charts
     for i in range(expected_charts):
         box = charts.nth(i).locator("path.line").first.bounding_box()
@@ -291,7 +291,12 @@ def check_report(browser, path: Path, sequences) -> None:
     page, problems = open_page(browser, path)
     assert "protocol otb" in page.locator("header .protocol").inner_text()
     check_sorting(page, "#overall-table", evaluation["overall"], "tracker")
-    check_plots(page, 3 + len(evaluation["attribute_curves"]))
+    check_plots(page, 3 + len(evaluation["attribute_curves"]), "#plots svg.chart, #attribute-plots svg.chart")
+    long_term = bool(evaluation["long_term"].get("rows"))  # dcfkit eval writes confidences: a precision-recall plot
+    assert page.locator("svg.chart").count() == 3 + len(evaluation["attribute_curves"]) + long_term
+    if long_term:  # Pr falls from 1: the curve has height even where its Re spans little
+        box = page.locator("#long-term svg.chart path.line").first.bounding_box()
+        assert box is not None and box["height"] > 50
     trackers = [r["tracker"] for r in evaluation["overall"]]
     check_tooltip_and_legend(page, evaluation["curves"], evaluation["thresholds"]["success"], trackers)
     check_filter(page, "#per-sequence-table", sequences[-1].name)
