@@ -172,7 +172,7 @@ class ContinuousLoop:
                                 f"must be learnt")
         labels, regs = [b.label for b in lay.blocks], [b.reg for b in lay.blocks]
         self.t.memory.replace(0, self.t.solver.learn_first(xs, labels, projections, regs))
-        self.t.position = pos
+        self.t.position = pos - 1  # 0-based, as the discrete loop's
 
     # -- frame t ----------------------------------------------------------------------------
     def update(self, image: np.ndarray) -> tuple[float, float, float, float]:
@@ -202,7 +202,7 @@ class ContinuousLoop:
         pos = sample_pos + np.array([dy, dx]) * (lay.support / np.array(lay.output)) * detect_scale
         if self.t.params.clamp_position:
             pos = np.clip(pos, 1, np.array(image.shape[:2], dtype=float))
-        self.t.position = pos
+        self.t.position = pos - 1  # 0-based, as the discrete loop's
         self.t.scale = float(self.t.scale_estimator.update(image, pos - 1, detect_scale))
         self.t.search.observe(pos - 1)
         grid = fs.sample(scores[best])
@@ -221,4 +221,4 @@ class ContinuousLoop:
 
     def box(self) -> tuple[float, float, float, float]:
         """Current (x, y, w, h), 0-based pixels (``tracker.box_output``)."""
-        return reported_box(self.t.position - 1, self.layout.base_target * self.t.scale, self.t.params.box_output)
+        return reported_box(self.t.position, self.layout.base_target * self.t.scale, self.t.params.box_output)

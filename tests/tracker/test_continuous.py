@@ -167,3 +167,12 @@ def test_the_continuous_loop_gives_the_schedule_each_detection(sequence):
         assert d.response.shape == tuple(output) and d.response.dtype == np.float32
         assert d.response[d.peak] == d.response.max()
         assert d.target_cells == tracker.geometry.target_cells and len(d.offset) == 2
+
+
+def test_the_position_is_0_based_under_both_loops():
+    seq = make_sequence(n_frames=3, seed=1)
+    for config in ("eco_hc", "strcf"):
+        tracker = dcfkit.load_tracker(config)
+        tracker.init(seq.frames[0], seq.ground_truth[0])
+        x, y, w, h = seq.ground_truth[0]
+        np.testing.assert_allclose(tracker.position, [y + (h - 1) / 2, x + (w - 1) / 2])
