@@ -66,6 +66,10 @@ def refuse_unused(tracker) -> None:
         if component is not None:
             raise ConfigError(f"{tracker.name}: {slot} '{component.name}': solver '{solver}' runs in the "
                               f"continuous loop, which would ignore it: set {slot}: null")
+    if getattr(tracker.schedule, "needs_reliability", False):
+        raise ConfigError(f"{tracker.name}: schedule '{tracker.schedule.name}' gates on the reliability of each "
+                          f"detection, which solver '{solver}''s continuous loop does not judge: use another "
+                          f"schedule (sparse, every_frame)")
 
 
 class ContinuousLoop:

@@ -108,3 +108,5 @@ def test_a_gate_or_redetection_without_reliability_is_refused(overrides, key):
 def test_the_continuous_loop_refuses_recovery(slot, spec):
     with pytest.raises(ConfigError, match=f"{slot} '{spec['name']}': solver 'eco' runs in the continuous loop"):
         load_tracker("eco_hc", overrides={slot: spec})
+    with pytest.raises(ConfigError, match="schedule 'reliable' gates on the reliability .* continuous loop"):
+        load_tracker("eco_hc", overrides={"schedule": {"name": "reliable"}})
