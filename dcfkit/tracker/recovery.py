@@ -9,6 +9,7 @@ import dataclasses
 import numpy as np
 
 from dcfkit.components.labels.base import Detection
+from dcfkit.components.reliability.base import unreliable
 from dcfkit.numerics.patches import round_half_away
 
 
@@ -37,19 +38,15 @@ def judged(tracker, detection: Detection) -> Detection:
     return dataclasses.replace(detection, score=float(tracker.reliability.score(detection)))
 
 
-def unreliable(detection: Detection) -> bool:
-    return detection.score is not None and detection.score < 1
-
-
 def gated(tracker, detection: Detection) -> bool:
     """Whether the schedule holds the models on this frame for its unreliable detection (the
     ``reliable`` schedule's frames, whose scale is then kept as well)."""
-    return getattr(tracker.schedule, "needs_reliability", False) and unreliable(detection)
+    return getattr(tracker.schedule, "needs_reliability", False) and unreliable(detection.score)
 
 
 def recovered(tracker, image: np.ndarray, found: Located) -> Located:
     """``found``, or the re-detection candidate that replaces it when its detection is unreliable."""
-    if tracker.redetect is None or not unreliable(found.detection):
+    if tracker.redetect is None or not unreliable(found.detection.score):
         return found
     g = tracker.geometry
     region = g.sample_size * tracker.scale  # image pixels one search region covers at the current scale

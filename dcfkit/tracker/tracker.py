@@ -21,6 +21,7 @@ import numpy as np
 from dcfkit.components.base import Target
 from dcfkit.components.features.base import extract_stack
 from dcfkit.components.labels.base import Detection, gaussian_label
+from dcfkit.components.reliability.base import unreliable
 from dcfkit.components.scale.base import scale_limits
 from dcfkit.config import load_config
 from dcfkit.config.slots import SLOTS, build
@@ -41,7 +42,7 @@ from dcfkit.tracker.geometry import (
     Geometry, geometry, hann2d, label_sigma, limit_step, patch_sampler, reported_box,
 )
 from dcfkit.tracker.learnt import channel_maps, learn_channels, masked_w2
-from dcfkit.tracker.recovery import Located, gated, judged, recovered, unreliable
+from dcfkit.tracker.recovery import Located, gated, judged, recovered
 
 
 class Tracker:
@@ -218,7 +219,7 @@ class Tracker:
         if self.reliability is not None:
             self.reliability.observe(detection, detection.score)
         if self.redetect is not None:
-            self.redetect.observe(self.position.copy(), not unreliable(detection))
+            self.redetect.observe(self.position.copy(), not unreliable(detection.score))
         if self.spatial is not None:
             self.w2 = read_only(self.spatial.adapt(self.w2, detection))
 

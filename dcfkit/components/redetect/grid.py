@@ -14,6 +14,7 @@ import dataclasses
 import numpy as np
 
 from dcfkit.components.redetect.base import Redetect
+from dcfkit.components.reliability.base import RELIABLE
 from dcfkit.params import param
 
 
@@ -71,7 +72,7 @@ class Grid(Redetect):
         if len(scores) == 0:
             return -1
         best = int(np.argmax(scores))
-        bar = max(1.0, self.params.margin * current)
+        bar = max(RELIABLE, self.params.margin * current)
         return best if scores[best] >= bar else -1
 
 

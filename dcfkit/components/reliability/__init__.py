@@ -10,9 +10,9 @@ gated learning (the ``reliable`` schedule) and re-detection (``redetect:``) act 
 Where to add one: subclass :class:`~dcfkit.components.reliability.base.Reliability`."""
 from __future__ import annotations
 
-from dcfkit.components.reliability.base import Reliability
+from dcfkit.components.reliability.base import RELIABLE, Reliability, unreliable
 from dcfkit.components.reliability.measures import LMCF, PSR, peak_to_sidelobe
 
 BUILTIN = (LMCF, PSR)
 
-__all__ = ["BUILTIN", "LMCF", "PSR", "Reliability", "peak_to_sidelobe"]
+__all__ = ["BUILTIN", "LMCF", "PSR", "RELIABLE", "Reliability", "peak_to_sidelobe", "unreliable"]

@@ -5,6 +5,14 @@ from dcfkit.components.base import Component, Contract
 from dcfkit.contracts import scalar
 
 
+RELIABLE = 1.0  #: the score at and above which a frame is reliable, whatever the component
+
+
+def unreliable(score: float | None) -> bool:
+    """Whether a reliability ``score`` judges its frame unreliable (None: no component, no verdict)."""
+    return score is not None and score < RELIABLE
+
+
 class Reliability(Component, declares="reliability"):
     """Scores detections (``reliability:`` in a config; none by default). The tracker calls
     ``reset()`` at every ``init``; ``score(detection)`` on every detection, the search's and

@@ -5,6 +5,7 @@ On the other frames the filter stays where it was, so a lost target's background
 learnt."""
 from __future__ import annotations
 
+from dcfkit.components.reliability.base import unreliable
 from dcfkit.components.schedule.base import Schedule
 
 
@@ -25,4 +26,4 @@ class Reliable(Schedule):
         self.last_score = getattr(detection, "score", None)
 
     def due(self, frame: int) -> bool:
-        return frame == 1 or self.last_score is None or self.last_score >= 1
+        return frame == 1 or not unreliable(self.last_score)
