@@ -49,13 +49,17 @@ def contributions(n_in: int, n_out: int, bilinear: bool = False) -> tuple[np.nda
 
 def _along(x: np.ndarray, axis: int, n_out: int, bilinear: bool) -> np.ndarray:
     """One axis resized, in float64, the taps summed in their order (as imresizemex)."""
+    from dcfkit.numerics import resize_kernels  # lazy: numba, compiled on first use
+
     index, weights = contributions(x.shape[axis], n_out, bilinear)
-    a = np.moveaxis(x, axis, 0)  # not cast whole: only the rows each tap gathers become float64
-    shape = (-1,) + (1,) * (a.ndim - 1)
-    out = weights[:, 0].reshape(shape) * a[index[:, 0]]
-    for j in range(1, index.shape[1]):  # a loop over the kernel's taps, not over pixels
-        out += weights[:, j].reshape(shape) * a[index[:, j]]
-    return np.moveaxis(out, 0, axis)
+    a = np.ascontiguousarray(x.reshape(x.shape[:2] + (-1,)))
+    if axis == 0:
+        out = np.empty((n_out, a.shape[1] * a.shape[2]))
+        resize_kernels.rows(a.reshape(a.shape[0], -1), index, weights, out)
+    else:
+        out = np.empty((a.shape[0], n_out, a.shape[2]))
+        resize_kernels.columns(a, index, weights, out)
+    return out.reshape((n_out, x.shape[1]) + x.shape[2:] if axis == 0 else (x.shape[0], n_out) + x.shape[2:])
 
 
 def imresize(x: np.ndarray, out: tuple[int, int], bilinear: bool = False) -> np.ndarray:
