@@ -23,7 +23,7 @@ from dcfkit.datasets.base import sequence_names
 from dcfkit.errors import ConfigError, DcfkitError, clip, shown
 
 SPEC_KEYS = ("name", "description", "dataset", "sequences", "base", "space", "experiments", "folds",
-             "trials", "startup_trials", "seed", "baselines")
+             "trials", "startup_trials", "seed", "baselines", "warm_start")
 KINDS = ("choice", "float", "int")
 PARAMETER_KEYS = (*KINDS, "log", "when")
 # configs resolved per group of related dimensions when a spec is read (some 4 ms each)
@@ -77,6 +77,7 @@ class SearchSpec:
     baselines: dict  # name -> resolved config
     pool: tuple = ()  # pooled datasets: (name, root, origin) of each, ``dataset`` their names joined by "+"
     max_frames: int | None = None  # a quick try (--max-frames): each sequence's first frames only
+    warm_start: bool = True  # trial 0 of every study is the base config
 
     def load_sequences(self) -> list:
         """The spec's sequences (of every pooled dataset), each cut to ``max_frames`` if given."""
@@ -136,7 +137,8 @@ def load_search_spec(source: str | os.PathLike, root=None) -> SearchSpec:
         sequences=tuple(sequences) if sequences is not None else None, base=base, base_source=base_source,
         parameters=parameters, experiments=experiments, folds=_whole(path, data, "folds", 4, 2),
         trials=_whole(path, data, "trials", 30, 1), startup_trials=_whole(path, data, "startup_trials", 10, 1),
-        seed=_whole(path, data, "seed", 0, 0), baselines=baselines, pool=pool)
+        seed=_whole(path, data, "seed", 0, 0), baselines=baselines, pool=pool,
+        warm_start=_flag(path, data, "warm_start", True))
 
 
 def _parse_baselines(path: Path, raw: Any) -> dict:
@@ -167,6 +169,13 @@ def _whole(path: Path, data: Mapping, key: str, default: int, least: int) -> int
     value = data.get(key, default)
     if isinstance(value, bool) or not isinstance(value, int) or value < least:
         raise ConfigError(f"{path}: {key}: expected a whole number >= {least}, got {shown(value)}")
+    return value
+
+
+def _flag(path: Path, data: Mapping, key: str, default: bool) -> bool:
+    value = data.get(key, default)
+    if not isinstance(value, bool):
+        raise ConfigError(f"{path}: {key}: expected true or false, got {shown(value)}")
     return value
 
 

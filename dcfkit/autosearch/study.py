@@ -1,7 +1,9 @@
 """The search: one Optuna study per fold on the other folds' sequences, its best config then
 scored on the fold it never saw, and a final study on every sequence (docs/search.md).
 
-Trials run one after another (a trial's runs use the pool); each is recorded in
+Trial 0 of each study is the base config (``warm_start``, :func:`~dcfkit.autosearch.warm_start.base_params`),
+so a study's best is never below the base on its own sequences. Trials run one after another
+(a trial's runs use the pool); each is recorded in
 ``OUT/trials/<study>/<n>.json`` once scored. Trial n's values depend only on the seed and
 trials 0..n-1 (a sampler seeded per trial is given the recorded trials), so a search killed
 at any point resumes to the same trials and the same result."""
@@ -22,6 +24,7 @@ from dcfkit.ablation.layout import warn_old_layout
 from dcfkit.ablation.spec_keys import data_record, roots_text
 from dcfkit.autosearch.evaluation import Evaluator
 from dcfkit.autosearch.space import SearchSpec, active
+from dcfkit.autosearch.warm_start import base_params
 from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, summarize
 from dcfkit.datasets import scored_sequences
 from dcfkit.errors import DcfkitError, clip, shown
@@ -51,6 +54,7 @@ def fingerprint(spec: SearchSpec, folds: list[list[str]], evaluator: Evaluator) 
             "startup_trials": spec.startup_trials, "dataset": data_record(spec)["dataset"],
             "protocol": evaluator.protocol.name if evaluator.protocol else None,
             "sequences": sorted(evaluator.sequences), "max_frames": spec.max_frames,  # folds sort them too
+            "warm_start": spec.warm_start,
             "data": {name: data_identity(seq) for name, seq in evaluator.sequences.items()}}
 
 
@@ -182,7 +186,14 @@ class Search:
             old = {**old, "data": mine["data"]}
         if old and "max_frames" not in old:  # recorded before --max-frames was: whole sequences
             old = {**old, "max_frames": None, "sequences": sorted(old.get("data") or {})}
+        if old and "warm_start" not in old:  # recorded before dcfkit 0.14.0: every trial sampled
+            old = {**old, "warm_start": False}
         changed = [k for k in mine if old.get(k) != mine[k]]
+        if "warm_start" in changed:
+            raise DcfkitError(f"{path}: its trials were made with warm_start: {str(old['warm_start']).lower()} "
+                              f"(trial 0 {'the base config' if old['warm_start'] else 'sampled'}), this spec has "
+                              f"warm_start: {str(mine['warm_start']).lower()}: set the recorded value in the spec "
+                              f"to resume it, or give a new --out")
         for key, option in (("max_frames", "--max-frames"), ("sequences", "--sequences")):
             if key in changed:
                 raise DcfkitError(f"{path}: its trials were made with {option} {_option_value(old[key])}, this "
@@ -223,7 +234,11 @@ class Search:
         config and run key are checked against each other and against this search."""
         if rec.get("number") != number:
             return f"number: expected {number}, got {shown(rec.get('number'))}"
-        fault = _params_fault(self.spec, rec.get("params"))
+        if number == 0 and self.spec.warm_start:
+            base = base_params(self.spec)
+            fault = None if rec.get("params") == base else f"params: expected the base config's, {shown(base)}"
+        else:
+            fault = _params_fault(self.spec, rec.get("params"))
         fault = fault or _scores_fault(rec, self.training(study))
         if fault:
             return fault
@@ -243,7 +258,8 @@ class Search:
         records = self.recorded(study)
         make_dir(self.out / "trials" / study)
         for n in range(len(records), self.spec.trials):
-            params = sample(self.spec, study, n, records)
+            # warm start: the base is trial 0, so a study's best is never below it on its sequences
+            params = base_params(self.spec) if n == 0 and self.spec.warm_start else sample(self.spec, study, n, records)
             try:
                 config = self.spec.config(params)
             except DcfkitError as exc:  # the spec check resolves every structure; a value inside a range may fail

@@ -20,6 +20,7 @@ from dcfkit import cli
 from dcfkit.ablation import load_spec
 from dcfkit.analysis.scoring import evaluate
 from dcfkit.autosearch import Search, SearchSpec, load_search_spec, make_folds
+from dcfkit.autosearch.warm_start import base_params
 from dcfkit.autosearch.study import sample
 from dcfkit.autosearch.summary import best
 from dcfkit.config import load_config
@@ -302,7 +303,7 @@ def test_experiments_on_the_command_line_replace_the_specs_and_are_recorded(tmp_
 
 @pytest.mark.slow
 def test_a_search_killed_with_sigkill_resumes_to_the_same_result(tmp_path, data):
-    spec = write(tmp_path / "s.yaml", SPEC)
+    spec = write(tmp_path / "s.yaml", SPEC.replace("trials: 3", "trials: 2"))  # the base, then one sampled
     cmd = [sys.executable, "-m", "dcfkit.cli", "search", str(spec), "--jobs", "2"]
     subprocess.run([*cmd, "--out", str(tmp_path / "whole")], check=True, capture_output=True, timeout=300)
     out = tmp_path / "killed"
@@ -354,3 +355,39 @@ def test_a_search_warns_once_of_runs_in_the_old_layout(tmp_path, data, caplog):
     said = [r.getMessage() for r in caplog.records if "old layout" in r.getMessage()]
     assert len(said) == 1 and "OUT/runs/<run key>/, OUT/baselines/<name>/" in said[0]
     assert (tmp_path / "out" / "baselines" / "KCF").is_dir()
+
+
+def test_trial_0_of_every_study_is_the_base_so_no_study_ends_below_it(tmp_path, data):
+    spec = load_search_spec(write(tmp_path / "s.yaml", SPEC.replace("trials: 3", "trials: 2")))
+    assert spec.warm_start
+    Search(spec, tmp_path / "out", {"jobs": 1}).run()
+    base = json.loads(json.dumps(spec.base))
+    for study in STUDIES:
+        trials = [json.loads(p.read_text()) for p in sorted((tmp_path / "out/trials" / study).glob("*.json"))]
+        # strcf as a point of the space: its label's choice, its θ and ADMM iterations
+        assert trials[0]["params"] == {"label": "gaussian", "regularizers.temporal.theta": 15.0, "solver.iterations": 2}
+        assert trials[0]["config"] == base
+        assert max(t["value"] for t in trials) >= trials[0]["value"]
+
+
+def test_a_base_outside_the_space_is_trial_0_by_its_score_alone(tmp_path, data):
+    outside = SPEC.replace("float: [4, 40]", "float: [20, 40]")  # strcf's θ is 15
+    spec = load_search_spec(write(tmp_path / "s.yaml", outside))
+    params = base_params(spec)
+    assert params == {} and spec.config(params) == spec.base
+    assert sample(spec, "fold1", 1, [{"params": params, "value": 0.4}])  # TPE takes a trial without values
+
+
+def test_warm_start_false_samples_trial_0_and_a_resume_across_the_switch_is_refused(tmp_path, data, capsys):
+    spec = write(tmp_path / "s.yaml", SPEC.replace("trials: 3", "trials: 1\nwarm_start: false"))
+    out = tmp_path / "out"
+    assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1"]) == 0
+    rec = json.loads((out / "trials/fold1/0000.json").read_text())
+    assert rec["params"] == sample(load_search_spec(spec), "fold1", 0, [])
+    write(spec, SPEC.replace("trials: 3", "trials: 1"))
+    capsys.readouterr()
+    assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1"]) != 0
+    assert "made with warm_start: false (trial 0 sampled), this spec has warm_start: true" in capsys.readouterr().err
+    write(spec, SPEC.replace("trials: 3", "trials: 1\nwarm_start: 1"))
+    with pytest.raises(ConfigError, match="warm_start: expected true or false, got 1"):
+        load_search_spec(spec)

@@ -79,8 +79,8 @@ def test_trials_without_a_readable_search_record_are_refused(copy, capsys, recor
 
 
 def _other_study(rec: dict, out: Path) -> str:
-    """Trial 0 of fold 2, whose training sequences are fold 1's held-out ones."""
-    return (out / "trials/fold2/0000.json").read_text()
+    """Trial 1 of fold 2, whose training sequences are fold 1's held-out ones."""
+    return (out / "trials/fold2/0001.json").read_text()
 
 
 def _edited(**change):
@@ -101,7 +101,7 @@ EDITS = {
     "params as text": (_edited(params={"solver.sigma": "0.5"}),
                        "params.solver.sigma: '0.5' is not a value its dimension takes"),
     "params empty": (_edited(params={}), "params: expected values for ['solver.sigma']"),
-    "number": (_edited(number=1), "number: expected 0, got 1"),
+    "number": (_edited(number=0), "number: expected 1, got 0"),
     "key": (_edited(key="0" * 16), "key: not its config's run key"),
     "other study": (_other_study, "scores: expected those of this study's training sequences ['seqA', 'seqD']"),
 }
@@ -111,18 +111,31 @@ EDITS = {
 def test_a_damaged_or_edited_trial_record_is_redone_with_a_warning_naming_it(copy, caplog, edit, fault):
     """Each edit used to resume silently or die in a traceback (TypeError, KeyError,
     AttributeError, Optuna's ValueError) naming no file; now the record is run again, to the
-    same values, and the warning names the file and what is wrong."""
-    path = copy / "out/trials/fold1/0000.json"
-    original = {p: p.read_bytes() for p in (path, copy / "out/trials/fold1/0001.json")}
+    same values, and the warning names the file and what is wrong. Trial 1 is edited: trial 0
+    is the base (warm start), whose own case follows."""
+    path = copy / "out/trials/fold1/0001.json"
+    original = {path: path.read_bytes()}
     summary = json.loads((copy / "out/summary.json").read_text())
     path.write_text(edit(json.loads(path.read_text()), copy / "out"))
     with caplog.at_level("WARNING", logger="dcfkit.autosearch.study"):
         Search(load_search_spec(copy / "s.yaml"), copy / "out", {"jobs": 1}).run()
     warned = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
     assert len(warned) == 1 and warned[0].startswith(f"{path} is not a trial record as dcfkit writes it ({fault}")
-    assert warned[0].endswith("trial 0 of fold1 is run again, and the trials after it")
+    assert warned[0].endswith("trial 1 of fold1 is run again, and the trials after it")
     assert {p: p.read_bytes() for p in original} == original
     assert {**json.loads((copy / "out/summary.json").read_text()), "spec": summary["spec"]} == summary
+
+
+def test_a_trial_0_that_is_not_the_base_is_redone_as_the_base(copy, caplog):
+    """Trial 1's record put in trial 0's place: sampled values, where the base's stand."""
+    path = copy / "out/trials/fold1/0000.json"
+    base = path.read_bytes()
+    path.write_text(json.dumps({**json.loads((copy / "out/trials/fold1/0001.json").read_text()), "number": 0}))
+    with caplog.at_level("WARNING", logger="dcfkit.autosearch.study"):
+        Search(load_search_spec(copy / "s.yaml"), copy / "out", {"jobs": 1}).run()
+    warned = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert len(warned) == 1 and "(params: expected the base config's, {'solver.sigma': 0.5})" in warned[0]
+    assert path.read_bytes() == base
 
 
 def test_a_chain_of_whens_is_followed_when_the_spec_is_read(tmp_path):

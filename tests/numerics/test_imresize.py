@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from dcfkit.numerics.imresize import imresize
+from dcfkit.numerics.imresize import _along, contributions, imresize
 
 
 def keys_cubic(x):
@@ -72,8 +72,6 @@ def test_uint8_is_rounded_after_each_axis_and_a_same_size_resize_is_a_copy():
 def test_each_axis_sums_its_taps_in_order_bit_for_bit(dtype, shape, out):
     """The compiled sums round as the whole-array tap passes do (imresizemex's order): a product,
     then a sum, tap by tap, so boxes stay the same whichever way the sum is written."""
-    from dcfkit.numerics.imresize import _along, contributions
-
     rng = np.random.default_rng(len(shape))
     x = (rng.integers(0, 256, shape) if dtype == np.uint8 else rng.random(shape) * 255).astype(dtype)
     for axis in (0, 1):
