@@ -28,7 +28,7 @@ from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.datasets.video import open_source
 from dcfkit.errors import ConfigError, DcfkitError, InputError
 
-CONFIGS = ("strcf", "bacf", "dr2track", "kcf", "dsst", "csrdcf")
+CONFIGS = ("strcf", "bacf", "dr2track", "kcf", "dsst", "csrdcf", "eco_hc")
 SEQUENCE = make_sequence(n_frames=2, size=(72, 96), target=(10, 14), distractor=False)
 _TRACKERS: dict[str, dcfkit.Tracker] = {}
 
@@ -144,18 +144,30 @@ def pyramid_span(least: int):
 def tracker_configs(draw):
     """A shipped config with its tracker section and scale parameters anywhere in their ranges."""
     config = draw(st.sampled_from(CONFIGS))
-    scale = load_config(config)["scale"]["name"]
+    shipped = load_config(config)
+    scale = shipped["scale"]["name"]
     sides = st.one_of(st.integers(8, 250), st.integers(8, 2000))  # of the sample areas' squares
     low, high = sorted(float(v * v) for v in draw(st.lists(sides, min_size=2, max_size=2)))
-    overrides = {"tracker.search_area_scale": draw(st.floats(1, 50)),
-                 "tracker.search_area_shape": draw(st.sampled_from(["square", "proportional"])),
+    template = shipped["tracker"].get("search_area_shape") == "padded_square"  # CSR-DCF's, whole pixels only
+    shape = draw(st.sampled_from(["square", "proportional"] + ["padded_square"] * template))
+    sampling = "whole_pixel" if shape == "padded_square" else draw(st.sampled_from(["subpixel", "whole_pixel"]))
+    overrides = {"tracker.search_area_scale": draw(st.floats(1, 50)), "tracker.search_area_shape": shape,
                  "tracker.min_image_sample_size": low, "tracker.max_image_sample_size": high,
                  "tracker.cell_size": draw(st.one_of(st.integers(2, 8), st.integers(1, 64))),
                  "tracker.cell_selection_thresh": draw(st.sampled_from([0.0, 0.75**2, 1.0])),
-                 "tracker.sampling": draw(st.sampled_from(["subpixel", "whole_pixel"]))}
+                 "tracker.sampling": sampling}
+    if shape != "padded_square" and shipped["tracker"].get("resize", "auto") != "auto":  # the template's resize
+        overrides["tracker.resize"] = "auto"
+    if shipped["solver"]["name"] == "eco":  # the continuous loop refuses the keys it does not read
+        del overrides["tracker.cell_selection_thresh"], overrides["tracker.sampling"]
     if scale == "fixed":  # KCF: one scale, no parameters
         return config, overrides
-    n, step = draw(pyramid_span(3 if scale == "dsst" else 1))
+    n, step = draw(pyramid_span(3 if scale in ("dsst", "fdsst") else 1))
+    if scale == "fdsst":  # ECO-HC's: the span is of the interpolated scales, sampled at fewer
+        overrides.update({"scale.n_interp": n, "scale.step": step, "scale.n_scales": draw(st.integers(3, n)),
+                          "scale.model_max_area": draw(st.integers(1, 10000)),
+                          "scale.cell_size": draw(st.integers(1, 16))})
+        return config, overrides
     overrides.update({"scale.n_scales": n, "scale.step": step})
     if scale == "dsst":
         overrides.update({"scale.model_max_area": draw(st.integers(1, 10000)),
