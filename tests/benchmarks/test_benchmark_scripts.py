@@ -53,6 +53,21 @@ def test_stages(tmp_path):
 
 
 @pytest.mark.slow
+def test_floor(tmp_path):
+    out = run("floor.py", "--root", str(tmp_path / "none"), "--configs", "kcf,eco_hc", "--frames", "8", "--probe", "3",
+              "--repeats", "2", "--json", "floor.json", tmp_path=tmp_path)
+    rows = {r["config"]: r for r in json.loads((tmp_path / "floor.json").read_text())["rows"]}
+    # the arithmetic of each loop is found: the discrete loop's components and FFTs, and the
+    # continuous loop's own numerics (ECO's projection, its Fourier-series peak)
+    assert {"extract_stack", "fft", "solver kernel_ridge", "subpixel_peak"} <= set(rows["kcf"]["floor_ms"])
+    assert {"extract", "project", "newton_maximum", "scale fdsst"} <= set(rows["eco_hc"]["floor_ms"])
+    for row in rows.values():
+        assert row["floor_fps"] == pytest.approx(1000 / sum(row["floor_ms"].values()))
+        assert row["ratio"] == pytest.approx(row["fps"] / row["floor_fps"])
+    assert "synthetic_720p kcf" in out and "median over the real sequences" in out
+
+
+@pytest.mark.slow
 def test_speed(tmp_path):
     from dcfkit.integrations.opencv import available_opencv_trackers  # reason: only this test asks
 
