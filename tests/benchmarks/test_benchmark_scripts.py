@@ -176,3 +176,10 @@ def test_decide_pairs_each_option_with_its_base(tmp_path, capsys):
     assert up["passes"] and not mixed["passes"] and (mixed["difference"].won, mixed["difference"].lost) == (4, 4)
     assert decide.main([str(path)]) == 0
     assert "- T + up: adopt" in capsys.readouterr().out
+    # non-inferiority: '+ mixed' (mean 0, lower bound -0.05 by hand: half the sequences lose 0.05)
+    # is within a margin of 0.06, not of 0.01; '+ up' is within any
+    for margin, kept in ((0.06, True), (0.01, False)):
+        rows = {r["option"]: r for r in decide.decide(decide.read_scores(path, "auc"), margin)}
+        assert rows["mixed"]["difference"].ci_low >= -0.05 and rows["mixed"]["passes"] is kept and rows["up"]["passes"]
+    assert decide.main([str(path), "--margin", "0.06"]) == 0
+    assert "- T + mixed: adopt (non-inferiority, δ 0.06)" in capsys.readouterr().out
