@@ -102,7 +102,7 @@ def load_config(source: str | Path | Mapping, overrides: Mapping[str, Any] | Non
                               f"apply; give that config instead (its shipped name or file), or write a file whose "
                               f"base: names it")
         check_value(value, f"override '{clip(key)}'")
-        set_dotted(data, key, value)
+        set_dotted(data, key, copy.deepcopy(value))  # a later dotted key must not write into the caller's value
     check_value(data, origin)  # dotted keys nest values deeper; merged files add up
     try:
         return resolve(data, origin)

@@ -391,3 +391,19 @@ def test_warm_start_false_samples_trial_0_and_a_resume_across_the_switch_is_refu
     write(spec, SPEC.replace("trials: 3", "trials: 1\nwarm_start: 1"))
     with pytest.raises(ConfigError, match="warm_start: expected true or false, got 1"):
         load_search_spec(spec)
+
+
+def test_a_choice_keeps_its_values_after_the_spec_check(tmp_path, data):
+    """Checking the space resolved each choice with its dimensions at both ends of their ranges,
+    and the resolving wrote those ends into the choice's own mapping: a trial that did not
+    sample label.mu (top_n 30) then ran with mu 1.0, the range's end, not the spec's 0.25."""
+    nested = SPEC.replace("  label: {choice: {gaussian: {name: gaussian}, repressed: {name: distractor_repressed}}}\n"
+                          "  label.mu: {float: [0.05, 1.0], log: true, when: {label: repressed}}\n",
+                          "  label: {choice: {gaussian: {name: gaussian}, repressed: {name: distractor_repressed, mu: 0.25}}}\n"
+                          "  label.top_n: {choice: [10, 30], when: {label: repressed}}\n"
+                          "  label.mu: {float: [0.05, 1.0], when: {label.top_n: '10'}}\n")
+    spec = load_search_spec(write(tmp_path / "s.yaml", nested))
+    assert spec.parameters[0].choices["repressed"] == {"name": "distractor_repressed", "mu": 0.25}
+    config = spec.config({"label": "repressed", "label.top_n": "30", "regularizers.temporal.theta": 10.0,
+                          "solver.iterations": 2})
+    assert (config["label"]["mu"], config["label"]["top_n"]) == (0.25, 30)

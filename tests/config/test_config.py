@@ -233,3 +233,10 @@ def test_missing_config_lists_shipped_ones():
     with pytest.raises(ConfigError, match=r"config not found: nope.*dr2track"):
         load_config("nope")
     assert (shipped_config_dir() / "dr2track.yaml").is_file()
+
+
+def test_an_override_value_is_not_written_into_by_a_later_key():
+    """load_config(base, {"label": d, "label.mu": 0.5}) set mu inside the caller's own d."""
+    label = {"name": "distractor_repressed", "mu": 0.25}
+    config = load_config("dr2track", {"label": label, "label.mu": 0.5})
+    assert config["label"]["mu"] == 0.5 and label == {"name": "distractor_repressed", "mu": 0.25}
