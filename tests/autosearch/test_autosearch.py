@@ -407,3 +407,12 @@ def test_a_choice_keeps_its_values_after_the_spec_check(tmp_path, data):
     config = spec.config({"label": "repressed", "label.top_n": "30", "regularizers.temporal.theta": 10.0,
                           "solver.iterations": 2})
     assert (config["label"]["mu"], config["label"]["top_n"]) == (0.25, 30)
+
+
+def test_the_shipped_base_is_a_point_of_the_shipped_space(tmp_path):
+    """Trial 0 of the uav search is DR²Track placed in the space, so TPE models the trials
+    around it (no data is read to place it)."""
+    spec = load_search_spec("uav", root=tmp_path)
+    params = base_params(spec)
+    assert params["label"] == "repressed" and params["scale"] == "dsst" and params["label.mu"] == 0.25
+    assert spec.config(params) == spec.base
