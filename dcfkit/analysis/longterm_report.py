@@ -110,12 +110,10 @@ def _image_sizes(sequences: Seq[Sequence]) -> tuple[dict[str, tuple[int, int]], 
     sizes, unread = {}, []
     for seq in sequences:
         try:
-            height, width = seq.frame(0).shape[:2]
+            sizes[seq.name] = seq.image_size
         except DcfkitError as exc:
             log.warning("long-term overlaps of %r are not bounded by the image: %s", seq.name, exc)
             unread.append(seq.name)
-            continue
-        sizes[seq.name] = (width, height)
     return sizes, unread
 
 

@@ -51,9 +51,8 @@ def reset_runs(folder: Path, sequences: Seq[Sequence]) -> dict[str, ResetRun]:
                         "dcfkit <= 0.9.0's continuous overlap" if rule is None else f"rule {rule!r}",
                         ", ".join(RULES))
             continue
-        height, width = seq.frame(0).shape[:2]
         run = ResetRun(result.boxes, seq.ground_truth, tuple(i - 1 for i in result.resets["starts"]),
-                       tuple(i - 1 for i in result.resets["failures"]), (width, height), rule)
+                       tuple(i - 1 for i in result.resets["failures"]), seq.image_size, rule)
         problem = resets_problem(run)
         if problem is not None:
             log.warning("%s: sequence %r left out, its sidecar's resets are not its boxes' (%s); run it again to "

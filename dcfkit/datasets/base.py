@@ -6,6 +6,7 @@ from __future__ import annotations
 import collections
 import dataclasses
 import difflib
+import functools
 import logging
 import os
 import warnings
@@ -130,6 +131,13 @@ class Sequence:
         """Frame ``i`` (0-based index) as ``(H, W, 3) uint8`` BGR; a :class:`DatasetError` if
         unreadable, which numbers the frame from 1 as the benchmarks' files do."""
         return read_frame(self.frames[i], f"frame {i + 1} of sequence {self.name!r}")
+
+    @functools.cached_property
+    def image_size(self) -> tuple[int, int]:
+        """``(width, height)`` of frame 1, read once per sequence (the bound of the toolkits'
+        overlaps); a :class:`DatasetError` if it cannot be read."""
+        height, width = self.frame(0).shape[:2]
+        return width, height
 
 
 # --------------------------------------------------------------------------- images

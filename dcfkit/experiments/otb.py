@@ -73,7 +73,7 @@ def tre_plan(seq: Sequence) -> Plan:
         raise DatasetError(f"sequence {seq.name!r}: {exc}") from None
     runs = [(dataclasses.replace(seq, name=run_name(seq, k), frames=seq.frames[s:], ground_truth=seq.ground_truth[s:],
                                  start_box=None), f"from frame {s + 1}") for k, s in enumerate(starts, 1)]
-    return plan_runs(seq, runs, "TRE", seq.frame(0).shape[:2])
+    return plan_runs(seq, runs, "TRE", seq.image_size[::-1])
 
 
 def tre_runs(seq: Sequence) -> list[Sequence]:
@@ -127,7 +127,7 @@ def sre_plan(seq: Sequence) -> Plan:
     first = seq.ground_truth[0]
     if not (np.isfinite(first).all() and (first[2:] > 0).all()):
         raise DatasetError(f"sequence {seq.name!r}: SRE shifts frame 1's ground truth, which is NaN or empty")
-    size = seq.frame(0).shape[:2]
+    size = seq.image_size[::-1]  # (h, w)
     return plan_runs(seq, [(dataclasses.replace(seq, name=run_name(seq, k), start_box=sre_box(first, shift, size)),
                             f"shift {shift}") for k, shift in enumerate(SRE_SHIFTS, 1)], "SRE", size)
 
