@@ -76,6 +76,13 @@ def _signed_frequencies(n: int) -> np.ndarray:
     return np.where(k <= (n - 1) // 2 + (n % 2 == 0), k, k - n).astype(np.float64)
 
 
+def _key(y: float, x: float) -> bytes:
+    """A Newton step's point bit for bit (+0.0 and -0.0 differ), NaN never twice alike."""
+    if y != y or x != x:
+        return object()  # a NaN step runs on, as it always did
+    return np.array([y, x], dtype=np.float64).tobytes()
+
+
 def newton_peak(maps: np.ndarray, iterations: int = 5, spectra: np.ndarray | None = None
                 ) -> tuple[int, float, float, float]:
     """The authors' ``resp_newton`` (STRCF, BACF, DR²Track): over (S, H, W) circular maps, the
@@ -103,7 +110,9 @@ def newton_peak(maps: np.ndarray, iterations: int = 5, spectra: np.ndarray | Non
         spectrum = np.fft.fft2(r) if spectra is None else np.asarray(spectra[s], np.complex128)
         y, x = y0, x0
         ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
-        for _ in range(iterations):
+        seen = {_key(y, x): 0}  # each point the steps reached -> after how many steps
+        path = [(y, x)]
+        for i in range(iterations):
             m00, m10, m01, m20, m02, m11 = _moments(spectrum, ey, ex, ky, kx)
             grad_y, grad_x = -m10.imag, -m01.imag
             ival = 1j * m00
@@ -111,6 +120,14 @@ def newton_peak(maps: np.ndarray, iterations: int = 5, spectra: np.ndarray | Non
             det = h_yy * h_xx - h_xy * h_xy
             with np.errstate(divide="ignore", invalid="ignore"):
                 y, x = y - (h_xx * grad_y - h_xy * grad_x) / det, x - (h_yy * grad_x - h_xy * grad_y) / det
+            first = seen.setdefault(_key(y, x), i + 1)
+            if first != i + 1:
+                # the steps cycle in the last bits: a step depends on (y, x) alone, so the point
+                # after all the iterations is the cycle's, bit for bit
+                y, x = path[first + (iterations - first) % (i + 1 - first)]
+                ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
+                break
+            path.append((y, x))
             ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
         value = float(_moments(spectrum, ey, ex, ky, kx)[0].real) / (h * w)
         if not value >= init_value:  # lower (or NaN): the grid maximum

@@ -341,3 +341,42 @@ def test_parabola_peak_by_hand():
     flat = np.zeros((5, 5), np.float32)
     flat[0, 0] = 1.0
     assert parabola_peak(flat) == (0.0, 0.0)
+
+
+def every_step(r, iterations):
+    """resp_newton's loop on one map, all ``iterations`` steps taken: (y, x) as angles."""
+    h, w = r.shape
+    ky, kx = _signed_frequencies(h), _signed_frequencies(w)
+    flat = int(np.argmax(r.T))
+    row, col = flat % h, flat // h
+    y = 2 * np.pi * (((row + (h - 1) // 2) % h) - (h - 1) // 2) / h
+    x = 2 * np.pi * (((col + (w - 1) // 2) % w) - (w - 1) // 2) / w
+    y0, x0 = y, x
+    spectrum = np.fft.fft2(r.astype(np.float64))
+    moments = lambda y, x: peak_kernels.moments(spectrum, np.exp(1j * ky * y), np.exp(1j * kx * x),  # noqa: E731
+                                                ky.astype(float), kx.astype(float))
+    for _ in range(iterations):
+        m = moments(y, x)
+        gy, gx, ival = -m[1].imag, -m[2].imag, 1j * m[0]
+        hyy, hxx, hxy = (-m[3] + ival).real, (-m[4] + ival).real, (-m[5]).real
+        det = hyy * hxx - hxy * hxy
+        with np.errstate(divide="ignore", invalid="ignore"):
+            y, x = y - (hxx * gy - hxy * gx) / det, x - (hyy * gx - hxy * gy) / det
+    value = moments(y, x)[0].real / (h * w)
+    return (y, x) if value >= r[row, col] else (y0, x0)  # a step that lost: the grid maximum
+
+
+@pytest.mark.parametrize("iterations", [5, 50, 51])
+def test_newton_peak_stops_at_a_cycle_with_the_result_of_every_step(iterations):
+    """BACF takes 50 steps; they reach a fixed point or a cycle of a few last-bit values within
+    about ten. newton_peak stops there and takes the point the remaining steps would end on:
+    the same bits as taking them all, whatever the parity of the steps left."""
+    rng = np.random.default_rng(iterations)
+    for trial in range(20):
+        n = 24 + trial % 7
+        r = cosine_peak_map(n, n, *rng.uniform(-3, 3, 2)) + 0.05 * rng.standard_normal((n, n))
+        r = r.astype(np.float32)
+        _, dy, dx, _ = newton_peak(r[None], iterations)
+        y, x = every_step(r, iterations)
+        assert dy == (np.mod(y + np.pi, 2 * np.pi) - np.pi) / (2 * np.pi) * n
+        assert dx == (np.mod(x + np.pi, 2 * np.pi) - np.pi) / (2 * np.pi) * n
