@@ -197,8 +197,8 @@ def main():
         hd = [r for r in rows if r["config"] == config and r["sequence"] == "synthetic_720p"]
         medians[config] = {k: statistics.median(r[k] for r in real) for k in ("fps", "floor_fps", "ratio")}
         m = medians[config]
-        print(f"  {config:<12} {m['fps']:7.1f} fps  floor {m['floor_fps']:7.1f} fps  x{m['ratio']:.2f}"
-              + (f"   720p {hd[0]['fps']:.1f} fps, floor {hd[0]['floor_fps']:.1f}, x{hd[0]['ratio']:.2f}" if hd else ""))
+        hd_text = f"   720p {hd[0]['fps']:.1f} fps, floor {hd[0]['floor_fps']:.1f}, x{hd[0]['ratio']:.2f}" if hd else ""
+        print(f"  {config:<12} {m['fps']:7.1f} fps  floor {m['floor_fps']:7.1f} fps  x{m['ratio']:.2f}{hd_text}")
     if args.json:
         Path(args.json).write_text(json.dumps({"rows": rows, "median": medians}, indent=1))
 

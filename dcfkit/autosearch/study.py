@@ -1,9 +1,9 @@
 """The search: one Optuna study per fold on the other folds' sequences, its best config then
 scored on the fold it never saw, and a final study on every sequence (docs/search.md).
 
-Trial 0 of each study is the base config (``warm_start``, :func:`~dcfkit.autosearch.warm_start.base_params`),
-so a study's best is never below the base on its own sequences. Trials run one after another
-(a trial's runs use the pool); each is recorded in
+Trial 0 of each study is the base config (``warm_start``,
+:func:`~dcfkit.autosearch.warm_start.base_params`), so a study's best is never below the base on
+its own sequences. Trials run one after another (a trial's runs use the pool); each is recorded in
 ``OUT/trials/<study>/<n>.json`` once scored. Trial n's values depend only on the seed and
 trials 0..n-1 (a sampler seeded per trial is given the recorded trials), so a search killed
 at any point resumes to the same trials and the same result."""
@@ -24,8 +24,8 @@ from dcfkit.ablation.layout import warn_old_layout
 from dcfkit.ablation.spec_keys import data_record, roots_text
 from dcfkit.autosearch.evaluation import Evaluator
 from dcfkit.autosearch.space import SearchSpec, active
-from dcfkit.autosearch.warm_start import base_params
 from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, summarize
+from dcfkit.autosearch.warm_start import base_params
 from dcfkit.datasets import scored_sequences
 from dcfkit.errors import DcfkitError, clip, shown
 from dcfkit.store.files import atomic_write, ensure_writable, exclusive, make_dir, read_json
