@@ -191,11 +191,14 @@ SIMULATED_PLATFORM = {
                     reason="the simulated platform switches x86-64 SIMD paths")
 def test_parity_on_a_simulated_platform(shared_data, tmp_path):
     """The box-for-box tests of STRCF, DR²Track and BACF above, again in a process whose
-    arithmetic is another platform's: they pass there as here."""
+    arithmetic is another platform's: they pass there as here. STRCF and DR²Track on their DTB70
+    and UAVDT sequences, BACF on its two: a platform's arithmetic parts boxes from frame 2
+    ("Platform noise" in docs/results.md), so these find it as the six longer UAV123@10fps
+    sequences would, in a quarter of the time."""
     env = {**os.environ, **SIMULATED_PLATFORM, "NUMBA_CACHE_DIR": str(tmp_path / "numba_cache"),
            "DCFKIT_TEST_DATA": str(shared_data)}
     command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(Path(__file__)),
-               "-k", "box_for_box or is_the_authors_code"]
+               "-k", "(box_for_box or is_the_authors_code) and not uav123_10fps"]
     run = subprocess.run(command, env=env, capture_output=True, text=True, cwd=Path(__file__).parents[2])
     assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-2000:]
-    assert "7 passed" in run.stdout, run.stdout[-2000:]
+    assert "5 passed" in run.stdout, run.stdout[-2000:]
