@@ -4,27 +4,15 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 from dcfkit.ablation.experiment import scope_title
 from dcfkit.ablation.spec import AblationSpec, format_value
 from dcfkit.analysis.plots import save_figure
+from dcfkit.config.overrides import get_dotted
 from dcfkit.protocols import DEFAULT
 
 METRICS = (("precision", "precision@20", "C3", "o", "#d62728"), ("auc", "AUC", "C0", "s", "#1f77b4"))
-
-
-def get_dotted(config: Any, key: str) -> Any:
-    """The value at dotted ``key`` of ``config`` (list items by index), or None."""
-    node = config
-    for part in key.split("."):
-        if isinstance(node, list) and part.lstrip("-").isdigit() and -len(node) <= int(part) < len(node):
-            node = node[int(part)]
-        elif isinstance(node, Mapping) and part in node:
-            node = node[part]
-        else:
-            return None
-    return node
 
 
 def _is_number(value: Any) -> bool:

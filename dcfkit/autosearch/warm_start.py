@@ -1,11 +1,12 @@
 """Warm start: the base config as trial 0 of every study, placed in the space (docs/search.md)."""
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Any
 
 from optuna.distributions import BaseDistribution, IntDistribution
 
 from dcfkit.autosearch.space import SearchSpec, active, resolve
+from dcfkit.config.overrides import get_dotted
 
 
 def base_params(spec: SearchSpec) -> dict[str, Any]:
@@ -21,21 +22,13 @@ def base_params(spec: SearchSpec) -> dict[str, Any]:
             found = [label for label, value in p.choices.items()
                      if resolve(spec.base, spec.parameters, {**params, p.key: label}) == spec.base]
         else:
-            held = _dotted(spec.base, p.key)
+            held = get_dotted(spec.base, p.key)
             kind = int if isinstance(p.distribution, IntDistribution) else float
             found = [kind(held)] if _inside(p.distribution, held) else []
         if not found:
             return {}
         params[p.key] = found[0]
     return params if resolve(spec.base, spec.parameters, params) == spec.base else {}
-
-
-def _dotted(config: Mapping, key: str) -> Any:
-    """The value at a dotted ``key`` of ``config`` (None where a part is missing)."""
-    value: Any = config
-    for part in key.split("."):
-        value = value.get(part) if isinstance(value, Mapping) else None
-    return value
 
 
 def _inside(distribution: BaseDistribution, value: Any) -> bool:

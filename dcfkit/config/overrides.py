@@ -47,6 +47,19 @@ def parse_overrides(items) -> dict:
     return out
 
 
+def get_dotted(config: Any, key: str) -> Any:
+    """The value at dotted ``key`` of ``config`` (list items by index), or None."""
+    node = config
+    for part in key.split("."):
+        if isinstance(node, list) and part.lstrip("-").isdigit() and -len(node) <= int(part) < len(node):
+            node = node[int(part)]
+        elif isinstance(node, Mapping) and part in node:
+            node = node[part]
+        else:
+            return None
+    return node
+
+
 def set_dotted(config: dict, key: str, value: Any) -> None:
     """Set ``a.b.0.c`` in nested dicts/lists; list indices are integers."""
     parts = key.split(".")
