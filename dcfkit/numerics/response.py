@@ -112,11 +112,10 @@ def newton_peak(maps: np.ndarray, iterations: int = 5, spectra: np.ndarray | Non
         # resp_newton refines on the response's spectrum as computed (complex with FullSpectra)
         spectrum = np.fft.fft2(r) if spectra is None else np.asarray(spectra[s], np.complex128)
         y, x = y0, x0
-        ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
         seen = {_key(y, x): 0}  # each point the steps reached -> after how many steps
         path = [(y, x)]
         for i in range(iterations):
-            m00, m10, m01, m20, m02, m11 = _moments(spectrum, ey, ex, ky, kx)
+            m00, m10, m01, m20, m02, m11 = _moments(spectrum, np.exp(1j * ky * y), np.exp(1j * kx * x), ky, kx)
             grad_y, grad_x = -m10.imag, -m01.imag
             ival = 1j * m00
             h_yy, h_xx, h_xy = (-m20 + ival).real, (-m02 + ival).real, (-m11).real
@@ -128,11 +127,9 @@ def newton_peak(maps: np.ndarray, iterations: int = 5, spectra: np.ndarray | Non
                 # the steps cycle in the last bits: a step depends on (y, x) alone, so the point
                 # after all the iterations is the cycle's, bit for bit
                 y, x = path[first + (iterations - first) % (i + 1 - first)]
-                ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
                 break
             path.append((y, x))
-            ey, ex = np.exp(1j * ky * y), np.exp(1j * kx * x)
-        value = float(_moments(spectrum, ey, ex, ky, kx)[0].real) / (h * w)
+        value = float(_moments(spectrum, np.exp(1j * ky * y), np.exp(1j * kx * x), ky, kx)[0].real) / (h * w)
         if not value >= init_value:  # lower (or NaN): the grid maximum
             y, x, value = y0, x0, init_value
         if value > best[3]:
