@@ -15,6 +15,7 @@ from optuna.distributions import BaseDistribution, CategoricalDistribution, Floa
 
 from dcfkit.ablation.experiment import check_experiment
 from dcfkit.ablation.spec import load_spec_config
+from dcfkit.autosearch.halving import Halving, parse_halving
 from dcfkit.ablation.spec_keys import as_mapping, check_keys, parse_datasets, pooled_sequences
 from dcfkit.config import load_config, shipped_config_dir
 from dcfkit.config.bounded_yaml import read_yaml
@@ -23,7 +24,7 @@ from dcfkit.datasets.base import sequence_names
 from dcfkit.errors import ConfigError, DcfkitError, clip, shown
 
 SPEC_KEYS = ("name", "description", "dataset", "sequences", "base", "space", "experiments", "folds",
-             "trials", "startup_trials", "seed", "baselines", "warm_start")
+             "trials", "startup_trials", "seed", "baselines", "warm_start", "halving")
 KINDS = ("choice", "float", "int")
 PARAMETER_KEYS = (*KINDS, "log", "when")
 # configs resolved per group of related dimensions when a spec is read (some 4 ms each)
@@ -78,6 +79,7 @@ class SearchSpec:
     pool: tuple = ()  # pooled datasets: (name, root, origin) of each, ``dataset`` their names joined by "+"
     max_frames: int | None = None  # a quick try (--max-frames): each sequence's first frames only
     warm_start: bool = True  # trial 0 of every study is the base config
+    halving: Halving | None = None  # multi-fidelity: successive halving on the sequence count
 
     def load_sequences(self) -> list:
         """The spec's sequences (of every pooled dataset), each cut to ``max_frames`` if given."""
@@ -138,7 +140,7 @@ def load_search_spec(source: str | os.PathLike, root=None) -> SearchSpec:
         parameters=parameters, experiments=experiments, folds=_whole(path, data, "folds", 4, 2),
         trials=_whole(path, data, "trials", 30, 1), startup_trials=_whole(path, data, "startup_trials", 10, 1),
         seed=_whole(path, data, "seed", 0, 0), baselines=baselines, pool=pool,
-        warm_start=_flag(path, data, "warm_start", True))
+        warm_start=_flag(path, data, "warm_start", True), halving=parse_halving(path, data.get("halving")))
 
 
 def _parse_baselines(path: Path, raw: Any) -> dict:

@@ -23,6 +23,7 @@ from optuna.trial import TrialState
 from dcfkit.ablation.layout import warn_old_layout
 from dcfkit.ablation.spec_keys import data_record, roots_text
 from dcfkit.autosearch.evaluation import Evaluator
+from dcfkit.autosearch.halving import Ladder, intermediate, sequence_order
 from dcfkit.autosearch.space import SearchSpec, active
 from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, summarize
 from dcfkit.autosearch.warm_start import base_params
@@ -54,7 +55,7 @@ def fingerprint(spec: SearchSpec, folds: list[list[str]], evaluator: Evaluator) 
             "startup_trials": spec.startup_trials, "dataset": data_record(spec)["dataset"],
             "protocol": evaluator.protocol.name if evaluator.protocol else None,
             "sequences": sorted(evaluator.sequences), "max_frames": spec.max_frames,  # folds sort them too
-            "warm_start": spec.warm_start,
+            "warm_start": spec.warm_start, "halving": spec.halving.as_record() if spec.halving else None,
             "data": {name: data_identity(seq) for name, seq in evaluator.sequences.items()}}
 
 
@@ -83,11 +84,16 @@ def sample(spec: SearchSpec, study: str, number: int, recorded: list[dict]) -> d
 
 def _frozen(rec: dict, distributions: dict) -> optuna.trial.FrozenTrial:
     """A trial record as Optuna's trial; one without a score (None, or the NaN of dcfkit 0.9.0)
-    is a failed trial, which TPE leaves out."""
+    is a failed trial, which TPE leaves out; a pruned one (successive halving) is known to TPE
+    by its mean AUC at the rungs it reached."""
+    dists = {k: distributions[k] for k in rec["params"]}
+    if rec.get("pruned"):
+        return optuna.trial.create_trial(params=rec["params"], distributions=dists, state=TrialState.PRUNED,
+                                         intermediate_values=intermediate(rec["steps"]))
     scored = is_score(rec["value"])
     return optuna.trial.create_trial(params=rec["params"], value=rec["value"] if scored else None,
                                      state=TrialState.COMPLETE if scored else TrialState.FAIL,
-                                     distributions={k: distributions[k] for k in rec["params"]})
+                                     distributions=dists)
 
 
 def _params_fault(spec: SearchSpec, params: Any) -> str | None:
@@ -120,19 +126,39 @@ def _takes(distribution: optuna.distributions.BaseDistribution, value: Any) -> b
     return True
 
 
-def _scores_fault(rec: dict, names: list[str]) -> str | None:
+def _scores_fault(rec: dict, names: list[str], pruned: bool = False) -> str | None:
     """What is wrong with a record's ``scores`` and ``value`` (None if nothing): the scores must be
-    of the study's training sequences, ``names``, and the value their mean AUC."""
+    of the study's training sequences, ``names`` (those a ``pruned`` trial reached), and the
+    value their mean AUC (null if the trial was pruned)."""
     scores = rec.get("scores")
     if not (isinstance(scores, dict) and sorted(scores) == sorted(names)):
-        return f"scores: expected those of this study's training sequences {shown(names)}"
+        which = "the sequences its rungs reached" if pruned else "this study's training sequences"
+        return f"scores: expected those of {which} {shown(names)}"
     if not all(isinstance(s, dict) and all(_number(s.get(k)) for k in ("auc", "precision")) for s in scores.values()):
         return "scores: expected {auc, precision} numbers or null for each sequence"
     value = rec.get("value")
+    if pruned:
+        return None if value is None else f"value: expected null for a pruned trial, got {shown(value)}"
     if isinstance(value, float) and math.isnan(value):  # dcfkit 0.9.0: NaN when a sequence had no score
         return None if any(not is_score(s["auc"]) for s in scores.values()) else "value: NaN, yet every AUC is scored"
     if not (_number(value) and value == mean_auc(scores, names)):
         return f"value: {shown(value)} is not the mean AUC of its scores"
+    return None
+
+
+def _steps_fault(rec: dict, order: list[str]) -> str | None:
+    """What is wrong with a record's ``steps`` (successive halving): ``[count, mean AUC]`` pairs,
+    each the mean AUC over the first ``count`` sequences of the study's ``order``."""
+    steps = rec.get("steps")
+    if not (isinstance(steps, list) and steps and all(
+            isinstance(s, list) and len(s) == 2 and type(s[0]) is int and 1 <= s[0] <= len(order) and _number(s[1])
+            for s in steps)):
+        return f"steps: expected [sequences, mean AUC] pairs, got {shown(steps)}"
+    scores = rec.get("scores")
+    for count, value in steps:
+        if isinstance(scores, dict) and all(n in scores for n in order[:count]) and \
+                value != mean_auc(scores, order[:count]):
+            return f"steps: {shown(value)} is not the mean AUC of the first {count} sequences' scores"
     return None
 
 
@@ -152,6 +178,10 @@ class Search:
         self.folds = make_folds(self.names, spec.folds, spec.seed)
         self.evaluator = Evaluator(self.out, spec.dataset, seqs, spec.experiments, **(evaluator_options or {}),
                                    baselines=spec.baselines)
+
+    def order(self, study: str) -> list[str]:
+        """The study's training sequences in the order successive halving scores them."""
+        return sequence_order(self.training(study), self.spec.seed, study)
 
     def training(self, study: str) -> list[str]:
         if study == FINAL:
@@ -188,7 +218,13 @@ class Search:
             old = {**old, "max_frames": None, "sequences": sorted(old.get("data") or {})}
         if old and "warm_start" not in old:  # recorded before dcfkit 0.14.0: every trial sampled
             old = {**old, "warm_start": False}
+        if old and "halving" not in old:  # recorded before dcfkit 0.15.0: every trial on every sequence
+            old = {**old, "halving": None}
         changed = [k for k in mine if old.get(k) != mine[k]]
+        if "halving" in changed:
+            raise DcfkitError(f"{path}: its trials were made with halving: {_halving_text(old['halving'])}, this "
+                              f"spec has halving: {_halving_text(mine['halving'])}: give the recorded halving in the "
+                              f"spec to resume it, or a new --out")
         if "warm_start" in changed:
             raise DcfkitError(f"{path}: its trials were made with warm_start: {str(old['warm_start']).lower()} "
                               f"(trial 0 {'the base config' if old['warm_start'] else 'sampled'}), this spec has "
@@ -210,28 +246,52 @@ class Search:
             raise DcfkitError(f"{path} records a different search (these differ: {', '.join(changed)}): "
                               f"give a new --out, or remove {self.out} to start again")
 
-    def recorded(self, study: str) -> list[dict]:
-        """The study's trial records up to the first missing one; a damaged or edited record is
-        missing (with a warning naming what is wrong), and it and those after it are run again,
-        to the same values."""
+    def recorded(self, study: str) -> tuple[list[dict], Ladder | None]:
+        """The study's trial records up to the first missing one, and its successive halving
+        told them (None without ``halving``); a damaged or edited record is missing (with a
+        warning naming what is wrong), and it and those after it are run again, to the same values."""
         folder = self.out / "trials" / study
-        records = []
+        records: list[dict] = []
+        ladder = self._ladder(study, records)
         for n in range(self.spec.trials):
             path = folder / f"{n:04d}.json"
             rec = read_json(path)
             fault = "not a JSON object" if rec is None else self._fault(rec, n, study)
+            if not fault and ladder is not None:
+                fault = ladder.replay(rec["steps"], rec.get("pruned"))
+                if fault:  # the pruner saw its values: told again without it
+                    ladder = self._ladder(study, records)
             if fault:
                 if path.exists():
                     log.warning("%s is not a trial record as dcfkit writes it (%s): trial %d of %s is run again, "
                                 "and the trials after it", path, fault, n, study)
                 break
             records.append(rec)
-        return records
+        return records, ladder
+
+    def _ladder(self, study: str, records: list[dict]) -> Ladder | None:
+        """The study's successive halving told ``records`` (already checked), or None without it."""
+        if self.spec.halving is None:
+            return None
+        ladder = Ladder(self.spec.halving, len(self.training(study)))
+        for rec in records:
+            ladder.replay(rec["steps"], rec["pruned"])
+        return ladder
 
     def _fault(self, rec: dict, number: int, study: str) -> str | None:
         """What makes ``rec`` not trial ``number`` of ``study`` as :meth:`run_study` records it
         (None if nothing): its number, values, scores (on the study's training sequences), value,
         config and run key are checked against each other and against this search."""
+        names = self.training(study)
+        if self.spec.halving is None and ("steps" in rec or "pruned" in rec):
+            return "steps, pruned: only a search with halving records them"
+        if self.spec.halving is not None:
+            order = self.order(study)
+            fault = _steps_fault(rec, order)
+            if fault:
+                return fault
+            if rec.get("pruned") is True:  # a complete trial's value is the mean in the training order
+                names = order[:rec["steps"][-1][0]]
         if rec.get("number") != number:
             return f"number: expected {number}, got {shown(rec.get('number'))}"
         if number == 0 and self.spec.warm_start:
@@ -239,7 +299,7 @@ class Search:
             fault = None if rec.get("params") == base else f"params: expected the base config's, {shown(base)}"
         else:
             fault = _params_fault(self.spec, rec.get("params"))
-        fault = fault or _scores_fault(rec, self.training(study))
+        fault = fault or _scores_fault(rec, names, pruned=rec.get("pruned") is True)
         if fault:
             return fault
         try:
@@ -255,7 +315,7 @@ class Search:
     def run_study(self, study: str) -> list[dict]:
         """The study's trials, the missing ones run; returns their records."""
         names = self.training(study)
-        records = self.recorded(study)
+        records, ladder = self.recorded(study)
         make_dir(self.out / "trials" / study)
         for n in range(len(records), self.spec.trials):
             # warm start: the base is trial 0, so a study's best is never below it on its sequences
@@ -264,16 +324,32 @@ class Search:
                 config = self.spec.config(params)
             except DcfkitError as exc:  # the spec check resolves every structure; a value inside a range may fail
                 raise DcfkitError(f"{self.spec.path}: {study} trial {n}, {shown(params)}: {exc}") from None
-            scores = finite(self.evaluator.scores(config, names))
-            value = mean_auc(scores, names)
-            rec = {"number": n, "params": params, "value": value, "key": self.evaluator.key(config),
-                   "scores": scores, "config": config}
+            rec = {"number": n, "params": params, **self._scored(config, names, study, ladder),
+                   "key": self.evaluator.key(config), "config": config}
             atomic_write(self.out / "trials" / study / f"{n:04d}.json", json.dumps(rec, indent=1) + "\n")
             records.append(rec)
             best = max((r["value"] for r in records if is_score(r["value"])), default=None)
-            self.report(f"{study} trial {n} ({n + 1} of {self.spec.trials}): mean AUC {_shown_auc(value)} on "
-                        f"{len(names)} sequences (best {_shown_auc(best)}) {shown(params)}")
+            scored = "pruned after" if rec.get("pruned") else "on"
+            self.report(f"{study} trial {n} ({n + 1} of {self.spec.trials}): mean AUC "
+                        f"{_shown_auc(rec['steps'][-1][1] if rec.get('pruned') else rec['value'])} {scored} "
+                        f"{len(rec['scores'])} sequence{'s' if len(rec['scores']) != 1 else ''} (best {_shown_auc(best)}) {shown(params)}")
         return records
+
+    def _scored(self, config: dict, names: list[str], study: str, ladder: Ladder | None) -> dict:
+        """A trial's value and scores: on every training sequence, or (successive halving) up
+        the ``ladder``'s rungs, with its steps and whether it was pruned."""
+        if ladder is None:
+            scores = finite(self.evaluator.scores(config, names))
+            return {"value": mean_auc(scores, names), "scores": scores}
+        order, scores = self.order(study), {}
+
+        def score(start: int, stop: int) -> float | None:
+            scores.update(finite(self.evaluator.scores(config, order[start:stop])))
+            return mean_auc(scores, order[:stop])
+
+        steps, pruned = ladder.climb(score)
+        return {"value": None if pruned else mean_auc(scores, names), "scores": scores, "steps": steps,
+                "pruned": pruned}
 
     def run(self) -> dict:
         """Every study, then the held-out scores and the comparison (:mod:`dcfkit.autosearch.summary`)."""
@@ -290,6 +366,13 @@ def _option_value(value: Any) -> str:
     if value is None:
         return "(not given: whole sequences)"
     return shown(",".join(value)) if isinstance(value, list) else shown(value)
+
+
+def _halving_text(record: Any) -> str:
+    """A recorded ``halving`` as the spec gives it."""
+    if not isinstance(record, dict):
+        return "none (every trial on every sequence)"
+    return "{" + ", ".join(f"{k}: {shown(v)}" for k, v in record.items()) + "}"
 
 
 def _shown_auc(value: float | None) -> str:

@@ -77,7 +77,8 @@ def summarize(search, studies: dict[str, list[dict]]) -> dict:
                "comparisons": comparisons, "method": METHOD, "correction": HOLM,
                "beats_every_baseline": bool(comparisons) and all(c["significant"] for c in comparisons.values()),
                "final": {"trial": final["number"], "params": final["params"], "auc": final["value"],
-                         "key": final["key"]}}
+                         "key": final["key"]},
+               "halving": _halving(search, studies)}
     summary = finite(summary)  # as summary.json holds it
     atomic_write(search.out / "summary.json", json.dumps(summary, indent=1, allow_nan=False) + "\n")
     atomic_write(search.out / "summary.md", "\n".join(summary_lines(summary)) + "\n")
@@ -86,6 +87,21 @@ def summarize(search, studies: dict[str, list[dict]]) -> dict:
                                                                  if k not in ("name", "description")}}
     atomic_write(search.out / "best.yaml", yaml.safe_dump(best_config, sort_keys=False, allow_unicode=True))
     return summary
+
+
+def _halving(search, studies: dict[str, list[dict]]) -> dict | None:
+    """What successive halving spared: per study, the trials pruned and the frames of the
+    sequences scored (one pass each) against those of every trial on every training sequence."""
+    if search.spec.halving is None:
+        return None
+    frames = {name: len(seq) for name, seq in search.evaluator.sequences.items()}
+    per_study = {}
+    for study, records in studies.items():
+        training = search.training(study)
+        per_study[study] = {"trials": len(records), "pruned": sum(bool(r.get("pruned")) for r in records),
+                            "frames": sum(frames[n] for r in records for n in r["scores"]),
+                            "frames_unpruned": len(records) * sum(frames[n] for n in training)}
+    return {**search.spec.halving.as_record(), "studies": per_study}
 
 
 def _compare(names: list[str], held_out: dict, baselines: dict) -> dict:
@@ -120,6 +136,7 @@ def summary_lines(summary: dict) -> list[str]:
         found = (cells(MEAN, "search", Interval.from_record(summary["baselines"][name]["auc"]), "auc")
                  + cells(DIFFERENCE, "search", Corrected.from_record(record), "auc"))
         lines.append("| " + " | ".join([_cell(name), *found]) + " |")
+    lines += _halving_lines(summary.get("halving"))  # absent from the summaries of dcfkit <= 0.14
     final = summary["final"]
     verdict = ("it beats every baseline on held-out folds" if summary["beats_every_baseline"]
                else "it does not beat every baseline on held-out folds: do not ship it")
@@ -127,6 +144,20 @@ def summary_lines(summary: dict) -> list[str]:
               f"{printable(_values(final['params']))}; best.yaml. The search: {verdict}.", "", summary["method"] + "; "
               + summary["correction"] + " (beaten: significant and the interval above 0)."]
     return lines
+
+
+def _halving_lines(halving: dict | None) -> list[str]:
+    """What successive halving spared, a sentence; none without it."""
+    if not halving:
+        return []
+    studies = halving["studies"].values()
+    trials, pruned = sum(s["trials"] for s in studies), sum(s["pruned"] for s in studies)
+    frames, unpruned = sum(s["frames"] for s in studies), sum(s["frames_unpruned"] for s in studies)
+    share = f"{frames / unpruned:.0%}" if unpruned else "n/a"
+    first = halving["min_sequences"]
+    return ["", f"Successive halving (first rung {first} sequence{'s' if first != 1 else ''}, reduction factor "
+                f"{halving['reduction_factor']}): {pruned} of {trials} trials pruned; the studies tracked {share} of "
+                f"the frames of every trial on every training sequence ({frames:,} of {unpruned:,}, one pass each)."]
 
 
 def _cut(summary: dict) -> str:

@@ -1,0 +1,135 @@
+"""Multi-fidelity: a trial scored on a few sequences first, and on more only while it stays
+among the best, by Optuna's asynchronous successive halving (``SuccessiveHalvingPruner``) with
+the number of sequences scored as the budget (docs/search.md, "Successive halving").
+
+A study's training sequences are taken in one order, fixed by the seed and the study, so every
+trial at a rung is judged on the same sequences. The rungs are at ``min_sequences`` times
+``reduction_factor`` to the k, then all of them: a trial continues past a rung only if its mean
+AUC there is in the top 1 / ``reduction_factor`` of the trials that reached it. The pruner's
+decisions depend on the order of the trials, so they are replayed from the records (a
+:class:`Ladder`), never stored: a resumed search decides as the first run did."""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import math
+from typing import Any, Callable, Mapping
+
+import numpy as np
+import optuna
+from optuna.trial import TrialState
+
+from dcfkit.errors import ConfigError, shown
+
+KEYS = ("min_sequences", "reduction_factor")
+
+
+@dataclasses.dataclass(frozen=True)
+class Halving:
+    """The spec's ``halving``: the first rung's sequence count and the reduction factor η."""
+
+    min_sequences: int
+    reduction_factor: int
+
+    def rungs(self, n: int) -> list[int]:
+        """The sequence counts at which a trial of ``n`` training sequences is judged, then ``n``."""
+        counts, r = [], self.min_sequences
+        while r < n:
+            counts.append(r)
+            r *= self.reduction_factor
+        return [*counts, n]
+
+    def as_record(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+def parse_halving(path, raw: Any) -> Halving | None:
+    """The spec's ``halving`` mapping (None when absent or null: every trial on every sequence)."""
+    if raw is None:
+        return None
+    where = f"{path}: halving"
+    if not isinstance(raw, Mapping):
+        raise ConfigError(f"{where}: expected a mapping {{min_sequences: N, reduction_factor: η}}, got {shown(raw)}")
+    unknown = [k for k in raw if k not in KEYS]
+    if unknown:
+        raise ConfigError(f"{where}.{shown(unknown[0])}: not a key of halving (expected {', '.join(KEYS)})")
+    values = {}
+    for key, least in (("min_sequences", 1), ("reduction_factor", 2)):
+        value = raw.get(key)
+        if isinstance(value, bool) or not isinstance(value, int) or value < least:
+            raise ConfigError(f"{where}.{key}: expected a whole number >= {least}, got {shown(value)}")
+        values[key] = value
+    return Halving(**values)
+
+
+def sequence_order(names: list[str], seed: int, study: str) -> list[str]:
+    """The study's training sequences in the order the rungs take them: sorted, then shuffled
+    by (seed, study), so a rung holds a mix of the pooled datasets."""
+    digest = hashlib.sha256(f"{seed}/{study}/order".encode()).digest()
+    order = np.random.default_rng(int.from_bytes(digest[:8], "little")).permutation(sorted(names))
+    return [str(n) for n in order]
+
+
+class Ladder:
+    """A study's successive halving: Optuna's pruner, told each recorded trial in turn."""
+
+    def __init__(self, halving: Halving, n: int):
+        self.halving, self.n = halving, n
+        optuna.logging.set_verbosity(optuna.logging.WARNING)
+        pruner = optuna.pruners.SuccessiveHalvingPruner(min_resource=halving.min_sequences,
+                                                        reduction_factor=halving.reduction_factor)
+        self.study = optuna.create_study(direction="maximize", pruner=pruner)
+
+    def climb(self, score: Callable[[int, int], float | None]) -> tuple[list[list], bool]:
+        """A new trial up the rungs: ``score(start, stop)`` scores the sequences of the order
+        from ``start`` to ``stop`` and returns the mean AUC of the first ``stop``. Returns the
+        steps (``[count, mean AUC]`` per rung reached) and whether the trial was pruned."""
+        trial, steps, start = self.study.ask(), [], 0
+        for stop in self.halving.rungs(self.n):
+            steps.append([stop, score(start, stop)])
+            start = stop
+            if self._judged(trial, *steps[-1]):
+                self._tell(trial, steps, pruned=True)
+                return steps, True
+        self._tell(trial, steps, pruned=False)
+        return steps, False
+
+    def replay(self, steps: Any, pruned: Any) -> str | None:
+        """Tell the study a recorded trial; what makes it not one :meth:`climb` would have made
+        here (None if nothing). After a fault the ladder is spoilt (the pruner has seen the
+        trial's values): build a new one from the records before it."""
+        rungs = self.halving.rungs(self.n)
+        if not (isinstance(steps, list) and steps and all(isinstance(s, list) and len(s) == 2 for s in steps)):
+            return f"steps: expected [sequences, mean AUC] pairs, got {shown(steps)}"
+        if [s[0] for s in steps] != rungs[:len(steps)]:
+            return f"steps: expected the rungs {shown(rungs[:len(steps)])}, got {shown([s[0] for s in steps])}"
+        if not isinstance(pruned, bool):
+            return f"pruned: expected true or false, got {shown(pruned)}"
+        trial = self.study.ask()
+        decisions = [self._judged(trial, count, value) for count, value in steps]
+        expected = [False] * (len(steps) - 1) + [pruned]
+        if decisions != expected or (not pruned and len(steps) < len(rungs)):
+            return (f"pruned: {str(pruned).lower()} after {steps[-1][0]} sequences, where successive halving "
+                    f"{'prunes' if decisions[-1] else 'continues'} it")
+        self._tell(trial, steps, pruned)
+        return None
+
+    def _judged(self, trial: optuna.Trial, count: int, value: float | None) -> bool:
+        """Report the mean AUC at ``count`` sequences; whether the pruner stops the trial there
+        (never at the last rung: the trial is then complete)."""
+        trial.report(math.nan if value is None else float(value), count)
+        return count < self.n and trial.should_prune()
+
+    def _tell(self, trial: optuna.Trial, steps: list, pruned: bool) -> None:
+        value = steps[-1][1]
+        if pruned:
+            self.study.tell(trial, state=TrialState.PRUNED)
+        elif value is None:
+            self.study.tell(trial, state=TrialState.FAIL)
+        else:
+            self.study.tell(trial, float(value))
+
+
+def intermediate(steps: list) -> dict[int, float]:
+    """A record's steps as Optuna's intermediate values (NaN where no sequence had a score)."""
+    return {int(count): math.nan if value is None else float(value) for count, value in steps}
