@@ -149,7 +149,8 @@ def test_ablate_help_names_every_shipped_spec():
     specs = {p.stem for p in (DOCS.parent / "configs" / "ablations").glob("*.yaml")
              if "\nvariants:" in p.read_text(encoding="utf-8") or "\ngrid:" in p.read_text(encoding="utf-8")}
     helps = build_parser()._subparsers._group_actions[0].choices["ablate"].format_help()
-    assert specs == {"departures", "family", "recovery", "sensitivity", "table3", "validation_departures"}
+    assert specs == {"departures", "family", "recovery", "sensitivity", "speed_departures", "table3",
+                     "validation_departures"}
     assert all(name in " ".join(helps.split()) for name in specs), helps
 
 

@@ -412,7 +412,7 @@ def test_a_choice_keeps_its_values_after_the_spec_check(tmp_path, data):
 def test_the_shipped_base_is_a_point_of_the_shipped_space(tmp_path):
     """Trial 0 of the uav search is DR²Track placed in the space, so TPE models the trials
     around it (no data is read to place it)."""
-    spec = load_search_spec("uav", root=tmp_path)
+    spec = load_search_spec("uav", root=[tmp_path] * 4)
     params = base_params(spec)
     assert params["label"] == "repressed" and params["scale"] == "dsst" and params["label.mu"] == 0.25
     assert spec.config(params) == spec.base
