@@ -409,10 +409,14 @@ def test_a_choice_keeps_its_values_after_the_spec_check(tmp_path, data):
     assert (config["label"]["mu"], config["label"]["top_n"]) == (0.25, 30)
 
 
-def test_the_shipped_base_is_a_point_of_the_shipped_space(tmp_path):
-    """Trial 0 of the uav search is DR²Track placed in the space, so TPE models the trials
+@pytest.mark.parametrize("name", ["uav", "lineage"])
+def test_the_shipped_base_is_a_point_of_the_shipped_space(tmp_path, name):
+    """Trial 0 of the shipped searches is DR²Track placed in the space, so TPE models the trials
     around it (no data is read to place it)."""
-    spec = load_search_spec("uav", root=[tmp_path] * 4)
+    spec = load_search_spec(name, root=[tmp_path] * 4)
     params = base_params(spec)
     assert params["label"] == "repressed" and params["scale"] == "dsst" and params["label.mu"] == 0.25
     assert spec.config(params) == spec.base
+    if name == "lineage":  # the broadened dimensions, each absent in the base
+        assert (params["mask"], params["channel_weights"], params["reliability"]) == ("none",) * 3
+        assert "schedule" not in params and "redetect" not in params  # sampled only under lmcf
