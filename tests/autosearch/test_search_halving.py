@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 import random
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -176,3 +178,17 @@ def test_a_record_whose_pruning_was_edited_is_redone(searches, tmp_path, caplog)
     assert "successive halving continues it" in caplog.text and str(path) in caplog.text
     done = search.run_study(study)
     assert done[rec["number"]] == rec  # redone to the same record
+
+
+def test_the_halving_benchmark_replays_the_plain_trials_and_compares_the_halved(searches):
+    script = Path(__file__).resolve().parents[2] / "benchmarks" / "halving.py"
+    done = subprocess.run([sys.executable, str(script), str(searches / "plain.yaml"), str(searches / "plain"),
+                           "--settings", "1x2,9x2", "--halved", str(searches / "halved")],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    replay_9x2, ran = done.stdout.split("\nReplayed: ")[2].split("\nRun: ")
+    # a first rung beyond every study's sequences prunes nothing
+    assert "all studies: 0 of 18 trials pruned, 100% of the frames" in replay_9x2
+    summary = json.loads((searches / "halved/summary.json").read_text())
+    pruned = sum(s["pruned"] for s in summary["halving"]["studies"].values())
+    assert f"all studies: {pruned} of 18 trials pruned" in ran

@@ -1,0 +1,122 @@
+"""What successive halving spares a search, and what it costs (docs/search.md, "Successive
+halving"): a plain search's trials replayed through the pruner, and a halved search of the same
+seed against the plain one.
+
+    python benchmarks/halving.py SPEC PLAIN_OUT [--root DIR ...] [--settings 4x2,4x3]
+        [--halved HALVED_OUT]
+
+SPEC and ``--root`` are those the plain search ran with (``halving`` in SPEC is ignored).
+
+- **Replayed** (each ``--settings`` MINxETA): every study's trials, in their order, go up the
+  rungs of ``halving: {min_sequences: MIN, reduction_factor: ETA}`` with the scores the plain
+  search recorded. Printed per study: the trials pruned, the share of the frames tracked,
+  whether the plain study's best was pruned, and the best left against it (its mean AUC on the
+  study's sequences). TPE would have been told other trials after the first pruned one, so this
+  measures the pruner on the plain search's trials, not a halved search.
+- **Run** (``--halved``): a search of SPEC with ``halving``, same seed, its own records: its
+  best against the plain best, the frames it tracked (one pass each), whether it pruned the
+  plain best's config when it sampled it.
+"""
+import argparse
+import dataclasses
+import json
+import sys
+from pathlib import Path
+
+from dcfkit.autosearch import Search, load_search_spec
+from dcfkit.autosearch.halving import Halving, Ladder
+from dcfkit.autosearch.summary import is_score, mean_auc
+
+
+def records(out: Path, study: str) -> list[dict]:
+    return [json.loads(p.read_text(encoding="utf-8")) for p in sorted((out / "trials" / study).glob("*.json"))]
+
+
+def best(recs: list[dict]) -> dict | None:
+    scored = [r for r in recs if is_score(r["value"])]
+    return max(scored, key=lambda r: (r["value"], -r["number"])) if scored else None
+
+
+def replayed(search: Search, plain: Path, halving: Halving, frames: dict[str, int]) -> list[dict]:
+    """Each study's plain trials through ``halving``'s pruner: what it prunes, and what is left."""
+    rows = []
+    for study in search.studies():
+        names, order = search.training(study), search.order(study)
+        recs = records(plain, study)
+        ladder = Ladder(halving, len(names))
+        reached = []
+        for rec in recs:
+            steps, pruned = ladder.climb(lambda start, stop, r=rec: mean_auc(r["scores"], order[:stop]))
+            reached.append((rec, pruned, steps[-1][0]))
+        top = best(recs)
+        left = best([rec for rec, pruned, _ in reached if not pruned])
+        tracked = sum(frames[n] for _, _, count in reached for n in order[:count])
+        rows.append({"study": study, "trials": len(recs), "pruned": sum(p for _, p, _ in reached),
+                     "frames": tracked / (len(recs) * sum(frames[n] for n in names)),
+                     "best": top["number"], "best_auc": top["value"],
+                     "best_pruned": next(p for rec, p, _ in reached if rec is top),
+                     "left": left["number"], "left_auc": left["value"]})
+    return rows
+
+
+def run(search: Search, plain: Path, halved: Path, frames: dict[str, int]) -> list[dict]:
+    """A halved search's studies against the plain search's."""
+    rows = []
+    for study in search.studies():
+        names = search.training(study)
+        mine, theirs = records(halved, study), records(plain, study)
+        top, found = best(theirs), best(mine)
+        same = [r for r in mine if r["params"] == top["params"]]
+        tracked = sum(frames[n] for r in mine for n in r["scores"])
+        rows.append({"study": study, "trials": len(mine), "pruned": sum(bool(r.get("pruned")) for r in mine),
+                     "frames": tracked / (len(mine) * sum(frames[n] for n in names)),
+                     "best": top["number"], "best_auc": top["value"],
+                     "best_pruned": ("not sampled" if not same else "pruned" if same[0].get("pruned") else "kept"),
+                     "left": found["number"], "left_auc": found["value"]})
+    return rows
+
+
+def table(title: str, rows: list[dict]) -> None:
+    print(f"\n{title}\n")
+    print("| study | trials | pruned | frames tracked | plain best (trial, AUC) | it pruned? | best left (trial, AUC) "
+          "| left − plain best |")
+    print("|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        pruned = r["best_pruned"] if isinstance(r["best_pruned"], str) else ("yes" if r["best_pruned"] else "no")
+        print(f"| {r['study']} | {r['trials']} | {r['pruned']} | {r['frames']:.0%} | {r['best']}, {r['best_auc']:.4f} "
+              f"| {pruned} | {r['left']}, {r['left_auc']:.4f} | {r['left_auc'] - r['best_auc']:+.4f} |")
+    share = sum(r["frames"] * r["trials"] for r in rows) / sum(r["trials"] for r in rows)
+    print(f"\nall studies: {sum(r['pruned'] for r in rows)} of {sum(r['trials'] for r in rows)} trials pruned, "
+          f"{share:.0%} of the frames (trial-weighted)")
+
+
+def setting(text: str) -> Halving:
+    try:
+        first, eta = (int(v) for v in text.lower().split("x"))
+        return Halving(first, eta)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected MINxETA such as 4x2, got {text!r}") from None
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("spec", help="the plain search's spec")
+    parser.add_argument("plain", type=Path, help="the plain search's --out")
+    parser.add_argument("--root", action="append", type=Path, default=None)
+    parser.add_argument("--settings", default="4x2", help="halving settings to replay, MINxETA, comma-separated")
+    parser.add_argument("--halved", type=Path, default=None, help="a halved search's --out, same seed")
+    args = parser.parse_args()
+    spec = dataclasses.replace(load_search_spec(args.spec, root=args.root), halving=None)
+    search = Search(spec, args.plain, {"jobs": 1})
+    frames = {name: len(seq) for name, seq in search.evaluator.sequences.items()}
+    for text in args.settings.split(","):
+        halving = setting(text)
+        table(f"Replayed: the plain trials through halving {{min_sequences: {halving.min_sequences}, "
+              f"reduction_factor: {halving.reduction_factor}}}", replayed(search, args.plain, halving, frames))
+    if args.halved is not None:
+        table(f"Run: {args.halved} against {args.plain}", run(search, args.plain, args.halved, frames))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
