@@ -71,25 +71,9 @@ class Recorder:
         setattr(owner, name, recorded)
 
     def instrument(self, tracker) -> None:
-        """Every component method its kind's contract names, the FFTs and the patch sampler."""
-        t = tracker.loop.t if getattr(tracker, "loop", None) is not None else tracker
-        for component in components(t):
-            contract = type(component).contract
-            for name in (*contract.required, *contract.optional):
-                if name not in ("reset", "start", "init"):  # frame 1 only
-                    self.wrap(component, name, f"{component.kind} {component.name}")
-        fft = getattr(t, "fft", None)
-        for name in ("rfft2", "irfft2", "fft2", "ifft2"):
-            if fft is not None and callable(getattr(fft, name, None)):
-                self.wrap(fft, name, "fft")
-        if callable(getattr(t, "_patch", None)):
-            self.wrap(t, "_patch", "patch extraction")
-        # the loops' own arithmetic: the numerics they import (peaks, ECO's projection, Fourier
-        # series and feature blocks), by the names the loops call them
-        for module in (tracker_module, continuous_module, fourier_series):
-            for name, fn in list(vars(module).items()):
-                if inspect.isfunction(fn) and fn.__module__.startswith(ARITHMETIC) and not name.startswith("_"):
-                    self.wrap(module, name, name)
+        """Every call :func:`arithmetic` names."""
+        for owner, name, stage in arithmetic(tracker):
+            self.wrap(owner, name, stage)
 
     def restore(self) -> None:
         """The module functions as they were (the next tracker gets its own recorder)."""
@@ -122,6 +106,31 @@ def snapshot(value):
     if isinstance(value, dict):
         return {k: snapshot(v) for k, v in value.items()}
     return value
+
+
+def arithmetic(tracker) -> list[tuple]:
+    """``(owner, name, stage)`` of each call that is the tracker's arithmetic: every component
+    method its kind's contract names (but those of frame 1), the FFTs, the patch sampler, and the
+    numerics the loops import (peaks, ECO's projection, Fourier series and feature blocks) by
+    the names the loops call them."""
+    t = tracker.loop.t if getattr(tracker, "loop", None) is not None else tracker
+    found = []
+    for component in components(t):
+        contract = type(component).contract
+        for name in (*contract.required, *contract.optional):
+            if name not in ("reset", "start", "init"):  # frame 1 only
+                found.append((component, name, f"{component.kind} {component.name}.{name}"))
+    fft = getattr(t, "fft", None)
+    for name in ("rfft2", "irfft2", "fft2", "ifft2"):
+        if fft is not None and callable(getattr(fft, name, None)):
+            found.append((fft, name, "fft"))
+    if callable(getattr(t, "_patch", None)):
+        found.append((t, "_patch", "patch extraction"))
+    for module in (tracker_module, continuous_module, fourier_series):
+        for name, fn in list(vars(module).items()):
+            if inspect.isfunction(fn) and fn.__module__.startswith(ARITHMETIC) and not name.startswith("_"):
+                found.append((module, name, name))
+    return found
 
 
 def components(tracker) -> list:

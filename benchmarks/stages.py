@@ -1,6 +1,6 @@
-"""Per-stage time of one tracker per frame (patch extraction, each feature, FFTs, detection,
-label, solver, scale), by wrapping the tracker's components with timers — the tracker code
-itself carries no instrumentation.
+"""Per-stage time of one tracker per frame (patch extraction, each component method, FFTs,
+peaks), by wrapping the tracker's arithmetic with timers as benchmarks/floor.py finds it — the
+tracker code itself carries no instrumentation.
 
     python benchmarks/stages.py [--config dr2track] [--root ../shared/data/UAV123_10fps]
         [--sequence boat1] [--frames 100] [--synthetic] [--json stages.json]
@@ -23,9 +23,9 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 
 import dcfkit  # noqa: E402
-import dcfkit.tracker.tracker as tracker_module  # noqa: E402
 from dcfkit.datasets.synthetic import make_sequence  # noqa: E402
 from dcfkit.experiments.loop import track  # noqa: E402
+from floor import arithmetic  # noqa: E402  (benchmarks/floor.py: one discovery of a tracker's arithmetic)
 
 cv2.setNumThreads(1)
 TOTALS = collections.defaultdict(float)
@@ -43,18 +43,11 @@ def timed(stage, fn):
 
 
 def instrument(tracker):
-    """Wrap the stages; nested stages (features inside 'scale') are counted in both."""
-    tracker._patch = timed("patch extraction", tracker._patch)
-    tracker.solver.response = timed("detection (response)", tracker.solver.response)
-    tracker_module.subpixel_peak = timed("detection (peak)", tracker_module.subpixel_peak)
-    tracker_module.newton_peak = timed("detection (peak)", tracker_module.newton_peak)
-    for f in tracker.features:
-        f.extract = timed(f"feature {f.name}", f.extract)
-    tracker.fft.rfft2 = timed("fft", tracker.fft.rfft2)
-    tracker.fft.irfft2 = timed("fft", tracker.fft.irfft2)
-    tracker.label.make = timed(f"label {tracker.label.name}", tracker.label.make)
-    tracker.solver.train = timed(f"solver {tracker.solver.name} (incl. its FFTs)", tracker.solver.train)
-    tracker.scale_estimator.update = timed(f"scale {tracker.scale_estimator.name}", tracker.scale_estimator.update)
+    """Wrap every call of the tracker's arithmetic (:func:`floor.arithmetic`: the methods of its
+    components' contracts, FFTs, patch sampler, the loops' numerics); nested stages (features
+    inside the scale estimator) are counted in both."""
+    for owner, name, stage in arithmetic(tracker):
+        setattr(owner, name, timed(stage, getattr(owner, name)))
 
 
 def main():

@@ -48,8 +48,18 @@ def run(script: str, *args: str, tmp_path: Path) -> str:
 def test_stages(tmp_path):
     out = run("stages.py", "--synthetic", "--frames", "4", "--json", "stages.json", tmp_path=tmp_path)
     stages = json.loads((tmp_path / "stages.json").read_text())["ms_per_frame"]
-    assert {"patch extraction", "detection (response)", "detection (peak)", "feature fhog"} <= set(stages)
+    # found through the kinds' contracts, as floor.py finds them: a component's every method
+    assert {"patch extraction", "fft", "solver admm_strcf.train", "solver admm_strcf.response", "newton_peak",
+            "feature fhog.extract", "label distractor_repressed.make", "scale dsst.update"} <= set(stages)
     assert out.startswith("dr2track on synthetic_720p: ")
+
+
+@pytest.mark.slow
+def test_stages_names_csr_dcfs_mask_and_channel_weights(tmp_path):
+    run("stages.py", "--synthetic", "--frames", "4", "--config", "csrdcf", "--json", "stages.json", tmp_path=tmp_path)
+    stages = json.loads((tmp_path / "stages.json").read_text())["ms_per_frame"]
+    assert any(s.startswith("mask csr_segmentation.") for s in stages), stages
+    assert any(s.startswith("channel_weights csr_reliability.") for s in stages), stages
 
 
 @pytest.mark.slow
@@ -59,8 +69,8 @@ def test_floor(tmp_path):
     rows = {r["config"]: r for r in json.loads((tmp_path / "floor.json").read_text())["rows"]}
     # the arithmetic of each loop is found: the discrete loop's components and FFTs, and the
     # continuous loop's own numerics (ECO's projection, its Fourier-series peak)
-    assert {"extract_stack", "fft", "solver kernel_ridge", "subpixel_peak"} <= set(rows["kcf"]["floor_ms"])
-    assert {"extract", "project", "newton_maximum", "scale fdsst"} <= set(rows["eco_hc"]["floor_ms"])
+    assert {"extract_stack", "fft", "solver kernel_ridge.train", "subpixel_peak"} <= set(rows["kcf"]["floor_ms"])
+    assert {"extract", "project", "newton_maximum", "scale fdsst.update"} <= set(rows["eco_hc"]["floor_ms"])
     for row in rows.values():
         assert row["floor_fps"] == pytest.approx(1000 / sum(row["floor_ms"].values()))
         assert row["ratio"] == pytest.approx(row["fps"] / row["floor_fps"])
