@@ -48,13 +48,13 @@ def replayed(search: Search, plain: Path, halving: Halving, frames: dict[str, in
         for rec in recs:
             steps, pruned = ladder.climb(lambda start, stop, r=rec: mean_auc(r["scores"], order[:stop]))
             reached.append((rec, pruned, steps[-1][0]))
-        top = best(recs)
-        left = best([rec for rec, pruned, _ in reached if not pruned])
+        top = best(recs) or {"number": None, "value": None}
+        left = best([rec for rec, pruned, _ in reached if not pruned]) or {"number": None, "value": None}
         tracked = sum(frames[n] for _, _, count in reached for n in order[:count])
         rows.append({"study": study, "trials": len(recs), "pruned": sum(p for _, p, _ in reached),
                      "frames": tracked / (len(recs) * sum(frames[n] for n in names)),
                      "best": top["number"], "best_auc": top["value"],
-                     "best_pruned": next(p for rec, p, _ in reached if rec is top),
+                     "best_pruned": next((p for rec, p, _ in reached if rec is top), "none scored"),
                      "left": left["number"], "left_auc": left["value"]})
     return rows
 
@@ -65,7 +65,8 @@ def run(search: Search, plain: Path, halved: Path, frames: dict[str, int]) -> li
     for study in search.studies():
         names = search.training(study)
         mine, theirs = records(halved, study), records(plain, study)
-        top, found = best(theirs), best(mine)
+        top = best(theirs) or {"number": None, "value": None, "params": None}
+        found = best(mine) or {"number": None, "value": None}
         same = [r for r in mine if r["params"] == top["params"]]
         tracked = sum(frames[n] for r in mine for n in r["scores"])
         rows.append({"study": study, "trials": len(mine), "pruned": sum(bool(r.get("pruned")) for r in mine),
@@ -76,6 +77,10 @@ def run(search: Search, plain: Path, halved: Path, frames: dict[str, int]) -> li
     return rows
 
 
+def cell(number, auc) -> str:
+    return "none" if auc is None else f"{number}, {auc:.4f}"
+
+
 def table(title: str, rows: list[dict]) -> None:
     print(f"\n{title}\n")
     print("| study | trials | pruned | frames tracked | plain best (trial, AUC) | it pruned? | best left (trial, AUC) "
@@ -83,19 +88,23 @@ def table(title: str, rows: list[dict]) -> None:
     print("|---|---|---|---|---|---|---|---|")
     for r in rows:
         pruned = r["best_pruned"] if isinstance(r["best_pruned"], str) else ("yes" if r["best_pruned"] else "no")
-        print(f"| {r['study']} | {r['trials']} | {r['pruned']} | {r['frames']:.0%} | {r['best']}, {r['best_auc']:.4f} "
-              f"| {pruned} | {r['left']}, {r['left_auc']:.4f} | {r['left_auc'] - r['best_auc']:+.4f} |")
+        gap = "n/a" if None in (r["left_auc"], r["best_auc"]) else f"{r['left_auc'] - r['best_auc']:+.4f}"
+        print(f"| {r['study']} | {r['trials']} | {r['pruned']} | {r['frames']:.0%} | {cell(r['best'], r['best_auc'])} "
+              f"| {pruned} | {cell(r['left'], r['left_auc'])} | {gap} |")
     share = sum(r["frames"] * r["trials"] for r in rows) / sum(r["trials"] for r in rows)
     print(f"\nall studies: {sum(r['pruned'] for r in rows)} of {sum(r['trials'] for r in rows)} trials pruned, "
           f"{share:.0%} of the frames (trial-weighted)")
 
 
 def setting(text: str) -> Halving:
+    """``MINxETA`` as a halving: MIN >= 1 sequences, reduction factor ETA >= 2."""
     try:
         first, eta = (int(v) for v in text.lower().split("x"))
-        return Halving(first, eta)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected MINxETA such as 4x2, got {text!r}") from None
+    if first < 1 or eta < 2:
+        raise argparse.ArgumentTypeError(f"{text!r}: MIN must be >= 1 and ETA >= 2")
+    return Halving(first, eta)
 
 
 def main() -> int:
@@ -103,14 +112,14 @@ def main() -> int:
     parser.add_argument("spec", help="the plain search's spec")
     parser.add_argument("plain", type=Path, help="the plain search's --out")
     parser.add_argument("--root", action="append", type=Path, default=None)
-    parser.add_argument("--settings", default="4x2", help="halving settings to replay, MINxETA, comma-separated")
+    parser.add_argument("--settings", default=[Halving(4, 2)], type=lambda text: [setting(t) for t in text.split(",")],
+                        help="halving settings to replay, MINxETA, comma-separated (default 4x2)")
     parser.add_argument("--halved", type=Path, default=None, help="a halved search's --out, same seed")
     args = parser.parse_args()
     spec = dataclasses.replace(load_search_spec(args.spec, root=args.root), halving=None)
     search = Search(spec, args.plain, {"jobs": 1})
     frames = {name: len(seq) for name, seq in search.evaluator.sequences.items()}
-    for text in args.settings.split(","):
-        halving = setting(text)
+    for halving in args.settings:
         table(f"Replayed: the plain trials through halving {{min_sequences: {halving.min_sequences}, "
               f"reduction_factor: {halving.reduction_factor}}}", replayed(search, args.plain, halving, frames))
     if args.halved is not None:

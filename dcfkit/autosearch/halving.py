@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import math
 from typing import Any, Callable, Mapping
 
 import numpy as np
@@ -55,7 +54,9 @@ def parse_halving(path, raw: Any) -> Halving | None:
         raise ConfigError(f"{where}.{shown(unknown[0])}: not a key of halving (expected {', '.join(KEYS)})")
     values = {}
     for key, least in (("min_sequences", 1), ("reduction_factor", 2)):
-        value = raw.get(key)
+        if key not in raw:
+            raise ConfigError(f"{where}.{key}: missing (a whole number >= {least})")
+        value = raw[key]
         if isinstance(value, bool) or not isinstance(value, int) or value < least:
             raise ConfigError(f"{where}.{key}: expected a whole number >= {least}, got {shown(value)}")
         values[key] = value
@@ -105,19 +106,25 @@ class Ladder:
             return f"steps: expected the rungs {shown(rungs[:len(steps)])}, got {shown([s[0] for s in steps])}"
         if not isinstance(pruned, bool):
             return f"pruned: expected true or false, got {shown(pruned)}"
+        if not pruned and len(steps) < len(rungs):
+            return f"steps: a trial not pruned reaches every rung, {shown(rungs)}"
         trial = self.study.ask()
-        decisions = [self._judged(trial, count, value) for count, value in steps]
         expected = [False] * (len(steps) - 1) + [pruned]
-        if decisions != expected or (not pruned and len(steps) < len(rungs)):
-            return (f"pruned: {str(pruned).lower()} after {steps[-1][0]} sequences, where successive halving "
-                    f"{'prunes' if decisions[-1] else 'continues'} it")
+        for (count, value), wrote in zip(steps, expected):
+            if self._judged(trial, count, value) != wrote:
+                return (f"pruned: {str(wrote).lower()} after {count} sequences, where successive halving "
+                        f"{'continues' if wrote else 'prunes'} it")
         self._tell(trial, steps, pruned)
         return None
 
     def _judged(self, trial: optuna.Trial, count: int, value: float | None) -> bool:
         """Report the mean AUC at ``count`` sequences; whether the pruner stops the trial there
-        (never at the last rung: the trial is then complete)."""
-        trial.report(math.nan if value is None else float(value), count)
+        (never at the last rung: the trial is then complete). A rung none of whose sequences has
+        a score (no frame the protocol scores, whatever the config) judges nothing: the next
+        rung is judged for it too, by Optuna's pruner, against both rungs' values."""
+        if value is None:
+            return False
+        trial.report(float(value), count)
         return count < self.n and trial.should_prune()
 
     def _tell(self, trial: optuna.Trial, steps: list, pruned: bool) -> None:
@@ -131,5 +138,5 @@ class Ladder:
 
 
 def intermediate(steps: list) -> dict[int, float]:
-    """A record's steps as Optuna's intermediate values (NaN where no sequence had a score)."""
-    return {int(count): math.nan if value is None else float(value) for count, value in steps}
+    """A record's steps as the intermediate values reported (none where no sequence had a score)."""
+    return {int(count): float(value) for count, value in steps if value is not None}

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import random
+import re
 import shutil
 import subprocess
 import sys
@@ -90,16 +91,40 @@ def test_the_ladder_prunes_as_successive_halving_by_hand(eta, first, n):
     assert 0 < reached.count(len(rungs)) < len(values)  # some pruned, some not
 
 
+def test_a_rung_without_a_score_judges_nothing_and_replays_alike():
+    """A rung of sequences without a scored frame (whatever the config: a one-frame sequence
+    under got10k) has no mean: the trial goes on, and the next rung judges it."""
+    ladder, made = Ladder(Halving(1, 2), 4), []
+    for late in (0.6, 0.5, 0.7):
+        made.append(ladder.climb(lambda start, stop, v=late: None if stop == 1 else v))
+    assert made == [([[1, None], [2, 0.6], [4, 0.6]], False),  # the base: never pruned
+                    ([[1, None], [2, 0.5]], True),  # at 2 sequences, below 0.6
+                    ([[1, None], [2, 0.7], [4, 0.7]], False)]
+    again = Ladder(Halving(1, 2), 4)
+    assert [again.replay(steps, pruned) for steps, pruned in made] == [None] * 3
+
+
+def test_a_replay_names_the_first_rung_where_a_record_parts_from_the_rule():
+    ladder = Ladder(Halving(1, 2), 4)
+    for value in (0.9, 0.8):
+        ladder.climb(lambda start, stop, v=value: v)
+    # at 1 sequence, 0.1 is not in the top half of (0.9, 0.8, 0.1): the rule prunes it there
+    assert ladder.replay([[1, 0.1], [2, 0.5], [4, 0.5]], False) == \
+        "pruned: false after 1 sequences, where successive halving prunes it"
+    assert Ladder(Halving(1, 2), 4).replay([[1, 0.1], [2, 0.5]], False) == \
+        "steps: a trial not pruned reaches every rung, [1, 2, 4]"
+
+
 def test_the_spec_key_is_checked_where_it_is_read(tmp_path):
     for bad, message in (("halving: 3", "halving: expected a mapping"),
                          ("halving: {min_sequences: 0, reduction_factor: 2}", "halving.min_sequences: expected a "
                                                                              "whole number >= 1, got 0"),
                          ("halving: {min_sequences: 2, reduction_factor: 1}", "halving.reduction_factor: expected "
                                                                              "a whole number >= 2, got 1"),
-                         ("halving: {min_sequences: 2}", "halving.reduction_factor: expected a whole number"),
+                         ("halving: {min_sequences: 2}", "halving.reduction_factor: missing (a whole number >= 2)"),
                          ("halving: {min_sequences: 2, reduction_factor: 2, rungs: 3}", "'rungs': not a key")):
         (tmp_path / "s.yaml").write_text(SPEC + bad + "\n", encoding="utf-8")
-        with pytest.raises(ConfigError, match=message.replace("(", r"\(")) as err:
+        with pytest.raises(ConfigError, match=re.escape(message)) as err:
             load_search_spec(tmp_path / "s.yaml")
         assert str(tmp_path / "s.yaml") in str(err.value)
 
