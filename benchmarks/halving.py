@@ -43,6 +43,8 @@ def replayed(search: Search, plain: Path, halving: Halving, frames: dict[str, in
     for study in search.studies():
         names, order = search.training(study), search.order(study)
         recs = records(plain, study)
+        if not recs:  # a study not yet begun
+            continue
         ladder = Ladder(halving, len(names))
         reached = []
         for rec in recs:
@@ -65,6 +67,8 @@ def run(search: Search, plain: Path, halved: Path, frames: dict[str, int]) -> li
     for study in search.studies():
         names = search.training(study)
         mine, theirs = records(halved, study), records(plain, study)
+        if not (mine and theirs):  # a study not yet begun
+            continue
         top = best(theirs) or {"number": None, "value": None, "params": None}
         found = best(mine) or {"number": None, "value": None}
         same = [r for r in mine if r["params"] == top["params"]]
