@@ -15,8 +15,8 @@ from optuna.distributions import BaseDistribution, CategoricalDistribution, Floa
 
 from dcfkit.ablation.experiment import check_experiment
 from dcfkit.ablation.spec import load_spec_config
-from dcfkit.autosearch.halving import Halving, parse_halving
 from dcfkit.ablation.spec_keys import as_mapping, check_keys, parse_datasets, pooled_sequences
+from dcfkit.autosearch.halving import Halving, parse_halving
 from dcfkit.config import load_config, shipped_config_dir
 from dcfkit.config.bounded_yaml import read_yaml
 from dcfkit.datasets import load_dataset
