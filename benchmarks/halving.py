@@ -25,6 +25,7 @@ from pathlib import Path
 
 from dcfkit.autosearch import Search, load_search_spec
 from dcfkit.autosearch.halving import Halving, Ladder
+from dcfkit.autosearch.summary import best as summary_best
 from dcfkit.autosearch.summary import is_score, mean_auc
 
 
@@ -33,8 +34,9 @@ def records(out: Path, study: str) -> list[dict]:
 
 
 def best(recs: list[dict]) -> dict | None:
-    scored = [r for r in recs if is_score(r["value"])]
-    return max(scored, key=lambda r: (r["value"], -r["number"])) if scored else None
+    """The search's own choice of a study's best (:func:`dcfkit.autosearch.summary.best`), or
+    None where no trial has a score."""
+    return summary_best(recs, "") if any(is_score(r["value"]) for r in recs) else None
 
 
 def replayed(search: Search, plain: Path, halving: Halving, frames: dict[str, int]) -> list[dict]:

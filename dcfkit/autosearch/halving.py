@@ -95,17 +95,14 @@ class Ladder:
         self._tell(trial, steps, pruned=False)
         return steps, False
 
-    def replay(self, steps: Any, pruned: Any) -> str | None:
-        """Tell the study a recorded trial; what makes it not one :meth:`climb` would have made
-        here (None if nothing). After a fault the ladder is spoilt (the pruner has seen the
+    def replay(self, steps: list[list], pruned: bool) -> str | None:
+        """Tell the study a recorded trial, its ``steps`` already checked to be ``[count, mean
+        AUC]`` pairs (the search's ``_steps_fault``); what makes it not one :meth:`climb` would
+        have made here (None if nothing). After a fault the ladder is spoilt (the pruner has seen the
         trial's values): build a new one from the records before it."""
         rungs = self.halving.rungs(self.n)
-        if not (isinstance(steps, list) and steps and all(isinstance(s, list) and len(s) == 2 for s in steps)):
-            return f"steps: expected [sequences, mean AUC] pairs, got {shown(steps)}"
         if [s[0] for s in steps] != rungs[:len(steps)]:
             return f"steps: expected the rungs {shown(rungs[:len(steps)])}, got {shown([s[0] for s in steps])}"
-        if not isinstance(pruned, bool):
-            return f"pruned: expected true or false, got {shown(pruned)}"
         if not pruned and len(steps) < len(rungs):
             return f"steps: a trial not pruned reaches every rung, {shown(rungs)}"
         trial = self.study.ask()

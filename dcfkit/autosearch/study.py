@@ -147,13 +147,16 @@ def _scores_fault(rec: dict, names: list[str], pruned: bool = False) -> str | No
 
 
 def _steps_fault(rec: dict, order: list[str]) -> str | None:
-    """What is wrong with a record's ``steps`` (successive halving): ``[count, mean AUC]`` pairs,
-    each the mean AUC over the first ``count`` sequences of the study's ``order``."""
+    """What is wrong with a record's ``steps`` and ``pruned`` (successive halving): ``[count,
+    mean AUC]`` pairs, each the mean AUC over the first ``count`` sequences of the study's
+    ``order``, and true or false."""
     steps = rec.get("steps")
     if not (isinstance(steps, list) and steps and all(
             isinstance(s, list) and len(s) == 2 and type(s[0]) is int and 1 <= s[0] <= len(order) and _number(s[1])
             for s in steps)):
         return f"steps: expected [sequences, mean AUC] pairs, got {shown(steps)}"
+    if not isinstance(rec.get("pruned"), bool):
+        return f"pruned: expected true or false, got {shown(rec.get('pruned'))}"
     scores = rec.get("scores")
     for count, value in steps:
         if isinstance(scores, dict) and all(n in scores for n in order[:count]) and \
@@ -258,7 +261,7 @@ class Search:
             rec = read_json(path)
             fault = "not a JSON object" if rec is None else self._fault(rec, n, study)
             if not fault and ladder is not None:
-                fault = ladder.replay(rec["steps"], rec.get("pruned"))
+                fault = ladder.replay(rec["steps"], rec["pruned"])
                 if fault:  # the pruner saw its values: told again without it
                     ladder = self._ladder(study, records)
             if fault:
