@@ -3,19 +3,21 @@ halving"): a plain search's trials replayed through the pruner, and a halved sea
 seed against the plain one.
 
     python benchmarks/halving.py SPEC PLAIN_OUT [--root DIR ...] [--settings 4x2,4x3]
-        [--halved HALVED_OUT]
+        [--in-turn] [--halved HALVED_OUT]
 
 SPEC and ``--root`` are those the plain search ran with (``halving`` in SPEC is ignored).
 
 - **Replayed** (each ``--settings`` MINxETA): every study's trials, in their order, go up the
   rungs of ``halving: {min_sequences: MIN, reduction_factor: ETA}`` with the scores the plain
-  search recorded. Printed per study: the trials pruned, the share of the frames tracked,
+  search recorded (``--in-turn``: ``experiments: in_turn``, each trial's scores per experiment
+  read from the plain search's runs, which are all on disk). Printed per study: the trials
+  pruned, the share of the frames tracked (every experiment's runs),
   whether the plain study's best was pruned, and the best left against it (its mean AUC on the
   study's sequences). TPE would have been told other trials after the first pruned one, so this
   measures the pruner on the plain search's trials, not a halved search.
 - **Run** (``--halved``): a search of SPEC with ``halving``, same seed, its own records: its
-  best against the plain best, the frames it tracked (one pass each), whether it pruned the
-  plain best's config when it sampled it.
+  best against the plain best, the frames it tracked, whether it pruned the plain best's config
+  when it sampled it.
 """
 import argparse
 import dataclasses
@@ -26,7 +28,7 @@ from pathlib import Path
 from dcfkit.autosearch import Search, load_search_spec
 from dcfkit.autosearch.halving import Halving, Ladder
 from dcfkit.autosearch.summary import best as summary_best
-from dcfkit.autosearch.summary import is_score, mean_auc
+from dcfkit.autosearch.summary import is_score, mean_score
 
 
 def records(out: Path, study: str) -> list[dict]:
@@ -39,44 +41,59 @@ def best(recs: list[dict]) -> dict | None:
     return summary_best(recs, "") if any(is_score(r["value"]) for r in recs) else None
 
 
-def replayed(search: Search, plain: Path, halving: Halving, frames: dict[str, int]) -> list[dict]:
+def frames(search: Search, units: list) -> int:
+    """The frames a config tracks on ``units`` (every experiment's runs)."""
+    return sum(search.evaluator.frames(name, e) for exps, name in units for e in exps)
+
+
+def replayed(search: Search, plain: Path, halving: Halving) -> list[dict]:
     """Each study's plain trials through ``halving``'s pruner: what it prunes, and what is left."""
     rows = []
     for study in search.studies():
-        names, order = search.training(study), search.order(study)
+        units = halving.units(search.order(study), search.spec.experiments)
         recs = records(plain, study)
         if not recs:  # a study not yet begun
             continue
-        ladder = Ladder(halving, len(names))
+        ladder = Ladder(halving, len(units))
         reached = []
         for rec in recs:
-            steps, pruned = ladder.climb(lambda start, stop, r=rec: mean_auc(r["scores"], order[:stop]))
+            aucs = unit_aucs(search, rec, units)
+            steps, pruned = ladder.climb(lambda start, stop, a=aucs: mean_score(a[:stop]))
             reached.append((rec, pruned, steps[-1][0]))
         top = best(recs) or {"number": None, "value": None}
         left = best([rec for rec, pruned, _ in reached if not pruned]) or {"number": None, "value": None}
-        tracked = sum(frames[n] for _, _, count in reached for n in order[:count])
+        tracked = sum(frames(search, units[:count]) for _, _, count in reached)
         rows.append({"study": study, "trials": len(recs), "pruned": sum(p for _, p, _ in reached),
-                     "frames": tracked / (len(recs) * sum(frames[n] for n in names)),
+                     "frames": tracked / (len(recs) * frames(search, units)),
                      "best": top["number"], "best_auc": top["value"],
                      "best_pruned": next((p for rec, p, _ in reached if rec is top), "none scored"),
                      "left": left["number"], "left_auc": left["value"]})
     return rows
 
 
-def run(search: Search, plain: Path, halved: Path, frames: dict[str, int]) -> list[dict]:
+def unit_aucs(search: Search, rec: dict, units: list) -> list:
+    """A plain trial's AUC on each unit: its recorded scores, or (a unit under one of several
+    experiments) its score under that experiment, from the plain search's runs."""
+    if all(len(exps) == len(search.spec.experiments) for exps, _ in units):
+        return [rec["scores"][name]["auc"] for _, name in units]
+    found = search.evaluator.experiment_scores(rec["config"], list(rec["scores"]), search.spec.experiments)
+    return [found[exps[0]][name]["auc"] for exps, name in units]
+
+
+def run(search: Search, plain: Path, halved: Path, halving: Halving) -> list[dict]:
     """A halved search's studies against the plain search's."""
     rows = []
     for study in search.studies():
-        names = search.training(study)
+        units = halving.units(search.order(study), search.spec.experiments)
         mine, theirs = records(halved, study), records(plain, study)
         if not (mine and theirs):  # a study not yet begun
             continue
         top = best(theirs) or {"number": None, "value": None, "params": None}
         found = best(mine) or {"number": None, "value": None}
         same = [r for r in mine if r["params"] == top["params"]]
-        tracked = sum(frames[n] for r in mine for n in r["scores"])
+        tracked = sum(frames(search, units[:r["steps"][-1][0]]) for r in mine)
         rows.append({"study": study, "trials": len(mine), "pruned": sum(bool(r.get("pruned")) for r in mine),
-                     "frames": tracked / (len(mine) * sum(frames[n] for n in names)),
+                     "frames": tracked / (len(mine) * frames(search, units)),
                      "best": top["number"], "best_auc": top["value"],
                      "best_pruned": ("not sampled" if not same else "pruned" if same[0].get("pruned") else "kept"),
                      "left": found["number"], "left_auc": found["value"]})
@@ -120,16 +137,20 @@ def main() -> int:
     parser.add_argument("--root", action="append", type=Path, default=None)
     parser.add_argument("--settings", default=[Halving(4, 2)], type=lambda text: [setting(t) for t in text.split(",")],
                         help="halving settings to replay, MINxETA, comma-separated (default 4x2)")
+    parser.add_argument("--in-turn", action="store_true", help="replay with experiments: in_turn")
     parser.add_argument("--halved", type=Path, default=None, help="a halved search's --out, same seed")
     args = parser.parse_args()
     spec = dataclasses.replace(load_search_spec(args.spec, root=args.root), halving=None)
     search = Search(spec, args.plain, {"jobs": 1})
-    frames = {name: len(seq) for name, seq in search.evaluator.sequences.items()}
-    for halving in args.settings:
+    mode = "in_turn" if args.in_turn else "together"
+    for halving in (dataclasses.replace(h, experiments=mode) for h in args.settings):
         table(f"Replayed: the plain trials through halving {{min_sequences: {halving.min_sequences}, "
-              f"reduction_factor: {halving.reduction_factor}}}", replayed(search, args.plain, halving, frames))
+              f"reduction_factor: {halving.reduction_factor}, experiments: {mode}}}",
+              replayed(search, args.plain, halving))
     if args.halved is not None:
-        table(f"Run: {args.halved} against {args.plain}", run(search, args.plain, args.halved, frames))
+        recorded = json.loads((args.halved / "search.json").read_text(encoding="utf-8"))["fingerprint"]["halving"]
+        halving = Halving(**recorded)  # dcfkit 0.15.0's records have no experiments: together
+        table(f"Run: {args.halved} against {args.plain}", run(search, args.plain, args.halved, halving))
     return 0
 
 

@@ -6,6 +6,7 @@ in the layout ``dcfkit report`` and ``dcfkit compare`` read (docs/search.md, "Re
 from __future__ import annotations
 
 import logging
+import math
 from pathlib import Path
 from typing import Iterable, Mapping
 
@@ -53,16 +54,17 @@ class Evaluator:
             return self.out / TRIAL_RUNS, self.key(config)
         return self.out / BASELINES, self.baselines.get(baseline) or folder_names([baseline])[baseline]
 
-    def run(self, configs: Iterable[dict], names: list[str], baseline: str | None = None) -> list[str]:
+    def run(self, configs: Iterable[dict], names: list[str], baseline: str | None = None,
+            experiments: Iterable[str] | None = None) -> list[str]:
         """Make every missing run of ``configs`` (trials, or the one config of ``baseline``) on
-        the sequences ``names``; returns the failures' messages (a failed run scores as a total
-        failure)."""
+        the sequences ``names`` under ``experiments`` (default: the search's); returns the
+        failures' messages (a failed run scores as a total failure)."""
         entries: dict[str, Entry] = {}
         for config in configs:  # the trials of one config are one entry
             root, name = self._where(config, baseline)
             entries.setdefault(name, Entry(name, config))
         failures: list[str] = []
-        for experiment in self.experiments if entries else ():
+        for experiment in (self.experiments if experiments is None else experiments) if entries else ():
             plan = RunPlan(entries.values(), [self.sequences[n] for n in names], experiment, root,
                            "the search's runs", self.version)
             plan.run("dcfkit search", self.jobs, self.executor, self.scheduler)
@@ -76,19 +78,39 @@ class Evaluator:
         ``baseline`` if a baseline's), each the mean over the experiments. No fps: times measured
         in a busy pool rank nothing, and a search's records stay the same on every rerun
         (benchmarks/speed.py measures speed)."""
-        self.run([config], names, baseline)
+        return combined(self.experiment_scores(config, names, self.experiments, baseline), names)
+
+    def experiment_scores(self, config: dict, names: list[str], experiments: Iterable[str],
+                          baseline: str | None = None) -> dict[str, dict[str, dict]]:
+        """Experiment -> sequence name -> ``{"auc", "precision"}`` of ``config`` under each of
+        ``experiments`` (its runs made first), NaN where the protocol scores no frame."""
+        experiments = tuple(experiments)
+        self.run([config], names, baseline, experiments)
         root, name = self._where(config, baseline)
         key, seqs = self.key(config), [self.sequences[n] for n in names]
-        per_experiment = []
-        for e in self.experiments:
+        found = {}
+        for e in experiments:
             store = ResultStore(store_folder(root, name, e))
             done = [run for n in names for run in self.runs[e][n] if store.is_done(run, key)]
             results = store.load(done) if done else {}
             scored = evaluate({"trial": results}, seqs, protocol=self.protocol, experiment=e, runs=self.runs[e])
-            per_experiment.append({row["sequence"]: row for row in scored.per_sequence})
-        return {n: {k: _mean([rows[n][k] for rows in per_experiment]) for k in ("auc", "precision")}
-                for n in names}
+            found[e] = {row["sequence"]: {k: row[k] for k in ("auc", "precision")} for row in scored.per_sequence}
+        return found
+
+    def frames(self, name: str, experiment: str) -> int:
+        """The frames a config tracks on sequence ``name`` under ``experiment`` (all its runs)."""
+        return sum(len(run) for run in self.runs[experiment][name])
+
+
+def combined(per_experiment: Mapping[str, Mapping[str, dict]], names: Iterable[str]) -> dict[str, dict]:
+    """Sequence name -> ``{"auc", "precision"}``: the mean over the experiments of
+    ``per_experiment`` (in its order) of each of ``names``; NaN if any is NaN or None (no frame
+    scored)."""
+    return {n: {k: _mean([rows[n][k] for rows in per_experiment.values()]) for k in ("auc", "precision")}
+            for n in names}
 
 
 def _mean(values: list) -> float:
+    if any(v is None for v in values):  # a record's null: JSON's NaN
+        return math.nan
     return sum(values) / len(values)

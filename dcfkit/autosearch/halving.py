@@ -1,11 +1,14 @@
 """Multi-fidelity: a trial scored on a few sequences first, and on more only while it stays
 among the best, by Optuna's asynchronous successive halving (``SuccessiveHalvingPruner``) with
-the number of sequences scored as the budget (docs/search.md, "Successive halving").
+the number of *units* scored as the budget (docs/search.md, "Successive halving"). A unit is
+a sequence under every experiment of the spec (``experiments: together``), or under one
+(``in_turn``: the first experiment on every sequence, then the next, so a trial reaches the
+costly TRE only after OPE has kept it).
 
 A study's training sequences are taken in one order, fixed by the seed and the study, so every
-trial at a rung is judged on the same sequences. The rungs are at ``min_sequences`` times
+trial at a rung is judged on the same units. The rungs are at ``min_sequences`` times
 ``reduction_factor`` to the k, then all of them: a trial continues past a rung only if its mean
-AUC there is in the top 1 / ``reduction_factor`` of the trials that reached it. The pruner's
+AUC there (over its units) is in the top 1 / ``reduction_factor`` of the trials that reached it. The pruner's
 decisions depend on the order of the trials, so they are replayed from the records (a
 :class:`Ladder`), never stored: a resumed search decides as the first run did."""
 from __future__ import annotations
@@ -20,23 +23,38 @@ from optuna.trial import TrialState
 
 from dcfkit.errors import ConfigError, shown
 
-KEYS = ("min_sequences", "reduction_factor")
+KEYS = ("min_sequences", "reduction_factor", "experiments")
+MODES = ("together", "in_turn")  # halving's experiments: a unit is a sequence under all of them, or under one
+Unit = tuple[tuple[str, ...], str]  # (experiments, sequence name)
 
 
 @dataclasses.dataclass(frozen=True)
 class Halving:
-    """The spec's ``halving``: the first rung's sequence count and the reduction factor η."""
+    """The spec's ``halving``: the first rung's unit count, the reduction factor η and how the
+    experiments make units (:data:`MODES`)."""
 
     min_sequences: int
     reduction_factor: int
+    experiments: str = "together"
 
     def rungs(self, n: int) -> list[int]:
-        """The sequence counts at which a trial of ``n`` training sequences is judged, then ``n``."""
+        """The unit counts at which a trial of ``n`` units is judged, then ``n``."""
         counts, r = [], self.min_sequences
         while r < n:
             counts.append(r)
             r *= self.reduction_factor
         return [*counts, n]
+
+    def units(self, order: list[str], experiments: tuple[str, ...]) -> list[Unit]:
+        """The units of sequences ``order`` under ``experiments``, in the order the rungs take them."""
+        if self.experiments == "in_turn":
+            return [((e,), n) for e in experiments for n in order]
+        return [(experiments, n) for n in order]
+
+    def counted(self, count: int) -> str:
+        """``count`` units in words: sequences, or (in turn) (sequence, experiment) pairs."""
+        noun = "sequence" if self.experiments == "together" else "(sequence, experiment) pair"
+        return f"{count} {noun}{'s' if count != 1 else ''}"
 
     def as_record(self) -> dict:
         return dataclasses.asdict(self)
@@ -52,7 +70,9 @@ def parse_halving(path, raw: Any) -> Halving | None:
     unknown = [k for k in raw if k not in KEYS]
     if unknown:
         raise ConfigError(f"{where}.{shown(unknown[0])}: not a key of halving (expected {', '.join(KEYS)})")
-    values = {}
+    values = {"experiments": raw.get("experiments", MODES[0])}
+    if values["experiments"] not in MODES:
+        raise ConfigError(f"{where}.experiments: expected {' or '.join(MODES)}, got {shown(values['experiments'])}")
     for key, least in (("min_sequences", 1), ("reduction_factor", 2)):
         if key not in raw:
             raise ConfigError(f"{where}.{key}: missing (a whole number >= {least})")
@@ -82,9 +102,9 @@ class Ladder:
         self.study = optuna.create_study(direction="maximize", pruner=pruner)
 
     def climb(self, score: Callable[[int, int], float | None]) -> tuple[list[list], bool]:
-        """A new trial up the rungs: ``score(start, stop)`` scores the sequences of the order
-        from ``start`` to ``stop`` and returns the mean AUC of the first ``stop``. Returns the
-        steps (``[count, mean AUC]`` per rung reached) and whether the trial was pruned."""
+        """A new trial up the rungs: ``score(start, stop)`` scores the units of the order from
+        ``start`` to ``stop`` and returns the mean AUC of the first ``stop``. Returns the steps
+        (``[count, mean AUC]`` per rung reached) and whether the trial was pruned."""
         trial, steps, start = self.study.ask(), [], 0
         for stop in self.halving.rungs(self.n):
             steps.append([stop, score(start, stop)])
@@ -109,14 +129,14 @@ class Ladder:
         expected = [False] * (len(steps) - 1) + [pruned]
         for (count, value), wrote in zip(steps, expected):
             if self._judged(trial, count, value) != wrote:
-                return (f"pruned: {str(wrote).lower()} after {count} sequences, where successive halving "
+                return (f"pruned: {str(wrote).lower()} after {self.halving.counted(count)}, where successive halving "
                         f"{'continues' if wrote else 'prunes'} it")
         self._tell(trial, steps, pruned)
         return None
 
     def _judged(self, trial: optuna.Trial, count: int, value: float | None) -> bool:
-        """Report the mean AUC at ``count`` sequences; whether the pruner stops the trial there
-        (never at the last rung: the trial is then complete). A rung none of whose sequences has
+        """Report the mean AUC at ``count`` units; whether the pruner stops the trial there
+        (never at the last rung: the trial is then complete). A rung none of whose units has
         a score (no frame the protocol scores, whatever the config) judges nothing: the next
         rung is judged for it too, by Optuna's pruner, against both rungs' values."""
         if value is None:

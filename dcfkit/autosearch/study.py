@@ -10,9 +10,9 @@ at any point resumes to the same trials and the same result."""
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import logging
-import math
 from pathlib import Path
 from typing import Any, Callable
 
@@ -22,13 +22,14 @@ from optuna.trial import TrialState
 
 from dcfkit.ablation.layout import warn_old_layout
 from dcfkit.ablation.spec_keys import data_record, roots_text
-from dcfkit.autosearch.evaluation import Evaluator
-from dcfkit.autosearch.halving import Ladder, intermediate, sequence_order
+from dcfkit.autosearch.evaluation import Evaluator, combined
+from dcfkit.autosearch.halving import Ladder, Unit, intermediate, sequence_order
+from dcfkit.autosearch.records import complete, record_fault
 from dcfkit.autosearch.space import SearchSpec, active
-from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, summarize
+from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, mean_score, summarize
 from dcfkit.autosearch.warm_start import base_params
 from dcfkit.datasets import scored_sequences
-from dcfkit.errors import DcfkitError, clip, shown
+from dcfkit.errors import DcfkitError, clip, printable, shown
 from dcfkit.store.files import atomic_write, ensure_writable, exclusive, make_dir, read_json
 from dcfkit.store.provenance import shared_path
 from dcfkit.store.results import data_identity
@@ -96,80 +97,6 @@ def _frozen(rec: dict, distributions: dict) -> optuna.trial.FrozenTrial:
                                      distributions=dists)
 
 
-def _params_fault(spec: SearchSpec, params: Any) -> str | None:
-    """What is wrong with a record's ``params`` (None if nothing): they must be the dimensions
-    :func:`sample` samples, each with a value its dimension can take."""
-    if not isinstance(params, dict):
-        return f"params: expected a mapping of the space's keys, got {shown(params)}"
-    dims = {p.key: p for p in spec.parameters}
-    unknown = [k for k in params if k not in dims]
-    if unknown:
-        return f"params: {shown(unknown[0])} is not a key of the space"
-    for key, value in params.items():
-        if not _takes(dims[key].distribution, value):
-            return f"params.{clip(key)}: {shown(value)} is not a value its dimension takes"
-    sampled = [p.key for p in spec.parameters if active(p, params)]
-    if sorted(sampled) != sorted(params):
-        return f"params: expected values for {shown(sampled)} (as sampled under its choices), got {shown(list(params))}"
-    return None
-
-
-def _takes(distribution: optuna.distributions.BaseDistribution, value: Any) -> bool:
-    """Whether :func:`sample` could give ``value``: a label, a whole number or a float, in range."""
-    kind = {optuna.distributions.CategoricalDistribution: str, optuna.distributions.IntDistribution: int}
-    if type(value) is not kind.get(type(distribution), float):  # "0.5" or true would pass Optuna's check
-        return False
-    try:
-        optuna.trial.create_trial(params={"v": value}, distributions={"v": distribution}, value=0.0)
-    except (OverflowError, ValueError):  # an int past float's range
-        return False
-    return True
-
-
-def _scores_fault(rec: dict, names: list[str], pruned: bool = False) -> str | None:
-    """What is wrong with a record's ``scores`` and ``value`` (None if nothing): the scores must be
-    of the study's training sequences, ``names`` (those a ``pruned`` trial reached), and the
-    value their mean AUC (null if the trial was pruned)."""
-    scores = rec.get("scores")
-    if not (isinstance(scores, dict) and sorted(scores) == sorted(names)):
-        which = "the sequences its rungs reached" if pruned else "this study's training sequences"
-        return f"scores: expected those of {which} {shown(names)}"
-    if not all(isinstance(s, dict) and all(_number(s.get(k)) for k in ("auc", "precision")) for s in scores.values()):
-        return "scores: expected {auc, precision} numbers or null for each sequence"
-    value = rec.get("value")
-    if pruned:
-        return None if value is None else f"value: expected null for a pruned trial, got {shown(value)}"
-    if isinstance(value, float) and math.isnan(value):  # dcfkit 0.9.0: NaN when a sequence had no score
-        return None if any(not is_score(s["auc"]) for s in scores.values()) else "value: NaN, yet every AUC is scored"
-    if not (_number(value) and value == mean_auc(scores, names)):
-        return f"value: {shown(value)} is not the mean AUC of its scores"
-    return None
-
-
-def _steps_fault(rec: dict, order: list[str]) -> str | None:
-    """What is wrong with a record's ``steps`` and ``pruned`` (successive halving): ``[count,
-    mean AUC]`` pairs, each the mean AUC over the first ``count`` sequences of the study's
-    ``order``, and true or false."""
-    steps = rec.get("steps")
-    if not (isinstance(steps, list) and steps and all(
-            isinstance(s, list) and len(s) == 2 and type(s[0]) is int and 1 <= s[0] <= len(order) and _number(s[1])
-            for s in steps)):
-        return f"steps: expected [sequences, mean AUC] pairs, got {shown(steps)}"
-    if not isinstance(rec.get("pruned"), bool):
-        return f"pruned: expected true or false, got {shown(rec.get('pruned'))}"
-    scores = rec.get("scores")
-    for count, value in steps:
-        if isinstance(scores, dict) and all(n in scores for n in order[:count]) and \
-                value != mean_auc(scores, order[:count]):
-            return f"steps: {shown(value)} is not the mean AUC of the first {count} sequences' scores"
-    return None
-
-
-def _number(value: Any) -> bool:
-    """A score as records hold it: a number, or null (NaN in dcfkit 0.9.0's)."""
-    return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool))
-
-
 class Search:
     """A search spec run under ``out``: its folds, its studies and their records."""
 
@@ -185,6 +112,10 @@ class Search:
     def order(self, study: str) -> list[str]:
         """The study's training sequences in the order successive halving scores them."""
         return sequence_order(self.training(study), self.spec.seed, study)
+
+    def units(self, study: str) -> list[Unit]:
+        """The study's units in the order successive halving scores them (:mod:`~dcfkit.autosearch.halving`)."""
+        return self.spec.halving.units(self.order(study), self.spec.experiments)
 
     def training(self, study: str) -> list[str]:
         if study == FINAL:
@@ -223,6 +154,8 @@ class Search:
             old = {**old, "warm_start": False}
         if old and "halving" not in old:  # recorded before dcfkit 0.15.0: every trial on every sequence
             old = {**old, "halving": None}
+        if isinstance(old.get("halving"), dict) and "experiments" not in old["halving"]:  # dcfkit 0.15.0
+            old = {**old, "halving": {**old["halving"], "experiments": "together"}}
         changed = [k for k in mine if old.get(k) != mine[k]]
         if "halving" in changed:
             raise DcfkitError(f"{path}: its trials were made with halving: {_halving_text(old['halving'])}, this "
@@ -259,7 +192,7 @@ class Search:
         for n in range(self.spec.trials):
             path = folder / f"{n:04d}.json"
             rec = read_json(path)
-            fault = "not a JSON object" if rec is None else self._fault(rec, n, study)
+            fault = "not a JSON object" if rec is None else record_fault(self, rec, n, study)
             if not fault and ladder is not None:
                 fault = ladder.replay(rec["steps"], rec["pruned"])
                 if fault:  # the pruner saw its values: told again without it
@@ -276,44 +209,10 @@ class Search:
         """The study's successive halving told ``records`` (already checked), or None without it."""
         if self.spec.halving is None:
             return None
-        ladder = Ladder(self.spec.halving, len(self.training(study)))
+        ladder = Ladder(self.spec.halving, len(self.units(study)))
         for rec in records:
             ladder.replay(rec["steps"], rec["pruned"])
         return ladder
-
-    def _fault(self, rec: dict, number: int, study: str) -> str | None:
-        """What makes ``rec`` not trial ``number`` of ``study`` as :meth:`run_study` records it
-        (None if nothing): its number, values, scores (on the study's training sequences), value,
-        config and run key are checked against each other and against this search."""
-        names = self.training(study)
-        if self.spec.halving is None and ("steps" in rec or "pruned" in rec):
-            return "steps, pruned: only a search with halving records them"
-        if self.spec.halving is not None:
-            order = self.order(study)
-            fault = _steps_fault(rec, order)
-            if fault:
-                return fault
-            if rec.get("pruned") is True:  # a complete trial's value is the mean in the training order
-                names = order[:rec["steps"][-1][0]]
-        if rec.get("number") != number:
-            return f"number: expected {number}, got {shown(rec.get('number'))}"
-        if number == 0 and self.spec.warm_start:
-            base = base_params(self.spec)
-            fault = None if rec.get("params") == base else f"params: expected the base config's, {shown(base)}"
-        else:
-            fault = _params_fault(self.spec, rec.get("params"))
-        fault = fault or _scores_fault(rec, names, pruned=rec.get("pruned") is True)
-        if fault:
-            return fault
-        try:
-            config = json.loads(json.dumps(self.spec.config(rec["params"])))  # as the record holds it
-        except DcfkitError as exc:
-            return f"params: {exc}"
-        if rec.get("config") != config:
-            return "config: not the config its params make"
-        if rec.get("key") != self.evaluator.key(config):
-            return "key: not its config's run key"
-        return None
 
     def run_study(self, study: str) -> list[dict]:
         """The study's trials, the missing ones run; returns their records."""
@@ -340,19 +239,27 @@ class Search:
 
     def _scored(self, config: dict, names: list[str], study: str, ladder: Ladder | None) -> dict:
         """A trial's value and scores: on every training sequence, or (successive halving) up
-        the ``ladder``'s rungs, with its steps and whether it was pruned."""
+        the ``ladder``'s rungs, with its steps, whether it was pruned and (experiments in turn)
+        its scores under each experiment."""
         if ladder is None:
             scores = finite(self.evaluator.scores(config, names))
             return {"value": mean_auc(scores, names), "scores": scores}
-        order, scores = self.order(study), {}
+        units, experiments = self.units(study), self.spec.experiments
+        by_experiment: dict[str, dict] = {e: {} for e in experiments}
 
         def score(start: int, stop: int) -> float | None:
-            scores.update(finite(self.evaluator.scores(config, order[start:stop])))
-            return mean_auc(scores, order[:stop])
+            for exps, group in itertools.groupby(units[start:stop], key=lambda unit: unit[0]):
+                found = self.evaluator.experiment_scores(config, [n for _, n in group], exps)
+                for e in exps:
+                    by_experiment[e].update(found[e])
+            return mean_score([_unit_auc(by_experiment, unit) for unit in units[:stop]])
 
         steps, pruned = ladder.climb(score)
-        return {"value": None if pruned else mean_auc(scores, names), "scores": scores, "steps": steps,
-                "pruned": pruned}
+        reached = units[:steps[-1][0]]
+        scores = finite(combined(by_experiment, complete(reached, experiments)))
+        rec = {"value": None if pruned else mean_auc(scores, names), "scores": scores, "steps": steps,
+               "pruned": pruned}
+        return {**rec, "by_experiment": finite(by_experiment)} if self.spec.halving.experiments == "in_turn" else rec
 
     def run(self) -> dict:
         """Every study, then the held-out scores and the comparison (:mod:`dcfkit.autosearch.summary`)."""
@@ -375,7 +282,13 @@ def _halving_text(record: Any) -> str:
     """A recorded ``halving`` as the spec gives it."""
     if not isinstance(record, dict):
         return "none (every trial on every sequence)"
-    return "{" + ", ".join(f"{k}: {shown(v)}" for k, v in record.items()) + "}"
+    return "{" + ", ".join(f"{k}: {clip(printable(v)) if isinstance(v, str) else shown(v)}" for k, v in record.items()) + "}"
+
+
+def _unit_auc(by_experiment: dict[str, dict], unit: Unit) -> float:
+    """A unit's AUC: its sequence's mean over the unit's experiments (NaN if none scored)."""
+    exps, name = unit
+    return combined({e: by_experiment[e] for e in exps}, [name])[name]["auc"]
 
 
 def _shown_auc(value: float | None) -> str:

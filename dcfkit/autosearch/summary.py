@@ -12,6 +12,7 @@ from dcfkit.ablation.spec_keys import data_record
 from dcfkit.analysis.stats.columns import DIFFERENCE, MEAN, cells, headers
 from dcfkit.analysis.stats.results import Corrected, Interval
 from dcfkit.analysis.statistics import HOLM, METHOD, holm, mean_interval, paired_difference
+from dcfkit.autosearch.halving import KEYS, Halving
 from dcfkit.errors import DcfkitError, printable
 from dcfkit.store.files import atomic_write
 from dcfkit.store.provenance import shared_path
@@ -28,7 +29,12 @@ def is_score(value) -> bool:
 def mean_auc(scores: dict[str, dict], names: list[str]) -> float | None:
     """The mean AUC over those of ``names`` that have one; None if none has. A sequence with no
     frame the protocol scores (a one-frame sequence under ``got10k``) has none, whatever the config."""
-    values = [scores[n]["auc"] for n in names if is_score(scores[n]["auc"])]
+    return mean_score([scores[n]["auc"] for n in names])
+
+
+def mean_score(values: list) -> float | None:
+    """The mean of those of ``values`` that are scores; None if none is."""
+    values = [v for v in values if is_score(v)]
     return float(np.mean(values)) if values else None
 
 
@@ -90,17 +96,20 @@ def summarize(search, studies: dict[str, list[dict]]) -> dict:
 
 
 def _halving(search, studies: dict[str, list[dict]]) -> dict | None:
-    """What successive halving spared: per study, the trials pruned and the frames of the
-    sequences scored (one pass each) against those of every trial on every training sequence."""
+    """What successive halving spared: per study, the trials pruned and the frames tracked (every
+    experiment's runs of the units reached) against those of every trial on every unit."""
     if search.spec.halving is None:
         return None
-    frames = {name: len(seq) for name, seq in search.evaluator.sequences.items()}
+
+    def frames(units: list) -> int:
+        return sum(search.evaluator.frames(name, e) for exps, name in units for e in exps)
+
     per_study = {}
     for study, records in studies.items():
-        training = search.training(study)
+        units = search.units(study)
         per_study[study] = {"trials": len(records), "pruned": sum(bool(r.get("pruned")) for r in records),
-                            "frames": sum(frames[n] for r in records for n in r["scores"]),
-                            "frames_unpruned": len(records) * sum(frames[n] for n in training)}
+                            "frames": sum(frames(units[:r["steps"][-1][0]]) for r in records),
+                            "frames_unpruned": len(records) * frames(units)}
     return {**search.spec.halving.as_record(), "studies": per_study}
 
 
@@ -154,10 +163,11 @@ def _halving_lines(halving: dict | None) -> list[str]:
     trials, pruned = sum(s["trials"] for s in studies), sum(s["pruned"] for s in studies)
     frames, unpruned = sum(s["frames"] for s in studies), sum(s["frames_unpruned"] for s in studies)
     share = f"{frames / unpruned:.0%}" if unpruned else "n/a"
-    first = halving["min_sequences"]
-    return ["", f"Successive halving (first rung {first} sequence{'s' if first != 1 else ''}, reduction factor "
-                f"{halving['reduction_factor']}): {pruned} of {trials} trials pruned; the studies tracked {share} of "
-                f"the frames of every trial on every training sequence ({frames:,} of {unpruned:,}, one pass each)."]
+    rule = Halving(**{k: halving[k] for k in KEYS if k in halving})  # dcfkit 0.15.0 recorded no experiments
+    turn = ", the experiments in turn" if rule.experiments == "in_turn" else ""
+    return ["", f"Successive halving (first rung {rule.counted(rule.min_sequences)}, reduction factor "
+                f"{rule.reduction_factor}{turn}): {pruned} of {trials} trials pruned; the studies tracked {share} of "
+                f"the frames of every trial on every training sequence ({frames:,} of {unpruned:,})."]
 
 
 def _cut(summary: dict) -> str:

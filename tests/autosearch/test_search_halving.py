@@ -110,7 +110,7 @@ def test_a_replay_names_the_first_rung_where_a_record_parts_from_the_rule():
         ladder.climb(lambda start, stop, v=value: v)
     # at 1 sequence, 0.1 is not in the top half of (0.9, 0.8, 0.1): the rule prunes it there
     assert ladder.replay([[1, 0.1], [2, 0.5], [4, 0.5]], False) == \
-        "pruned: false after 1 sequences, where successive halving prunes it"
+        "pruned: false after 1 sequence, where successive halving prunes it"
     assert Ladder(Halving(1, 2), 4).replay([[1, 0.1], [2, 0.5]], False) == \
         "steps: a trial not pruned reaches every rung, [1, 2, 4]"
 
@@ -179,7 +179,8 @@ def test_a_resume_replays_the_pruner_and_runs_nothing(searches, tmp_path, capsys
     spec.write_text(spec.read_text().replace(HALVING, ""), encoding="utf-8")
     capsys.readouterr()
     assert cli.main(["search", str(spec), "--out", str(out), "--jobs", "1"]) != 0
-    assert ("made with halving: {min_sequences: 1, reduction_factor: 2}, this spec has halving: none"
+    assert ("made with halving: {min_sequences: 1, reduction_factor: 2, experiments: together}, this spec has "
+            "halving: none"
             in capsys.readouterr().err)
 
 
