@@ -16,9 +16,9 @@ into place only once they match. Reads are bounded (:data:`ANNOTATION_BYTES`, :d
 refused in one line. No sequence of ``RESERVED.tsv`` (``--reserved``) is ever written.
 
 Writes ``OUT/<DATASET>/<sequence>/img/000001.jpg ...`` and ``groundtruth_rect.txt`` (1-based
-``x,y,w,h``, ``nan`` where the target is absent): the OTB layout, so ``--dataset otb --root
-OUT/<DATASET>`` reads one benchmark and ``--root OUT/all`` (links to every sequence) the whole
-set. Needs git. docs/results.md ("The validation set") says what it covers.
+``x,y,w,h``, ``nan`` where the target is absent): the OTB layout, detected as such, so
+``--root OUT/<DATASET>`` reads one benchmark and ``--root OUT/all`` (links to every sequence)
+the whole set. Needs git. docs/results.md ("The validation set") says what it covers.
 """
 from __future__ import annotations
 
@@ -364,7 +364,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{dataset}: {len(counts)} sequences, {sum(counts)} frames")
     if totals:
         print(f"all: {sum(len(c) for c in totals.values())} sequences, {sum(map(sum, totals.values()))} frames "
-              f"-> {args.out} (read with --dataset otb --root {args.out / 'all'})")
+              f"-> {args.out} (read with --root {args.out / 'all'})")
     return 0
 
 

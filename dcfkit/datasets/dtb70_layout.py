@@ -29,13 +29,16 @@ def dtb70(root, sequences=None) -> list[Sequence]:
 
 
 def detect_dtb70(root: Path) -> Evidence:
-    """OTB's layout too, so told apart by the root's name, else by 5-digit frame names."""
+    """OTB's layout too, so told apart by the root's name, else by 5-digit frame names. A root
+    with other frame names is not DTB70's, whatever its name: its loader reads ``%05d.jpg``
+    only (OTB's reads any, so a mixed set is OTB's)."""
     folders = image_sequence_folders(root)
-    if not folders:
+    digits = first_frame_digits(folders)
+    if not folders or digits - {5}:
         return Evidence.NONE
     if "dtb" in root.name.lower():
         return Evidence.NAME
-    return Evidence.FILES if first_frame_digits(folders) == {5} else Evidence.FOLDERS
+    return Evidence.FILES if digits == {5} else Evidence.FOLDERS
 
 
 register_layout("dtb70", dtb70, "ROOT/<seq>/img/%05d.jpg, ROOT/<seq>/groundtruth_rect.txt",

@@ -3,6 +3,7 @@ real development data in ../shared/data (skipped when absent)."""
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -342,11 +343,20 @@ def test_dataset_names_and_detection_errors(tmp_path):
         detect_dataset(root)
     amb = tmp_path / "bench"
     write_anno(amb / "A" / "groundtruth_rect.txt", 1)
-    touch_frames(amb / "A" / "img", "%04d.jpg", 1, 1)
-    write_anno(amb / "B" / "groundtruth_rect.txt", 1)
-    touch_frames(amb / "B" / "img", "%05d.jpg", 1, 1)
+    (amb / "A" / "img").mkdir()  # no frame yet: the names tell nothing
     with pytest.raises(DatasetError, match="dtb70 or otb"):
         detect_dataset(amb)
+    # a 4- or 6-digit name anywhere: DTB70's loader reads %05d.jpg only, so OTB's (a mixed set)
+    touch_frames(amb / "A" / "img", "%06d.jpg", 1, 1)
+    write_anno(amb / "B" / "groundtruth_rect.txt", 1)
+    touch_frames(amb / "B" / "img", "%05d.jpg", 1, 1)
+    assert detect_dataset(amb) == "otb"
+    assert [s.name for s in load_dataset(None, amb)] == ["A", "B"]
+    with pytest.raises(DatasetError, match="DTB70 A"):
+        load_dataset("dtb70", amb)
+    named = tmp_path / "DTB70"  # the validation set's DTB70 sequences, 6-digit names: OTB's layout
+    shutil.copytree(amb / "A", named / "A")
+    assert detect_dataset(named) == "otb"
 
 
 # --------------------------------------------------------------------------- real data
