@@ -18,6 +18,7 @@ import pytest
 import dcfkit
 from dcfkit.analysis.metrics import average, score_sequence
 from dcfkit.datasets import load_dataset
+from dcfkit.running.runner import run_pool, usable_cores
 
 FLOORS = {"dr2track": 0.88, "strcf": 0.81, "bacf": 0.64, "kcf": 0.48, "dsst": 0.27,  # measured minus ~0.08
           "eco_hc": 0.75}
@@ -50,12 +51,18 @@ def one_pass_each(configs, seq) -> dict[str, list]:
 def precision(uav123_10fps) -> dict[str, float]:
     """Mean precision of each config in FLOORS: every config is stepped through a sequence
     together, so that each frame is decoded once (decoding a 720p frame costs about what a
-    tracker's update does)."""
-    scores = {config: [] for config in FLOORS}
-    for seq in uav123_10fps:
-        for config, boxes in one_pass_each(list(FLOORS), seq).items():
-            scores[config].append(score_sequence(boxes, seq.ground_truth))
-    return {config: average(found)["precision"] for config, found in scores.items()}
+    tracker's update does), and the sequences are shared among worker processes, one a core
+    (the suite runs one test at a time), longest first so that the workers end together."""
+    calls = {seq.name: (one_pass_each, list(FLOORS), seq) for seq in sorted(uav123_10fps, key=lambda s: -len(s))}
+    found = {}
+    run_pool(calls, usable_cores(), found.__setitem__, crashed)
+    return {config: average([score_sequence(found[seq.name][config], seq.ground_truth)
+                             for seq in uav123_10fps])["precision"] for config in FLOORS}
+
+
+def crashed(name, exc):
+    """run_pool's ``on_crash``: a worker that failed fails the fixture, naming the sequence."""
+    raise RuntimeError(f"tracking {name} failed in its worker: {exc!r}") from exc
 
 
 @pytest.mark.parametrize("config", sorted(FLOORS))

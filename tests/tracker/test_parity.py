@@ -34,6 +34,7 @@ from dcfkit.analysis.compare import compare_folders
 from dcfkit.config import load_config
 from dcfkit.datasets import load_dataset, read_boxes
 from dcfkit.running.evaluation import run_one_pass
+from dcfkit.running.runner import usable_cores
 
 OCTAVE_RUNS = Path(__file__).parents[1] / "data" / "authors_octave"
 UAV = ("uav123_10fps", "UAV123_10fps")
@@ -58,7 +59,11 @@ def compare_preset(preset, dataset, folder, sequences, reference, shared_data, r
     ``runs`` holds that run already, and compare it with ``reference``."""
     seqs = load_dataset(dataset, shared_data / folder, sequences)
     config = load_config(preset if preset in FAITHFUL else f"reference/{preset}")
-    run_one_pass(config, seqs, runs, progress=False)
+    # sequences in worker processes, one a core: the suite runs one test at a time, which
+    # would leave CI's second core idle (``dcfkit eval --jobs``: the same runs, the same boxes).
+    # Two sequences or fewer stay here: a worker's start (imports, numba's compile in the
+    # simulated platform's fresh cache) costs about what it would save.
+    run_one_pass(config, seqs, runs, progress=False, jobs=usable_cores() if len(seqs) > 2 else 1)
     table = compare_folders(runs / config["name"], reference, seqs, protocol="otb")
     assert [r["sequence"] for r in table["rows"]] == [s.name for s in seqs]
     return table["rows"]
