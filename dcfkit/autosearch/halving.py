@@ -8,9 +8,9 @@ costly TRE only after OPE has kept it).
 A study's training sequences are taken in one order, fixed by the seed and the study, so every
 trial at a rung is judged on the same units. The rungs are at ``min_sequences`` times
 ``reduction_factor`` to the k, then all of them: a trial continues past a rung only if its mean
-AUC there (over its units) is in the top 1 / ``reduction_factor`` of the trials that reached it. The pruner's
-decisions depend on the order of the trials, so they are replayed from the records (a
-:class:`Ladder`), never stored: a resumed search decides as the first run did."""
+AUC there (over its units) is in the top 1 / ``reduction_factor`` of the trials that reached
+it. The pruner's decisions depend on the order of the trials, so they are replayed from the
+records (a :class:`Ladder`), never stored: a resumed search decides as the first run did."""
 from __future__ import annotations
 
 import dataclasses

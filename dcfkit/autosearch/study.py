@@ -231,10 +231,12 @@ class Search:
             atomic_write(self.out / "trials" / study / f"{n:04d}.json", json.dumps(rec, indent=1) + "\n")
             records.append(rec)
             best = max((r["value"] for r in records if is_score(r["value"])), default=None)
-            scored = "pruned after" if rec.get("pruned") else "on"
+            n_scored = len(rec["scores"])
+            scored = (f"pruned after {self.spec.halving.counted(rec['steps'][-1][0])}" if rec.get("pruned")
+                      else f"on {n_scored} sequence{'s' if n_scored != 1 else ''}")
             self.report(f"{study} trial {n} ({n + 1} of {self.spec.trials}): mean AUC "
                         f"{_shown_auc(rec['steps'][-1][1] if rec.get('pruned') else rec['value'])} {scored} "
-                        f"{len(rec['scores'])} sequence{'s' if len(rec['scores']) != 1 else ''} (best {_shown_auc(best)}) {shown(params)}")
+                        f"(best {_shown_auc(best)}) {shown(params)}")
         return records
 
     def _scored(self, config: dict, names: list[str], study: str, ladder: Ladder | None) -> dict:

@@ -36,7 +36,9 @@ def searches(tmp_path_factory) -> Path:
         write_otb(folder / "data", f"seq{i}", seed=i, n_frames=21)
     (folder / "plain.yaml").write_text(BOTH, encoding="utf-8")
     (folder / "in_turn.yaml").write_text(BOTH + IN_TURN, encoding="utf-8")
-    search(folder).run()
+    lines: list[str] = []
+    Search(load_search_spec(folder / "in_turn.yaml"), folder / "in_turn", {"jobs": 1}, report=lines.append).run()
+    (folder / "printed.txt").write_text("\n".join(lines), encoding="utf-8")
     return folder
 
 
@@ -99,6 +101,8 @@ def test_a_trial_pruned_under_ope_never_runs_tre(searches):
     assert saved["frames_unpruned"] == len(trials(searches / "in_turn", "all")) * frames
     assert saved["frames"] < saved["frames_unpruned"]
     assert "experiments in turn" in (searches / "in_turn/summary.md").read_text()
+    assert "mean AUC" in (printed := (searches / "printed.txt").read_text())
+    assert f"pruned after {early[0]['steps'][-1][0]} (sequence, experiment) pair" in printed
 
 
 def test_a_trial_left_unpruned_scores_as_in_the_plain_search(searches):
