@@ -178,3 +178,23 @@ def test_the_benchmark_replays_a_plain_search_in_turn_as_the_halved_search_ran(s
     pruned = sum(r["pruned"] for study in STUDIES for r in trials(searches / "in_turn", study)[:3])
     assert "experiments: in_turn" in done.stdout
     assert f"all studies: {pruned} of 9 trials pruned" in done.stdout
+
+
+def test_the_audit_completes_the_furthest_pruned_trials_and_sets_them_against_the_best(searches, tmp_path):
+    out = tmp_path / "in_turn"
+    shutil.copytree(searches / "in_turn", out)  # the audit's runs must not reach the fixture's folder
+    spec = tmp_path / "in_turn.yaml"
+    spec.write_text(BOTH.replace("root: data", f"root: {searches / 'data'}") + IN_TURN, encoding="utf-8")
+    script = Path(__file__).resolve().parents[2] / "benchmarks" / "halving_audit.py"
+    done = subprocess.run([sys.executable, str(script), str(spec), str(out), "--top", "1"],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    search = Search(load_search_spec(spec), out, {"jobs": 1})
+    rows = [line.strip("| ").split(" | ") for line in done.stdout.splitlines() if line.startswith(("| fold", "| all"))]
+    assert [r[0] for r in rows] == [s for s in STUDIES if any(t["pruned"] for t in trials(out, s))]
+    for study, trial, _, _, completed, best, winner in rows:
+        rec, names = trials(out, study)[int(trial)], search.training(study)
+        expected = search._scored(rec["config"], names, study, None)["value"]  # plain scoring: its runs are made
+        top = max(t["value"] for t in trials(out, study) if t["value"] is not None)
+        assert completed == f"{expected:.4f}" and best.endswith(f", {top:.4f}")
+        assert winner == ("yes" if expected > top else "no")
