@@ -14,8 +14,9 @@ given dataset, and returns one row per sequence:
 * ``diverges_at``: the first frame (1-based) where the two centres are more than
   ``divergence_px`` apart (a box NaN in one file only counts as apart), or None.
 
-The ``mean`` row averages precision and AUC as the protocol averages sequences, and the
-per-sequence IoUs with equal weights. Sequences found in only one folder, in both but not
+Under TRE or SRE (``experiment``) the files are each sequence's runs, and a row pools them
+(:func:`compare_folders`). The ``mean`` row averages precision and AUC as the protocol averages
+sequences, and the per-sequence IoUs with equal weights. Sequences found in only one folder, in both but not
 in the dataset, or whose dcfkit sidecar says the file is damaged, are listed in ``left_out``.
 ``platforms`` lists each folder's platforms as their sidecars record them
 (:mod:`dcfkit.store.platforms`; "not recorded" for files without one) and ``platform_differences``
@@ -39,6 +40,7 @@ from dcfkit.analysis.report import refuse_reset_runs
 from dcfkit.analysis.statistics import METHOD, Difference, mean_interval, paired_difference
 from dcfkit.datasets import DatasetError, Sequence, benchmark_protocol, read_boxes, scored_sequences
 from dcfkit.errors import clip, shown
+from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
 from dcfkit.protocols import Protocol, get_protocol
 from dcfkit.store import platforms
 from dcfkit.store.results import ResultStore, result_files
@@ -84,8 +86,14 @@ def _identical(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def compare_folders(results, reference, sequences: Iterable[Sequence], protocol: str | Protocol | None = None,
-                    divergence_px: float = 2.0) -> dict:
+                    divergence_px: float = 2.0, experiment: str | Experiment = "ope") -> dict:
     """Compare the result files of two folders on ``sequences`` (their ground truth).
+
+    ``experiment`` ``tre`` or ``sre``: the files are the runs of each sequence (``<run>.txt``,
+    :mod:`dcfkit.experiments`); a sequence is compared when both folders hold all its runs.
+    Its scores pool its runs' frames (:func:`metrics.pool_runs`, as ``dcfkit report``), its
+    ``iou`` is the mean over all their frames, and ``diverges_at`` is ``"k:f"``, frame ``f``
+    of run ``k``, the first run that diverges.
 
     Returns a plain dict: ``protocol`` (name), ``divergence_px``, ``results`` and
     ``reference`` (the folders), ``rows`` (one per compared sequence, keys
@@ -102,39 +110,47 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     """
     sequences = list(sequences)
     proto = get_protocol(protocol or benchmark_protocol(sequences))
+    exp = get_experiment(experiment)
+    if exp.scoring != "otb":
+        raise DatasetError(f"compare sets box series side by side; {exp.name} runs are scored by dcfkit report "
+                           f"--experiment {exp.name}")
     if not divergence_px >= 0:
         raise DatasetError(f"divergence_px must be a number >= 0, got {shown(divergence_px)}")
-    by_name = {s.name: s for s in sequences}
+    sequences = scored_sequences(sequences)
+    runs = runs_by_sequence(sequences, exp) if exp.pooled else {seq.name: [seq] for seq in sequences}
+    by_name = {run.name: run for found in runs.values() for run in found}
     (ours, damaged, our_platforms), (theirs, damaged_ref, their_platforms) = (_intact_files(results, by_name),
                                                                               _intact_files(reference, by_name))
-    sequences = scored_sequences(sequences)
-    known = {s.name for s in sequences}
-    both = [s for s in sequences if s.name in ours and s.name in theirs]
-    left_out = {"only_in_results": sorted(set(ours) - set(theirs)),
-                "only_in_reference": sorted(set(theirs) - set(ours)),
-                "not_in_dataset": sorted((set(ours) & set(theirs)) - known),
+    complete = [{s.name for s in sequences if runs[s.name] and all(r.name in files for r in runs[s.name])}
+                for files in (ours, theirs)]
+    both = [s for s in sequences if s.name in complete[0] & complete[1]]
+    stray = set(ours) - set(by_name), set(theirs) - set(by_name)  # files of no run of a dataset sequence
+    left_out = {"only_in_results": sorted((complete[0] - complete[1]) | (stray[0] - stray[1])),
+                "only_in_reference": sorted((complete[1] - complete[0]) | (stray[1] - stray[0])),
+                "not_in_dataset": sorted((set(ours) & set(theirs)) - set(by_name)),
                 "damaged": sorted(set(damaged) | set(damaged_ref))}
     if not both:
-        raise DatasetError(f"no sequence has results in both {clip(str(results))} ({len(ours)} files) and {clip(str(reference))} "
-                           f"({len(theirs)} files) and ground truth in the dataset ({len(known)} sequences)")
+        raise DatasetError(f"no sequence has {_what(exp)} in both {clip(str(results))} ({len(ours)} files) and "
+                           f"{clip(str(reference))} ({len(theirs)} files) and ground truth in the dataset "
+                           f"({len(sequences)} sequences)")
     rows, scores, scores_ref = [], [], []
     for seq in both:
-        a, b = _boxes(seq, ours[seq.name], theirs[seq.name])
-        s, s_ref = (metrics.score_sequence(x, seq.ground_truth, protocol=proto) for x in (a, b))
+        row, s, s_ref = _compared(seq, runs[seq.name], ours, theirs, proto, divergence_px, exp.pooled)
+        rows.append(row)
         scores.append(s)
         scores_ref.append(s_ref)
-        rows.append(_row(seq.name, len(seq), s, s_ref, float(series_iou(a, b).mean()),
-                         first_divergence(a, b, divergence_px)))
+    files = [run.name for s in both for run in runs[s.name]]  # each compared file, a run's under TRE or SRE
+    unit = "runs" if exp.pooled else "sequences"
     mean = _row("mean", sum(r["frames"] for r in rows), metrics.average(scores, protocol=proto),
                 metrics.average(scores_ref, protocol=proto), float(np.mean([r["iou"] for r in rows])), None)
-    return {"protocol": proto.name, "divergence_px": float(divergence_px), "results": str(results),
-            "reference": str(reference), "rows": rows, "mean": mean, **score_statistics(rows),
+    return {"protocol": proto.name, "experiment": exp.name, "divergence_px": float(divergence_px),
+            "results": str(results), "reference": str(reference), "rows": rows, "mean": mean, **score_statistics(rows),
             "noise_floor": noise_floor(rows),
             "diverged": sum(r["diverges_at"] is not None for r in rows), "left_out": left_out,
-            "platforms": {side: counted_lines(Counter(platforms.describe(records[s.name]) for s in both), len(both))
+            "platforms": {side: counted_lines(Counter(platforms.describe(records[f]) for f in files), len(files), unit)
                           for side, records in (("results", our_platforms), ("reference", their_platforms))},
-            "platform_differences": counted_lines(Counter(d for s in both for d in set(
-                platforms.differences(our_platforms[s.name], their_platforms[s.name]))), len(both))}
+            "platform_differences": counted_lines(Counter(d for f in files for d in set(
+                platforms.differences(our_platforms[f], their_platforms[f]))), len(files), unit)}
 
 
 def score_statistics(rows: list[dict]) -> dict:
@@ -178,12 +194,12 @@ def _non_finite(rows: list[dict], key: str) -> list[str]:
     return [r["sequence"] for r in rows if not math.isfinite(r[key])]
 
 
-def counted_lines(counts: Mapping[str, int], total: int, limit: int = 10) -> list[str]:
-    """The different lines of ``counts`` (line -> how many of ``total`` sequences have it), most
-    frequent first, each with its count of sequences unless every sequence has it; at most
+def counted_lines(counts: Mapping[str, int], total: int, unit: str = "sequences", limit: int = 10) -> list[str]:
+    """The different lines of ``counts`` (line -> how many of ``total`` sequences, or other
+    ``unit``, have it), most frequent first, each with its count unless every one has it; at most
     ``limit`` of them and a last line counting the others (one line per sequence would be thousands)."""
     ranked = sorted(counts.items(), key=lambda item: (-item[1], item[0]))
-    out = [line if n == total else f"{line} ({n:,} of {total:,} sequences)" for line, n in ranked[:limit]]
+    out = [line if n == total else f"{line} ({n:,} of {total:,} {unit})" for line, n in ranked[:limit]]
     if len(ranked) > limit:
         out.append(f"and {len(ranked) - limit:,} more")
     return out
@@ -215,6 +231,29 @@ def _intact_files(folder, sequences: Mapping[str, Sequence]
     return files, [p.stem for p in damaged], platform_records
 
 
+def _what(exp: Experiment) -> str:
+    return f"all its {exp.name.upper()} runs" if exp.pooled else "results"
+
+
+def _compared(seq: Sequence, runs: list[Sequence], ours: Mapping[str, Path], theirs: Mapping[str, Path],
+              proto: Protocol, divergence_px: float, pooled: bool) -> tuple[dict, dict, dict]:
+    """(the row, the two scores) of ``seq`` from the files of its ``runs`` (the sequence itself
+    in one pass): scores pooled over the runs, IoU over all their frames, the first divergence
+    (``"k:f"`` where the experiment has runs, ``pooled``)."""
+    found, found_ref, ious, diverges_at = [], [], [], None
+    for k, run in enumerate(runs, 1):
+        a, b = _boxes(run, ours[run.name], theirs[run.name])
+        found.append(metrics.score_sequence(a, run.ground_truth, protocol=proto))
+        found_ref.append(metrics.score_sequence(b, run.ground_truth, protocol=proto))
+        ious.append(series_iou(a, b))
+        frame = first_divergence(a, b, divergence_px)
+        if diverges_at is None and frame is not None:
+            diverges_at = f"{k}:{frame}" if pooled else frame
+    s, s_ref = ((scores[0] if len(runs) == 1 else metrics.pool_runs(scores, proto)) for scores in (found, found_ref))
+    frames = sum(len(run) for run in runs)
+    return _row(seq.name, frames, s, s_ref, float(np.concatenate(ious).mean()), diverges_at), s, s_ref
+
+
 def _boxes(seq: Sequence, path: Path, path_ref: Path) -> tuple[np.ndarray, np.ndarray]:
     a, b = read_boxes(path), read_boxes(path_ref)
     if len(a) != len(b):
@@ -225,7 +264,7 @@ def _boxes(seq: Sequence, path: Path, path_ref: Path) -> tuple[np.ndarray, np.nd
     return a, b
 
 
-def _row(name: str, frames: int, s: dict, s_ref: dict, iou: float, diverges_at: int | None) -> dict:
+def _row(name: str, frames: int, s: dict, s_ref: dict, iou: float, diverges_at: int | str | None) -> dict:
     return {"sequence": name, "frames": frames,
             "precision": s["precision"], "precision_ref": s_ref["precision"],
             "d_precision": s["precision"] - s_ref["precision"],

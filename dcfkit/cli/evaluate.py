@@ -37,7 +37,7 @@ from dcfkit.config import load_config
 from dcfkit.config.overrides import parse_overrides
 from dcfkit.datasets import benchmark_protocol, load_datasets, scored_sequences
 from dcfkit.errors import ConfigError, printable, shown
-from dcfkit.experiments import Experiment, runs_by_sequence
+from dcfkit.experiments import EXPERIMENTS, Experiment, get_experiment, runs_by_sequence
 from dcfkit.integrations.opencv import opencv_tracker
 from dcfkit.running.evaluation import check_one_pass, results_folder, run_one_pass, tracker_name
 from dcfkit.store.results import load_results
@@ -256,6 +256,10 @@ def add_compare_arguments(p: argparse.ArgumentParser) -> None:
                         "REFERENCE")
     add_dataset_arguments(p, "benchmark root folder (the ground truth)")
     add_protocol_argument(p)
+    p.add_argument("--experiment", choices=[n for n, e in EXPERIMENTS.items() if e.scoring == "otb"], default="ope",
+                   help="ope: a file per sequence (default); tre, sre: a file per run, read from "
+                        "FOLDER/<experiment>/ where FOLDER holds one, each sequence's runs pooled as dcfkit "
+                        "report pools them")
     p.add_argument("--divergence-px", type=pixels, default=2.0,
                    help="centres further apart than this (pixels) count as diverged")
     p.add_argument("--format", choices=("table", "markdown", "csv", "json"), default="table",
@@ -263,9 +267,13 @@ def add_compare_arguments(p: argparse.ArgumentParser) -> None:
                         "divergences, left-out sequences) go to stderr")
 
 
-def _named(folder: str) -> tuple[str | None, Path]:
-    """(its name, the folder) of a RESULTS or REFERENCE argument: ``NAME=FOLDER`` or a folder."""
-    return named_folder(Path.cwd(), folder) if "=" in folder and not os.path.isdir(folder) else (None, Path(folder))
+def _named(folder: str, experiment: str = "ope") -> tuple[str | None, Path]:
+    """(its name, the folder) of a RESULTS or REFERENCE argument: ``NAME=FOLDER`` or a folder;
+    its experiment's sub-folder (TRE's ``tre/``) where it holds one (an eval's tracker folder)."""
+    name, path = (named_folder(Path.cwd(), folder) if "=" in folder and not os.path.isdir(folder)
+                  else (None, Path(folder)))
+    sub = get_experiment(experiment).folder
+    return name, path / sub if sub and (path / sub).is_dir() else path
 
 
 def side_names(named: tuple[tuple[str | None, Path], tuple[str | None, Path]]) -> list[str]:
@@ -281,20 +289,25 @@ def side_names(named: tuple[tuple[str | None, Path], tuple[str | None, Path]]) -
 def run_compare(args: argparse.Namespace) -> int:
     """Print the per-sequence comparison, each side named (:func:`side_names`)."""
     sequences = load_datasets(args.dataset, args.root, args.sequences)
-    named = _named(args.results), _named(args.reference)
-    res = compare_folders(named[0][1], named[1][1], sequences, args.protocol, args.divergence_px)
+    named = _named(args.results, args.experiment), _named(args.reference, args.experiment)
+    res = compare_folders(named[0][1], named[1][1], sequences, args.protocol, args.divergence_px, args.experiment)
     res["names"] = ours, theirs = side_names(named)
     if args.format == "json":
         print(json.dumps(json_ready(res), indent=1))
         return 0
-    print(format_table(res["rows"] + [res["mean"]], args.format, COLUMNS, res["protocol"]), end="")
+    pooled = get_experiment(args.experiment).pooled
+    print(format_table(res["rows"] + [res["mean"]], args.format, COLUMNS, res["protocol"],
+                       experiment=args.experiment if pooled else None), end="")
     notes = sys.stderr if args.format == "csv" else sys.stdout
     sides = {"results": ours, "reference": theirs}
     labels = {"only_in_results": f"only in {ours}", "only_in_reference": f"only in {theirs}"}
-    left = "; ".join(f"{labels.get(k, k.replace('_', ' '))}: {', '.join(v)}" for k, v in res["left_out"].items() if v)
+    left = "; ".join(f"{labels.get(k, k.replace('_', ' '))}: {', '.join(v[:10])}"
+                     f"{f' and {len(v) - 10:,} more (--format json lists them)' if len(v) > 10 else ''}"
+                     for k, v in res["left_out"].items() if v)
     print(f"\n{ours} (RESULTS): {res['results']}\n{theirs} (REFERENCE): {res['reference']}\n"
           f"{res['diverged']} of {len(res['rows'])} sequences diverge (centres more than "
-          f"{args.divergence_px:g} px apart); precision, auc: {ours}; precision_ref, auc_ref: {theirs}; "
+          f"{args.divergence_px:g} px apart{'; diverges_at k:f, frame f of run k' if pooled else ''}); "
+          f"precision, auc: {ours}; precision_ref, auc_ref: {theirs}; "
           f"d_ = {ours} minus {theirs}\nleft out: {left or 'none'}", file=notes)
     for side, name in sides.items():
         print(f"{name} platform: {'; '.join(res['platforms'][side])}", file=notes)
