@@ -65,6 +65,9 @@ class Evaluator:
             entries.setdefault(name, Entry(name, config))
         failures: list[str] = []
         for experiment in (self.experiments if experiments is None else experiments) if entries else ():
+            if baseline is not None:  # its one entry
+                (entry,) = entries.values()
+                self._adopt(dict(entry.config), names, experiment, store_folder(root, entry.name, experiment))
             plan = RunPlan(entries.values(), [self.sequences[n] for n in names], experiment, root,
                            "the search's runs", self.version)
             plan.run("dcfkit search", self.jobs, self.executor, self.scheduler)
@@ -72,6 +75,15 @@ class Evaluator:
                 failures.append(f"{run}: {message}")
                 log.warning("run failed, scored as a total failure: %s: %s", run, message)
         return failures
+
+    def _adopt(self, config: dict, names: list[str], experiment: str, folder: Path) -> None:
+        """Copy into a baseline's ``folder`` the runs a trial of the same config (the same run
+        key: config and version) has done: the base config is trial 0 and often a baseline too."""
+        key = self.key(config)
+        trial, mine = ResultStore(store_folder(self.out / TRIAL_RUNS, key, experiment)), ResultStore(folder)
+        for run in (r for n in names for r in self.runs[experiment][n]):
+            if trial.is_done(run, key) and not mine.is_done(run, key):
+                mine.copy_run(trial, run.name)
 
     def scores(self, config: dict, names: list[str], baseline: str | None = None) -> dict[str, dict]:
         """Sequence name -> ``{"auc", "precision"}`` of ``config`` (its runs made first; those of

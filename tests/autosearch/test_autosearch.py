@@ -326,6 +326,8 @@ def test_a_search_killed_with_sigkill_resumes_to_the_same_result(tmp_path, data)
 
 def test_trials_of_one_config_share_their_runs_and_a_baseline_has_its_own_folder(tmp_path, data, monkeypatch,
                                                                                    capsys):
+    """A baseline of a trial's config (the base, trial 0) gets the trial's runs copied into its
+    own folder, tracking nothing; a baseline of another config tracks its own."""
     from test_evaluation import DriftTracker  # a fake tracker: the runs it makes are counted
 
     from dcfkit.autosearch.evaluation import Evaluator
@@ -341,8 +343,13 @@ def test_trials_of_one_config_share_their_runs_and_a_baseline_has_its_own_folder
     assert len(made) == 2 and sorted(p.name for p in (out / "runs" / evaluator.key(config)).glob("*.txt")) == [
         "seqA.txt", "seqB.txt"]  # OUT/runs/<run key>/
     assert evaluator.scores({**config, "name": "trial 7"}, names) == first and len(made) == 2  # its runs reused
-    assert evaluator.scores(config, names, baseline="KCF") == first and len(made) == 4
+    assert evaluator.scores(config, names, baseline="KCF") == first and len(made) == 2  # copied, not tracked
     assert sorted(p.name for p in (out / "baselines" / "KCF").glob("*.txt")) == ["seqA.txt", "seqB.txt"]
+    trial = out / "runs" / evaluator.key(config)
+    assert all((out / "baselines" / "KCF" / p.name).read_bytes() == p.read_bytes() for p in trial.glob("seq*"))
+    other = {**config, "solver": {**config["solver"], "sigma": 0.7}}
+    evaluator.scores(other, names, baseline="KCF")  # the folder's runs are of another key: tracked again
+    assert len(made) == 4
     assert cli.main(["compare", str(out / "runs" / evaluator.key(config)), str(out / "baselines" / "KCF"),
                      "--dataset", "otb", "--root", str(data)]) == 0  # eval's layout: compare reads it
 
