@@ -801,12 +801,17 @@ def test_a_config_name_with_a_control_character_is_a_config_error(tmp_path, otb_
                      str(tmp_path / "out"), "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert err == ("dcfkit eval: error: config 'name' 'a\\x00b' must be usable as a folder name that report lists "
-                   "(no / \\ :, no leading dot, no control character such as a null byte or a line break)\n")
+                   "(no / \\ : or comma, no leading dot or space, no control character such as a null byte or a line "
+                   "break)\n")
     from dcfkit.running.evaluation import tracker_name
 
-    for name in (".mine", ".locks", "..", "a\nb"):
+    # a comma or a trailing space too: report --trackers could not name the folder (as eval's
+    # folders for ablation variants are checked)
+    for name in (".mine", ".locks", "..", "a\nb", "a,b", "a "):
         with pytest.raises(ConfigError, match="must be usable as a folder name"):
             tracker_name({"name": name})
+    with pytest.raises(ConfigError, match="too long for a folder name"):
+        tracker_name({"name": "x" * 300})
 
 
 def test_a_name_cannot_add_rows_to_a_markdown_or_text_table():

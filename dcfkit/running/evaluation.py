@@ -24,7 +24,7 @@ from typing import Iterable, Mapping
 from dcfkit.datasets import Sequence
 from dcfkit.errors import ConfigError, shown
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
-from dcfkit.running.layout import store_folder
+from dcfkit.running.layout import folder_problem, store_folder
 from dcfkit.running.plan import Entry, RunPlan
 from dcfkit.running.progress import FrameBar
 
@@ -36,9 +36,9 @@ def tracker_name(config: Mapping) -> str:
     name = config.get("name") if isinstance(config, Mapping) else None
     if not isinstance(name, str) or not name.strip():
         raise ConfigError("config has no top-level 'name' (the tracker name used for the output folder)")
-    if name.startswith(".") or any(c in name for c in "/\\:") or not name.isprintable():
-        raise ConfigError(f"config 'name' {shown(name)} must be usable as a folder name that report lists (no / \\ :, "
-                          f"no leading dot, no control character such as a null byte or a line break)")
+    problem = folder_problem(name)  # the rule every folder of a tracker's results is held to
+    if problem:
+        raise ConfigError(f"config 'name' {shown(name)} {problem}")
     return name
 
 
