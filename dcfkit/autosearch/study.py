@@ -26,7 +26,7 @@ from dcfkit.autosearch.evaluation import Evaluator, combined
 from dcfkit.autosearch.halving import Ladder, Unit, intermediate, sequence_order
 from dcfkit.autosearch.records import complete, record_fault
 from dcfkit.autosearch.space import SearchSpec, active
-from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, mean_score, summarize
+from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, mean_score, status_lines, summarize
 from dcfkit.autosearch.warm_start import base_params
 from dcfkit.datasets import scored_sequences
 from dcfkit.errors import DcfkitError, clip, printable, shown
@@ -126,19 +126,23 @@ class Search:
     def studies(self) -> list[str]:
         return [f"fold{i + 1}" for i in range(len(self.folds))] + [FINAL]
 
-    def check_record(self) -> None:
-        """Write ``OUT/search.json``, or refuse to resume a search whose trials would not stand."""
+    def check_record(self, write: bool = True) -> None:
+        """Write ``OUT/search.json`` (unless not ``write``: then it must be there), or refuse to
+        resume a search whose trials would not stand."""
         path = self.out / "search.json"
         mine = fingerprint(self.spec, self.folds, self.evaluator)
         recorded = read_json(path)  # None: missing, unreadable or not an object
         if recorded is not None:
             self._check_fingerprint(path, recorded.get("fingerprint"), mine)
+        elif not write:
+            raise DcfkitError(f"no search is recorded under {self.out}: {path} is missing or not a search record")
         elif any(any((self.out / "trials" / study).glob("*.json")) for study in self.studies()):
             state = "not a search record as dcfkit writes it" if path.exists() else "missing"
             raise DcfkitError(f"{path} is {state}, yet {self.out / 'trials'} holds trial records: nothing shows which "
                               f"search made them; give a new --out, or remove {self.out / 'trials'} to start again")
-        atomic_write(path, json.dumps({"spec": shared_path(self.spec.path, self.out), "name": self.spec.name,
-                                       "fingerprint": mine}, indent=1) + "\n")
+        if write:
+            atomic_write(path, json.dumps({"spec": shared_path(self.spec.path, self.out), "name": self.spec.name,
+                                           "fingerprint": mine}, indent=1) + "\n")
 
     def _check_fingerprint(self, path: Path, old: Any, mine: dict) -> None:
         """Refuse to resume when the recorded fingerprint ``old`` is not ``mine``; one without the
@@ -179,7 +183,9 @@ class Search:
                               f"{roots_text(self.spec)} differ from the recorded ones; give the recorded search's --root, "
                               f"or a new --out")
         if changed:
-            raise DcfkitError(f"{path} records a different search (these differ: {', '.join(changed)}): "
+            why = ("; the base config's run key differs: another base config, dcfkit version or box code (a "
+                   "search resumes with the code that recorded it)" if "base" in changed else "")
+            raise DcfkitError(f"{path} records a different search (these differ: {', '.join(changed)}{why}): "
                               f"give a new --out, or remove {self.out} to start again")
 
     def recorded(self, study: str) -> tuple[list[dict], Ladder | None]:
@@ -262,6 +268,12 @@ class Search:
         rec = {"value": None if pruned else mean_auc(scores, names), "scores": scores, "steps": steps,
                "pruned": pruned}
         return {**rec, "by_experiment": finite(by_experiment)} if self.spec.halving.experiments == "in_turn" else rec
+
+    def status(self) -> list[str]:
+        """Where the recorded search stands, running nothing: per study, its trials recorded
+        (those that stand), pruned, and its best so far (:func:`~dcfkit.autosearch.summary.status_lines`)."""
+        self.check_record(write=False)
+        return status_lines(self, {study: self.recorded(study)[0] for study in self.studies()})
 
     def run(self) -> dict:
         """Every study, then the held-out scores and the comparison (:mod:`dcfkit.autosearch.summary`)."""

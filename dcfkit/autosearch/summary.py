@@ -113,6 +113,28 @@ def _halving(search, studies: dict[str, list[dict]]) -> dict | None:
     return {**search.spec.halving.as_record(), "studies": per_study}
 
 
+def status_lines(search, studies: dict[str, list[dict]]) -> list[str]:
+    """Where a search stands from its studies' records (those that stand): per study, the
+    trials recorded, pruned and the best so far; then whether its summary is written."""
+    budget = search.spec.trials
+    lines = [f"search {printable(search.spec.name)} under {search.out}: "
+             f"{sum(len(r) == budget for r in studies.values())} of {len(studies)} studies complete, "
+             f"{sum(len(r) for r in studies.values())} of {budget * len(studies)} trials recorded"]
+    for study, records in studies.items():
+        if not records:
+            lines.append(f"  {study}: not begun")
+            continue
+        pruned = sum(bool(r.get("pruned")) for r in records)
+        top = best(records, study) if any(is_score(r["value"]) for r in records) else None
+        found = (f"best trial {top['number']}, mean AUC {top['value']:.4f} on {len(search.training(study))} "
+                 f"sequences" if top else "no trial scored yet")
+        lines.append(f"  {study}: {len(records)} of {budget} trials" + (f" ({pruned} pruned)" if pruned else "")
+                     + f"; {found}")
+    done = (search.out / "summary.md").is_file() and all(len(r) == budget for r in studies.values())
+    lines.append(f"summary.md: {'written' if done else 'not yet: it is written when every study is complete'}")
+    return lines
+
+
 def _compare(names: list[str], held_out: dict, baselines: dict) -> dict:
     """The held-out AUC minus each baseline's, per sequence: interval, Wilcoxon p, Holm across
     the baselines; ``significant``: Holm p < 0.05 and the interval above 0."""

@@ -41,6 +41,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="a quick try: each sequence's first N frames only (its runs are of the cut sequences, "
                              "never taken for full ones); recorded, so a rerun must give the same")
     add_protocol_argument(parser)
+    parser.add_argument("--status", action="store_true",
+                        help="run nothing: say where the search recorded under --out stands (trials per study, "
+                             "pruned, the best so far), with the options it runs with")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -73,6 +76,9 @@ def run(args: argparse.Namespace) -> int:
     search = Search(spec, args.out, {"protocol": args.protocol, "jobs": jobs, "executor": executor,
                                      "scheduler": args.scheduler},
                     report=lambda line: print(line, file=sys.stderr, flush=True))
+    if args.status:
+        print("\n".join(search.status()))
+        return 0
     summary = search.run()
     print("\n".join(summary_lines(summary)))
     return 0

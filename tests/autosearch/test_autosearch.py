@@ -282,6 +282,19 @@ def test_a_rerun_resumes_and_more_trials_extend_the_studies(tmp_path, data, caps
     assert "records a different search (these differ: folds, seed)" in capsys.readouterr().err
 
 
+def test_a_resume_with_other_box_code_is_refused_saying_why(tmp_path, data, capsys, monkeypatch):
+    from dcfkit.autosearch import evaluation
+
+    spec = write(tmp_path / "s.yaml", SPEC.replace("trials: 3", "trials: 1"))
+    (tmp_path / "out").mkdir()
+    Search(load_search_spec(spec), tmp_path / "out", {"jobs": 1}).check_record()
+    monkeypatch.setattr(evaluation, "dcfkit_version", lambda: "0.0.1")  # as another version or box code
+    assert cli.main(["search", str(spec), "--out", str(tmp_path / "out"), "--status"]) != 0
+    err = capsys.readouterr().err
+    assert "these differ: base, space; the base config's run key differs: another base config, dcfkit version " \
+           "or box code (a search resumes with the code that recorded it)" in err
+
+
 def test_experiments_on_the_command_line_replace_the_specs_and_are_recorded(tmp_path, capsys):
     data = tmp_path / "data"
     for i, name in enumerate(("seqA", "seqB", "seqC", "seqD")):

@@ -198,3 +198,30 @@ def test_the_audit_completes_the_furthest_pruned_trials_and_sets_them_against_th
         top = max(t["value"] for t in trials(out, study) if t["value"] is not None)
         assert completed == f"{expected:.4f}" and best.endswith(f", {top:.4f}")
         assert winner == ("yes" if expected > top else "no")
+
+
+def test_status_says_where_the_search_stands_and_runs_nothing(searches, tmp_path, capsys):
+    out = tmp_path / "in_turn"
+    shutil.copytree(searches / "in_turn", out)
+    spec = tmp_path / "in_turn.yaml"
+    spec.write_text(BOTH.replace("root: data", f"root: {searches / 'data'}") + IN_TURN, encoding="utf-8")
+    command = ["search", str(spec), "--out", str(out), "--status"]
+    assert cli.main(command) == 0
+    printed = capsys.readouterr().out.splitlines()
+    summary = json.loads((out / "summary.json").read_text())
+    final = trials(out, "all")[summary["final"]["trial"]]
+    pruned = sum(r["pruned"] for r in trials(out, "all"))
+    assert printed[0] == f"search halved under {out}: 3 of 3 studies complete, 15 of 15 trials recorded"
+    assert printed[3] == (f"  all: 5 of 5 trials ({pruned} pruned); best trial {final['number']}, mean AUC "
+                          f"{final['value']:.4f} on 4 sequences")
+    assert printed[-1] == "summary.md: written"
+    (out / "trials" / "all" / "0004.json").unlink()
+    before = sorted(p.relative_to(out) for p in out.rglob("*"))
+    assert cli.main(command) == 0
+    printed = capsys.readouterr().out.splitlines()
+    assert printed[0].endswith("2 of 3 studies complete, 14 of 15 trials recorded")
+    assert printed[3].startswith("  all: 4 of 5 trials")
+    assert printed[-1] == "summary.md: not yet: it is written when every study is complete"
+    assert sorted(p.relative_to(out) for p in out.rglob("*")) == before  # nothing run, nothing written
+    assert cli.main(["search", str(spec), "--out", str(tmp_path / "none"), "--status"]) != 0
+    assert "no search is recorded under" in capsys.readouterr().err
