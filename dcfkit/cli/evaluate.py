@@ -258,8 +258,8 @@ def add_compare_arguments(p: argparse.ArgumentParser) -> None:
     add_protocol_argument(p)
     p.add_argument("--experiment", choices=[n for n, e in EXPERIMENTS.items() if e.scoring == "otb"], default="ope",
                    help="ope: a file per sequence (default); tre, sre: a file per run, read from "
-                        "FOLDER/<experiment>/ where FOLDER holds one, each sequence's runs pooled as dcfkit "
-                        "report pools them")
+                        "FOLDER/<experiment>/ where FOLDER holds one, each sequence's runs pooled (as in "
+                        "'dcfkit report --experiment')")
     p.add_argument("--divergence-px", type=pixels, default=2.0,
                    help="centres further apart than this (pixels) count as diverged")
     p.add_argument("--format", choices=("table", "markdown", "csv", "json"), default="table",
