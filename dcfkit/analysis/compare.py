@@ -16,8 +16,9 @@ given dataset, and returns one row per sequence:
 
 Under TRE or SRE (``experiment``) the files are each sequence's runs, and a row pools them
 (:func:`compare_folders`). The ``mean`` row averages precision and AUC as the protocol averages
-sequences, and the per-sequence IoUs with equal weights. Sequences found in only one folder, in both but not
-in the dataset, or whose dcfkit sidecar says the file is damaged, are listed in ``left_out``.
+sequences, and the per-sequence IoUs with equal weights. Sequences found in only one folder
+(all their runs), files in both but of no sequence of the dataset, and files whose dcfkit
+sidecar says they are damaged are listed in ``left_out``.
 ``platforms`` lists each folder's platforms as their sidecars record them
 (:mod:`dcfkit.store.platforms`; "not recorded" for files without one) and ``platform_differences``
 what differs between the two files of a sequence, each with its count of sequences unless all have
