@@ -76,6 +76,9 @@ def unit_aucs(search: Search, rec: dict, units: list) -> list:
     experiments) its score under that experiment, from the plain search's runs."""
     if all(len(exps) == len(search.spec.experiments) for exps, _ in units):
         return [rec["scores"][name]["auc"] for _, name in units]
+    if rec["key"] != search.evaluator.key(rec["config"]):  # its runs would be tracked again, by this code
+        sys.exit(f"{search.out}: trial {rec['number']} was run by other code or another dcfkit version (its run "
+                 f"key differs): replay in turn with the dcfkit that ran the search")
     found = search.evaluator.experiment_scores(rec["config"], list(rec["scores"]), search.spec.experiments)
     return [found[exps[0]][name]["auc"] for exps, name in units]
 
@@ -149,6 +152,8 @@ def main() -> int:
               replayed(search, args.plain, halving))
     if args.halved is not None:
         recorded = json.loads((args.halved / "search.json").read_text(encoding="utf-8"))["fingerprint"]["halving"]
+        if not recorded:
+            parser.error(f"{args.halved} is a search without halving")
         halving = Halving(**recorded)  # dcfkit 0.15.0's records have no experiments: together
         table(f"Run: {args.halved} against {args.plain}", run(search, args.plain, args.halved, halving))
     return 0

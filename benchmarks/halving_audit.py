@@ -5,13 +5,13 @@ study's best (docs/search.md, "Successive halving").
 
     python benchmarks/halving_audit.py SPEC OUT [--root DIR ...] [--top 2] [--jobs 2]
 
-SPEC and ``--root`` are those the search ran with; OUT is its ``--out``. The runs made go to
+SPEC and ``--root`` are those the search ran with (a search of other options, data or box
+code is refused, as a resume would be); OUT is its ``--out``. The runs made go to
 ``OUT/runs/`` like a trial's (a resumed search reuses them, and they change no record). Where
 no plain search of the same seed exists (benchmarks/halving.py replays one), this measures the
 pruner's worst misses at the cost of ``--top`` trials a study.
 """
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -19,15 +19,13 @@ from dcfkit.autosearch import Search, load_search_spec
 from dcfkit.autosearch.summary import finite, is_score, mean_auc
 
 
-def records(out: Path, study: str) -> list[dict]:
-    return [json.loads(p.read_text(encoding="utf-8")) for p in sorted((out / "trials" / study).glob("*.json"))]
-
-
 def audit(search: Search, top: int) -> list[dict]:
-    """Per study, its ``top`` furthest pruned trials completed, against the study's best."""
+    """Per study, its ``top`` furthest pruned trials completed, against the study's best (the
+    records that stand, as a resume reads them)."""
+    search.check_record(write=False)  # the recorded search, with the options and code it ran with
     rows = []
     for study in search.studies():
-        recs = records(search.out, study)
+        recs = search.recorded(study)[0]
         scored = [r for r in recs if is_score(r["value"])]
         if not scored:  # a study not yet begun, or none of its trials complete
             continue

@@ -801,8 +801,8 @@ def test_a_config_name_with_a_control_character_is_a_config_error(tmp_path, otb_
                      str(tmp_path / "out"), "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert err == ("dcfkit eval: error: config 'name' 'a\\x00b' must be usable as a folder name that report lists "
-                   "(no / \\ : or comma, no leading dot or space, no control character such as a null byte or a line "
-                   "break)\n")
+                   "(no / \\ : or comma, no leading dot, no leading or trailing space, no control character such as a "
+                   "null byte or a line break)\n")
     from dcfkit.running.evaluation import tracker_name
 
     # a comma or a trailing space too: report --trackers could not name the folder (as eval's

@@ -17,8 +17,9 @@ given dataset, and returns one row per sequence:
 Under TRE or SRE (``experiment``) the files are each sequence's runs, and a row pools them
 (:func:`compare_folders`). The ``mean`` row averages precision and AUC as the protocol averages
 sequences, and the per-sequence IoUs with equal weights. Sequences found in only one folder
-(all their runs), files in both but of no sequence of the dataset, and files whose dcfkit
-sidecar says they are damaged are listed in ``left_out``.
+(all their runs), files in both but of no sequence of the dataset, sequences with some runs
+but all of them in neither folder (``incomplete``) and files whose dcfkit sidecar says they
+are damaged are listed in ``left_out``.
 ``platforms`` lists each folder's platforms as their sidecars record them
 (:mod:`dcfkit.store.platforms`; "not recorded" for files without one) and ``platform_differences``
 what differs between the two files of a sequence, each with its count of sequences unless all have
@@ -129,6 +130,9 @@ def compare_folders(results, reference, sequences: Iterable[Sequence], protocol:
     left_out = {"only_in_results": sorted((complete[0] - complete[1]) | (stray[0] - stray[1])),
                 "only_in_reference": sorted((complete[1] - complete[0]) | (stray[1] - stray[0])),
                 "not_in_dataset": sorted((set(ours) & set(theirs)) - set(by_name)),
+                "incomplete": sorted({s.name for s in sequences if any(r.name in ours or r.name in theirs
+                                                                       for r in runs[s.name])}
+                                     - complete[0] - complete[1]),  # some runs, but all in neither folder
                 "damaged": sorted(set(damaged) | set(damaged_ref))}
     if not both:
         raise DatasetError(f"no sequence has {_what(exp)} in both {clip(str(results))} ({len(ours)} files) and "

@@ -166,4 +166,6 @@ def is_number(value: Any) -> bool:
 
 
 def _score_rows(rows: dict) -> bool:
-    return all(isinstance(s, dict) and all(is_number(s.get(k)) for k in ("auc", "precision")) for s in rows.values())
+    """Whether each row holds ``auc`` and ``precision``, each a number or null."""
+    return all(isinstance(s, dict) and all(k in s and is_number(s[k]) for k in ("auc", "precision"))
+               for s in rows.values())

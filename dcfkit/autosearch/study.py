@@ -147,16 +147,18 @@ class Search:
     def _check_fingerprint(self, path: Path, old: Any, mine: dict) -> None:
         """Refuse to resume when the recorded fingerprint ``old`` is not ``mine``; one without the
         data's identity (dcfkit <= 0.9.0) is taken to be on this data."""
-        old = old if isinstance(old, dict) else {}
-        if old and "data" not in old:
+        if not isinstance(old, dict) or not old:
+            raise DcfkitError(f"{path} holds no search fingerprint: not a search record as dcfkit writes it; give a "
+                              f"new --out, or remove {self.out} to start again")
+        if "data" not in old:
             log.warning("%s was written by dcfkit <= 0.9.0, without what identifies the data: the recorded "
                         "trials are taken to be on the data under %s", path, roots_text(self.spec))
             old = {**old, "data": mine["data"]}
-        if old and "max_frames" not in old:  # recorded before --max-frames was: whole sequences
+        if "max_frames" not in old:  # recorded before --max-frames was: whole sequences
             old = {**old, "max_frames": None, "sequences": sorted(old.get("data") or {})}
-        if old and "warm_start" not in old:  # recorded before dcfkit 0.14.0: every trial sampled
+        if "warm_start" not in old:  # recorded before dcfkit 0.14.0: every trial sampled
             old = {**old, "warm_start": False}
-        if old and "halving" not in old:  # recorded before dcfkit 0.15.0: every trial on every sequence
+        if "halving" not in old:  # recorded before dcfkit 0.15.0: every trial on every sequence
             old = {**old, "halving": None}
         if isinstance(old.get("halving"), dict) and "experiments" not in old["halving"]:  # dcfkit 0.15.0
             old = {**old, "halving": {**old["halving"], "experiments": "together"}}

@@ -328,6 +328,7 @@ def image_sequence_folders(root: Path) -> list[Path]:
 
 def first_frame_digits(folders: list[Path], sample: int = 10) -> set[int]:
     """Lengths of the first frame names (without extension) in the first ``sample`` ``img/``
-    folders: ``{5}`` for DTB70's ``00001.jpg``, ``{4}`` for OTB's ``0001.jpg``."""
+    folders: ``{5}`` for DTB70's ``00001.jpg``, ``{4}`` for OTB's ``0001.jpg``. Hidden files
+    (``.DS_Store``, macOS's ``._00001.jpg``) are no frames."""
     return {len(os.path.splitext(f)[0]) for p in folders[:sample]
-            for f in sorted(os.listdir(p / "img"))[:1]}
+            for f in sorted(n for n in os.listdir(p / "img") if not n.startswith("."))[:1]}

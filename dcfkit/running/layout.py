@@ -27,8 +27,8 @@ def folder_problem(name: str) -> str | None:
     if not isinstance(name, str) or not name.strip():
         return "is empty"
     if name.startswith(".") or name != name.strip() or not name.isprintable() or _UNSAFE.search(name):
-        return ("must be usable as a folder name that report lists (no / \\ : or comma, no leading dot or space, "
-                "no control character such as a null byte or a line break)")
+        return ("must be usable as a folder name that report lists (no / \\ : or comma, no leading dot, no leading "
+                "or trailing space, no control character such as a null byte or a line break)")
     if len(name.encode("utf-8")) > MAX_NAME_BYTES:
         return f"is over {MAX_NAME_BYTES} bytes, too long for a folder name"
     return None

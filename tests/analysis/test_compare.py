@@ -72,7 +72,7 @@ def test_hand_made_pair(folders):
     assert res["mean"]["auc"] == pytest.approx((75 / 105 + 20 / 21) / 2)
     assert res["mean"]["iou"] == pytest.approx((A_IOU + 1) / 2)
     assert res["left_out"] == {"only_in_results": ["only_ours"], "only_in_reference": ["only_theirs"],
-                               "not_in_dataset": ["c"], "damaged": []}
+                               "not_in_dataset": ["c"], "incomplete": [], "damaged": []}
     assert res["protocol"] == "otb"
     # a looser threshold: frame 4 is 3 px off, frame 5 is 5 px off
     assert compare_folders(ours, theirs, [sequence("a")], divergence_px=4)["rows"][0]["diverges_at"] == 5

@@ -64,7 +64,13 @@ def test_a_sequence_missing_a_run_is_left_out_and_the_cli_reads_the_experiments_
         (ours / "tre" / f"{first}{suffix}").unlink(missing_ok=True)
     res = compare_folders(ours / "tre", evaluated / "out" / "dsst" / "tre", seqs, experiment="tre")
     assert [r["sequence"] for r in res["rows"]] == ["seq0", "seq2"]
-    assert res["left_out"]["only_in_reference"] == ["seq1"]
+    assert res["left_out"]["only_in_reference"] == ["seq1"] and res["left_out"]["incomplete"] == []
+    theirs = tmp_path / "dsst"  # another run of seq1 missing on the other side: complete in neither
+    shutil.copytree(evaluated / "out" / "dsst", theirs)
+    (theirs / "tre" / f"{runs_by_sequence(seqs, 'tre')['seq1'][7].name}.txt").unlink()
+    res = compare_folders(ours / "tre", theirs / "tre", seqs, experiment="tre")
+    assert [r["sequence"] for r in res["rows"]] == ["seq0", "seq2"]
+    assert res["left_out"]["only_in_reference"] == [] and res["left_out"]["incomplete"] == ["seq1"]
     # the tracker folder is given: its tre/ is read, and the table says which experiment
     assert cli.main(["compare", str(ours), str(evaluated / "out" / "dsst"), "--dataset", "otb",
                      "--root", str(evaluated / "data"), "--experiment", "tre", "--format", "json"]) == 0

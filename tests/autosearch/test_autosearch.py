@@ -440,3 +440,12 @@ def test_the_shipped_base_is_a_point_of_the_shipped_space(tmp_path, name):
     if name == "lineage":  # the broadened dimensions, each absent in the base
         assert (params["mask"], params["channel_weights"], params["reliability"]) == ("none",) * 3
         assert "schedule" not in params and "redetect" not in params  # sampled only under lmcf
+
+
+def test_a_search_record_without_its_fingerprint_is_refused_in_one_line(tmp_path, data, capsys):
+    spec = write(tmp_path / "s.yaml", SPEC.replace("trials: 3", "trials: 1"))
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "search.json").write_text('{"name": "tiny"}', encoding="utf-8")
+    assert cli.main(["search", str(spec), "--out", str(tmp_path / "out"), "--status"]) != 0
+    assert "search.json holds no search fingerprint: not a search record as dcfkit writes it" in \
+        capsys.readouterr().err

@@ -357,6 +357,11 @@ def test_dataset_names_and_detection_errors(tmp_path):
     named = tmp_path / "DTB70"  # the validation set's DTB70 sequences, 6-digit names: OTB's layout
     shutil.copytree(amb / "A", named / "A")
     assert detect_dataset(named) == "otb"
+    real = tmp_path / "real" / "DTB70"  # DTB70's own names, and hidden files a copy may bring
+    shutil.copytree(amb / "B", real / "B")
+    for hidden in (".DS_Store", "._00001.jpg"):
+        (real / "B" / "img" / hidden).write_bytes(b"")
+    assert detect_dataset(real) == "dtb70"
 
 
 # --------------------------------------------------------------------------- real data
