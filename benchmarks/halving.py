@@ -41,11 +41,6 @@ def best(recs: list[dict]) -> dict | None:
     return summary_best(recs, "") if any(is_score(r["value"]) for r in recs) else None
 
 
-def frames(search: Search, units: list) -> int:
-    """The frames a config tracks on ``units`` (every experiment's runs)."""
-    return sum(search.evaluator.frames(name, e) for exps, name in units for e in exps)
-
-
 def replayed(search: Search, plain: Path, halving: Halving) -> list[dict]:
     """Each study's plain trials through ``halving``'s pruner: what it prunes, and what is left."""
     rows = []
@@ -62,9 +57,9 @@ def replayed(search: Search, plain: Path, halving: Halving) -> list[dict]:
             reached.append((rec, pruned, steps[-1][0]))
         top = best(recs) or {"number": None, "value": None}
         left = best([rec for rec, pruned, _ in reached if not pruned]) or {"number": None, "value": None}
-        tracked = sum(frames(search, units[:count]) for _, _, count in reached)
+        tracked = sum(search.evaluator.frames(units[:count]) for _, _, count in reached)
         rows.append({"study": study, "trials": len(recs), "pruned": sum(p for _, p, _ in reached),
-                     "frames": tracked / (len(recs) * frames(search, units)),
+                     "frames": tracked / (len(recs) * search.evaluator.frames(units)),
                      "best": top["number"], "best_auc": top["value"],
                      "best_pruned": next((p for rec, p, _ in reached if rec is top), "none scored"),
                      "left": left["number"], "left_auc": left["value"]})
@@ -94,9 +89,9 @@ def run(search: Search, plain: Path, halved: Path, halving: Halving) -> list[dic
         top = best(theirs) or {"number": None, "value": None, "params": None}
         found = best(mine) or {"number": None, "value": None}
         same = [r for r in mine if r["params"] == top["params"]]
-        tracked = sum(frames(search, units[:r["steps"][-1][0]]) for r in mine)
+        tracked = sum(search.evaluator.frames(units[:r["steps"][-1][0]]) for r in mine)
         rows.append({"study": study, "trials": len(mine), "pruned": sum(bool(r.get("pruned")) for r in mine),
-                     "frames": tracked / (len(mine) * frames(search, units)),
+                     "frames": tracked / (len(mine) * search.evaluator.frames(units)),
                      "best": top["number"], "best_auc": top["value"],
                      "best_pruned": ("not sampled" if not same else "pruned" if same[0].get("pruned") else "kept"),
                      "left": found["number"], "left_auc": found["value"]})

@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 
 from dcfkit.autosearch import Search, load_search_spec
+from dcfkit.autosearch.summary import best as summary_best
 from dcfkit.autosearch.summary import finite, is_score, mean_auc
 
 
@@ -29,7 +30,7 @@ def audit(search: Search, top: int) -> list[dict]:
         scored = [r for r in recs if is_score(r["value"])]
         if not scored:  # a study not yet begun, or none of its trials complete
             continue
-        best = max(scored, key=lambda r: (r["value"], -r["number"]))
+        best = summary_best(scored, study)
         pruned = sorted((r for r in recs if r.get("pruned") and is_score(r["steps"][-1][1])),
                         key=lambda r: (r["steps"][-1][0], r["steps"][-1][1]), reverse=True)[:top]
         names = search.training(study)

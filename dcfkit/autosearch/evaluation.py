@@ -109,9 +109,10 @@ class Evaluator:
             found[e] = {row["sequence"]: {k: row[k] for k in ("auc", "precision")} for row in scored.per_sequence}
         return found
 
-    def frames(self, name: str, experiment: str) -> int:
-        """The frames a config tracks on sequence ``name`` under ``experiment`` (all its runs)."""
-        return sum(len(run) for run in self.runs[experiment][name])
+    def frames(self, units: Iterable[tuple[tuple[str, ...], str]]) -> int:
+        """The frames a config tracks on ``units`` ((experiments, sequence name) pairs of
+        successive halving): every run of each sequence under each of its experiments."""
+        return sum(len(run) for exps, name in units for e in exps for run in self.runs[e][name])
 
 
 def combined(per_experiment: Mapping[str, Mapping[str, dict]], names: Iterable[str]) -> dict[str, dict]:

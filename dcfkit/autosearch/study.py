@@ -298,7 +298,8 @@ def _halving_text(record: Any) -> str:
     """A recorded ``halving`` as the spec gives it."""
     if not isinstance(record, dict):
         return "none (every trial on every sequence)"
-    return "{" + ", ".join(f"{k}: {clip(printable(v)) if isinstance(v, str) else shown(v)}" for k, v in record.items()) + "}"
+    values = (f"{k}: {clip(printable(v)) if isinstance(v, str) else shown(v)}" for k, v in record.items())
+    return "{" + ", ".join(values) + "}"
 
 
 def _unit_auc(by_experiment: dict[str, dict], unit: Unit) -> float:

@@ -100,10 +100,7 @@ def _halving(search, studies: dict[str, list[dict]]) -> dict | None:
     experiment's runs of the units reached) against those of every trial on every unit."""
     if search.spec.halving is None:
         return None
-
-    def frames(units: list) -> int:
-        return sum(search.evaluator.frames(name, e) for exps, name in units for e in exps)
-
+    frames = search.evaluator.frames
     per_study = {}
     for study, records in studies.items():
         units = search.units(study)

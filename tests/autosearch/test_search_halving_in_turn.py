@@ -20,6 +20,7 @@ from dcfkit.autosearch import Search, load_search_spec
 from dcfkit.autosearch.halving import Halving
 from dcfkit.autosearch.records import complete
 from dcfkit.errors import ConfigError
+from dcfkit.experiments import runs_by_sequence
 
 pytest.importorskip("optuna")
 
@@ -97,7 +98,8 @@ def test_a_trial_pruned_under_ope_never_runs_tre(searches):
     assert untried
     summary = json.loads((searches / "in_turn/summary.json").read_text())
     saved = summary["halving"]["studies"]["all"]
-    frames = sum(s.evaluator.frames(name, e) for name in s.names for e in ("ope", "tre"))
+    seqs = list(s.evaluator.sequences.values())
+    frames = sum(len(run) for e in ("ope", "tre") for runs in runs_by_sequence(seqs, e).values() for run in runs)
     assert saved["frames_unpruned"] == len(trials(searches / "in_turn", "all")) * frames
     assert saved["frames"] < saved["frames_unpruned"]
     assert "experiments in turn" in (searches / "in_turn/summary.md").read_text()
