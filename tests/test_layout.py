@@ -114,6 +114,21 @@ def test_the_top_level_shows_the_layers():
     assert all((PACKAGE / "components" / f / "__init__.py").is_file() for f in families)
 
 
+#: The design card's top level, and what a repository needs beside it (CI, benchmarks).
+TOP_LEVEL = {"pyproject.toml", "dcfkit", "plugins", "configs", "tests", "docs", "README.md",
+             "benchmarks", ".ci", ".gitignore"}
+
+
+def test_the_repository_tracks_only_the_design_cards_top_level():
+    """Nothing else is committed beside them: a wheel or a stray script at the top was once."""
+    root = PACKAGE.parent
+    listed = subprocess.run(["git", "-C", str(root), "ls-files", "-z"], capture_output=True)
+    if listed.returncode or not (root / ".git").exists():
+        pytest.skip(f"{root} is not a git checkout: no tracked files to check")
+    top = {path.split("/", 1)[0] for path in listed.stdout.decode().split("\0") if path}
+    assert top <= TOP_LEVEL, f"tracked at the top level beyond the design card: {sorted(top - TOP_LEVEL)}"
+
+
 def test_no_shim_of_the_moved_modules_is_left():
     """The 0.6 module paths that dcfkit/_moved kept went in 0.11 (docs/changes.md): no ``_moved``
     package or module, and no folder added to dcfkit's import path to find them."""
