@@ -108,6 +108,7 @@ class Search:
         self.folds = make_folds(self.names, spec.folds, spec.seed)
         self.evaluator = Evaluator(self.out, spec.dataset, seqs, spec.experiments, **(evaluator_options or {}),
                                    baselines=spec.baselines)
+        self._units: dict[str, list[Unit]] = {}  # each record's check asks for its study's
 
     def order(self, study: str) -> list[str]:
         """The study's training sequences in the order successive halving scores them."""
@@ -115,7 +116,9 @@ class Search:
 
     def units(self, study: str) -> list[Unit]:
         """The study's units in the order successive halving scores them (:mod:`~dcfkit.autosearch.halving`)."""
-        return self.spec.halving.units(self.order(study), self.spec.experiments)
+        if study not in self._units:
+            self._units[study] = self.spec.halving.units(self.order(study), self.spec.experiments)
+        return self._units[study]
 
     def training(self, study: str) -> list[str]:
         if study == FINAL:
@@ -190,10 +193,11 @@ class Search:
             raise DcfkitError(f"{path} records a different search (these differ: {', '.join(changed)}{why}): "
                               f"give a new --out, or remove {self.out} to start again")
 
-    def recorded(self, study: str) -> tuple[list[dict], Ladder | None]:
+    def recorded(self, study: str, running: bool = True) -> tuple[list[dict], Ladder | None]:
         """The study's trial records up to the first missing one, and its successive halving
         told them (None without ``halving``); a damaged or edited record is missing (with a
-        warning naming what is wrong), and it and those after it are run again, to the same values."""
+        warning naming what is wrong), and it and those after it are run again, to the same
+        values (a search ``running``; ``--status`` says they would be)."""
         folder = self.out / "trials" / study
         records: list[dict] = []
         ladder = self._ladder(study, records)
@@ -207,8 +211,8 @@ class Search:
                     ladder = self._ladder(study, records)
             if fault:
                 if path.exists():
-                    log.warning("%s is not a trial record as dcfkit writes it (%s): trial %d of %s is run again, "
-                                "and the trials after it", path, fault, n, study)
+                    log.warning("%s is not a trial record as dcfkit writes it (%s): trial %d of %s %s run again, "
+                                "and the trials after it", path, fault, n, study, "is" if running else "would be")
                 break
             records.append(rec)
         return records, ladder
@@ -275,7 +279,7 @@ class Search:
         """Where the recorded search stands, running nothing: per study, its trials recorded
         (those that stand), pruned, and its best so far (:func:`~dcfkit.autosearch.summary.status_lines`)."""
         self.check_record(write=False)
-        return status_lines(self, {study: self.recorded(study)[0] for study in self.studies()})
+        return status_lines(self, {study: self.recorded(study, running=False)[0] for study in self.studies()})
 
     def run(self) -> dict:
         """Every study, then the held-out scores and the comparison (:mod:`dcfkit.autosearch.summary`)."""

@@ -126,6 +126,19 @@ def test_a_damaged_or_edited_trial_record_is_redone_with_a_warning_naming_it(cop
     assert {**json.loads((copy / "out/summary.json").read_text()), "spec": summary["spec"]} == summary
 
 
+def test_status_says_a_damaged_record_would_be_run_again_and_runs_nothing(copy, caplog):
+    """--status reads the records as a resume would, but runs nothing: its warning must not say
+    the trial is run again."""
+    path = copy / "out/trials/fold1/0001.json"
+    path.write_text(EDITS["key"][0](json.loads(path.read_text()), copy / "out"))
+    before = {p: p.read_bytes() for p in (copy / "out").rglob("*") if p.is_file()}
+    with caplog.at_level("WARNING", logger="dcfkit.autosearch.study"):
+        lines = Search(load_search_spec(copy / "s.yaml"), copy / "out", {"jobs": 1}).status()
+    warned = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert len(warned) == 1 and warned[0].endswith("trial 1 of fold1 would be run again, and the trials after it")
+    assert lines and {p: p.read_bytes() for p in (copy / "out").rglob("*") if p.is_file()} == before
+
+
 def test_a_trial_0_that_is_not_the_base_is_redone_as_the_base(copy, caplog):
     """Trial 1's record put in trial 0's place: sampled values, where the base's stand."""
     path = copy / "out/trials/fold1/0000.json"
