@@ -126,6 +126,25 @@ def test_a_damaged_or_edited_trial_record_is_redone_with_a_warning_naming_it(cop
     assert {**json.loads((copy / "out/summary.json").read_text()), "spec": summary["spec"]} == summary
 
 
+def test_a_search_moved_with_only_its_records_resumes_without_running_a_trial(searched, tmp_path):
+    """search.json and trials/ are a search's whole state (docs/search.md, "Moving a search"):
+    moved to another folder, its data under another path, it runs no trial again and ends on the
+    same summary; only the runs the summary scores are tracked again."""
+    moved = tmp_path / "elsewhere"
+    shutil.copytree(searched / "data", moved / "frames")
+    (moved / "s.yaml").write_text(SPEC.replace("root: data", "root: frames"), encoding="utf-8")
+    (moved / "out").mkdir()
+    shutil.copy(searched / "out/search.json", moved / "out")
+    shutil.copytree(searched / "out/trials", moved / "out/trials")
+    trials = {p.relative_to(moved / "out"): p.read_bytes() for p in (moved / "out/trials").rglob("*.json")}
+    said: list[str] = []
+    Search(load_search_spec(moved / "s.yaml"), moved / "out", {"jobs": 1}, report=said.append).run()
+    assert not [line for line in said if " trial " in line], said
+    assert {p.relative_to(moved / "out"): p.read_bytes() for p in (moved / "out/trials").rglob("*.json")} == trials
+    summary = json.loads((searched / "out/summary.json").read_text())
+    assert {**json.loads((moved / "out/summary.json").read_text()), "spec": summary["spec"]} == summary
+
+
 def test_status_says_a_damaged_record_would_be_run_again_and_runs_nothing(copy, caplog):
     """--status reads the records as a resume would, but runs nothing: its warning must not say
     the trial is run again."""
