@@ -5,7 +5,8 @@ from __future__ import annotations
 from typing import Any
 
 from dcfkit.errors import ConfigError, shown
-from dcfkit.experiments import EXPERIMENTS, get_experiment
+from dcfkit.analysis.setting import cut_phrase, experiment_line
+from dcfkit.experiments import EXPERIMENTS
 
 
 def ablation_experiments() -> tuple[str, ...]:
@@ -36,10 +37,7 @@ def scope_title(experiment: str, max_frames: int | None = None) -> str:
 
 
 def scope_line(experiment: str, protocol: str, max_frames: int | None = None) -> str:
-    """One line naming the runs an ablation scored: ``experiment TRE (temporal robustness: 20
-    starts; each sequence's runs pooled), protocol otb`` and a smoke run's ``--max-frames`` cut."""
-    found = get_experiment(experiment)
-    pooled = "; each sequence's runs pooled, as the OTB toolkit's perfPlot.m" if found.pooled else ""
-    cut = (f", each sequence's first {max_frames} frames only (--max-frames {max_frames}: a smoke run, "
-           f"not the benchmark's scores)" if max_frames else "")
-    return f"experiment {found.name.upper()} ({found.title}{pooled}), protocol {protocol}{cut}"
+    """One line naming the runs an ablation scored: the report's
+    :func:`~dcfkit.analysis.setting.experiment_line` with the protocol before a smoke run's cut,
+    ``experiment TRE (...), each sequence's runs pooled, protocol otb; a smoke run: ...``."""
+    return f"{experiment_line(experiment)}, protocol {protocol}{cut_phrase(max_frames)}"

@@ -202,7 +202,7 @@ def test_cli_runs_and_lists_jobs(tmp_path, data, capsys):
     out = str(tmp_path / "out")
     assert cli.main(["ablate", spec, "--out", out, "--sequences", "seqB", "--jobs", "1", "--no-progress"]) == 0
     printed = capsys.readouterr().out
-    assert printed.startswith("spec: experiment OPE (one-pass evaluation), protocol otb\n"
+    assert printed.startswith("spec: experiment OPE (one-pass evaluation; Wu et al., TPAMI 2015), protocol otb\n"
                               "protocol otb: OTB / UAV123 MATLAB toolkit")  # the default scoring rules, named
     assert "\n\n| variant | precision | auc | fps | sequences | failed |\n" in printed
     assert "1 jobs (1 distinct runs): 1 run, 0 already done, 0 failed" in printed

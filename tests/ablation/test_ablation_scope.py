@@ -32,7 +32,7 @@ def test_an_sre_smoke_ablation_names_its_experiment_and_cut_everywhere(tmp_path,
                      "--experiment", "sre", "--max-frames", "6"]) == 0
     printed = capsys.readouterr().out
     scope = "experiment SRE (spatial robustness"
-    cut = "first 6 frames only (--max-frames 6"
+    cut = "first 6 frames (--max-frames 6)"
     assert printed.startswith(f"scoped: {scope}") and cut in printed.splitlines()[0]
     summary = (out / "summary.md").read_text().splitlines()
     assert summary[0].startswith(f"# scoped: {scope}") and "protocol otb" in summary[0] and cut in summary[0]
