@@ -26,7 +26,7 @@ def audit(search: Search, top: int) -> list[dict]:
     search.check_record(write=False)  # the recorded search, with the options and code it ran with
     rows = []
     for study in search.studies():
-        recs = search.recorded(study)[0]
+        recs = search.recorded(study, running=False)[0]  # the audit completes trials, never reruns one
         scored = [r for r in recs if is_score(r["value"])]
         if not scored:  # a study not yet begun, or none of its trials complete
             continue
