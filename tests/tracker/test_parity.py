@@ -202,7 +202,7 @@ def test_parity_on_a_simulated_platform(shared_data, tmp_path):
     sequences would, in a quarter of the time."""
     env = {**os.environ, **SIMULATED_PLATFORM, "NUMBA_CACHE_DIR": str(tmp_path / "numba_cache"),
            "DCFKIT_TEST_DATA": str(shared_data)}
-    command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(Path(__file__)),
+    command = [sys.executable, "-m", "pytest", "-q", "-n", "0", "-p", "no:cacheprovider", str(Path(__file__)),
                "-k", "(box_for_box or is_the_authors_code) and not uav123_10fps"]
     run = subprocess.run(command, env=env, capture_output=True, text=True, cwd=Path(__file__).parents[2])
     assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-2000:]
