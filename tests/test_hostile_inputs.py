@@ -7,6 +7,7 @@ The property tests use the derandomized profile of conftest.py; their budgets ar
 through the environment variables a user would set, so that each example stays small."""
 from __future__ import annotations
 
+import io
 import struct
 import tracemalloc
 import warnings
@@ -16,6 +17,7 @@ import cv2
 import numpy as np
 import pytest
 import scipy.fft
+import simplejpeg
 from hypothesis import event, example, given
 from hypothesis import strategies as st
 from PIL import Image
@@ -280,15 +282,20 @@ def jpeg_declaring(width: int, height: int) -> bytes:
 
 @pytest.fixture
 def decodes(monkeypatch):
-    """The calls made to cv2.imdecode (read_frame's decoder) while the test runs."""
+    """The calls made to read_frame's decoders while the test runs: ``("cv2", args)`` for
+    cv2.imdecode, ``("simplejpeg", args)`` for a full-size simplejpeg.decode_jpeg (not its
+    1/8-scale damage check, which passes ``min_width``)."""
     calls = []
-    real = cv2.imdecode
 
-    def counted(*args, **kwargs):
-        calls.append(args)
-        return real(*args, **kwargs)
+    def counting(name, real):
+        def counted(*args, **kwargs):
+            if "min_width" not in kwargs:
+                calls.append((name, args))
+            return real(*args, **kwargs)
+        return counted
 
-    monkeypatch.setattr(cv2, "imdecode", counted)
+    monkeypatch.setattr(cv2, "imdecode", counting("cv2", cv2.imdecode))
+    monkeypatch.setattr(simplejpeg, "decode_jpeg", counting("simplejpeg", simplejpeg.decode_jpeg))
     return calls
 
 
@@ -400,18 +407,46 @@ def test_a_jpeg_whose_data_libjpeg_reports_corrupt_is_refused(flips, tmp_path, c
         np.testing.assert_array_equal(read_frame(path, "frame 9"), expected)
 
 
-def test_valid_jpegs_decode_as_opencv_decodes_them(tmp_path):
-    """The strict check changes no pixel: the same array as cv2.imdecode, for baseline,
-    progressive, gray and 4:4:4 JPEGs."""
-    variants = {"baseline": [], "progressive": [cv2.IMWRITE_JPEG_PROGRESSIVE, 1],
-                "444": [cv2.IMWRITE_JPEG_SAMPLING_FACTOR, cv2.IMWRITE_JPEG_SAMPLING_FACTOR_444]}
-    for name, params in variants.items():
-        for image in (TEXTURE, cv2.cvtColor(TEXTURE, cv2.COLOR_BGR2GRAY)):
-            data = cv2.imencode(".jpg", image, params)[1].tobytes()
-            path = tmp_path / f"{name}.jpg"
+JPEG_VARIANTS = {"baseline": [], "quality 100": [cv2.IMWRITE_JPEG_QUALITY, 100],
+                 "quality 20": [cv2.IMWRITE_JPEG_QUALITY, 20], "progressive": [cv2.IMWRITE_JPEG_PROGRESSIVE, 1],
+                 "optimized": [cv2.IMWRITE_JPEG_OPTIMIZE, 1], "restarts": [cv2.IMWRITE_JPEG_RST_INTERVAL, 3],
+                 **{f"{name[-3:]}": [cv2.IMWRITE_JPEG_SAMPLING_FACTOR, getattr(cv2, name)]
+                    for name in ("IMWRITE_JPEG_SAMPLING_FACTOR_411", "IMWRITE_JPEG_SAMPLING_FACTOR_422",
+                                 "IMWRITE_JPEG_SAMPLING_FACTOR_440", "IMWRITE_JPEG_SAMPLING_FACTOR_444")}}
+
+
+@pytest.mark.parametrize("variant", JPEG_VARIANTS)
+def test_valid_jpegs_decode_as_opencv_decodes_them(variant, tmp_path, decodes):
+    """A JPEG libjpeg decodes cleanly is decoded once, not by OpenCV, to the same array as
+    cv2.imdecode: colour and gray, each chroma subsampling, progressive, optimized and with
+    restart markers, at sizes that leave partial blocks (1x1, 9x17, 33x65)."""
+    for size in ((96, 128), (1, 1), (9, 17), (33, 65)):
+        colour = cv2.resize(TEXTURE, size[::-1], interpolation=cv2.INTER_AREA)
+        for image in (colour, cv2.cvtColor(colour, cv2.COLOR_BGR2GRAY)):
+            data = cv2.imencode(".jpg", image, JPEG_VARIANTS[variant])[1].tobytes()
+            expected = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+            path = tmp_path / "frame.jpg"
             path.write_bytes(data)
-            np.testing.assert_array_equal(read_frame(path), cv2.imdecode(np.frombuffer(data, np.uint8),
-                                                                         cv2.IMREAD_COLOR))
+            decodes.clear()
+            np.testing.assert_array_equal(read_frame(path), expected, err_msg=f"{variant}, {image.shape}")
+            assert [decoder for decoder, _ in decodes] == ["simplejpeg"], (variant, image.shape)
+
+
+@pytest.mark.parametrize("orientation", [1, 3, 6, 8])
+def test_a_jpeg_with_exif_is_turned_as_opencv_turns_it(orientation, tmp_path, decodes):
+    """OpenCV turns an image as its EXIF orientation tag says (6: 90 degrees clockwise), which
+    libjpeg alone does not: read_frame leaves a JPEG with EXIF data to OpenCV."""
+    exif = Image.Exif()
+    exif[0x0112] = orientation
+    buffer = io.BytesIO()
+    Image.fromarray(TEXTURE[..., ::-1]).save(buffer, "JPEG", quality=90, exif=exif.tobytes())
+    path = tmp_path / "frame.jpg"
+    path.write_bytes(buffer.getvalue())
+    expected = cv2.imdecode(np.frombuffer(buffer.getvalue(), np.uint8), cv2.IMREAD_COLOR)
+    assert expected.shape[:2] == (TEXTURE.shape[:2] if orientation in (1, 3) else TEXTURE.shape[1::-1])
+    decodes.clear()
+    np.testing.assert_array_equal(read_frame(path), expected)
+    assert "cv2" in [decoder for decoder, _ in decodes]
 
 
 def with_padding(data: bytes, padding: bytes) -> bytes:

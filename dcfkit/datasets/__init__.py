@@ -12,7 +12,7 @@ Conventions
   (the frame still exists and the tracker still sees it); each scoring protocol of
   :mod:`dcfkit.protocols` says how they count. A test split that publishes frame 1's box
   only has NaN rows after it and ``ground_truth_withheld`` set (:func:`scored_sequences`).
-* Images are decoded by OpenCV (:func:`read_frame`): ``(H, W, 3) uint8``, **BGR** channel order.
+* Images are read as OpenCV decodes them (:func:`read_frame`): ``(H, W, 3) uint8``, **BGR** channel order.
 
 Only sequences present on disk are listed. :func:`load_datasets` pools the sequences of several
 roots into one set. Each layout lives in its own module and registers

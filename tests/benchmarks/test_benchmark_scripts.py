@@ -112,6 +112,13 @@ def test_compare_speed_of_a_checkout_with_itself(tmp_path, synthetic_uav123):
 
 
 @pytest.mark.slow
+def test_frame_reading_reads_every_frame_both_ways_and_finds_the_same_pixels(tmp_path, synthetic_uav123):
+    out = run("frame_reading.py", str(synthetic_uav123), tmp_path=tmp_path)
+    folder, first, last = uav123_sequence_table()["UAV123_10fps"]["wakeboard7"]
+    (row,) = [line.split() for line in out.splitlines() if line.startswith(str(synthetic_uav123)[-40:])]
+    assert int(row[-5]) == last - first + 1 and row[-1] == "0", out
+
+
 def test_restarts(tmp_path, synthetic_uav123):
     spec = tmp_path / "spec.yaml"
     spec.write_text("name: smoke\ndataset: uav123_10fps\nvariants:\n  plain: kcf\n")

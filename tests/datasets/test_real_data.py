@@ -12,6 +12,7 @@ as its authors' code does under Octave). Six sequences are few: a last-bit chang
 tracker's mean by up to ±0.05 (measured), hence the margins, and no test of the ranking between
 trackers.
 """
+import cv2
 import numpy as np
 import pytest
 
@@ -83,3 +84,13 @@ def test_dr2track_runs_on_other_benchmarks(dataset, folder, frames, shared_data)
     assert boxes.shape == (frames, 4) and np.all(np.isfinite(boxes))
     if dataset == "uavdt":  # before the occlusion it is an easy car
         assert score_sequence(boxes[:25], seq.ground_truth[:25])["precision"] == 1.0
+
+
+@pytest.mark.parametrize("dataset,folder", [("uav123_10fps", "UAV123_10fps"), ("dtb70", "DTB70"), ("uavdt", "UAVDT")])
+def test_real_frames_read_as_opencv_decodes_them(dataset, folder, shared_data):
+    """The first, a middle and the last frame of every sequence: read_frame (simplejpeg's decode
+    of a clean JPEG) gives cv2.imread's pixels. ``benchmarks/frame_reading.py`` checks them all."""
+    for seq in load_dataset(dataset, shared_data / folder):
+        for i in (0, len(seq) // 2, len(seq) - 1):
+            np.testing.assert_array_equal(seq.frame(i), cv2.imread(str(seq.frames[i]), cv2.IMREAD_COLOR),
+                                          err_msg=str(seq.frames[i]))
