@@ -9,16 +9,19 @@ of fewer frames, each folder writable), claims the runs it writes (:mod:`dcfkit.
 and says what it recomputes and why. Each distinct run (run key, tracker factory, run) is
 tracked once, by :func:`dcfkit.running.runner.execute`; the other entries of its key get its
 files (:meth:`~dcfkit.store.results.ResultStore.copy_run`), as does an entry lacking a run
-another entry of its key holds done. A consumer makes a plan, calls :meth:`RunPlan.run` and
-reports (docs/architecture.md, "Where to add")."""
+another entry of its key holds done, or a run the entry has done in another experiment (OPE's
+run is TRE's first when that starts at frame 1). A consumer makes a plan, calls
+:meth:`RunPlan.run` and reports (docs/architecture.md, "Where to add")."""
 from __future__ import annotations
 
 import dataclasses
 from typing import Callable, Iterable, Mapping
 
-from dcfkit.datasets import Sequence
+import numpy as np
+
+from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.errors import DcfkitError, shown
-from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
+from dcfkit.experiments import EXPERIMENTS, Experiment, get_experiment, runs_by_sequence
 from dcfkit.running.checks import check_first_boxes, check_same_dataset, say_other_rule, say_what_is_recomputed
 from dcfkit.running.layout import store_folder
 from dcfkit.running.progress import Progress
@@ -86,7 +89,7 @@ class RunPlan:
 
     def __init__(self, entries: Iterable[Entry], sequences: Iterable[Sequence], experiment: str | Experiment,
                  out, what: str | None = None, version: str | None = None):
-        self.experiment, self.sequences = get_experiment(experiment), list(sequences)
+        self.experiment, self.sequences, self.out = get_experiment(experiment), list(sequences), out
         self.version, self.what = version if version is not None else provenance.dcfkit_version(), what
         self.by_sequence = runs_by_sequence(self.sequences, self.experiment)
         runs = [run for found in self.by_sequence.values() for run in found]
@@ -137,10 +140,11 @@ class RunPlan:
 
     def shared(self) -> tuple[list[Shared], list[tuple[Planned, list[Planned], str]]]:
         """(the runs to track, each once, with the entries that get it; the copies to make: a
-        run done in one entry, the entries of its key lacking it, its name)."""
+        run done in one entry, the entries of its key lacking it, its name). A run an entry
+        has made now (a copy from another experiment) counts as done in it."""
         tasks, copies = [], []
         for members in self._groups():
-            todo = [{run.name for run in p.todo} for p in members]
+            todo = [{run.name for run in p.todo} - set(p.done) for p in members]
             for run in members[0].runs:
                 lacking = [p for p, names in zip(members, todo) if run.name in names]
                 having = [p for p, names in zip(members, todo) if run.name not in names]
@@ -171,11 +175,33 @@ class RunPlan:
             self.execute(jobs, executor, scheduler, progress)
         return self
 
+    def made_elsewhere(self, p: Planned) -> dict[str, tuple[ResultStore, str]]:
+        """Run name -> (the store, the name) of the same run done in another experiment of
+        ``p``'s entry, for ``p``'s runs to do: the same frames from the same first box, tracked
+        once from it (OPE's run and TRE's first, which starts at frame 1 when its ground truth
+        is valid), under ``p``'s run key."""
+        if not _tracked_once(self.experiment):
+            return {}
+        others = [e for e in EXPERIMENTS.values() if e.name != self.experiment.name and _tracked_once(e)
+                  and store_folder(self.out, p.name, e).is_dir()]
+        todo, found = {run.name for run in p.todo}, {}
+        for seq in self.sequences if others and todo else ():
+            for run in (r for r in self.by_sequence[seq.name] if r.name in todo):
+                twin = _same_run(run, seq, others, self.out, p)
+                if twin is not None:
+                    found[run.name] = twin
+        return found
+
     def execute(self, jobs: int = 1, executor: str = "local", scheduler: str | None = None,
                 progress: Progress | None = None) -> None:
-        """Copy the runs done in another entry of their key, then track the others, each once
-        (in order in this process, else longest first: the workers end together), with
-        ``progress``; each run's outcome goes to every entry that gets it."""
+        """Copy the runs done in another experiment of their entry (:meth:`made_elsewhere`) or
+        in another entry of their key, then track the others, each once (in order in this
+        process, else longest first: the workers end together), with ``progress``; each run's
+        outcome goes to every entry that gets it."""
+        for p in self.entries:
+            for name, (source, source_name) in self.made_elsewhere(p).items():
+                p.store.copy_run(source, name, source_name)
+                p.done.append(name)
         tasks, copies = self.shared()
         for source, targets, name in copies:
             for p in targets:
@@ -205,6 +231,29 @@ class RunPlan:
                     version=self.version, on_frame=progress.frame)
         finally:
             progress.close()
+
+
+def _tracked_once(experiment: Experiment) -> bool:
+    """Whether ``experiment`` tracks each run once from its first box, by no rule of its own."""
+    return type(experiment).track is Experiment.track and experiment.rule is None
+
+
+def _same_run(run: Sequence, seq: Sequence, others: list[Experiment], out,
+              p: Planned) -> tuple[ResultStore, str] | None:
+    """(the store, the name) of a run of ``seq`` in one of ``others`` that is ``run`` (the same
+    frames, ground truth and first box) and done under ``p``'s key in ``p``'s entry, or None."""
+    for other in others:
+        try:
+            candidates = other.plan(seq).runs
+        except DatasetError:  # too short for TRE, say: it has no runs
+            continue
+        for twin in candidates:
+            if (len(twin) == len(run) and twin.frames == run.frames and np.array_equal(twin.init_box, run.init_box)
+                    and np.array_equal(twin.ground_truth, run.ground_truth, equal_nan=True)):
+                store = ResultStore(store_folder(out, p.name, other))
+                if store.status(twin, p.key) == "done":
+                    return store, twin.name
+    return None
 
 
 def _claim_text(p: Planned, kind: str) -> Callable[[str], str]:

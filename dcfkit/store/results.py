@@ -204,23 +204,28 @@ class ResultStore:
         make_dir(self.folder)
         atomic_write(self.error_path(seq.name), json.dumps(record, indent=1, default=json_default) + "\n")
 
-    def copy_run(self, source: "ResultStore", name: str) -> None:
-        """Make run ``name`` here what it is in ``source`` (the same run key's run, made once for
-        both), file by file as :meth:`write` and :meth:`write_failure` order them: the sidecar
-        removed first and written last, each file written whole; a file ``source`` lacks, removed."""
+    def copy_run(self, source: "ResultStore", name: str, source_name: str | None = None) -> None:
+        """Make run ``name`` here what run ``source_name`` (default ``name``) is in ``source``
+        (the same run key's run, made once for both), file by file as :meth:`write` and
+        :meth:`write_failure` order them: the sidecar removed first and written last, each file
+        written whole; a file ``source`` lacks, removed. A run copied under another name (OPE's
+        run as TRE's first) has that name as its sidecar's ``sequence``."""
+        source_name = name if source_name is None else source_name
         with contextlib.suppress(FileNotFoundError):
             self.sidecar_path(name).unlink()
         make_dir(self.folder)
-        for path in (*self._written(name), self.error_path(name), self.sidecar_path(name)):
+        records = (self.error_path(name), self.sidecar_path(name))  # JSON naming their run
+        for path in (*self._written(name), *records):
+            origin = source.folder / (source_name + path.name[len(name):])
             try:
-                data = (source.folder / path.name).read_bytes()
+                data = origin.read_bytes()
             except FileNotFoundError:
                 with contextlib.suppress(FileNotFoundError):
                     path.unlink()
                 continue
             except OSError as exc:
-                raise StoreError(f"cannot read {clip(str(source.folder / path.name))}: {exc.strerror}") from None
-            atomic_write(path, data)
+                raise StoreError(f"cannot read {clip(str(origin))}: {exc.strerror}") from None
+            atomic_write(path, _renamed(data, name, origin) if path in records and source_name != name else data)
 
     def load(self, sequences: Iterable[Sequence | str]) -> dict[str, SequenceResult]:
         """Intact results for ``sequences`` (names or :class:`Sequence`); others (not run,
@@ -253,6 +258,15 @@ class ResultStore:
                 f"`dcfkit eval` with one config, or give the other config a different 'name' (a key also "
                 f"changes with dcfkit's version and box code: rerunning the eval recomputes the older runs)")
         return results
+
+
+def _renamed(record: bytes, name: str, path: Path) -> bytes:
+    """A sidecar's or failure record's JSON with ``name`` as its ``sequence``."""
+    try:
+        found = json.loads(record)
+    except ValueError:
+        raise StoreError(f"cannot read {clip(str(path))}: not JSON") from None
+    return (json.dumps({**found, "sequence": name}, indent=1, default=json_default) + "\n").encode()
 
 
 def data_identity(seq: Sequence) -> str:

@@ -242,3 +242,51 @@ def test_tre_and_reset_runs_start_at_the_first_valid_box(tmp_path, seqs):
     assert first["init_box"] == gt[2].tolist() and first["frames"] == N - 2
     run_one_pass(CONFIG, [seq], tmp_path / "out", make_tracker=Counter(), progress=False, experiment="reset")
     assert json.loads((tmp_path / "out" / "drift" / "reset" / "late.json").read_text())["resets"]["starts"][0] == 3
+
+
+def test_the_one_pass_run_is_tres_first_and_is_tracked_once(tmp_path, seqs):
+    """OPE's run of a sequence and TRE's runs from frame 1's box (the first; a short sequence
+    repeats it) are one run: made by either experiment, it is copied into the other under its
+    name, not tracked again; the boxes are those of TRE run into an empty folder."""
+    made, out = Counter(), tmp_path / "out"
+    run_one_pass(CONFIG, seqs, out, make_tracker=made, progress=False)
+    assert made.made == 2
+    tre = run_one_pass(CONFIG, seqs, out, make_tracker=made, progress=False, experiment="tre")
+    starts = tre_starts(seqs[0].ground_truth)
+    assert starts[:2] == [0, 0]  # 25 frames: splitSeqTRE repeats starts
+    assert made.made == 2 + 2 * (len(starts) - starts.count(0)) and len(tre["done"]) == 2 * len(starts)
+    alone = tmp_path / "alone"
+    run_one_pass(CONFIG, seqs, alone, make_tracker=Counter(), progress=False, experiment="tre")
+    for name in (f"{s.name}_{k:03d}" for s in seqs for k in range(1, len(starts) + 1)):
+        for end in (".txt", ".confidence"):
+            assert (out / "drift" / "tre" / f"{name}{end}").read_bytes() == \
+                (alone / "drift" / "tre" / f"{name}{end}").read_bytes(), name + end
+    copied = json.loads((out / "drift" / "tre" / "a_001.json").read_text())
+    one_pass = json.loads((out / "drift" / "a.json").read_text())
+    assert copied == {**one_pass, "sequence": "a_001"}
+    again = run_one_pass(CONFIG, seqs, out, make_tracker=made, progress=False, experiment="tre")
+    tracked = made.made
+    assert again["done"] == [] and made.made == tracked  # the copies are runs done
+    # the other way round: TRE first, then OPE copies its first run
+    run_one_pass(CONFIG, seqs, alone, make_tracker=made, progress=False)
+    assert made.made == tracked
+    assert (alone / "drift" / "b.txt").read_bytes() == (alone / "drift" / "tre" / "b_001.txt").read_bytes()
+
+
+def test_a_run_of_another_config_or_from_another_box_is_not_taken_for_tres_first(tmp_path, seqs):
+    """TRE's first run is tracked when OPE's was made by another config, or when frame 1's box,
+    from which OPE starts, is one TRE cannot start from (OTB's splitSeqTRE wants x, y > 0)."""
+    out, starts = tmp_path / "out", tre_starts(seqs[0].ground_truth)
+    run_one_pass(CONFIG, seqs, out, make_tracker=Counter(), progress=False)
+    made = Counter()
+    run_one_pass({**CONFIG, "drift": 2.0, "name": "drift"}, seqs, out, make_tracker=made, progress=False,
+                 experiment="tre")
+    assert made.made == 2 * len(starts)
+    gt = seqs[0].ground_truth.copy()
+    gt[0] = [-3.0, 3, 6, 7]  # partly left of the image: a one-pass start, not a TRE start
+    seq = Sequence("left", seqs[0].frames, gt, {}, "fake")
+    run_one_pass(CONFIG, [seq], out, make_tracker=Counter(), progress=False)
+    made = Counter()
+    run_one_pass(CONFIG, [seq], out, make_tracker=made, progress=False, experiment="tre")
+    assert made.made == len(tre_starts(gt))
+    assert json.loads((out / "drift" / "tre" / "left_001.json").read_text())["init_box"] == gt[1].tolist()
