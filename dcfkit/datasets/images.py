@@ -85,8 +85,8 @@ def _clean_jpeg(data: bytes) -> np.ndarray | None:
     decode with libjpeg-turbo's defaults (the accurate integer IDCT, fancy upsampling), whose
     SIMD paths give the C code's bits: the same pixels in 3.5 ms for a 1280x720 frame, where
     OpenCV and the damage check took 6.3 ms (``benchmarks/frame_reading.py``); the strict
-    decode is that check.
-    A JPEG with EXIF data is left to OpenCV, which turns the image as its orientation tag says."""
+    decode is that check. A JPEG with EXIF data is left to OpenCV, which turns the image as its
+    orientation tag says."""
     if not data.startswith(b"\xff\xd8") or b"Exif\0\0" in data[:data.find(b"\xff\xda")]:
         return None
     import simplejpeg  # deferred, as OpenCV

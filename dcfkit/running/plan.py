@@ -186,8 +186,10 @@ class RunPlan:
                   and store_folder(self.out, p.name, e).is_dir()]
         todo, found = {run.name for run in p.todo}, {}
         for seq in self.sequences if others and todo else ():
-            for run in (r for r in self.by_sequence[seq.name] if r.name in todo):
-                twin = _same_run(run, seq, others, self.out, p)
+            runs = [run for run in self.by_sequence[seq.name] if run.name in todo]
+            candidates = [(other, twin) for other in others for twin in (_runs_of(other, seq) if runs else ())]
+            for run in runs:
+                twin = _same_run(run, candidates, self.out, p)
                 if twin is not None:
                     found[run.name] = twin
         return found
@@ -238,21 +240,25 @@ def _tracked_once(experiment: Experiment) -> bool:
     return type(experiment).track is Experiment.track and experiment.rule is None
 
 
-def _same_run(run: Sequence, seq: Sequence, others: list[Experiment], out,
+def _runs_of(experiment: Experiment, seq: Sequence) -> list[Sequence]:
+    """``seq``'s runs in ``experiment``; none if it has none (too short for TRE, say)."""
+    try:
+        return experiment.plan(seq).runs
+    except DatasetError:
+        return []
+
+
+def _same_run(run: Sequence, candidates: list[tuple[Experiment, Sequence]], out,
               p: Planned) -> tuple[ResultStore, str] | None:
-    """(the store, the name) of a run of ``seq`` in one of ``others`` that is ``run`` (the same
-    frames, ground truth and first box) and done under ``p``'s key in ``p``'s entry, or None."""
-    for other in others:
-        try:
-            candidates = other.plan(seq).runs
-        except DatasetError:  # too short for TRE, say: it has no runs
-            continue
-        for twin in candidates:
-            if (len(twin) == len(run) and twin.frames == run.frames and np.array_equal(twin.init_box, run.init_box)
-                    and np.array_equal(twin.ground_truth, run.ground_truth, equal_nan=True)):
-                store = ResultStore(store_folder(out, p.name, other))
-                if store.status(twin, p.key) == "done":
-                    return store, twin.name
+    """(the store, the name) of the first of ``candidates`` (an experiment and its run) that is
+    ``run`` (the same frames, ground truth and first box) and done under ``p``'s key in ``p``'s
+    entry, or None."""
+    for other, twin in candidates:
+        if (len(twin) == len(run) and twin.frames == run.frames and np.array_equal(twin.init_box, run.init_box)
+                and np.array_equal(twin.ground_truth, run.ground_truth, equal_nan=True)):
+            store = ResultStore(store_folder(out, p.name, other))
+            if store.status(twin, p.key) == "done":
+                return store, twin.name
     return None
 
 
