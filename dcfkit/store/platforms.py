@@ -24,9 +24,9 @@ except ImportError:  # numpy 1.x
 
 __all__ = ["cpu_model", "describe", "differences", "record"]
 
-# packages whose builds decide last bits: FFTs, BLAS, resizing, compiled loops
+# packages whose builds decide last bits: FFTs, BLAS, resizing, compiled loops, JPEG decoding
 LIBRARIES = {"numpy": "numpy", "scipy": "scipy", "opencv": "opencv-contrib-python-headless",
-             "numba": "numba", "llvmlite": "llvmlite", "pyfftw": "pyFFTW"}
+             "numba": "numba", "llvmlite": "llvmlite", "pyfftw": "pyFFTW", "simplejpeg": "simplejpeg"}
 OPENCV_WHEELS = ("opencv-contrib-python-headless", "opencv-contrib-python", "opencv-python-headless",
                  "opencv-python")
 # environment variables that switch SIMD paths or BLAS kernels

@@ -1,5 +1,6 @@
 """The platform record (dcfkit.store.platforms): what it holds, in sidecars and reports, and the
 warning of `dcfkit compare` and `dcfkit report` when result folders come from different platforms."""
+import importlib.metadata
 import json
 import os
 import subprocess
@@ -26,6 +27,7 @@ def test_record_names_this_process():
     rec = platforms.record()
     assert set(rec) == {"arch", "cpu", "simd", "blas", "libc", "libraries", "switches"}
     assert rec["libraries"]["numpy"] == np.__version__
+    assert rec["libraries"]["simplejpeg"] == importlib.metadata.version("simplejpeg")  # it decodes JPEG frames
     assert rec["simd"] and rec["blas"] and rec["cpu"]
     assert json.loads(json.dumps(rec)) == rec  # it goes into JSON sidecars as it is
 
