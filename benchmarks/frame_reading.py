@@ -3,9 +3,10 @@
     python benchmarks/frame_reading.py ../shared/data/UAV123_10fps ../shared/data/DTB70 ...
 
 Reads every frame of every sequence under each root (its layout detected) twice, one read
-after the other (in turn first), in one thread: with :func:`dcfkit.datasets.read_frame`, which decodes a clean
-JPEG once with simplejpeg, and with its OpenCV path alone (``cv2.imdecode``, then libjpeg's
-damage check at 1/8 scale), as every frame was read before 0.17.0. Prints each root's frames,
+after the other (each first in turn), in one thread: with :func:`dcfkit.datasets.read_frame`,
+which decodes a clean JPEG once with simplejpeg, and with its OpenCV path alone
+(``cv2.imdecode``, then libjpeg's damage check at 1/8 scale), as every frame was read before
+0.17.0. Prints each root's frames,
 ms a frame each way and the ratio, and exits with 1 if any frame's pixels differ. ``--every N``
 reads every N-th frame only.
 """

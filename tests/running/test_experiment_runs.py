@@ -264,8 +264,8 @@ def test_the_one_pass_run_is_tres_first_and_is_tracked_once(tmp_path, seqs):
     copied = json.loads((out / "drift" / "tre" / "a_001.json").read_text())
     one_pass = json.loads((out / "drift" / "a.json").read_text())
     assert copied == {**one_pass, "sequence": "a_001"}
-    again = run_one_pass(CONFIG, seqs, out, make_tracker=made, progress=False, experiment="tre")
     tracked = made.made
+    again = run_one_pass(CONFIG, seqs, out, make_tracker=made, progress=False, experiment="tre")
     assert again["done"] == [] and made.made == tracked  # the copies are runs done
     # the other way round: TRE first, then OPE copies its first run
     run_one_pass(CONFIG, seqs, alone, make_tracker=made, progress=False)
