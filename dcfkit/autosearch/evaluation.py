@@ -12,7 +12,7 @@ from typing import Iterable, Mapping
 
 from dcfkit.analysis.scoring import evaluate
 from dcfkit.datasets import Sequence, benchmark_protocol
-from dcfkit.experiments import runs_by_sequence
+from dcfkit.experiments import get_experiment, runs_by_sequence
 from dcfkit.protocols import get_protocol
 from dcfkit.running.layout import folder_names, store_folder
 from dcfkit.running.plan import Entry, RunPlan
@@ -111,8 +111,20 @@ class Evaluator:
 
     def frames(self, units: Iterable[tuple[tuple[str, ...], str]]) -> int:
         """The frames a config tracks on ``units`` ((experiments, sequence name) pairs of
-        successive halving): every run of each sequence under each of its experiments."""
-        return sum(len(run) for exps, name in units for e in exps for run in self.runs[e][name])
+        successive halving, in order): every run of each sequence under each of its experiments
+        but one an earlier experiment made (TRE's from frame 1 after OPE's: docs/evaluation.md,
+        "One run, two experiments")."""
+        made_by: dict[tuple, str] = {}
+        total = 0
+        for exps, name in units:
+            for e in exps:
+                once = get_experiment(e).tracks_once
+                for run in self.runs[e][name]:
+                    same = (name, str(run.frames[0]), len(run), tuple(run.init_box.tolist()))
+                    if once and made_by.setdefault(same, e) != e:
+                        continue  # copied from the other experiment's run
+                    total += len(run)
+        return total
 
 
 def combined(per_experiment: Mapping[str, Mapping[str, dict]], names: Iterable[str]) -> dict[str, dict]:

@@ -55,6 +55,13 @@ class Experiment:
         """The name of the rule bound into the runs (part of the run key), or None."""
         return None
 
+    @property
+    def tracks_once(self) -> bool:
+        """Whether each run is tracked once from its first box, by no rule of the experiment's
+        own: then two such experiments' runs with the same frames and first box are one run
+        (OPE's and TRE's first), made once (:meth:`dcfkit.running.plan.RunPlan.made_elsewhere`)."""
+        return type(self).track is Experiment.track and self.rule is None
+
     def track(self, tracker, make_tracker: Callable[[], object], run: Sequence, read: Read,
               tick: Tick | None = None):
         """Track ``run`` with ``tracker`` (``make_tracker()`` makes another), frames read by ``read``;

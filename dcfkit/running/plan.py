@@ -180,9 +180,9 @@ class RunPlan:
         ``p``'s entry, for ``p``'s runs to do: the same frames from the same first box, tracked
         once from it (OPE's run and TRE's first, which starts at frame 1 when its ground truth
         is valid), under ``p``'s run key."""
-        if not _tracked_once(self.experiment):
+        if not self.experiment.tracks_once:
             return {}
-        others = [e for e in EXPERIMENTS.values() if e.name != self.experiment.name and _tracked_once(e)
+        others = [e for e in EXPERIMENTS.values() if e.name != self.experiment.name and e.tracks_once
                   and store_folder(self.out, p.name, e).is_dir()]
         todo, found = {run.name for run in p.todo}, {}
         for seq in self.sequences if others and todo else ():
@@ -233,11 +233,6 @@ class RunPlan:
                     version=self.version, on_frame=progress.frame)
         finally:
             progress.close()
-
-
-def _tracked_once(experiment: Experiment) -> bool:
-    """Whether ``experiment`` tracks each run once from its first box, by no rule of its own."""
-    return type(experiment).track is Experiment.track and experiment.rule is None
 
 
 def _runs_of(experiment: Experiment, seq: Sequence) -> list[Sequence]:
