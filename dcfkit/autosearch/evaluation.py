@@ -12,7 +12,7 @@ from typing import Iterable, Mapping
 
 from dcfkit.analysis.scoring import evaluate
 from dcfkit.datasets import Sequence, benchmark_protocol
-from dcfkit.experiments import get_experiment, runs_by_sequence
+from dcfkit.experiments import get_experiment, run_identity, runs_by_sequence
 from dcfkit.protocols import get_protocol
 from dcfkit.running.layout import folder_names, store_folder
 from dcfkit.running.plan import Entry, RunPlan
@@ -120,8 +120,7 @@ class Evaluator:
             for e in exps:
                 once = get_experiment(e).tracks_once
                 for run in self.runs[e][name]:
-                    same = (name, str(run.frames[0]), len(run), tuple(run.init_box.tolist()))
-                    if once and made_by.setdefault(same, e) != e:
+                    if once and made_by.setdefault((name, *run_identity(run)), e) != e:
                         continue  # copied from the other experiment's run
                     total += len(run)
         return total

@@ -17,12 +17,12 @@ from typing import Iterable
 
 from dcfkit.datasets import DatasetWarning, Sequence
 from dcfkit.errors import DcfkitError, shown
-from dcfkit.experiments.base import Experiment
+from dcfkit.experiments.base import Experiment, run_identity
 from dcfkit.experiments.otb import sre_plan, tre_plan
 from dcfkit.experiments.starts import Plan
 from dcfkit.experiments.reset import ResetExperiment
 
-__all__ = ["EXPERIMENTS", "Experiment", "get_experiment", "left_out_runs", "runs_by_sequence"]
+__all__ = ["EXPERIMENTS", "Experiment", "get_experiment", "left_out_runs", "run_identity", "runs_by_sequence"]
 
 
 def _one_run(seq: Sequence) -> Plan:

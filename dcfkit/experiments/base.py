@@ -17,6 +17,14 @@ Read = Callable[[int], np.ndarray]  # frame i (0-based) of the run's sequence, d
 Tick = Callable[[], None]  # called after every tracked frame (progress bars)
 
 
+def run_identity(run: Sequence) -> tuple:
+    """What makes two runs of one sequence one run where their experiments track each run once
+    (:attr:`Experiment.tracks_once`): the first frame's file, the number of frames and the first
+    box (a run is its sequence from one frame to the end, so these fix its frames and ground
+    truth)."""
+    return str(run.frames[0]), len(run), tuple(np.asarray(run.init_box, dtype=np.float64).tolist())
+
+
 @dataclasses.dataclass(frozen=True)
 class Experiment:
     """An experiment whose runs are each tracked once from their first box (OPE, TRE, SRE).

@@ -17,11 +17,9 @@ from __future__ import annotations
 import dataclasses
 from typing import Callable, Iterable, Mapping
 
-import numpy as np
-
 from dcfkit.datasets import DatasetError, Sequence
 from dcfkit.errors import DcfkitError, shown
-from dcfkit.experiments import EXPERIMENTS, Experiment, get_experiment, runs_by_sequence
+from dcfkit.experiments import EXPERIMENTS, Experiment, get_experiment, run_identity, runs_by_sequence
 from dcfkit.running.checks import check_first_boxes, check_same_dataset, say_other_rule, say_what_is_recomputed
 from dcfkit.running.layout import store_folder
 from dcfkit.running.progress import Progress
@@ -187,11 +185,16 @@ class RunPlan:
         todo, found = {run.name for run in p.todo}, {}
         for seq in self.sequences if others and todo else ():
             runs = [run for run in self.by_sequence[seq.name] if run.name in todo]
-            candidates = [(other, twin) for other in others for twin in (_runs_of(other, seq) if runs else ())]
+            twins: dict[tuple, list[tuple[ResultStore, Sequence]]] = {}
+            for other in others if runs else ():
+                store = ResultStore(store_folder(self.out, p.name, other))
+                for twin in _runs_of(other, seq):
+                    twins.setdefault(run_identity(twin), []).append((store, twin))
             for run in runs:
-                twin = _same_run(run, candidates, self.out, p)
-                if twin is not None:
-                    found[run.name] = twin
+                done = next(((store, twin.name) for store, twin in twins.get(run_identity(run), ())
+                             if store.status(twin, p.key) == "done"), None)
+                if done is not None:
+                    found[run.name] = done
         return found
 
     def execute(self, jobs: int = 1, executor: str = "local", scheduler: str | None = None,
@@ -241,20 +244,6 @@ def _runs_of(experiment: Experiment, seq: Sequence) -> list[Sequence]:
         return experiment.plan(seq).runs
     except DatasetError:
         return []
-
-
-def _same_run(run: Sequence, candidates: list[tuple[Experiment, Sequence]], out,
-              p: Planned) -> tuple[ResultStore, str] | None:
-    """(the store, the name) of the first of ``candidates`` (an experiment and its run) that is
-    ``run`` (the same frames, ground truth and first box) and done under ``p``'s key in ``p``'s
-    entry, or None."""
-    for other, twin in candidates:
-        if (len(twin) == len(run) and twin.frames == run.frames and np.array_equal(twin.init_box, run.init_box)
-                and np.array_equal(twin.ground_truth, run.ground_truth, equal_nan=True)):
-            store = ResultStore(store_folder(out, p.name, other))
-            if store.status(twin, p.key) == "done":
-                return store, twin.name
-    return None
 
 
 def _claim_text(p: Planned, kind: str) -> Callable[[str], str]:
