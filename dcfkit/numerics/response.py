@@ -1,4 +1,4 @@
-"""Detection: the response map (Eq. 12), its peak and its local maxima.
+"""Detection: the response map (Eq. 12) and its peak (its maxima: :mod:`dcfkit.numerics.maxima`).
 
 Filters and samples are Fourier maps of real signals, shape (C, H, W//2+1) complex64.
 The response is the circular cross-correlation R(τ) = Σ_c Σ_x h_c(x) s_c(x+τ), i.e.
@@ -7,7 +7,6 @@ the mirrored filter. Offsets τ are circular: index i stands for i - H when i > 
 """
 from __future__ import annotations
 
-import cv2
 import numpy as np
 
 from dcfkit.numerics.fft import multiply
@@ -137,24 +136,6 @@ def newton_peak(maps: np.ndarray, iterations: int = 5, spectra: np.ndarray | Non
             dx = (np.mod(x + np.pi, 2 * np.pi) - np.pi) / (2 * np.pi) * w
             best = (s, float(dy), float(dx), value)
     return best
-
-
-def local_maxima(r: np.ndarray, size: int = 3) -> tuple[np.ndarray, np.ndarray]:
-    """Local maxima of a circular (H, W) map: rows, cols of pixels equal to the max of their
-    ``size`` x ``size`` (odd; wrapped) neighbourhood and strictly above its minimum (no plateaus
-    of a flat map). Sorted by value, highest first."""
-    if size < 1 or size % 2 == 0:
-        raise ValueError(f"local_maxima: size must be odd and positive, got {size}")
-    # cv2's morphology on a wrap-padded copy (scipy.ndimage would cost 0.3 s of import)
-    half = size // 2
-    padded = np.pad(r, half, mode="wrap")
-    kernel = np.ones((size, size), np.uint8)
-    inner = (slice(half, half + r.shape[0]), slice(half, half + r.shape[1]))
-    filtered = cv2.dilate(padded, kernel)[inner]
-    lowest = cv2.erode(padded, kernel)[inner]
-    rows, cols = np.nonzero((r == filtered) & (r > lowest))
-    order = np.argsort(-r[rows, cols], kind="stable")
-    return rows[order], cols[order]
 
 
 def shift_spectrum(xf: np.ndarray, dy: float, dx: float, shape: tuple[int, int], full: bool = False) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Detection (Eq. 12), peak and local maxima against brute force."""
+"""Detection (Eq. 12) and its peak against brute force."""
 import itertools
 
 import numpy as np
@@ -8,7 +8,6 @@ from dcfkit.numerics import peak_kernels
 from dcfkit.numerics.fft import make_fft
 from dcfkit.numerics.response import (
     _signed_frequencies,
-    local_maxima,
     newton_peak,
     response,
     shift_spectrum,
@@ -30,28 +29,6 @@ def test_response_is_circular_cross_correlation(backend):
             brute = sum(h[c, y, x] * s[k, c, (y + ty) % H, (x + tx) % W]
                         for c in range(C) for y in range(H) for x in range(W))
             assert got[k, ty, tx] == pytest.approx(brute, abs=1e-4)
-
-
-@pytest.mark.parametrize("size, dtype", [(3, np.float32), (3, np.float64), (5, np.float32), (7, np.float64)])
-def test_local_maxima_match_brute_force(size, dtype):
-    rng = np.random.default_rng(1)
-    r = rng.standard_normal((9, 11)).astype(dtype)
-    rows, cols = local_maxima(r, size)
-    H, W = r.shape
-    brute = []
-    offsets = range(-(size // 2), size // 2 + 1)
-    for y, x in itertools.product(range(H), range(W)):
-        neigh = [r[(y + dy) % H, (x + dx) % W] for dy in offsets for dx in offsets if dy or dx]
-        if r[y, x] >= max(neigh):
-            brute.append((y, x))
-    assert sorted(zip(rows.tolist(), cols.tolist())) == sorted(brute)
-    values = r[rows, cols]
-    assert np.all(np.diff(values) <= 0)  # highest first
-
-
-def test_flat_map_has_no_local_maxima():
-    rows, _ = local_maxima(np.ones((5, 5), np.float32))
-    assert rows.size == 0
 
 
 @pytest.mark.parametrize("true_dy,true_dx", [(0.3, -0.2), (-2.4, 3.1), (5.45, -5.0)])

@@ -7,8 +7,8 @@ channel's response counts at detection.
 from __future__ import annotations
 
 from dcfkit.components.channel_weights.base import ChannelWeights
-from dcfkit.components.channel_weights.reliability import CSRReliability, detection_reliability, regional_maxima
+from dcfkit.components.channel_weights.reliability import CSRReliability, detection_reliability, maxima_values
 
 BUILTIN = (CSRReliability,)
 
-__all__ = ["BUILTIN", "CSRReliability", "ChannelWeights", "detection_reliability", "regional_maxima"]
+__all__ = ["BUILTIN", "CSRReliability", "ChannelWeights", "detection_reliability", "maxima_values"]

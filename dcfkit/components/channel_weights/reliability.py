@@ -4,37 +4,25 @@ from __future__ import annotations
 
 import dataclasses
 
-import cv2
 import numpy as np
 
 from dcfkit.components.base import running_average
 from dcfkit.components.channel_weights.base import ChannelWeights
+from dcfkit.numerics.maxima import maxima_components
 from dcfkit.params import param
 
 
-def regional_maxima(maps: np.ndarray) -> list[np.ndarray]:
+def maxima_values(maps: np.ndarray) -> list[np.ndarray]:
     """The values of the regional maxima of each (H, W) map of a (C, H, W) stack, highest first:
-    MATLAB's ``imregionalmax`` (8-connected plateaus higher than every neighbour, the map not
-    wrapped), then one value per connected component (``bwconncomp``)."""
-    from scipy import ndimage  # deferred: 0.3 s of import, for trackers with channel weights only
-
-    r = np.ascontiguousarray(np.moveaxis(np.asarray(maps, np.float32), 0, -1))  # (H, W, C) for OpenCV
-    kernel = np.ones((3, 3), np.uint8)
-    top = r >= cv2.dilate(r, kernel)  # no neighbour higher (cv2 pads with -inf)
-    # a plateau touching an equal pixel that has a higher neighbour is no regional maximum
-    others = cv2.dilate(np.where(top, -np.inf, r).astype(np.float32), kernel)
-    structure = np.zeros((3, 3, 3), bool)
-    structure[:, :, 1] = True  # 8-connected within a channel, never across channels
-    labels, n = ndimage.label(top, structure)
-    keep = np.ones(n + 1, bool)
-    keep[0] = False
-    keep[labels[top & (others == r)]] = False
+    one value per connected plateau of MATLAB's ``imregionalmax`` (``bwconncomp``)."""
+    maps = np.asarray(maps, np.float32)
+    labels, n = maxima_components(maps)
     value, channel = np.zeros(n + 1, np.float32), np.zeros(n + 1, np.int64)
-    value[labels] = r  # every pixel of a component has its value
-    channel[labels] = np.arange(r.shape[2])
-    order = np.lexsort((-value[keep], channel[keep]))
-    kept_channel, kept_value = channel[keep][order], value[keep][order]
-    return np.split(kept_value, np.searchsorted(kept_channel, np.arange(1, r.shape[2])))
+    value[labels] = maps  # every pixel of a plateau has its value
+    channel[labels] = np.arange(len(maps))[:, None, None]
+    order = np.lexsort((-value[1:], channel[1:]))
+    kept_channel, kept_value = channel[1:][order], value[1:][order]
+    return np.split(kept_value, np.searchsorted(kept_channel, np.arange(1, len(maps))))
 
 
 def detection_reliability(maps: np.ndarray, floor: float = 0.5) -> np.ndarray:
@@ -46,7 +34,7 @@ def detection_reliability(maps: np.ndarray, floor: float = 0.5) -> np.ndarray:
     span = np.where(high > low, high - low, 1).astype(np.float32)
     normalised = (maps - low[:, None, None]) / span[:, None, None]
     out = np.ones(len(maps))
-    for c, peaks in enumerate(regional_maxima(normalised)):
+    for c, peaks in enumerate(maxima_values(normalised)):
         if high[c] > low[c] and len(peaks) > 1 and peaks[0] > 0:
             out[c] = max(1.0 - peaks[1] / peaks[0], floor)
     return out

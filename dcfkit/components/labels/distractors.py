@@ -23,13 +23,15 @@ Labels are (H, W) float32 maps with the target peak at index (0, 0) (circular la
 from __future__ import annotations
 
 import dataclasses
+import itertools
 
 import numpy as np
 
 from dcfkit.components.labels.base import Detection, Label
 from dcfkit.components.regularizers import target_mask
 from dcfkit.numerics.patches import round_half_away
-from dcfkit.numerics.response import local_maxima, wrap
+from dcfkit.numerics.maxima import components, local_maxima, regional_maxima
+from dcfkit.numerics.response import wrap
 from dcfkit.params import param
 
 MAX_MU = 1e6
@@ -108,31 +110,6 @@ class DistractorRepressed(Label):
         return y, offsets
 
 
-def regional_maxima(r: np.ndarray) -> np.ndarray:
-    """MATLAB's ``imregionalmax`` (8-connected) of a non-circular (H, W) map: the pixels of every
-    connected plateau whose neighbours outside it are all lower. Boolean (H, W)."""
-    padded = np.pad(r.astype(np.float64), 1, constant_values=-np.inf)
-    h, w = r.shape
-    shifts = [(a, b) for a in (0, 1, 2) for b in (0, 1, 2) if (a, b) != (1, 1)]
-    neighbours = np.stack([padded[a:a + h, b:b + w] for a, b in shifts])
-    top = r >= neighbours.max(axis=0)  # no higher neighbour
-    # a plateau is not a maximum if one of its pixels has an equal neighbour that has a higher one
-    top_padded = np.pad(top, 1)
-    leaks = np.zeros_like(top)
-    for (a, b), n in zip(shifts, neighbours):
-        leaks |= (n == r) & ~top_padded[a:a + h, b:b + w]
-    labels, _ = _components(top)
-    bad = np.unique(labels[top & leaks])
-    return top & ~np.isin(labels, bad)
-
-
-def _components(mask: np.ndarray) -> tuple[np.ndarray, int]:
-    """8-connected components of a boolean map (MATLAB's bwconncomp): labels and their count."""
-    import scipy.ndimage  # only the authors' label selection needs it (0.3 s of import)
-
-    return scipy.ndimage.label(mask, structure=np.ones((3, 3)))
-
-
 def authors_distractors(detection: Detection, top_n: int) -> tuple[np.ndarray, np.ndarray]:
     """Distractors as DR²Track's tracker.m picks them: (N, 2) (dy, dx) offsets from the target
     and their values R̃, highest first; an offset appears once per value that matched it.
@@ -151,14 +128,17 @@ def authors_distractors(detection: Detection, top_n: int) -> tuple[np.ndarray, n
     dy, dx = detection.offset if detection.offset is not None else (0.0, 0.0)
     shift = (h // 2 - int(round_half_away(dy)), w // 2 - int(round_half_away(dx)))
     rn = np.roll(r / top, shift, axis=(0, 1))
-    outside = ~target_mask((h, w), detection.target_cells, "authors")
+    wanted = np.asarray(_strongest_maxima(rn, detection.target_cells, top_n), rn.dtype)
+    where = np.flatnonzero(~target_mask((h, w), detection.target_cells, "authors") & (rn >= wanted.min()))
+    where = where[np.argsort(rn.ravel()[where])]  # the pixels outside that may match, by value
+    values = rn.ravel()[where]
     offsets, kept = [], []
-    for value in _strongest_maxima(rn, detection.target_cells, top_n):
-        found_rows, found_cols = np.nonzero(outside & (rn == value))
-        for row in np.unique(found_rows):
-            for col in np.unique(found_cols):
-                offsets.append((row - h // 2, col - w // 2))
-                kept.append(value)
+    for value, start, stop in zip(wanted, values.searchsorted(wanted, "left"), values.searchsorted(wanted, "right")):
+        found = where[start:stop]
+        for row, col in itertools.product(np.unique(found // w), np.unique(found % w)) if len(found) > 1 else \
+                ((p // w, p % w) for p in found.tolist()):
+            offsets.append((row - h // 2, col - w // 2))
+            kept.append(value)
     if not offsets:
         return np.zeros((0, 2), dtype=int), np.zeros(0, np.float32)
     return np.array(offsets, dtype=int), np.array(kept, np.float32)
@@ -176,10 +156,10 @@ def _strongest_maxima(rn: np.ndarray, target_cells, top_n: int) -> list:
     rows = slice(max(int(np.floor(h / 2 - reg[0] / 2)) - 1, 0), int(np.floor(h / 2 + reg[0] / 2)))
     cols = slice(max(int(np.floor(w / 2 - reg[1] / 2)) - 1, 0), int(np.floor(w / 2 + reg[1] / 2)))
     maxima[rows, cols] = False
-    labels, count = _components(maxima)
+    labels, count = components(maxima)
     if count <= 1:
         return [rn.max(), np.float32(0)][:top_n]
-    first = {}
-    for col, row in zip(*np.nonzero(labels.T)):
-        first.setdefault(labels[row, col], rn[row, col])
-    return sorted(first.values(), reverse=True)[:top_n]
+    cols, rows = np.nonzero(labels.T)  # column-major
+    _, first = np.unique(labels[rows, cols], return_index=True)
+    values = rn[rows[np.sort(first)], cols[np.sort(first)]]  # in the order MATLAB meets them
+    return list(values[np.argsort(-values, kind="stable")][:top_n])

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from dcfkit.components.channel_weights import CSRReliability, detection_reliability, regional_maxima
+from dcfkit.components.channel_weights import CSRReliability, detection_reliability, maxima_values
 
 
 def bumps(shape, peaks):
@@ -40,11 +40,11 @@ def brute_regional_maxima(r):
 
 
 @pytest.mark.parametrize("seed", range(5))
-def test_regional_maxima_match_a_flood_fill(seed):
+def test_maxima_values_match_a_flood_fill(seed):
     rng = np.random.default_rng(seed)
     r = rng.integers(0, 4, (9, 11)).astype(np.float32)  # few levels: plateaus, and plateaus next to higher ones
     stack = np.stack([r, r[::-1], np.zeros_like(r)])
-    got = regional_maxima(stack)
+    got = maxima_values(stack)
     for c in range(3):
         np.testing.assert_array_equal(got[c], brute_regional_maxima(stack[c]))
 

@@ -7,12 +7,13 @@ import pytest
 
 import dcfkit
 from dcfkit.components.labels.base import Detection, Label, gaussian_label
-from dcfkit.components.labels.distractors import DistractorRepressed, authors_distractors, regional_maxima
+from dcfkit.components.labels.distractors import DistractorRepressed, authors_distractors
 from dcfkit.components.labels.gaussian import Gaussian
+from dcfkit.components.regularizers import target_mask
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.errors import ConfigError
+from dcfkit.numerics.maxima import local_maxima, regional_maxima
 from dcfkit.numerics.patches import round_half_away
-from dcfkit.numerics.response import local_maxima
 from dcfkit.params import parse_params
 
 
@@ -130,68 +131,6 @@ def test_init_resets_the_label_before_the_first_frame_of_a_target():
 # --------------------------------------------------------------------------------------------
 # the authors' MATLAB: DR²Track's distractor selection: imregionalmax, its exclusion box, find(bg == value)
 # --------------------------------------------------------------------------------------------
-
-def imregionalmax_brute(r):
-    """MATLAB's imregionalmax (8-connected, default conn for 2-D): every connected plateau of equal
-    values whose neighbours outside it (inside the image; not circular) are all strictly lower."""
-    h, w = r.shape
-    out = np.zeros((h, w), bool)
-    seen = np.zeros((h, w), bool)
-    for start in itertools.product(range(h), range(w)):
-        if seen[start]:
-            continue
-        plateau, queue, seen[start] = [], collections.deque([start]), True
-        is_max = True
-        while queue:
-            p = queue.popleft()
-            plateau.append(p)
-            for dy, dx in itertools.product((-1, 0, 1), repeat=2):
-                q = (p[0] + dy, p[1] + dx)
-                if (dy, dx) == (0, 0) or not (0 <= q[0] < h and 0 <= q[1] < w):
-                    continue
-                if r[q] == r[start]:
-                    if not seen[q]:
-                        seen[q] = True
-                        queue.append(q)
-                elif r[q] > r[start]:
-                    is_max = False
-        for p in plateau:
-            out[p] = is_max
-    return out
-
-
-@pytest.mark.parametrize("seed, shape, levels", [(0, (9, 11), 3), (1, (12, 12), 4), (2, (7, 16), 2),
-                                                 (3, (10, 10), 6), (4, (13, 9), 3), (5, (6, 6), 1000)])
-def test_regional_maxima_match_imregionalmax(seed, shape, levels):
-    rng = np.random.default_rng(seed)
-    r = (rng.integers(0, levels, shape) / levels).astype(np.float32)  # quantised: many plateaus
-    expected = imregionalmax_brute(r)
-    assert np.array_equal(regional_maxima(r), expected)
-
-
-def test_regional_maxima_of_special_maps():
-    flat = np.full((4, 5), 0.3, np.float32)
-    assert regional_maxima(flat).all()  # one plateau with no outer neighbour: a maximum
-    r = np.zeros((6, 6), np.float32)
-    r[0:3, 0:3] = 1.0
-    r[2, 2] = 2.0  # the plateau has a higher pixel inside its own neighbourhood: not a maximum
-    expected = np.zeros((6, 6), bool)
-    expected[2, 2] = True
-    assert np.array_equal(regional_maxima(r), expected)
-    r = np.zeros((5, 5), np.float32)
-    r[0, 0] = r[0, 1] = r[1, 2] = 1.0  # a diagonal step joins (1, 2) to the plateau: 8-connected
-    r[4, 4] = 0.5
-    expected = (r > 0)
-    assert np.array_equal(regional_maxima(r), expected)
-    # a diagonal chain (1, 1), (2, 2), (3, 3) is one plateau; (3, 3) touches the higher (4, 4), so none
-    # of it is a maximum, although (1, 1) only touches the plateau's (2, 2)
-    r = np.zeros((6, 6), np.float32)
-    r[1, 1] = r[2, 2] = r[3, 3] = 1.0
-    r[4, 4] = 2.0
-    expected = np.zeros((6, 6), bool)
-    expected[4, 4] = True
-    assert np.array_equal(regional_maxima(r), expected)
-
 
 # A hand-built 12x12 map in the frame tracker.m works in after its two circshifts (lines 67-69):
 # the detection at index (6, 6) = floor(size/2) (0-based). target_cells (5.5, 3.9): reg_sz = (5, 3).
@@ -333,3 +272,50 @@ def test_authors_label_fallback_finds_the_maximum_and_exact_zeros():
     label1 = DistractorRepressed(DistractorRepressed.Params(top_n=1, mu=0.25, variant="overwrite",
                                                             selection="authors"))
     np.testing.assert_array_equal(label1.make(g, det)[0], expected_label(g, repressed[:1], 0.25))
+
+
+def authors_distractors_brute(rn, target_cells, top_n):
+    """tracker.m:70-93 read line by line on the centred, normalised map ``rn``: imregionalmax (tested
+    against a flood fill in tests/numerics/test_maxima.py), the
+    exclusion box cleared, bwconncomp's components by their first pixel in column-major order, the
+    ``top_n`` highest values (or [max 0] with one component at most), and for each value every row
+    of a pixel outside the target box that holds it with every such column, one pixel at a time."""
+    import scipy.ndimage
+
+    h, w = rn.shape
+    maxima = regional_maxima(rn)
+    reg = np.floor(target_cells)
+    for row, col in itertools.product(range(h), range(w)):
+        if (np.floor(h / 2 - reg[0] / 2) <= row + 1 <= np.floor(h / 2 + reg[0] / 2)
+                and np.floor(w / 2 - reg[1] / 2) <= col + 1 <= np.floor(w / 2 + reg[1] / 2)):
+            maxima[row, col] = False
+    labels, count = scipy.ndimage.label(maxima, structure=np.ones((3, 3)))
+    first = {}
+    for col, row in itertools.product(range(w), range(h)):
+        if labels[row, col]:
+            first.setdefault(labels[row, col], rn[row, col])
+    wanted = [rn.max(), 0.0] if count <= 1 else sorted(first.values(), reverse=True)
+    outside = ~target_mask((h, w), target_cells, "authors")
+    found = []
+    for value in wanted[:top_n]:
+        rows = sorted({r for r, c in itertools.product(range(h), range(w)) if outside[r, c] and rn[r, c] == value})
+        cols = sorted({c for r, c in itertools.product(range(h), range(w)) if outside[r, c] and rn[r, c] == value})
+        found += [((r - h // 2, c - w // 2), float(value)) for r in rows for c in cols]
+    return found
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_authors_distractors_match_the_lines_of_tracker_m(seed):
+    """Quantised random maps (plateaus, one value at several places, exact zeros) of odd and even
+    sizes and target sizes: the same distractors, in the same order, as the line-by-line reading."""
+    rng = np.random.default_rng(seed)
+    h, w = rng.integers(7, 30, 2)
+    centred = (rng.integers(0, [3, 8, 40][seed % 3], (h, w)) / 8).astype(np.float32)
+    centred[h // 2, w // 2] = centred.max() + 1
+    target_cells = tuple(rng.uniform(1, [h / 2, w / 2]))
+    response = np.roll(centred, (-(h // 2), -(w // 2)), axis=(0, 1))
+    det = Detection(response, (0, 0), target_cells, (0.0, 0.0))
+    top_n = int(rng.integers(1, 40))
+    offsets, values = authors_distractors(det, top_n)
+    expected = authors_distractors_brute(centred / centred.max(), target_cells, top_n)
+    assert [(tuple(o), float(v)) for o, v in zip(offsets.tolist(), values)] == expected
