@@ -25,7 +25,7 @@ from PIL import Image
 import dcfkit
 from dcfkit import cli
 from dcfkit.config import load_config
-from dcfkit.datasets import DatasetError, read_frame
+from dcfkit.datasets import DatasetError, images, read_frame
 from dcfkit.datasets.synthetic import make_sequence
 from dcfkit.datasets.video import open_source
 from dcfkit.errors import ConfigError, DcfkitError, InputError
@@ -286,6 +286,7 @@ def decodes(monkeypatch):
     cv2.imdecode, ``("simplejpeg", args)`` for a full-size simplejpeg.decode_jpeg (not its
     1/8-scale damage check, which passes ``min_width``)."""
     calls = []
+    images.decoders_agree()  # its own decodes, once a process, before counting
 
     def counting(name, real):
         def counted(*args, **kwargs):
@@ -432,6 +433,31 @@ def test_valid_jpegs_decode_as_opencv_decodes_them(variant, tmp_path, decodes):
             assert [decoder for decoder, _ in decodes] == ["simplejpeg"], (variant, image.shape)
 
 
+def test_where_simplejpeg_decodes_otherwise_opencv_decodes_every_frame(tmp_path, monkeypatch, decodes):
+    """An OpenCV built on another libjpeg would decode some JPEG otherwise than simplejpeg: the
+    check at the first read finds it (here simplejpeg's 4:2:0 pixels are made one level off),
+    and every frame is OpenCV's."""
+    real = simplejpeg.decode_jpeg
+
+    def otherwise(data, *args, **kwargs):
+        image = real(data, *args, **kwargs)
+        header = simplejpeg.decode_jpeg_header(data)
+        return image + 1 if header[3] == "420" else image
+
+    images.decoders_agree.cache_clear()
+    monkeypatch.setattr(simplejpeg, "decode_jpeg", otherwise)
+    try:
+        assert not images.decoders_agree()
+        path = tmp_path / "frame.jpg"
+        path.write_bytes(JPEG)
+        expected = cv2.imdecode(np.frombuffer(JPEG, np.uint8), cv2.IMREAD_COLOR)
+        decodes.clear()
+        np.testing.assert_array_equal(read_frame(path), expected)
+        assert [decoder for decoder, _ in decodes] == ["cv2"]
+    finally:
+        images.decoders_agree.cache_clear()
+
+
 @pytest.mark.parametrize("orientation", [1, 3, 6, 8])
 def test_a_jpeg_with_exif_is_turned_as_opencv_turns_it(orientation, tmp_path, decodes):
     """OpenCV turns an image as its EXIF orientation tag says (6: 90 degrees clockwise), which
@@ -444,6 +470,34 @@ def test_a_jpeg_with_exif_is_turned_as_opencv_turns_it(orientation, tmp_path, de
     path.write_bytes(buffer.getvalue())
     expected = cv2.imdecode(np.frombuffer(buffer.getvalue(), np.uint8), cv2.IMREAD_COLOR)
     assert expected.shape[:2] == (TEXTURE.shape[:2] if orientation in (1, 3) else TEXTURE.shape[1::-1])
+    decodes.clear()
+    np.testing.assert_array_equal(read_frame(path), expected)
+    assert "cv2" in [decoder for decoder, _ in decodes]
+
+
+def segment(marker: int, payload: bytes) -> bytes:
+    """A JPEG header segment: its marker, its length (which counts itself) and ``payload``."""
+    return bytes([0xFF, marker]) + struct.pack(">H", len(payload) + 2) + payload
+
+
+@pytest.mark.parametrize("before", ["an ICC profile holding the bytes of a scan marker", "a JFXX thumbnail"])
+def test_exif_after_a_segment_holding_marker_bytes_is_still_seen(before, tmp_path, decodes):
+    """EXIF data after a segment whose payload holds FF DA (the start-of-scan marker's bytes) is
+    still EXIF data: OpenCV's turn, not libjpeg's unturned picture."""
+    exif = Image.Exif()
+    exif[0x0112] = 6
+    buffer = io.BytesIO()
+    Image.fromarray(TEXTURE[..., ::-1]).save(buffer, "JPEG", quality=90, exif=exif.tobytes())
+    start = buffer.getvalue().index(b"\xff\xe1")  # Pillow's EXIF segment
+    exif_segment = buffer.getvalue()[start:start + 2 + struct.unpack(">H", buffer.getvalue()[start + 2:start + 4])[0]]
+    rest = buffer.getvalue().replace(exif_segment, b"")
+    first = (segment(0xE2, b"ICC_PROFILE\0\x01\x01" + b"\x00\x10\xff\xda\x00\x00" * 4)
+             if before.startswith("an ICC") else segment(0xE0, b"JFXX\0\x10" + JPEG))
+    data = rest[:2] + first + exif_segment + rest[2:]
+    path = tmp_path / "frame.jpg"
+    path.write_bytes(data)
+    expected = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+    assert expected.shape[:2] == TEXTURE.shape[1::-1]  # turned
     decodes.clear()
     np.testing.assert_array_equal(read_frame(path), expected)
     assert "cv2" in [decoder for decoder, _ in decodes]
@@ -646,7 +700,7 @@ def test_only_regular_frame_files_of_bounded_size_are_read(tmp_path, monkeypatch
     import os
 
     """A FIFO would block, /dev/zero never end, a sparse 6 GB file fill memory: refused unread."""
-    from dcfkit.datasets import DatasetError, read_frame
+    from dcfkit.datasets import DatasetError, images, read_frame
 
     fifo = tmp_path / "00001.jpg"
     os.mkfifo(fifo)

@@ -1,7 +1,9 @@
 """Frames read from image files, whose damage is an error naming the file (docs/hardening.md)."""
 from __future__ import annotations
 
+import functools
 import io
+import logging
 import os
 import re
 import stat
@@ -16,6 +18,7 @@ from dcfkit.errors import DatasetError, InputWarning
 from dcfkit.limits import IMAGE_PIXELS_VARIABLE, max_image_pixels
 
 _FEW_LEVELS_WARNED: set[str] = set()
+log = logging.getLogger(__name__)
 
 
 def regular_file_bytes(path, name: str, limit: int, over: str) -> bytes:
@@ -86,15 +89,45 @@ def _clean_jpeg(data: bytes) -> np.ndarray | None:
     SIMD paths give the C code's bits: the same pixels in 3.5 ms for a 1280x720 frame, where
     OpenCV and the damage check took 6.3 ms (``benchmarks/frame_reading.py``); the strict
     decode is that check. A JPEG with EXIF data is left to OpenCV, which turns the image as its
-    orientation tag says."""
-    if not data.startswith(b"\xff\xd8") or b"Exif\0\0" in data[:data.find(b"\xff\xda")]:
+    orientation tag says: the whole file is searched for the EXIF header, as a segment before
+    it may hold the bytes of any marker (an ICC profile, a thumbnail), and a false match costs
+    only the slower path."""
+    if not data.startswith(b"\xff\xd8") or b"Exif\0\0" in data or not decoders_agree():
         return None
     import simplejpeg  # deferred, as OpenCV
 
     try:
         return simplejpeg.decode_jpeg(data, colorspace="BGR", strict=True)
-    except ValueError:  # a warning, an error, or a layout it does not decode (CMYK, 12-bit)
+    except ValueError:  # a warning, an error, or a layout it does not decode (12-bit, lossless)
         return None
+
+
+@functools.cache
+def decoders_agree() -> bool:
+    """Whether simplejpeg decodes as OpenCV does here (once a process): a patterned image in
+    each chroma subsampling, baseline and progressive, decoded by both. They agree where both
+    bundle libjpeg-turbo (the pip wheels); an OpenCV built on IJG's libjpeg 7 or later, which
+    upsamples chroma otherwise, would not, and then OpenCV decodes every frame."""
+    import cv2  # deferred, as in read_frame
+    import simplejpeg  # deferred, as OpenCV
+
+    rows, cols = np.mgrid[0:37, 0:53]
+    image = np.stack([(rows * 7 + cols * 3) % 256, (rows * cols) % 251, ((rows - cols) ** 2) % 241], -1).astype(np.uint8)
+    for sampling in ("411", "420", "422", "440", "444"):
+        for progressive in (0, 1):
+            params = [cv2.IMWRITE_JPEG_SAMPLING_FACTOR, getattr(cv2, f"IMWRITE_JPEG_SAMPLING_FACTOR_{sampling}"),
+                      cv2.IMWRITE_JPEG_PROGRESSIVE, progressive]
+            data = cv2.imencode(".jpg", image, params)[1].tobytes()
+            expected = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+            try:
+                same = np.array_equal(simplejpeg.decode_jpeg(data, colorspace="BGR", strict=True), expected)
+            except ValueError:
+                same = False
+            if not same:
+                log.info("simplejpeg decodes JPEGs otherwise than OpenCV here (%s sampling): OpenCV decodes "
+                         "every frame", sampling)
+                return False
+    return True
 
 
 def _warn_if_few_levels(image: np.ndarray, path) -> None:
