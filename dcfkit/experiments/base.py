@@ -19,9 +19,9 @@ Tick = Callable[[], None]  # called after every tracked frame (progress bars)
 
 def run_identity(run: Sequence) -> tuple:
     """What makes two runs of one sequence one run where their experiments track each run once
-    (:attr:`Experiment.tracks_once`): the first frame's file, the number of frames and the first
-    box (a run is its sequence from one frame to the end, so these fix its frames and ground
-    truth)."""
+    (:attr:`Experiment.tracks_once`: OPE, TRE, SRE): the first frame's file, the number of
+    frames and the first box (a run is its sequence from one frame to the end, so these fix its
+    frames and ground truth)."""
     return str(run.frames[0]), len(run), tuple(np.asarray(run.init_box, dtype=np.float64).tolist())
 
 
@@ -66,9 +66,13 @@ class Experiment:
     @property
     def tracks_once(self) -> bool:
         """Whether each run is tracked once from its first box, by no rule of the experiment's
-        own: then two such experiments' runs with the same frames and first box are one run
-        (OPE's and TRE's first), made once (:meth:`dcfkit.running.plan.RunPlan.made_elsewhere`)."""
-        return type(self).track is Experiment.track and self.rule is None
+        own, and stored with nothing of the experiment's own: then two such experiments' runs
+        with the same frames and first box are one run (OPE's and TRE's first, or SRE's shifts
+        that leave the box where it is), made once
+        (:meth:`dcfkit.running.plan.RunPlan.made_elsewhere`)."""
+        kind = type(self)
+        return (self.rule is None and kind.track is Experiment.track and kind.record is Experiment.record
+                and kind.stored_elsewise is Experiment.stored_elsewise)
 
     def track(self, tracker, make_tracker: Callable[[], object], run: Sequence, read: Read,
               tick: Tick | None = None):

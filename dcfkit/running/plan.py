@@ -15,6 +15,7 @@ run is TRE's first when that starts at frame 1). A consumer makes a plan, calls
 from __future__ import annotations
 
 import dataclasses
+import logging
 from typing import Callable, Iterable, Mapping
 
 from dcfkit.datasets import DatasetError, Sequence
@@ -26,8 +27,10 @@ from dcfkit.running.progress import Progress
 from dcfkit.running.runner import RunTask, execute, warm_up_compiled
 from dcfkit.store import provenance
 from dcfkit.store.claims import claimed_folders
-from dcfkit.store.files import ensure_writable, make_dir, remove_temporary_files
+from dcfkit.store.files import StoreError, ensure_writable, make_dir, remove_temporary_files
 from dcfkit.store.results import ResultStore
+
+log = logging.getLogger(__name__)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -204,9 +207,10 @@ class RunPlan:
         process, else longest first: the workers end together), with ``progress``; each run's
         outcome goes to every entry that gets it."""
         for p in self.entries:
+            runs = {run.name: run for run in p.todo}
             for name, (source, source_name) in self.made_elsewhere(p).items():
-                p.store.copy_run(source, name, source_name)
-                p.done.append(name)
+                if _copied_twin(p, runs[name], source, source_name):
+                    p.done.append(name)
         tasks, copies = self.shared()
         for source, targets, name in copies:
             for p in targets:
@@ -236,6 +240,18 @@ class RunPlan:
                     version=self.version, on_frame=progress.frame)
         finally:
             progress.close()
+
+
+def _copied_twin(p: Planned, run: Sequence, source: ResultStore, source_name: str) -> bool:
+    """Copy ``run`` from its twin in another experiment's folder, which this command has not
+    claimed; whether the copy is done under ``p``'s key. Another command may have rewritten
+    or removed the twin since it was found done: the run is then tracked, not lost."""
+    try:
+        p.store.copy_run(source, run.name, source_name)
+    except StoreError as exc:
+        log.warning("%s: tracked instead of copied (%s)", run.name, exc)
+        return False
+    return p.store.status(run, p.key) == "done"
 
 
 def _runs_of(experiment: Experiment, seq: Sequence) -> list[Sequence]:

@@ -2,12 +2,14 @@
 splitSeqTRE.m and shiftInitBB.m (Wu et al., TPAMI 2015)."""
 from __future__ import annotations
 
+import dataclasses
+
 import cv2
 import numpy as np
 import pytest
 
 from dcfkit.datasets import DatasetError, Sequence
-from dcfkit.experiments import EXPERIMENTS, get_experiment, runs_by_sequence
+from dcfkit.experiments import EXPERIMENTS, Experiment, get_experiment, runs_by_sequence
 from dcfkit.experiments.otb import SRE_SHIFTS, sre_box, tre_runs, tre_starts
 
 
@@ -87,3 +89,26 @@ def test_experiments_by_name(tmp_path):
     seq = Sequence("a", frames(tmp_path, 30), np.ones((30, 4)))
     assert runs_by_sequence([seq], "ope") == {"a": [seq]}
     assert [len(r) for r in runs_by_sequence([seq], "tre")["a"]][-1] == 20
+
+
+def test_which_experiments_track_each_run_once():
+    """OPE's, TRE's and SRE's runs are each tracked once from their first box and stored with
+    nothing of their own: one run where two coincide. The reset experiment restarts; an
+    experiment that tracks or records differently, or stores runs under a rule, is not one."""
+    assert [name for name, e in EXPERIMENTS.items() if e.tracks_once] == ["ope", "tre", "sre"]
+    base = dataclasses.asdict(EXPERIMENTS["ope"])
+
+    class Recording(Experiment):
+        def record(self, result):
+            return {"mine": 1}
+
+    class Checking(Experiment):
+        def stored_elsewise(self, meta):
+            return None
+
+    class Tracking(Experiment):
+        def track(self, tracker, make_tracker, run, read, tick=None):
+            return super().track(tracker, make_tracker, run, read, tick)
+
+    assert Experiment(**base).tracks_once
+    assert not any(kind(**base).tracks_once for kind in (Recording, Checking, Tracking))

@@ -290,3 +290,33 @@ def test_a_run_of_another_config_or_from_another_box_is_not_taken_for_tres_first
     run_one_pass(CONFIG, [seq], out, make_tracker=made, progress=False, experiment="tre")
     assert made.made == len(tre_starts(gt))
     assert json.loads((out / "drift" / "tre" / "left_001.json").read_text())["init_box"] == gt[1].tolist()
+
+
+@pytest.mark.parametrize("meanwhile", ["removed", "unreadable"])
+def test_a_twin_another_command_changes_before_the_copy_is_tracked(tmp_path, seqs, monkeypatch, meanwhile):
+    """OPE's folder is not TRE's to claim: when its run of ``a`` is removed, or cannot be read,
+    between the plan finding it done and the copy, TRE tracks that run itself, and every TRE
+    run ends done, with its files."""
+    from dcfkit.running.plan import RunPlan
+
+    out, starts = tmp_path / "out", tre_starts(seqs[0].ground_truth)
+    run_one_pass(CONFIG, seqs, out, make_tracker=Counter(), progress=False)
+    found = RunPlan.made_elsewhere
+
+    def then_changed(self, p):
+        twins = found(self, p)
+        if meanwhile == "removed":
+            for path in (out / "drift").glob("a.*"):
+                path.unlink()
+        else:
+            (out / "drift" / "a.txt").unlink()
+            (out / "drift" / "a.txt").mkdir()  # reading it fails: not a file
+        return twins
+
+    monkeypatch.setattr(RunPlan, "made_elsewhere", then_changed)
+    made = Counter()
+    tre = run_one_pass(CONFIG, seqs, out, make_tracker=made, progress=False, experiment="tre")
+    assert made.made == 2 * len(starts) - starts.count(0)  # b's first run copied; a's tracked
+    assert len(tre["done"]) == 2 * len(starts) and not tre["failed"]
+    record = json.loads((out / "drift" / "tre" / "a_001.json").read_text())
+    assert record["sequence"] == "a_001" and (out / "drift" / "tre" / "a_001.txt").is_file()
