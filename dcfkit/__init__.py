@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 # part of every run key (dcfkit.store.provenance.run_key): bump it when boxes change (docs/changes.md)
-__version__ = "0.17.0"
+__version__ = "0.17.1"
 
 __all__ = ["__version__", "load_tracker", "load_config", "Tracker"]
 
