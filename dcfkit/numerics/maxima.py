@@ -30,7 +30,8 @@ def local_maxima(r: np.ndarray, size: int = 3) -> tuple[np.ndarray, np.ndarray]:
 def regional_maxima(maps: np.ndarray) -> np.ndarray:
     """MATLAB's ``imregionalmax`` (8-connected, the map not wrapped) of an (H, W) map or of each
     map of a (C, H, W) stack: the pixels of every connected plateau whose neighbours outside it
-    are all lower. Boolean, the shape of ``maps``; float32 and float64 maps keep their values."""
+    are all lower. Boolean, the shape of ``maps``. float32 and float64 maps keep their values
+    (others are read as float64); the maps must be free of NaN, which has no order."""
     top, leaks = _tops(maps)
     if leaks.any():
         labels, _ = components(top)
@@ -60,8 +61,11 @@ def _tops(maps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     maps = np.asarray(maps)
     r = maps if maps.dtype in (np.float32, np.float64) else maps.astype(np.float64)
     r = np.ascontiguousarray(np.moveaxis(r, 0, -1) if r.ndim == 3 else r)
-    top = r >= cv2.dilate(r, _KERNEL)  # OpenCV pads a dilation with -inf
-    beside = cv2.dilate(np.where(top, -np.inf, r).astype(r.dtype, copy=False), _KERNEL)
+    # OpenCV pads a dilation with the lowest finite value, which no border pixel is below but
+    # -inf (and a plateau of -inf is a maximum only where the whole map is -inf, as MATLAB's);
+    # it returns one channel's (H, W, 1) as (H, W)
+    top = r >= cv2.dilate(r, _KERNEL).reshape(r.shape)
+    beside = cv2.dilate(np.where(top, -np.inf, r).astype(r.dtype, copy=False), _KERNEL).reshape(r.shape)
     return top, top & (beside == r)
 
 

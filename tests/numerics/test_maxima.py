@@ -140,3 +140,16 @@ def test_maxima_components_number_the_regional_maxima_plateaus(seed):
         assert len(set(plane)) == 1 and len(set(stack[plane, rows, cols])) == 1
     single, n = maxima_components(stack[0])
     assert single.shape == stack[0].shape and n == components(regional_maxima(stack[0]))[1]
+
+
+@pytest.mark.parametrize("shape", [(5, 5), (5, 4), (1, 7)])
+def test_a_stack_of_one_map_is_that_map(shape):
+    """OpenCV returns the dilation of one channel without its channel axis: a (1, H, W) stack
+    has the maxima of its one map, square or not, as it has beside another map."""
+    rng = np.random.default_rng(sum(shape))
+    r = (rng.integers(0, 3, shape) / 3).astype(np.float32)
+    expected = imregionalmax_brute(r)
+    assert np.array_equal(regional_maxima(r[None]), expected[None])
+    assert np.array_equal(regional_maxima(np.stack([r, np.zeros_like(r)]))[0], expected)
+    labels, count = maxima_components(r[None])
+    assert labels.shape == (1, *shape) and count == components(expected)[1]

@@ -123,7 +123,7 @@ def authors_distractors(detection: Detection, top_n: int) -> tuple[np.ndarray, n
     r = detection.response
     h, w = r.shape
     top = r.max()
-    if not np.isfinite(top) or top <= 0 or top_n == 0:
+    if not np.isfinite(top) or top <= 0 or top_n <= 0:
         return np.zeros((0, 2), dtype=int), np.zeros(0, np.float32)
     dy, dx = detection.offset if detection.offset is not None else (0.0, 0.0)
     shift = (h // 2 - int(round_half_away(dy)), w // 2 - int(round_half_away(dx)))

@@ -2,7 +2,9 @@
 import numpy as np
 import pytest
 
+import dcfkit
 from dcfkit.components.channel_weights import CSRReliability, detection_reliability, maxima_values
+from dcfkit.datasets.synthetic import make_sequence
 
 
 def bumps(shape, peaks):
@@ -74,3 +76,26 @@ def test_weights_learn_from_the_maxima_and_detection_and_weight_the_responses():
     np.testing.assert_allclose(w.discrimination, [1.0, 0.5], atol=1e-3)
     w.learn(maps)  # new: 1 * 1 and 3 * 0.5, normalised to 0.4, 0.6; averaged with 0.25, 0.75 at rate 0.5
     np.testing.assert_allclose(w.weights, [0.325, 0.675], atol=1e-3)
+
+
+def test_one_channel_is_weighed_as_beside_others():
+    """A tracker with one feature channel (gray) gives (1, H, W) maps, square or not: each is
+    weighed as it is in a stack of two."""
+    for shape in ((20, 20), (20, 30)):
+        two = bumps(shape, [((5, 5), 1.0), ((15, 15), 0.7)])
+        alone = detection_reliability(two[None])
+        np.testing.assert_array_equal(alone, detection_reliability(np.stack([two, two]))[:1])
+        assert alone[0] == pytest.approx(0.5)  # 1 - 0.7 = 0.3, raised to the floor
+
+
+def test_csr_dcf_tracks_with_gray_features_alone():
+    """CSR-DCF with the gray feature alone and a non-square search area: its one channel's
+    reliability each frame (OpenCV's dilation of one channel once broke its shape)."""
+    seq = make_sequence(n_frames=4, size=(120, 160), target=(14, 26))
+    tracker = dcfkit.load_tracker("csrdcf", overrides={"tracker.search_area_shape": "proportional",
+                                                       "tracker.sampling": "subpixel", "tracker.resize": "auto",
+                                                       "features": [{"name": "gray"}]})
+    tracker.init(seq.frames[0], seq.ground_truth[0])
+    for frame in seq.frames[1:]:
+        tracker.update(frame)
+    assert tracker.channel_weights.discrimination.shape == (1,)
