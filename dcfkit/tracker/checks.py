@@ -227,6 +227,27 @@ def first_due(tracker) -> None:
 
 def blank(tracker, pixels: np.ndarray) -> float | None:
     """The standard deviation of the pixel values (RMS over colour channels) if it is below
-    ``tracker.blank_std``, else None."""
-    std = float(np.sqrt(np.mean(np.square(cv2.meanStdDev(pixels)[1]))))
-    return std if std < tracker.params.blank_std else None
+    ``tracker.blank_std``, else None. Asked of every frame: most are told varied by a
+    sixteenth of their rows (:func:`_surely_varied`), the same answer at a fraction of the
+    cost (it was a quarter of KCF's frame on a 720p sequence)."""
+    limit = tracker.params.blank_std
+    if not limit > 0 or _surely_varied(pixels, limit):  # a standard deviation is never below 0
+        return None
+    std = _rms_std(pixels)
+    return std if std < limit else None
+
+
+def _rms_std(pixels: np.ndarray) -> float:
+    """The population standard deviation of each channel, their RMS."""
+    return float(np.sqrt(np.mean(np.square(cv2.meanStdDev(pixels)[1]))))
+
+
+def _surely_varied(pixels: np.ndarray, limit: float) -> bool:
+    """Whether every sixteenth row of ``pixels`` (k of their n pixels) varies so much that all
+    of them vary by at least twice ``limit``: n var(all) >= k var(subset) in each channel (the
+    subset's squared deviations from the mean of all are at least those from its own), so
+    std(all) >= sqrt(k / n) std(subset); the factor 2 leaves the rounding of the sums far
+    behind. Whole rows: a frame is read from memory by the cache line, and a sixteenth of the
+    rows is a sixteenth of the lines."""
+    subset = pixels[::16]
+    return np.sqrt(len(subset) / len(pixels)) * _rms_std(subset) >= 2 * limit
