@@ -29,6 +29,17 @@ def shared_data() -> Path:
     return SHARED_DATA
 
 
+def pytest_addoption(parser, pluginmanager):
+    """pyproject's ``addopts`` asks pytest-xdist (the test extras) for workers; without it
+    (``pip install .`` alone, or ``-p no:xdist``) its options are accepted and the tests run in
+    this one process, rather than pytest refusing them as unknown arguments (``addopts`` spells
+    ``-n`` long: a short option only pytest itself may add)."""
+    if not pluginmanager.hasplugin("xdist"):
+        parser.addoption("--numprocesses", dest="numprocesses", help="(pytest-xdist is not installed)")
+        parser.addoption("--maxprocesses", dest="maxprocesses", help="(pytest-xdist is not installed)")
+        parser.addoption("--dist", dest="dist", help="(pytest-xdist is not installed)")
+
+
 def pytest_collection_modifyitems(config, items):
     """Tiers: ``realdata`` (needs ../shared/data), ``install`` (pip-installs a copy), ``slow``
     (marked by hand: spawns worker processes or a cluster). The fast tier is
