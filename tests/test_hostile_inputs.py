@@ -700,7 +700,7 @@ def test_only_regular_frame_files_of_bounded_size_are_read(tmp_path, monkeypatch
     import os
 
     """A FIFO would block, /dev/zero never end, a sparse 6 GB file fill memory: refused unread."""
-    from dcfkit.datasets import DatasetError, images, read_frame
+    from dcfkit.datasets import DatasetError, read_frame
 
     fifo = tmp_path / "00001.jpg"
     os.mkfifo(fifo)
