@@ -128,10 +128,11 @@ def authors_distractors(detection: Detection, top_n: int) -> tuple[np.ndarray, n
     dy, dx = detection.offset if detection.offset is not None else (0.0, 0.0)
     shift = (h // 2 - int(round_half_away(dy)), w // 2 - int(round_half_away(dx)))
     rn = np.roll(r / top, shift, axis=(0, 1))
-    wanted = np.asarray(_strongest_maxima(rn, detection.target_cells, top_n), rn.dtype)
-    where = np.flatnonzero(~target_mask((h, w), detection.target_cells, "authors") & (rn >= wanted.min()))
-    where = where[np.argsort(rn.ravel()[where])]  # the pixels outside that may match, by value
-    values = rn.ravel()[where]
+    wanted = _strongest_maxima(rn, detection.target_cells, top_n)
+    flat = rn.ravel()
+    where = np.flatnonzero(~target_mask((h, w), detection.target_cells, "authors").ravel() & (flat >= wanted.min()))
+    where = where[np.argsort(flat[where])]  # the pixels outside that may match, by value
+    values = flat[where]
     offsets, kept = [], []
     for value, start, stop in zip(wanted, values.searchsorted(wanted, "left"), values.searchsorted(wanted, "right")):
         found = where[start:stop]
@@ -144,7 +145,7 @@ def authors_distractors(detection: Detection, top_n: int) -> tuple[np.ndarray, n
     return np.array(offsets, dtype=int), np.array(kept, np.float32)
 
 
-def _strongest_maxima(rn: np.ndarray, target_cells, top_n: int) -> list:
+def _strongest_maxima(rn: np.ndarray, target_cells, top_n: int) -> np.ndarray:
     """The ``top_n`` highest values of the regional maxima of the centred map ``rn`` outside a
     box of floor(size/2 ± target/2) cells (1-based) around the middle, one per connected
     component (its first pixel in column-major order, MATLAB's PixelIdxList{i}(1)). With at
@@ -158,8 +159,9 @@ def _strongest_maxima(rn: np.ndarray, target_cells, top_n: int) -> list:
     maxima[rows, cols] = False
     labels, count = components(maxima)
     if count <= 1:
-        return [rn.max(), np.float32(0)][:top_n]
+        return np.array([rn.max(), 0], rn.dtype)[:top_n]
     cols, rows = np.nonzero(labels.T)  # column-major
     _, first = np.unique(labels[rows, cols], return_index=True)
-    values = rn[rows[np.sort(first)], cols[np.sort(first)]]  # in the order MATLAB meets them
-    return list(values[np.argsort(-values, kind="stable")][:top_n])
+    first = np.sort(first)  # in the order MATLAB meets them
+    values = rn[rows[first], cols[first]]
+    return values[np.argsort(-values, kind="stable")][:top_n]
