@@ -94,18 +94,19 @@ def closest(name: str, options) -> str:
     return f" (did you mean '{match[0]}'?)" if match else ""
 
 
-def _coerce(value: Any, kind: Any, where: str) -> Any:
-    """``value`` checked against the annotation ``kind`` (and converted where YAML is loose)."""
+def coerce(value: Any, kind: Any, where: str) -> Any:
+    """``value`` checked against the annotation ``kind`` (and converted where YAML is loose); a
+    :class:`ConfigError` naming ``where`` otherwise. Specs' own keys are read with it too."""
     origin = typing.get_origin(kind)
     if kind is Any:
         return value
     if origin in (typing.Union, types.UnionType):
         args = [a for a in typing.get_args(kind) if a is not type(None)]
-        return None if value is None else _coerce(value, args[0], where)
+        return None if value is None else coerce(value, args[0], where)
     if origin in (tuple, list) or kind in (tuple, list):
         return _coerce_sequence(value, kind, where)
-    coerce = _SCALAR_COERCERS.get(kind)
-    return coerce(value, where) if coerce else value
+    scalar = _SCALAR_COERCERS.get(kind)
+    return scalar(value, where) if scalar else value
 
 
 def _coerce_sequence(value: Any, kind: Any, where: str) -> tuple:
@@ -115,9 +116,9 @@ def _coerce_sequence(value: Any, kind: Any, where: str) -> tuple:
     if typing.get_origin(kind) is tuple and args and Ellipsis not in args:  # tuple[X, Y]: exactly these items
         if len(value) != len(args):
             raise ConfigError(f"{where}: expected a list of {len(args)} values, got {shown(value)}")
-        return tuple(_coerce(v, a, f"{where}[{i}]") for i, (v, a) in enumerate(zip(value, args)))
+        return tuple(coerce(v, a, f"{where}[{i}]") for i, (v, a) in enumerate(zip(value, args)))
     item = args[0] if args else Any
-    return tuple(_coerce(v, item, f"{where}[{i}]") for i, v in enumerate(value))
+    return tuple(coerce(v, item, f"{where}[{i}]") for i, v in enumerate(value))
 
 
 def _coerce_bool(value: Any, where: str) -> bool:
@@ -226,7 +227,7 @@ def _checked(field: dataclasses.Field, value: Any, kind: Any, where: str) -> Any
     """``value`` of ``field`` coerced to its annotation ``kind`` and checked against its choices
     and bounds (a ConfigError naming ``where`` and the field otherwise)."""
     key = f"{where}.{clip(field.name)}"
-    value = _coerce(value, kind, key)
+    value = coerce(value, kind, key)
     choices = field.metadata.get("choices")
     if choices is not None and value not in choices:
         raise ConfigError(f"{key}: {shown(value)} is not one of {', '.join(map(str, choices))}"

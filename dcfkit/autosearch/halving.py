@@ -83,11 +83,17 @@ def parse_halving(path, raw: Any) -> Halving | None:
     return Halving(**values)
 
 
+def derived_seed(nbytes: int, *parts: Any) -> int:
+    """A seed drawn from ``parts`` (the spec's seed, a study, a trial number or a purpose): the
+    first ``nbytes`` of the SHA-256 of ``"a/b/c"``, the same on every machine and Python."""
+    digest = hashlib.sha256("/".join(str(p) for p in parts).encode()).digest()
+    return int.from_bytes(digest[:nbytes], "little")
+
+
 def sequence_order(names: list[str], seed: int, study: str) -> list[str]:
     """The study's training sequences in the order the rungs take them: sorted, then shuffled
     by (seed, study), so a rung holds a mix of the pooled datasets."""
-    digest = hashlib.sha256(f"{seed}/{study}/order".encode()).digest()
-    order = np.random.default_rng(int.from_bytes(digest[:8], "little")).permutation(sorted(names))
+    order = np.random.default_rng(derived_seed(8, seed, study, "order")).permutation(sorted(names))
     return [str(n) for n in order]
 
 

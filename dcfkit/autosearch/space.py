@@ -22,6 +22,7 @@ from dcfkit.config.bounded_yaml import read_yaml
 from dcfkit.datasets import load_dataset
 from dcfkit.datasets.base import sequence_names
 from dcfkit.errors import ConfigError, DcfkitError, clip, shown
+from dcfkit.params import coerce
 
 SPEC_KEYS = ("name", "description", "dataset", "sequences", "base", "space", "experiments", "folds",
              "trials", "startup_trials", "seed", "baselines", "warm_start", "halving")
@@ -140,7 +141,7 @@ def load_search_spec(source: str | os.PathLike, root=None) -> SearchSpec:
         parameters=parameters, experiments=experiments, folds=_whole(path, data, "folds", 4, 2),
         trials=_whole(path, data, "trials", 30, 1), startup_trials=_whole(path, data, "startup_trials", 10, 1),
         seed=_whole(path, data, "seed", 0, 0), baselines=baselines, pool=pool,
-        warm_start=_flag(path, data, "warm_start", True), halving=parse_halving(path, data.get("halving")))
+        warm_start=coerce(data.get("warm_start", True), bool, f"{path}: warm_start"), halving=parse_halving(path, data.get("halving")))
 
 
 def _parse_baselines(path: Path, raw: Any) -> dict:
@@ -171,13 +172,6 @@ def _whole(path: Path, data: Mapping, key: str, default: int, least: int) -> int
     value = data.get(key, default)
     if isinstance(value, bool) or not isinstance(value, int) or value < least:
         raise ConfigError(f"{path}: {key}: expected a whole number >= {least}, got {shown(value)}")
-    return value
-
-
-def _flag(path: Path, data: Mapping, key: str, default: bool) -> bool:
-    value = data.get(key, default)
-    if not isinstance(value, bool):
-        raise ConfigError(f"{path}: {key}: expected true or false, got {shown(value)}")
     return value
 
 

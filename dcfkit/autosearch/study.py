@@ -9,7 +9,6 @@ trials 0..n-1 (a sampler seeded per trial is given the recorded trials), so a se
 at any point resumes to the same trials and the same result."""
 from __future__ import annotations
 
-import hashlib
 import itertools
 import json
 import logging
@@ -23,7 +22,7 @@ from optuna.trial import TrialState
 from dcfkit.ablation.layout import warn_old_layout
 from dcfkit.ablation.spec_keys import data_record, roots_text
 from dcfkit.autosearch.evaluation import Evaluator, combined
-from dcfkit.autosearch.halving import Ladder, Unit, intermediate, sequence_order
+from dcfkit.autosearch.halving import Ladder, Unit, derived_seed, intermediate, sequence_order
 from dcfkit.autosearch.records import complete, record_fault
 from dcfkit.autosearch.space import SearchSpec, active
 from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, mean_score, status_lines, summarize
@@ -60,15 +59,10 @@ def fingerprint(spec: SearchSpec, folds: list[list[str]], evaluator: Evaluator) 
             "data": {name: data_identity(seq) for name, seq in evaluator.sequences.items()}}
 
 
-def _trial_seed(seed: int, study: str, number: int) -> int:
-    digest = hashlib.sha256(f"{seed}/{study}/{number}".encode()).digest()
-    return int.from_bytes(digest[:4], "little")
-
-
 def sample(spec: SearchSpec, study: str, number: int, recorded: list[dict]) -> dict[str, Any]:
     """Trial ``number``'s values: a TPE sampler seeded for (seed, study, number) told the
     ``recorded`` trials (each ``{"params", "value"}``)."""
-    sampler = optuna.samplers.TPESampler(seed=_trial_seed(spec.seed, study, number),
+    sampler = optuna.samplers.TPESampler(seed=derived_seed(4, spec.seed, study, number),
                                          n_startup_trials=spec.startup_trials)
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     opt = optuna.create_study(direction="maximize", sampler=sampler)

@@ -85,9 +85,11 @@ class ResultStore:
     def confidence_path(self, name: str) -> Path:
         return self.folder / f"{name}{CONFIDENCE_END}"
 
+    _WRITTEN = (boxes_path, time_path, confidence_path)  # the files a finished run writes besides its sidecar
+    _RECORDS = (error_path, sidecar_path)  # JSON naming their run
+
     def _written(self, name: str) -> tuple[Path, ...]:
-        """The files a finished run writes besides its sidecar."""
-        return self.boxes_path(name), self.time_path(name), self.confidence_path(name)
+        return tuple(path_of(self, name) for path_of in self._WRITTEN)
 
     def file_names(self, name: str) -> list[str]:
         return [p.name for p in (*self._written(name), self.sidecar_path(name), self.error_path(name))]
@@ -214,9 +216,8 @@ class ResultStore:
         with contextlib.suppress(FileNotFoundError):
             self.sidecar_path(name).unlink()
         make_dir(self.folder)
-        records = (self.error_path(name), self.sidecar_path(name))  # JSON naming their run
-        for path in (*self._written(name), *records):
-            origin = source.folder / (source_name + path.name[len(name):])
+        for path_of in (*self._WRITTEN, *self._RECORDS):
+            path, origin = path_of(self, name), path_of(source, source_name)
             try:
                 data = origin.read_bytes()
             except FileNotFoundError:
@@ -225,7 +226,7 @@ class ResultStore:
                 continue
             except OSError as exc:
                 raise StoreError(f"cannot read {clip(str(origin))}: {exc.strerror}") from None
-            atomic_write(path, _renamed(data, name, origin) if path in records and source_name != name else data)
+            atomic_write(path, _renamed(data, name, origin) if path_of in self._RECORDS and source_name != name else data)
 
     def load(self, sequences: Iterable[Sequence | str]) -> dict[str, SequenceResult]:
         """Intact results for ``sequences`` (names or :class:`Sequence`); others (not run,
