@@ -141,7 +141,8 @@ def load_search_spec(source: str | os.PathLike, root=None) -> SearchSpec:
         parameters=parameters, experiments=experiments, folds=_whole(path, data, "folds", 4, 2),
         trials=_whole(path, data, "trials", 30, 1), startup_trials=_whole(path, data, "startup_trials", 10, 1),
         seed=_whole(path, data, "seed", 0, 0), baselines=baselines, pool=pool,
-        warm_start=coerce(data.get("warm_start", True), bool, f"{path}: warm_start"), halving=parse_halving(path, data.get("halving")))
+        warm_start=coerce(data.get("warm_start", True), bool, f"{path}: warm_start"),
+        halving=parse_halving(path, data.get("halving")))
 
 
 def _parse_baselines(path: Path, raw: Any) -> dict:

@@ -226,7 +226,8 @@ class ResultStore:
                 continue
             except OSError as exc:
                 raise StoreError(f"cannot read {clip(str(origin))}: {exc.strerror}") from None
-            atomic_write(path, _renamed(data, name, origin) if path_of in self._RECORDS and source_name != name else data)
+            renamed = path_of in self._RECORDS and source_name != name
+            atomic_write(path, _renamed(data, name, origin) if renamed else data)
 
     def load(self, sequences: Iterable[Sequence | str]) -> dict[str, SequenceResult]:
         """Intact results for ``sequences`` (names or :class:`Sequence`); others (not run,
