@@ -25,7 +25,8 @@ from dcfkit.errors import ConfigError, DcfkitError, clip, shown
 from dcfkit.params import coerce
 
 SPEC_KEYS = ("name", "description", "dataset", "sequences", "base", "space", "experiments", "folds",
-             "trials", "startup_trials", "seed", "baselines", "warm_start", "halving")
+             "trials", "startup_trials", "seed", "baselines", "warm_start", "halving", "final_study")
+FINAL_STUDY = ("always", "if_it_wins")  # run the final study always, or only if the folds beat every baseline
 KINDS = ("choice", "float", "int")
 PARAMETER_KEYS = (*KINDS, "log", "when")
 # configs resolved per group of related dimensions when a spec is read (some 4 ms each)
@@ -81,6 +82,7 @@ class SearchSpec:
     max_frames: int | None = None  # a quick try (--max-frames): each sequence's first frames only
     warm_start: bool = True  # trial 0 of every study is the base config
     halving: Halving | None = None  # multi-fidelity: successive halving on the sequence count
+    final_study: str = "always"  # FINAL_STUDY: "if_it_wins" skips it when the held-out folds lose
 
     def load_sequences(self) -> list:
         """The spec's sequences (of every pooled dataset), each cut to ``max_frames`` if given."""
@@ -142,7 +144,7 @@ def load_search_spec(source: str | os.PathLike, root=None) -> SearchSpec:
         trials=_whole(path, data, "trials", 30, 1), startup_trials=_whole(path, data, "startup_trials", 10, 1),
         seed=_whole(path, data, "seed", 0, 0), baselines=baselines, pool=pool,
         warm_start=coerce(data.get("warm_start", True), bool, f"{path}: warm_start"),
-        halving=parse_halving(path, data.get("halving")))
+        halving=parse_halving(path, data.get("halving")), final_study=_final_study(path, data))
 
 
 def _parse_baselines(path: Path, raw: Any) -> dict:
@@ -173,6 +175,13 @@ def _whole(path: Path, data: Mapping, key: str, default: int, least: int) -> int
     value = data.get(key, default)
     if isinstance(value, bool) or not isinstance(value, int) or value < least:
         raise ConfigError(f"{path}: {key}: expected a whole number >= {least}, got {shown(value)}")
+    return value
+
+
+def _final_study(path: Path, data: Mapping) -> str:
+    value = data.get("final_study", "always")
+    if value not in FINAL_STUDY:
+        raise ConfigError(f"{path}: final_study: expected one of {', '.join(FINAL_STUDY)}, got {shown(value)}")
     return value
 
 

@@ -25,7 +25,8 @@ from dcfkit.autosearch.evaluation import Evaluator, combined
 from dcfkit.autosearch.halving import Ladder, Unit, derived_seed, intermediate, sequence_order
 from dcfkit.autosearch.records import complete, record_fault
 from dcfkit.autosearch.space import SearchSpec, active
-from dcfkit.autosearch.summary import FINAL, finite, is_score, mean_auc, mean_score, status_lines, summarize
+from dcfkit.autosearch.summary import (FINAL, finite, is_score, judge, mean_auc, mean_score, status_lines, summarize,
+                                        verdict_line)
 from dcfkit.autosearch.warm_start import base_params
 from dcfkit.datasets import scored_sequences
 from dcfkit.errors import DcfkitError, clip, printable, shown
@@ -276,13 +277,21 @@ class Search:
         return status_lines(self, {study: self.recorded(study, running=False)[0] for study in self.studies()})
 
     def run(self) -> dict:
-        """Every study, then the held-out scores and the comparison (:mod:`dcfkit.autosearch.summary`)."""
+        """The fold studies, their held-out scores against the baselines, then the final study
+        (unless ``final_study: if_it_wins`` and the folds lost), and the summary
+        (:mod:`dcfkit.autosearch.summary`)."""
         ensure_writable(self.out, ("search.json",), "the search")
         warn_old_layout(self.out, "dcfkit search", "OUT/runs/<run key>/, OUT/baselines/<name>/")
         with exclusive(self.out / ".lock", "dcfkit search", f"to {self.out}"):
             self.check_record()
-            studies = {study: self.run_study(study) for study in self.studies()}
-            return summarize(self, studies)
+            studies = {study: self.run_study(study) for study in self.studies() if study != FINAL}
+            judged = judge(self, studies)
+            runs_final = self.spec.final_study == "always" or judged["beats_every_baseline"]
+            self.report(f"{verdict_line(judged)}: the final study "
+                        + ("follows" if runs_final else "is skipped (final_study: if_it_wins)"))
+            if runs_final:
+                studies[FINAL] = self.run_study(FINAL)
+            return summarize(self, studies, judged)
 
 
 def _option_value(value: Any) -> str:

@@ -14,7 +14,7 @@ from dcfkit.analysis.stats.results import Corrected, Interval
 from dcfkit.analysis.statistics import HOLM, METHOD, holm, mean_interval, paired_difference
 from dcfkit.autosearch.halving import KEYS, Halving
 from dcfkit.errors import DcfkitError, printable
-from dcfkit.store.files import atomic_write
+from dcfkit.store.files import atomic_write, read_json
 from dcfkit.store.provenance import shared_path
 
 FINAL = "all"  # the final study's name: every sequence chooses
@@ -58,9 +58,10 @@ def best(records: list[dict], study: str) -> dict:
     return max(scored, key=lambda r: (r["value"], -r["number"]))
 
 
-def summarize(search, studies: dict[str, list[dict]]) -> dict:
-    """For a :class:`~dcfkit.autosearch.study.Search` and its studies' records: score and write ``OUT/summary.json``, ``summary.md`` and ``best.yaml``; returns the summary."""
-    spec, ev = search.spec, search.evaluator
+def judge(search, studies: dict[str, list[dict]]) -> dict:
+    """Each fold study's best config scored on the fold it never saw, and those held-out scores
+    against each baseline's on every sequence (docs/search.md, steps 3 and 4)."""
+    ev = search.evaluator
     held_out: dict[str, dict] = {}
     folds = []
     for i, names in enumerate(search.folds):
@@ -69,25 +70,43 @@ def summarize(search, studies: dict[str, list[dict]]) -> dict:
         held_out.update(scores)
         folds.append({"fold": i + 1, "held_out": names, "trial": chosen["number"], "params": chosen["params"],
                       "training_auc": chosen["value"], "held_out_auc": mean_auc(scores, names)})
-    baselines = {name: ev.scores(config, search.names, baseline=name) for name, config in spec.baselines.items()}
+    baselines = {name: ev.scores(config, search.names, baseline=name) for name, config in search.spec.baselines.items()}
     comparisons = _compare(search.names, held_out, baselines)
-    final = best(studies[FINAL], FINAL)
+    return {"unscored": [n for n in search.names if not is_score(held_out[n]["auc"])], "folds": folds,
+            "held_out": {"auc": mean_interval([held_out[n]["auc"] for n in search.names]).as_record(),
+                         "per_sequence": held_out},
+            "baselines": {name: {"auc": mean_interval([s[n]["auc"] for n in search.names]).as_record(),
+                                 "per_sequence": s} for name, s in baselines.items()},
+            "comparisons": comparisons, "method": METHOD, "correction": HOLM,
+            "beats_every_baseline": bool(comparisons) and all(c["significant"] for c in comparisons.values())}
+
+
+def verdict_line(judged: dict) -> str:
+    """The held-out verdict in a line, for the log before the final study."""
+    h = Interval.from_record(judged["held_out"]["auc"])
+    beaten = sum(c["significant"] for c in judged["comparisons"].values())
+    return (f"held-out folds: mean AUC {_n(h.mean, '.4f')} [{_n(h.ci_low, '.4f')}, {_n(h.ci_high, '.4f')}]; "
+            f"{beaten} of {len(judged['comparisons'])} baselines beaten")
+
+
+def summarize(search, studies: dict[str, list[dict]], judged: dict) -> dict:
+    """For a :class:`~dcfkit.autosearch.study.Search`, its studies' records and its held-out
+    verdict (:func:`judge`): write ``OUT/summary.json``, ``summary.md`` and ``best.yaml`` (the
+    final study's best; none when it was skipped); returns the summary."""
+    spec = search.spec
+    final = best(studies[FINAL], FINAL) if FINAL in studies else None
     summary = {"name": spec.name, "spec": shared_path(spec.path, search.out), "dataset": data_record(spec)["dataset"],
                "experiments": list(spec.experiments), "trials_per_study": spec.trials, "max_frames": spec.max_frames,
-               "sequences": search.names, "unscored": [n for n in search.names if not is_score(held_out[n]["auc"])],
-               "folds": folds,
-               "held_out": {"auc": mean_interval([held_out[n]["auc"] for n in search.names]).as_record(),
-                            "per_sequence": held_out},
-               "baselines": {name: {"auc": mean_interval([s[n]["auc"] for n in search.names]).as_record(),
-                                    "per_sequence": s} for name, s in baselines.items()},
-               "comparisons": comparisons, "method": METHOD, "correction": HOLM,
-               "beats_every_baseline": bool(comparisons) and all(c["significant"] for c in comparisons.values()),
-               "final": {"trial": final["number"], "params": final["params"], "auc": final["value"],
-                         "key": final["key"]},
+               "sequences": search.names, **judged, "final_study": spec.final_study,
+               "final": final and {"trial": final["number"], "params": final["params"], "auc": final["value"],
+                                   "key": final["key"]},
                "halving": _halving(search, studies)}
     summary = finite(summary)  # as summary.json holds it
     atomic_write(search.out / "summary.json", json.dumps(summary, indent=1, allow_nan=False) + "\n")
     atomic_write(search.out / "summary.md", "\n".join(summary_lines(summary)) + "\n")
+    if final is None:  # a best.yaml of an earlier run would read as this one's choice
+        (search.out / "best.yaml").unlink(missing_ok=True)
+        return summary
     best_config = {"name": f"{spec.name}_best", "description": f"found by dcfkit search {spec.name} "
                    f"(final study, trial {final['number']})", **{k: v for k, v in final["config"].items()
                                                                  if k not in ("name", "description")}}
@@ -114,12 +133,15 @@ def status_lines(search, studies: dict[str, list[dict]]) -> list[str]:
     """Where a search stands from its studies' records (those that stand): per study, the
     trials recorded, pruned and the best so far; then whether its summary is written."""
     budget = search.spec.trials
+    written = read_json(search.out / "summary.json")
+    skipped = isinstance(written, dict) and "final" in written and written["final"] is None  # the folds lost
     lines = [f"search {printable(search.spec.name)} under {search.out}: "
              f"{sum(len(r) == budget for r in studies.values())} of {len(studies)} studies complete, "
              f"{sum(len(r) for r in studies.values())} of {budget * len(studies)} trials recorded"]
     for study, records in studies.items():
         if not records:
-            lines.append(f"  {study}: not begun")
+            lines.append(f"  {study}: " + ("skipped: the folds lost held out (final_study: if_it_wins)" if skipped
+                                          and study == FINAL else "not begun" + _when(search, study)))
             continue
         pruned = sum(bool(r.get("pruned")) for r in records)
         top = best(records, study) if any(is_score(r["value"]) for r in records) else None
@@ -127,9 +149,16 @@ def status_lines(search, studies: dict[str, list[dict]]) -> list[str]:
                  f"sequences" if top else "no trial scored yet")
         lines.append(f"  {study}: {len(records)} of {budget} trials" + (f" ({pruned} pruned)" if pruned else "")
                      + f"; {found}")
-    done = (search.out / "summary.md").is_file() and all(len(r) == budget for r in studies.values())
-    lines.append(f"summary.md: {'written' if done else 'not yet: it is written when every study is complete'}")
+    done = (search.out / "summary.md").is_file() and all(len(r) == budget or (skipped and study == FINAL)
+                                                         for study, r in studies.items())
+    lines.append(f"summary.md: {'written' if done else 'not yet: it is written when the studies it runs are complete'}")
     return lines
+
+
+def _when(search, study: str) -> str:
+    """When a study not begun will run, if not surely."""
+    return (" (it runs only if the folds beat every baseline held out: final_study: if_it_wins)"
+            if study == FINAL and search.spec.final_study == "if_it_wins" else "")
 
 
 def _compare(names: list[str], held_out: dict, baselines: dict) -> dict:
@@ -168,8 +197,10 @@ def summary_lines(summary: dict) -> list[str]:
     final = summary["final"]
     verdict = ("it beats every baseline on held-out folds" if summary["beats_every_baseline"]
                else "it does not beat every baseline on held-out folds: do not ship it")
-    lines += ["", f"Final study (every sequence): trial {final['trial']}, AUC {_n(final['auc'], '.4f')}, "
-              f"{printable(_values(final['params']))}; best.yaml. The search: {verdict}.", "", summary["method"] + "; "
+    chosen = (f"Final study (every sequence): trial {final['trial']}, AUC {_n(final['auc'], '.4f')}, "
+              f"{printable(_values(final['params']))}; best.yaml." if final else
+              "Final study: not run (`final_study: if_it_wins`, and the folds lost); no best.yaml.")
+    lines += ["", f"{chosen} The search: {verdict}.", "", summary["method"] + "; "
               + summary["correction"] + " (beaten: significant and the interval above 0)."]
     return lines
 

@@ -40,6 +40,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--max-frames", type=frame_limit, default=None, metavar="N",
                         help="a quick try: each sequence's first N frames only (its runs are of the cut sequences, "
                              "never taken for full ones); recorded, so a rerun must give the same")
+    parser.add_argument("--final-study", choices=("always", "if_it_wins"), default=None,
+                        help="run the final study always, or only if the folds beat every baseline held out "
+                             "(default: the spec's 'final_study', else always); the trials do not depend on it")
     add_protocol_argument(parser)
     parser.add_argument("--status", action="store_true",
                         help="run nothing: say where the search recorded under --out stands (trials per study, "
@@ -68,6 +71,8 @@ def run(args: argparse.Namespace) -> int:
     if args.sequences is not None:
         spec = dataclasses.replace(spec, sequences=tuple(sequence_names(args.sequences, "--sequences")))
     spec = dataclasses.replace(spec, max_frames=args.max_frames)
+    if args.final_study is not None:
+        spec = dataclasses.replace(spec, final_study=args.final_study)
     if args.experiments is not None:
         names = [e.strip() for e in args.experiments.split(",") if e.strip()]
         if not names:

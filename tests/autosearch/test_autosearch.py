@@ -211,6 +211,7 @@ def test_a_sequence_whose_ground_truth_is_withheld_is_left_out_of_the_search(tmp
     ("folds: 2", "folds: 1", r"folds: expected a whole number >= 2, got 1"),
     ("trials: 3", "trials: 0", r"trials: expected a whole number >= 1"),
     ("trials: 3", "trials: 3\nwarm_start: 'no'", r"warm_start: expected true or false, got 'no'"),
+    ("trials: 3", "trials: 3\nfinal_study: sometimes", r"final_study: expected one of always, if_it_wins, got 'some"),
     ("folds: 2", "folds: 2\nexperiments: [reset]", r"experiments: expected one of ope, tre, sre"),
     ("folds: 2", "folds: 2\nfold: 3", r"unknown key 'fold' \(did you mean 'folds'\?\)"),
     ("baselines: {KCF: kcf}", "baselines: {KCF: nope}", r"baselines\.KCF: config 'nope' not found"),

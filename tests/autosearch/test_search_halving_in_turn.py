@@ -239,7 +239,7 @@ def test_status_says_where_the_search_stands_and_runs_nothing(searches, tmp_path
     printed = capsys.readouterr().out.splitlines()
     assert printed[0].endswith("2 of 3 studies complete, 14 of 15 trials recorded")
     assert printed[3].startswith("  all: 4 of 5 trials")
-    assert printed[-1] == "summary.md: not yet: it is written when every study is complete"
+    assert printed[-1] == "summary.md: not yet: it is written when the studies it runs are complete"
     assert {p: p.stat().st_mtime_ns for p in out.rglob("*")} == before  # nothing run, nothing written
     assert cli.main(["search", str(spec), "--out", str(tmp_path / "none"), "--status"]) != 0
     assert "no search is recorded under" in capsys.readouterr().err
