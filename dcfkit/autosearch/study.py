@@ -104,6 +104,9 @@ class Search:
         self.evaluator = Evaluator(self.out, spec.dataset, seqs, spec.experiments, **(evaluator_options or {}),
                                    baselines=spec.baselines)
         self._units: dict[str, list[Unit]] = {}  # each record's check asks for its study's
+        if spec.final_study == "if_it_wins" and not spec.baselines:
+            raise DcfkitError(f"{spec.path}: final_study: if_it_wins needs baselines: with none, the folds beat "
+                              f"nothing and the final study would never run; add baselines, or final_study: always")
 
     def order(self, study: str) -> list[str]:
         """The study's training sequences in the order successive halving scores them."""
@@ -286,11 +289,14 @@ class Search:
             self.check_record()
             studies = {study: self.run_study(study) for study in self.studies() if study != FINAL}
             judged = judge(self, studies)
-            runs_final = self.spec.final_study == "always" or judged["beats_every_baseline"]
+            recorded = len(self.recorded(FINAL)[0])  # a complete final study is read, whatever the verdict
+            runs_final = self.spec.final_study == "always" or judged["beats_every_baseline"] \
+                or recorded == self.spec.trials
             self.report(f"{verdict_line(judged)}: the final study "
                         + ("follows" if runs_final else "is skipped (final_study: if_it_wins)"))
-            if runs_final:
-                studies[FINAL] = self.run_study(FINAL)
+            if not runs_final:
+                return summarize(self, studies, judged, final_recorded=recorded)
+            studies[FINAL] = self.run_study(FINAL)
             return summarize(self, studies, judged)
 
 

@@ -89,10 +89,11 @@ def verdict_line(judged: dict) -> str:
             f"{beaten} of {len(judged['comparisons'])} baselines beaten")
 
 
-def summarize(search, studies: dict[str, list[dict]], judged: dict) -> dict:
+def summarize(search, studies: dict[str, list[dict]], judged: dict, final_recorded: int = 0) -> dict:
     """For a :class:`~dcfkit.autosearch.study.Search`, its studies' records and its held-out
     verdict (:func:`judge`): write ``OUT/summary.json``, ``summary.md`` and ``best.yaml`` (the
-    final study's best; none when it was skipped); returns the summary."""
+    final study's best; none when it was skipped, after ``final_recorded`` trials of an earlier
+    run); returns the summary."""
     spec = search.spec
     final = best(studies[FINAL], FINAL) if FINAL in studies else None
     summary = {"name": spec.name, "spec": shared_path(spec.path, search.out), "dataset": data_record(spec)["dataset"],
@@ -100,6 +101,7 @@ def summarize(search, studies: dict[str, list[dict]], judged: dict) -> dict:
                "sequences": search.names, **judged, "final_study": spec.final_study,
                "final": final and {"trial": final["number"], "params": final["params"], "auc": final["value"],
                                    "key": final["key"]},
+               **({} if final else {"final_recorded": final_recorded}),
                "halving": _halving(search, studies)}
     summary = finite(summary)  # as summary.json holds it
     atomic_write(search.out / "summary.json", json.dumps(summary, indent=1, allow_nan=False) + "\n")
@@ -133,26 +135,36 @@ def status_lines(search, studies: dict[str, list[dict]]) -> list[str]:
     """Where a search stands from its studies' records (those that stand): per study, the
     trials recorded, pruned and the best so far; then whether its summary is written."""
     budget = search.spec.trials
-    written = read_json(search.out / "summary.json")
-    skipped = isinstance(written, dict) and "final" in written and written["final"] is None  # the folds lost
+    skipped = _final_skipped(search, studies)
     lines = [f"search {printable(search.spec.name)} under {search.out}: "
              f"{sum(len(r) == budget for r in studies.values())} of {len(studies)} studies complete, "
              f"{sum(len(r) for r in studies.values())} of {budget * len(studies)} trials recorded"]
     for study, records in studies.items():
-        if not records:
-            lines.append(f"  {study}: " + ("skipped: the folds lost held out (final_study: if_it_wins)" if skipped
-                                          and study == FINAL else "not begun" + _when(search, study)))
-            continue
-        pruned = sum(bool(r.get("pruned")) for r in records)
-        top = best(records, study) if any(is_score(r["value"]) for r in records) else None
-        found = (f"best trial {top['number']}, mean AUC {top['value']:.4f} on {len(search.training(study))} "
-                 f"sequences" if top else "no trial scored yet")
-        lines.append(f"  {study}: {len(records)} of {budget} trials" + (f" ({pruned} pruned)" if pruned else "")
-                     + f"; {found}")
+        if records:
+            pruned = sum(bool(r.get("pruned")) for r in records)
+            top = best(records, study) if any(is_score(r["value"]) for r in records) else None
+            found = (f"best trial {top['number']}, mean AUC {top['value']:.4f} on {len(search.training(study))} "
+                     f"sequences" if top else "no trial scored yet")
+            line = f"  {study}: {len(records)} of {budget} trials" + (f" ({pruned} pruned)" if pruned else "") + \
+                f"; {found}"
+        else:
+            line = f"  {study}: not begun" + ("" if skipped else _when(search, study))
+        lines.append(line + ("; skipped: the folds lost held out (final_study: if_it_wins)"
+                             if skipped and study == FINAL else ""))
     done = (search.out / "summary.md").is_file() and all(len(r) == budget or (skipped and study == FINAL)
                                                          for study, r in studies.items())
     lines.append(f"summary.md: {'written' if done else 'not yet: it is written when the studies it runs are complete'}")
     return lines
+
+
+def _final_skipped(search, studies: dict[str, list[dict]]) -> bool:
+    """Whether a run under this spec's budget stops before the end of the final study: the
+    summary written by the last run says the folds lost, and a rerun would skip it again."""
+    written = read_json(search.out / "summary.json")
+    return (search.spec.final_study == "if_it_wins" and isinstance(written, dict) and written.get("final", 0) is None
+            and written.get("trials_per_study") == search.spec.trials and not written.get("beats_every_baseline")
+            and len(studies.get(FINAL, ())) < search.spec.trials
+            and all(len(r) == search.spec.trials for study, r in studies.items() if study != FINAL))
 
 
 def _when(search, study: str) -> str:
@@ -198,11 +210,19 @@ def summary_lines(summary: dict) -> list[str]:
     verdict = ("it beats every baseline on held-out folds" if summary["beats_every_baseline"]
                else "it does not beat every baseline on held-out folds: do not ship it")
     chosen = (f"Final study (every sequence): trial {final['trial']}, AUC {_n(final['auc'], '.4f')}, "
-              f"{printable(_values(final['params']))}; best.yaml." if final else
-              "Final study: not run (`final_study: if_it_wins`, and the folds lost); no best.yaml.")
+              f"{printable(_values(final['params']))}; best.yaml." if final else _final_not_run(summary))
     lines += ["", f"{chosen} The search: {verdict}.", "", summary["method"] + "; "
               + summary["correction"] + " (beaten: significant and the interval above 0)."]
     return lines
+
+
+def _final_not_run(summary: dict) -> str:
+    """Why a summary has no final study, a sentence."""
+    if summary["beats_every_baseline"]:  # a verdict written before its final study (never by Search.run)
+        return "Final study: not run yet (the folds beat every baseline: resume the search to run it); no best.yaml."
+    k = summary.get("final_recorded") or 0
+    before = f", after {k} of {summary['trials_per_study']} trials of an earlier run" if k else ""
+    return f"Final study: not run (`final_study: if_it_wins`, and the folds lost{before}); no best.yaml."
 
 
 def _halving_lines(halving: dict | None) -> list[str]:

@@ -33,10 +33,16 @@ def data(tmp_path):
     return tmp_path / "data"
 
 
-def spec_file(tmp_path, extra: str = ""):
-    path = tmp_path / "s.yaml"
+def spec_file(tmp_path, extra: str = "", name: str = "s.yaml"):
+    path = tmp_path / name
     path.write_text(SPEC + extra, encoding="utf-8")
     return path
+
+
+def status(spec, out, capsys, *options) -> list[str]:
+    capsys.readouterr()
+    assert cli.main(["search", str(spec), "--out", str(out), "--status", *options]) == 0
+    return capsys.readouterr().out.splitlines()
 
 
 def trials(out, name):
@@ -53,8 +59,8 @@ def test_if_it_wins_skips_the_final_study_when_the_folds_lose(tmp_path, data, ca
     out.mkdir()
     (out / "best.yaml").write_text("name: stale\n")
     capsys.readouterr()
-    assert cli.main(["search", str(spec_file(tmp_path, "final_study: if_it_wins\n")), "--out", str(out),
-                     "--jobs", "1"]) == 0
+    skipping = spec_file(tmp_path, "final_study: if_it_wins\n", "skipping.yaml")
+    assert cli.main(["search", str(skipping), "--out", str(out), "--jobs", "1"]) == 0
     printed = capsys.readouterr()
     whole, skipped = (json.loads((d / "summary.json").read_text()) for d in (tmp_path / "always", out))
     assert {k: skipped[k] for k in VERDICT} == {k: whole[k] for k in VERDICT}
@@ -64,10 +70,48 @@ def test_if_it_wins_skips_the_final_study_when_the_folds_lose(tmp_path, data, ca
     assert not (out / "best.yaml").exists()
     assert "Final study: not run (`final_study: if_it_wins`, and the folds lost); no best.yaml." in printed.out
     assert "0 of 1 baselines beaten: the final study is skipped (final_study: if_it_wins)" in printed.err
-    assert cli.main(["search", str(spec), "--out", str(out), "--status"]) == 0
-    status = capsys.readouterr().out.splitlines()
-    assert "  all: skipped: the folds lost held out (final_study: if_it_wins)" in status
-    assert status[-1] == "summary.md: written"
+    assert status(skipping, out, capsys)[-2:] == [
+        "  all: not begun; skipped: the folds lost held out (final_study: if_it_wins)", "summary.md: written"]
+    assert status(spec, out, capsys)[-2:] == [  # under always, a rerun would run it
+        "  all: not begun", "summary.md: not yet: it is written when the studies it runs are complete"]
+    assert status(skipping, out, capsys, "--trials", "3")[-1].startswith("summary.md: not yet")  # another budget
+
+
+def test_a_final_study_recorded_before_is_read_when_complete_and_not_continued_when_not(tmp_path, data, capsys):
+    """A search recorded with ``always`` resumed under ``if_it_wins``: its complete final study
+    costs nothing and is reported (best.yaml kept); one stopped part-way is left as it is, and
+    the summary says after how many trials."""
+    out = tmp_path / "out"
+    assert cli.main(["search", str(spec_file(tmp_path)), "--out", str(out), "--jobs", "1"]) == 0
+    whole = json.loads((out / "summary.json").read_text())
+    skipping = spec_file(tmp_path, "final_study: if_it_wins\n", "skipping.yaml")
+    assert cli.main(["search", str(skipping), "--out", str(out), "--jobs", "1"]) == 0
+    assert json.loads((out / "summary.json").read_text())["final"] == whole["final"] and (out / "best.yaml").is_file()
+    trials(out, "all")[-1].unlink()
+    capsys.readouterr()
+    assert cli.main(["search", str(skipping), "--out", str(out), "--jobs", "1"]) == 0
+    assert "(`final_study: if_it_wins`, and the folds lost, after 1 of 2 trials of an earlier run)" in \
+        capsys.readouterr().out
+    assert len(trials(out, "all")) == 1 and not (out / "best.yaml").exists()
+    assert status(skipping, out, capsys)[-2].endswith("; skipped: the folds lost held out (final_study: if_it_wins)")
+
+
+def test_a_skipped_final_study_under_halving_counts_the_fold_studies_alone(tmp_path, data):
+    spec = load_search_spec(spec_file(tmp_path, "final_study: if_it_wins\n"
+                                                "halving: {min_sequences: 1, reduction_factor: 2}\n"))
+    summary = Search(spec, tmp_path / "out", {"jobs": 1}).run()
+    assert summary["final"] is None and list(summary["halving"]["studies"]) == ["fold1", "fold2"]
+    assert "Successive halving (first rung 1" in (tmp_path / "out" / "summary.md").read_text()
+
+
+def test_if_it_wins_without_baselines_is_refused(tmp_path, data, capsys):
+    """With no baseline the folds beat nothing: the final study would never run."""
+    path = tmp_path / "none.yaml"
+    path.write_text(SPEC.replace("baselines: {KCF: kcf}\n", ""), encoding="utf-8")
+    Search(load_search_spec(path), tmp_path / "out")  # always: allowed
+    assert cli.main(["search", str(path), "--out", str(tmp_path / "out"), "--final-study", "if_it_wins"]) != 0
+    assert (f"{path}: final_study: if_it_wins needs baselines: with none, the folds beat nothing and the final "
+            f"study would never run") in capsys.readouterr().err
 
 
 def test_the_final_study_runs_after_the_verdict_when_the_folds_win(tmp_path, data, monkeypatch):

@@ -5,7 +5,8 @@ final study. Main's ``final_study: if_it_wins`` runs the final study only if the
 every baseline; this script does the same for this search: it reads the four complete fold
 studies, scores them with the calls of 0.16.0's ``summarize`` up to its final study, and writes
 ``OUT/summary.json`` with ``"final": null`` (README.md says how summary.md is rendered from
-it). Checked on a small search against 0.16.0's own summary: every key equal but ``final``.
+it). Checked on small searches against 0.16.0's own summary: every key equal but ``final``,
+and ``halving``, which counts no final study.
 
     PYTHONPATH=<0.16.0 checkout> python verdict.py SPEC OUT ROOT...   # with the search stopped
 """
