@@ -20,7 +20,7 @@ from dcfkit.analysis.report_html import PAGE, write_page
 from dcfkit.analysis.scoring import evaluate, protocol_record
 from dcfkit.analysis.setting import experiment_line
 from dcfkit.analysis.statistics import versus_baseline
-from dcfkit.analysis.tables import format_table, statistics_lines
+from dcfkit.analysis.tables import format_table, statistics_files
 from dcfkit.datasets import Sequence
 from dcfkit.experiments import runs_by_sequence
 from dcfkit.protocols import DEFAULT, get_protocol
@@ -167,9 +167,11 @@ def _write_files(spec: AblationSpec, out: Path, info: dict, curves: dict, protoc
                                                                         if info["fps_note"] else "")
             atomic_write(path, table)
             files.append(path)
-    path = out / "statistics.txt"
-    atomic_write(path, "\n".join([info["scope"], *statistics_lines(info["statistics"])]) + "\n")
-    files.append(path)
+    setting = {"protocol": get_protocol(protocol).name, "experiment": spec.experiment,
+               **({} if spec.max_frames is None else {"max_frames": spec.max_frames})}
+    for name, content in statistics_files(info["statistics"], [info["scope"]], setting).items():
+        atomic_write(out / name, content)
+        files.append(out / name)
     path = out / "summary.json"
     atomic_write(path, json.dumps(json_ready(info), indent=1, ensure_ascii=False, default=str) + "\n")
     files.append(path)

@@ -36,7 +36,7 @@ from dcfkit.analysis.scoring import Evaluation, evaluate
 from dcfkit.analysis.result_fit import check_results_fit, other_folders
 from dcfkit.analysis.setting import cut_length, experiment_line
 from dcfkit.analysis.stats.results import Comparison, Interval
-from dcfkit.analysis.tables import columns, format_table, statistics_lines
+from dcfkit.analysis.tables import STATISTICS_FILES, columns, format_table, statistics_files
 from dcfkit.datasets import ATTRIBUTE_NAMES, DatasetError, Sequence, scored_sequences
 from dcfkit.errors import clip, shown
 from dcfkit.experiments import Experiment, get_experiment, runs_by_sequence
@@ -169,7 +169,8 @@ def report_file_names(sequences: Seq[Sequence]) -> list[str]:
     """Every file a report on ``sequences`` may write."""
     attributes = sorted({a for s in sequences for a, present in s.attributes.items() if present})
     plots = ["precision", "success"] + [f"{kind}_{a}" for a in attributes for kind in ("precision", "success")]
-    return ([f"{t}.{ext}" for t in REPORT_TABLES for _, ext in TABLE_FORMATS] + ["statistics.txt", "report.json", "report.html"]
+    return ([f"{t}.{ext}" for t in REPORT_TABLES for _, ext in TABLE_FORMATS] + [*STATISTICS_FILES, "report.json",
+                                                                                   "report.html"]
             + list(LONG_TERM_FILES)
             + [f"{p}.{ext}" for p in plots for ext in ("png", "svg")])
 
@@ -198,7 +199,10 @@ def write_files(evaluation: Evaluation, report_dir: Path) -> list[Path]:
             noted = note and fmt in NOTED and stem != "per_attribute"
             text(f"{stem}.{ext}", table + (f"\n{note}\n" if noted else ""))
     head = [experiment_line(experiment, cut), evaluation.protocol.describe(), ""]
-    text("statistics.txt", "\n".join(head + statistics_lines(evaluation.statistics)) + "\n")
+    setting = {"protocol": protocol, "experiment": get_experiment(experiment).name,
+               **({} if cut is None else {"max_frames": cut})}  # the CSV tables' last columns
+    for name, content in statistics_files(evaluation.statistics, head, setting).items():
+        text(name, content)
     text("report.json", json.dumps(json_ready(evaluation.as_record()), indent=1) + "\n")
     if evaluation.long_term:
         long_term_files(evaluation.long_term, experiment, cut, text)

@@ -17,7 +17,7 @@ from dcfkit.analysis.result_fit import check_results_fit, other_folders
 from dcfkit.analysis.reset_scores import ResetRun, score_resets
 from dcfkit.analysis.setting import cut_length, experiment_line, experiment_record
 from dcfkit.analysis.stats.results import Interval
-from dcfkit.analysis.tables import format_rows, statistics_lines
+from dcfkit.analysis.tables import STATISTICS_FILES, format_rows, statistics_files
 from dcfkit.datasets import DatasetError, Sequence, scored_sequences
 from dcfkit.errors import ConfigError, clip
 from dcfkit.experiments import EXPERIMENTS
@@ -148,7 +148,7 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
                            f"eval --experiment reset")
     rule = _one_rule(results, protocol)
     names = [f"reset_{t}.{ext}" for t in RESET_COLUMNS for _, ext in TABLE_FORMATS if ext != "tex"]
-    ensure_writable(report_dir, names + ["reset_overall.tex", "statistics.txt", "reset.json"], "the report")
+    ensure_writable(report_dir, names + ["reset_overall.tex", *STATISTICS_FILES, "reset.json"], "the report")
     scores = score_resets(results, {s.name: len(s) for s in sequences}, interval, baseline)
     scores["experiment"] = experiment_record(EXPERIMENT)
     scores["max_frames"] = cut_length(sequences)
@@ -160,7 +160,10 @@ def write_reset_report(out_dir, sequences: Seq[Sequence], trackers: Iterable[str
                 paths.append(_write(report_dir / f"reset_{table}.{ext}", reset_table(scores, table, fmt)))
     paths.append(_write(report_dir / "reset_overall.tex", reset_latex(scores)))
     head = [experiment_line(EXPERIMENT, scores["max_frames"]), _eao_line(scores), ""]
-    paths.append(_write(report_dir / "statistics.txt", "\n".join(head + statistics_lines(scores["statistics"])) + "\n"))
+    setting = {"rule": rule.name, "experiment": EXPERIMENT.name,
+               **({} if scores["max_frames"] is None else {"max_frames": scores["max_frames"]})}
+    for name, content in statistics_files(scores["statistics"], head, setting).items():
+        paths.append(_write(report_dir / name, content))
     paths.append(_write(report_dir / "reset.json", json.dumps(json_ready(scores), indent=1) + "\n"))
     return scores, paths
 

@@ -208,6 +208,23 @@ def statistics_rows(statistics: Comparison) -> tuple[list[dict], list[str]]:
     return rows, names
 
 
+STATISTICS_FILES = ("statistics.txt", "statistics.md", "statistics.csv")
+
+
+def statistics_files(statistics: Comparison, head: Seq[str], setting: Mapping[str, object]) -> dict[str, str]:
+    """The statistics of a report as :data:`STATISTICS_FILES` (name -> text): the ``head`` lines
+    (experiment, protocol or rule; as given in ``.txt``, blank ones left out in ``.md``), then :func:`statistics_lines` (``.txt``) or the flat table of
+    :func:`statistics_rows` (``.md``); the ``.csv`` is that table alone, with the ``setting``
+    (``protocol``, ``experiment``, ...) as its last columns, so that it stays one table."""
+    rows, names = statistics_rows(statistics) if statistics else ([], ["tracker", "score"])  # {}: no tracker
+    lead = "".join(f"{line}\n" for line in head if line) + "\n" if any(head) else ""
+    method = (f"\nd_: the paired difference from {statistics.baseline}. Over {statistics_scope(statistics)[0]} "
+              f"sequences: {statistics.method}; {statistics.correction}\n" if statistics else "")
+    return {"statistics.txt": "\n".join([*head, *statistics_lines(statistics)]) + "\n",
+            "statistics.md": lead + format_rows(rows, "markdown", names) + method,
+            "statistics.csv": format_rows([{**row, **setting} for row in rows], "csv", [*names, *setting])}
+
+
 def _left_out(statistics: Comparison, keys: Seq[str]) -> dict[str, list[str]]:
     """Where -> the sequences left out for a non-finite score: one entry, ``every mean and
     difference``, when the same sequences are left out of each tracker's every score (a

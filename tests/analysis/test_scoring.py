@@ -79,6 +79,37 @@ def test_report_prints_and_writes_the_statistics(tmp_path, monkeypatch, capsys):
     assert written.startswith("experiment OPE (one-pass evaluation") and written.splitlines()[1].startswith("protocol ")
 
 
+def test_report_writes_the_statistics_as_one_flat_table_in_markdown_and_csv(tmp_path, monkeypatch):
+    """statistics.csv: a row per tracker and score holding report.json's statistics at full
+    precision (the difference's keys prefixed d_, none for the baseline), the protocol and
+    experiment as last columns; statistics.md: the same rows under the experiment and protocol."""
+    import csv
+
+    import dcfkit.cli.evaluate
+
+    write_results(tmp_path / "out", RESULTS)
+    monkeypatch.setattr(dcfkit.cli.evaluate, "load_datasets", lambda *a, **k: SEQUENCES)
+    assert cli.main(["report", str(tmp_path / "out"), "--root", str(tmp_path)]) == 0
+    folder = tmp_path / "out_report"
+    statistics = json.loads((folder / "report.json").read_text())["statistics"]
+    rows = list(csv.DictReader((folder / "statistics.csv").open()))
+    assert len(rows) == sum(len(scores) for scores in statistics["means"].values()) == 3 * 2
+    for row in rows:
+        mean = statistics["means"][row["tracker"]][row["score"]]
+        assert float(row["mean"]) == mean["mean"] and float(row["ci_low"]) == mean["ci_low"]
+        difference = statistics["differences"].get(row["tracker"], {}).get(row["score"])
+        if difference is None:  # the baseline
+            assert row["tracker"] == statistics["baseline"] and row["d_mean"] == row["d_holm_p"] == ""
+        else:
+            assert float(row["d_mean"]) == difference["mean"] and float(row["d_holm_p"]) == difference["holm_p"]
+            assert row["d_significant"] == str(difference["significant"])
+        assert (row["protocol"], row["experiment"]) == ("otb", "ope")
+    markdown = (folder / "statistics.md").read_text().splitlines()
+    assert markdown[0].startswith("experiment OPE (one-pass evaluation") and markdown[1].startswith("protocol otb")
+    assert markdown[3].startswith("| tracker | score | mean | ci_low | ci_high |") and len(markdown) == 7 + len(rows)
+    assert markdown[-1].startswith(f"d_: the paired difference from {statistics['baseline']}. Over 5 sequences: 95%")
+
+
 def test_report_takes_the_differences_from_the_baseline_it_is_given(tmp_path, monkeypatch, capsys):
     """``--baseline far``: every other tracker's paired difference is from far (the worst here),
     in the printed LaTeX table and in report.json; a name that is no tracker is one clear error."""
