@@ -367,6 +367,11 @@ grid: {base: dr2, parameters: {label.mu: [0, 0.5]}}
     assert [stats["differences"][v]["auc"]["holm_p"] for v in ("strcf", "label.mu=0", "label.mu=0.5")] == \
         pytest.approx(holm(ps))
     assert (out / "statistics.txt").read_text().splitlines()[1].startswith("statistics over 4 sequences: 95% BCa")
+    flat = [line.split(",") for line in (out / "statistics.csv").read_text().splitlines()]
+    assert [(r[0], r[1]) for r in flat[1:]] == [(v, s) for v in ("dr2", "strcf", "label.mu=0", "label.mu=0.5")
+                                                for s in ("auc", "precision")]
+    assert float(flat[3][flat[0].index("d_holm_p")]) == stats["differences"]["strcf"]["auc"]["holm_p"]
+    assert (out / "statistics.md").read_text().startswith((out / "statistics.txt").read_text().splitlines()[0])
     assert (out / "summary.md").read_text().splitlines()[4].startswith("| variant | precision | auc | fps |")
     assert (out / "per_sequence.csv").read_text().count("\n") == 1 + total
     assert (out / "per_sequence.csv").read_text().splitlines()[0].endswith(",status,protocol")

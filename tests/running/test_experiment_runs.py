@@ -149,8 +149,9 @@ def test_eval_and_report_of_each_experiment(tmp_path, capsys):
             assert scores["overall"][0]["tracker"] == "kcf" and scores["overall"][0]["sequences"] == 2
             assert "EAO over sequence lengths" in printed and scores["interval"] == [N, N]
             assert scores["experiment"]["name"] == "reset" and scores["max_frames"] is None
-            texts = ["reset_overall.txt", "reset_per_sequence.md", "statistics.txt"]
+            texts = ["reset_overall.txt", "reset_per_sequence.md", "statistics.txt", "statistics.md"]
             assert (folder / "reset_overall.csv").read_text().splitlines()[1].endswith(",reset")
+            assert (folder / "statistics.csv").read_text().splitlines()[0].endswith(",rule,experiment")
             assert cli.main(report + ["--format", "latex"]) == 0
             latex = capsys.readouterr().out
             assert latex == (folder / "reset_overall.tex").read_text()
@@ -161,8 +162,9 @@ def test_eval_and_report_of_each_experiment(tmp_path, capsys):
             assert record["experiment"]["name"] == experiment and record["settings"]["max_frames"] is None
             assert f"{named}" in printed and "each sequence's runs pooled" in printed
             assert (folder / "success.png").is_file()
-            texts = ["overall.txt", "overall.md", "per_sequence.txt", "statistics.txt"]
+            texts = ["overall.txt", "overall.md", "per_sequence.txt", "statistics.txt", "statistics.md"]
             assert (folder / "overall.csv").read_text().splitlines()[0].endswith(",protocol,experiment")
+            assert (folder / "statistics.csv").read_text().splitlines()[1].endswith(f",otb,{experiment}")
             assert rf"\caption{{Experiment {experiment.upper()} (" in (folder / "overall.tex").read_text()
             assert cli.main(report + ["--html"]) == 0  # dcfkit < 0.10 refused --html but for one pass
             page = (folder / "report.html").read_text()
