@@ -7,7 +7,7 @@ tracked it checks what ``eval`` always checked (:mod:`dcfkit.running.checks`: th
 when the experiment starts from them, one benchmark per folder, no intact run replaced by one
 of fewer frames, each folder writable), claims the runs it writes (:mod:`dcfkit.store.claims`)
 and says what it recomputes and why. Each distinct run (run key, tracker factory, run) is
-tracked once, by :func:`dcfkit.running.runner.execute`; the other entries of its key get its
+tracked once, by :func:`dcfkit.running.execute.execute`; the other entries of its key get its
 files (:meth:`~dcfkit.store.results.ResultStore.copy_run`), as does an entry lacking a run
 another entry of its key holds done, or a run the entry has done in another experiment (OPE's
 run is TRE's first when that starts at frame 1). A consumer makes a plan, calls
@@ -24,7 +24,8 @@ from dcfkit.experiments import EXPERIMENTS, Experiment, get_experiment, run_iden
 from dcfkit.running.checks import check_first_boxes, check_same_dataset, say_other_rule, say_what_is_recomputed
 from dcfkit.running.layout import store_folder
 from dcfkit.running.progress import Progress
-from dcfkit.running.runner import RunTask, execute, warm_up_compiled
+from dcfkit.running.execute import execute
+from dcfkit.running.runner import RunTask, warm_up_compiled
 from dcfkit.store import provenance
 from dcfkit.store.claims import claimed_folders
 from dcfkit.store.files import StoreError, ensure_writable, make_dir, remove_temporary_files

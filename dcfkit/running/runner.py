@@ -1,12 +1,13 @@
-"""Running many (config, sequence) runs into result stores: in this process, in a local
-process pool or on dask.distributed. ``dcfkit eval`` (:mod:`dcfkit.running.evaluation`) and
-``dcfkit ablate`` (:mod:`dcfkit.ablation`) differ only in which runs they ask for.
+"""One run into its result store, and the process pool and dask cluster that run many:
+:func:`dcfkit.running.execute.execute` runs them all, the runs of a sequence that share its
+frames (TRE's, SRE's) together (:mod:`dcfkit.running.lockstep`). ``dcfkit eval``
+(:mod:`dcfkit.running.evaluation`) and ``dcfkit ablate`` (:mod:`dcfkit.ablation`) differ only
+in which runs they ask for.
 
 Each run is tracked as its experiment says (:meth:`dcfkit.experiments.base.Experiment.track`)
-from a fresh tracker, and written to a
-:class:`dcfkit.store.results.ResultStore`; a tracker exception fails only its run (an
-``.error`` naming the 1-based frame and its file). Workers have one BLAS/OpenMP/OpenCV
-thread each and die with the parent.
+from a fresh tracker, and written to a :class:`dcfkit.store.results.ResultStore`; a tracker
+exception fails only its run (an ``.error`` naming the 1-based frame and its file). Workers
+have one BLAS/OpenMP/OpenCV thread each and die with the parent.
 """
 from __future__ import annotations
 
@@ -27,12 +28,11 @@ import cv2
 import numpy as np
 
 from dcfkit.datasets import Sequence
-from dcfkit.errors import DcfkitError, shown
+from dcfkit.errors import DcfkitError
 from dcfkit.experiments import EXPERIMENTS, Experiment
 from dcfkit.experiments.loop import TrackerFailure
 from dcfkit.registry import PluginWarning
 from dcfkit.store import platforms
-from dcfkit.store.files import StoreError
 from dcfkit.store.code_state import box_code
 from dcfkit.store.provenance import (
     dcfkit_version,
@@ -108,6 +108,11 @@ def warm_up_compiled(tasks: Iterable[RunTask]) -> None:
             _warm_up(task)
 
 
+def make_tracker(task: RunTask):
+    """A fresh tracker for ``task``: its ``make_tracker``, else dcfkit's for its config."""
+    return (task.make_tracker or load_dcfkit_tracker)(dict(task.config))
+
+
 def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | None = None,
                  origin: Mapping | None = None, timing: Mapping | None = None) -> dict:
     """Run ``task`` and store its boxes or its failure; returns ``{"sequence", "status",
@@ -115,7 +120,7 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
     :func:`~dcfkit.store.provenance.invocation` (default: this process's), recorded in the sidecar
     with the machine that ran it; ``timing``: how its speed was measured
     (:func:`dcfkit.store.timing.timing_record`; default: alone, in this process)."""
-    seq, store = task.seq, ResultStore(task.folder)
+    seq = task.seq
     _warm_up(task)
     reading = [0]  # the 1-based number of the frame being read, for errors in decoding
 
@@ -124,7 +129,7 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
         return seq.frame(i)
 
     def make():
-        return (task.make_tracker or load_dcfkit_tracker)(dict(task.config))
+        return make_tracker(task)
 
     tracker = None
     try:
@@ -132,7 +137,14 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
         run = task.experiment.track(tracker, make, seq, read, on_frame)
     except Exception as exc:
         frame = exc.frame if isinstance(exc, TrackerFailure) else reading[0] or None
-        return record_failure(task, version, _failure_message(seq, exc, tracker is None, frame), exc, frame)
+        return record_failure(task, version, failure_message(seq, exc, tracker is None, frame), exc, frame)
+    return store_run(task, run, version, origin, timing)
+
+
+def store_run(task: RunTask, run, version: str, origin: Mapping | None, timing: Mapping | None) -> dict:
+    """Write ``task``'s finished :class:`~dcfkit.experiments.loop.Track` ``run`` with its
+    sidecar (:func:`run_sequence`'s ``origin`` and ``timing``); returns the run's summary."""
+    seq, store = task.seq, ResultStore(task.folder)
     plugins = plugin_versions(task.config)
     meta = {"sequence": seq.name, "dataset": seq.dataset, "tracker": task.config.get("name"),
             "init_box": [float(v) for v in seq.init_box], "fps": run.fps,
@@ -146,7 +158,7 @@ def run_sequence(task: RunTask, version: str, on_frame: Callable[[], None] | Non
     return {"sequence": seq.name, "status": "done", "fps": run.fps, "frames": len(seq)}
 
 
-def _failure_message(seq: Sequence, exc: Exception, creating: bool, frame: int | None) -> str:
+def failure_message(seq: Sequence, exc: Exception, creating: bool, frame: int | None) -> str:
     """What to say of a failed run, naming the sequence and the 1-based frame and its file."""
     if isinstance(exc, DcfkitError) and not isinstance(exc, TrackerFailure) and f"sequence {seq.name!r}" in str(exc):
         return str(exc)  # e.g. an unreadable frame: its message names the sequence and the frame
@@ -215,6 +227,12 @@ _worker_ready = False
 
 def run_in_worker(task: RunTask, version: str, origin: Mapping | None = None, timing: Mapping | None = None) -> dict:
     """:func:`run_sequence` in a pool or dask worker, which must run the client's dcfkit and plugins."""
+    check_worker(task, version)
+    return run_sequence(task, version, origin=origin, timing=timing)
+
+
+def check_worker(task: RunTask, version: str) -> None:
+    """Set a worker up once, and refuse to run where its dcfkit or plugins are not the client's."""
     global _worker_ready
     if not _worker_ready:  # dask workers have no initializer: one OpenCV thread each
         worker_init()
@@ -226,7 +244,6 @@ def run_in_worker(task: RunTask, version: str, origin: Mapping | None = None, ti
         plugins = ", ".join(plugin_versions(task.config)) or "none"
         raise DcfkitError(f"this worker's dcfkit code ({box_code()}) or plugins ({plugins}) are not the client's: "
                           f"install the same dcfkit source and plugin versions on every worker")
-    return run_sequence(task, version, origin=origin, timing=timing)
 
 
 def crash_message(seq: Sequence, exc: BaseException) -> str:
@@ -274,7 +291,7 @@ def _deliver(finished: Iterable, key_of: Callable, on_result: Callable, on_crash
         on_result(key, result)
 
 
-def _run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: str, origin: Mapping, on_result,
+def run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: str, origin: Mapping, on_result,
               on_crash) -> None:
     distributed = import_distributed()
     timing = timing_record("dask", None if scheduler else pool_size(jobs, len(tasks)))
@@ -315,40 +332,3 @@ def worker_count(jobs: int, tasks: int) -> int:
         log.warning("--jobs %d: running %d worker processes, one per usable core (more would only share them "
                     "and multiply the memory)", jobs, usable_cores())
     return pool_size(jobs, tasks)
-
-
-def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None], jobs: int = 1,
-            executor: str = "local", scheduler: str | None = None, version: str | None = None,
-            on_frame: Callable[[], None] | None = None) -> None:
-    """Run every task, calling ``on_result(task, summary)`` as each finishes (in this process).
-
-    ``executor="local"``: in this process when ``jobs == 1`` or there is one task (then
-    ``on_frame()`` is called after every frame), else in ``jobs`` spawned worker processes, at
-    most one a usable core (tasks and their ``make_tracker`` must be picklable). ``"dask"``: the scheduler at
-    ``scheduler`` (:func:`dcfkit.running.scheduler.connect`: a bad address, or one that is not a
-    Dask scheduler, is one line in bounded time), or a ``LocalCluster`` of ``jobs``
-    single-threaded workers when ``scheduler`` is None."""
-    tasks = list(tasks)
-    version = version if version is not None else dcfkit_version()
-    origin = invocation()  # the client's command, whichever process or machine runs a task
-    if executor not in ("local", "dask"):
-        raise DcfkitError(f"executor must be 'local' or 'dask', got {shown(executor)}")
-    if jobs < 1:
-        raise DcfkitError(f"jobs must be >= 1, got {jobs}")
-
-    def crashed(task: RunTask, exc: BaseException) -> dict:
-        if isinstance(exc, StoreError):  # as in this process: writing the next run would fail too
-            raise exc
-        return record_failure(task, version, crash_message(task.seq, exc), exc)
-
-    if not tasks:
-        return
-    if executor == "dask":
-        _run_dask(tasks, jobs, scheduler, version, origin, on_result, crashed)
-    elif jobs == 1 or len(tasks) == 1:
-        for task in tasks:
-            on_result(task, run_sequence(task, version, on_frame, origin, timing_record("local", 1)))
-    else:
-        timing = timing_record("local", pool_size(jobs, len(tasks)))
-        run_pool({i: (run_in_worker, t, version, origin, timing) for i, t in enumerate(tasks)}, jobs,
-                 lambda i, result: on_result(tasks[i], result), lambda i, exc: crashed(tasks[i], exc))

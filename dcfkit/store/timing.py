@@ -1,7 +1,8 @@
 """How a run's speed was measured, so that fps is shown as a score only when it means one.
 
 Runs that share the cores with other runs of the same command (``--jobs`` above 1, a dask
-cluster) are timed while they compete for the CPU and its caches: a variant doing more work
+cluster, or the runs of a sequence tracked in lockstep: :mod:`dcfkit.running.lockstep`) are
+timed while they compete for the CPU and its caches: a variant doing more work
 read 36 fps against its base's 25 in such a pool. Each run's sidecar records ``timing``
 (:func:`timing_record`); a report shows fps only for runs timed alone (:func:`fps_note` says
 why the others are left out). Sidecars written before the record have no ``timing``: how they
@@ -12,7 +13,7 @@ from __future__ import annotations
 from typing import Iterable, Mapping
 
 ALONE, SHARED, UNKNOWN = "alone", "shared", "unknown"
-ADVICE = "fps is a score only when measured alone: python benchmarks/speed.py, or dcfkit eval --jobs 1"
+ADVICE = "fps is a score only when measured alone: python benchmarks/speed.py, or a one-pass dcfkit eval --jobs 1"
 
 
 def timing_record(executor: str, workers: int | None) -> dict:
@@ -50,7 +51,8 @@ def fps_note(rows: Iterable[Mapping], name: str = "tracker") -> str | None:
         return None
     parts = []
     if shared:
-        parts.append(f"{', '.join(shared)} (measured with other runs sharing the CPU: --jobs above 1, or dask)")
+        parts.append(f"{', '.join(shared)} (measured with other runs sharing the CPU: --jobs above 1, dask, "
+                     f"or TRE's and SRE's runs of a sequence tracked in lockstep)")
     if unknown:
         parts.append(f"{', '.join(unknown)} (not known how measured: results from before dcfkit recorded it)")
     return f"fps not shown for {'; nor for '.join(parts)}. {ADVICE}."

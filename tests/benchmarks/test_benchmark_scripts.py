@@ -119,6 +119,12 @@ def test_frame_reading_reads_every_frame_both_ways_and_finds_the_same_pixels(tmp
     assert int(row[-5]) == last - first + 1 and row[-1] == "0", out
 
 
+def test_lockstep_tracks_each_way_and_finds_the_same_results(tmp_path, synthetic_uav123):
+    out = run("lockstep.py", str(synthetic_uav123), "--configs", "kcf", "--experiment", "sre", tmp_path=tmp_path)
+    (row,) = [line.split() for line in out.splitlines() if line.startswith("kcf ")]
+    assert row[1:3] == ["wakeboard7", "12"] and row[-1] == "yes", out
+
+
 def test_restarts(tmp_path, synthetic_uav123):
     spec = tmp_path / "spec.yaml"
     spec.write_text("name: smoke\ndataset: uav123_10fps\nvariants:\n  plain: kcf\n")

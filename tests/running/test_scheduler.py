@@ -17,7 +17,8 @@ import pytest
 from dcfkit import cli
 from dcfkit.datasets import Sequence
 from dcfkit.errors import DcfkitError
-from dcfkit.running.runner import RunTask, execute
+from dcfkit.running.execute import execute
+from dcfkit.running.runner import RunTask
 
 distributed = pytest.importorskip("distributed", reason="dask.distributed not installed (pip install 'dcfkit[dask]')")
 dask = pytest.importorskip("dask")

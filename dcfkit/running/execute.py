@@ -1,0 +1,73 @@
+"""Running many (config, sequence) runs: in this process, in a local process pool or on
+dask.distributed (:mod:`dcfkit.running.runner`), the runs that share their frames tracked
+together (:mod:`dcfkit.running.lockstep`). ``dcfkit eval`` and ``dcfkit ablate`` and ``dcfkit
+search`` go through :func:`execute` (:mod:`dcfkit.running.plan` says which runs)."""
+from __future__ import annotations
+
+from typing import Callable, Iterable, Mapping
+
+from dcfkit.errors import DcfkitError, shown
+from dcfkit.running.lockstep import groups, run_group
+from dcfkit.running.runner import (
+    RunTask,
+    run_dask,
+    check_worker,
+    crash_message,
+    pool_size,
+    record_failure,
+    run_pool,
+)
+from dcfkit.store.files import StoreError
+from dcfkit.store.provenance import dcfkit_version, invocation
+from dcfkit.store.timing import timing_record
+
+
+def run_unit_in_worker(unit: list[RunTask], version: str, origin: Mapping | None = None,
+                       timing: Mapping | None = None) -> list[dict]:
+    """:func:`dcfkit.running.lockstep.run_group` in a pool worker, as
+    :func:`~dcfkit.running.runner.run_in_worker` runs one run."""
+    check_worker(unit[0], version)
+    return run_group(unit, version, origin=origin, timing=timing)
+
+
+def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None], jobs: int = 1,
+            executor: str = "local", scheduler: str | None = None, version: str | None = None,
+            on_frame: Callable[[], None] | None = None) -> None:
+    """Run every task, calling ``on_result(task, summary)`` as each finishes (in this process).
+
+    ``executor="local"``: the tasks as units of :func:`dcfkit.running.lockstep.groups` (runs
+    sharing their frames tracked together), in this process when ``jobs == 1`` or there is one
+    unit (then ``on_frame()`` is called after every frame of every run), else in ``jobs``
+    spawned worker processes, at most one a usable core (tasks and their ``make_tracker`` must
+    be picklable). ``"dask"``: the scheduler at
+    ``scheduler`` (:func:`dcfkit.running.scheduler.connect`: a bad address, or one that is not a
+    Dask scheduler, is one line in bounded time), or a ``LocalCluster`` of ``jobs``
+    single-threaded workers when ``scheduler`` is None."""
+    tasks = list(tasks)
+    version = version if version is not None else dcfkit_version()
+    origin = invocation()  # the client's command, whichever process or machine runs a task
+    if executor not in ("local", "dask"):
+        raise DcfkitError(f"executor must be 'local' or 'dask', got {shown(executor)}")
+    if jobs < 1:
+        raise DcfkitError(f"jobs must be >= 1, got {jobs}")
+
+    def crashed(task: RunTask, exc: BaseException) -> dict:
+        if isinstance(exc, StoreError):  # as in this process: writing the next run would fail too
+            raise exc
+        return record_failure(task, version, crash_message(task.seq, exc), exc)
+
+    if not tasks:
+        return
+    if executor == "dask":
+        run_dask(tasks, jobs, scheduler, version, origin, on_result, crashed)
+        return
+    units = groups(tasks, 1 if jobs == 1 else pool_size(jobs, len(tasks)))
+    if jobs == 1 or len(units) == 1:
+        for unit in units:
+            for task, result in zip(unit, run_group(unit, version, on_frame, origin, timing_record("local", 1))):
+                on_result(task, result)
+        return
+    timing = timing_record("local", pool_size(jobs, len(units)))
+    run_pool({i: (run_unit_in_worker, unit, version, origin, timing) for i, unit in enumerate(units)}, jobs,
+             lambda i, results: [on_result(t, r) for t, r in zip(units[i], results)],
+             lambda i, exc: [crashed(t, exc) for t in units[i]])
