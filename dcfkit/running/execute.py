@@ -8,15 +8,8 @@ from typing import Callable, Iterable, Mapping
 
 from dcfkit.errors import DcfkitError, shown
 from dcfkit.running.lockstep import groups, run_group
-from dcfkit.running.runner import (
-    RunTask,
-    run_dask,
-    check_worker,
-    crash_message,
-    pool_size,
-    record_failure,
-    run_pool,
-)
+from dcfkit.running import runner  # its functions looked up when called, as tests replace them
+from dcfkit.running.runner import RunTask
 from dcfkit.store.files import StoreError
 from dcfkit.store.provenance import dcfkit_version, invocation
 from dcfkit.store.timing import timing_record
@@ -26,7 +19,7 @@ def run_unit_in_worker(unit: list[RunTask], version: str, origin: Mapping | None
                        timing: Mapping | None = None) -> list[dict]:
     """:func:`dcfkit.running.lockstep.run_group` in a pool worker, as
     :func:`~dcfkit.running.runner.run_in_worker` runs one run."""
-    check_worker(unit[0], version)
+    runner.check_worker(unit[0], version)
     return run_group(unit, version, origin=origin, timing=timing)
 
 
@@ -54,20 +47,20 @@ def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None]
     def crashed(task: RunTask, exc: BaseException) -> dict:
         if isinstance(exc, StoreError):  # as in this process: writing the next run would fail too
             raise exc
-        return record_failure(task, version, crash_message(task.seq, exc), exc)
+        return runner.record_failure(task, version, runner.crash_message(task.seq, exc), exc)
 
     if not tasks:
         return
     if executor == "dask":
-        run_dask(tasks, jobs, scheduler, version, origin, on_result, crashed)
+        runner.run_dask(tasks, jobs, scheduler, version, origin, on_result, crashed)
         return
-    units = groups(tasks, 1 if jobs == 1 else pool_size(jobs, len(tasks)))
+    units = groups(tasks, 1 if jobs == 1 else runner.pool_size(jobs, len(tasks)))
     if jobs == 1 or len(units) == 1:
         for unit in units:
             for task, result in zip(unit, run_group(unit, version, on_frame, origin, timing_record("local", 1))):
                 on_result(task, result)
         return
-    timing = timing_record("local", pool_size(jobs, len(units)))
-    run_pool({i: (run_unit_in_worker, unit, version, origin, timing) for i, unit in enumerate(units)}, jobs,
+    timing = timing_record("local", runner.pool_size(jobs, len(units)))
+    runner.run_pool({i: (run_unit_in_worker, unit, version, origin, timing) for i, unit in enumerate(units)}, jobs,
              lambda i, results: [on_result(t, r) for t, r in zip(units[i], results)],
              lambda i, exc: [crashed(t, exc) for t in units[i]])

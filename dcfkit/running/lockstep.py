@@ -45,14 +45,14 @@ def groups(tasks: Iterable[RunTask], parts: int = 1) -> list[list[RunTask]]:
     for found in candidates.values():
         found.sort(key=lambda t: -len(t.seq))
         parent = found[0].seq
-        members = [t for t in found if parent.frames[len(parent) - len(t.seq):] == t.seq.frames]
-        units += [members] + [[t] for t in found if t not in members]
+        tail = [parent.frames[len(parent) - len(t.seq):] == t.seq.frames for t in found]
+        units += [[t for t, inside in zip(found, tail) if inside]] + [[t] for t, inside in zip(found, tail)
+                                                                        if not inside]
     if parts > 1:
         share = sum(_frames(u) for u in units) / (2 * parts)
         while units and len(big := max(units, key=lambda u: _frames(u) if len(u) > 1 else 0)) > 1 \
                 and _frames(big) > share:
-            units.remove(big)
-            units += [big[0::2], big[1::2]]  # each half keeps its longest run first
+            units = [u for u in units if u is not big] + [big[0::2], big[1::2]]  # each half: its longest first
     return sorted(units, key=lambda u: -_frames(u))
 
 
