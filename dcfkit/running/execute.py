@@ -12,6 +12,7 @@ from dcfkit.running import runner  # its functions looked up when called, as tes
 from dcfkit.running.runner import RunTask
 from dcfkit.store.files import StoreError
 from dcfkit.store.provenance import dcfkit_version, invocation
+from dcfkit.store.results import ResultStore
 from dcfkit.store.timing import timing_record
 
 
@@ -62,5 +63,16 @@ def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None]
         return
     timing = timing_record("local", runner.pool_size(jobs, len(units)))
     runner.run_pool({i: (run_unit_in_worker, unit, version, origin, timing) for i, unit in enumerate(units)}, jobs,
-             lambda i, results: [on_result(t, r) for t, r in zip(units[i], results)],
-             lambda i, exc: [crashed(t, exc) for t in units[i]])
+                    lambda i, results: [on_result(t, r) for t, r in zip(units[i], results)],
+                    lambda i, exc: [_stored(t) or crashed(t, exc) for t in units[i]])
+
+
+def _stored(task: RunTask) -> dict | None:
+    """The summary of ``task``'s run if its unit stored it before the unit's worker died (a
+    unit's runs end together, and are stored one after another), else None: a run stored now
+    was to do when the command began, so this command made it."""
+    store = ResultStore(task.folder)
+    meta = store.sidecar(task.seq.name)
+    if store.status(task.seq, task.key, meta) != "done":
+        return None
+    return {"sequence": task.seq.name, "status": "done", "fps": meta.get("fps"), "frames": len(task.seq)}

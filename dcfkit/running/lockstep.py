@@ -37,7 +37,7 @@ def groups(tasks: Iterable[RunTask], parts: int = 1) -> list[list[RunTask]]:
     workers end together."""
     units, candidates = [], {}
     for task in tasks:
-        if type(task.experiment).track is not Experiment.track:
+        if task.alone or type(task.experiment).track is not Experiment.track:
             units.append([task])
             continue
         key = (task.key, str(task.folder), id(task.make_tracker), task.experiment.name, str(task.seq.frames[-1]))
@@ -102,8 +102,13 @@ def run_group(tasks: list[RunTask], version: str, on_frame: Callable[[], None] |
             except Exception as exc:
                 message = runner.failure_message(tasks[k].seq, exc, True, None)
                 results[k] = runner.record_failure(tasks[k], version, message, exc)
-        frames = {i: _read(parent, i) for i in block}
-        last = {i: max((k for k in active if offsets[k] <= i), default=None) for i in block}  # takes no copy
+        if not active:  # none running: decode nothing until the next run starts, if any does
+            if max(offsets) < block.stop:
+                break
+            continue
+        lowest = min(offsets[k] for k in active)
+        frames = {i: _read(parent, i) for i in block if i >= lowest}
+        last = {i: max(k for k in active if offsets[k] <= i) for i in frames}  # handed the frame, not a copy
         for k in list(active):
             for i in block[max(0, offsets[k] - first):]:
                 j = i - offsets[k]  # the run's own frame

@@ -94,6 +94,8 @@ class RunPlan:
         self.experiment, self.sequences, self.out = get_experiment(experiment), list(sequences), out
         self.version, self.what = version if version is not None else provenance.dcfkit_version(), what
         self.by_sequence = runs_by_sequence(self.sequences, self.experiment)
+        self.one_pass_twins = {run.name for seq in self.sequences for run in self.by_sequence.get(seq.name, ())
+                               if run_identity(run) == run_identity(seq)}  # OPE's run itself, TRE's first
         runs = [run for found in self.by_sequence.values() for run in found]
         self.entries = [Planned(e, ResultStore(store_folder(out, e.name, self.experiment)),
                                 provenance.run_key(e.config, self.version, self.experiment.rule), runs) for e in entries]
@@ -155,7 +157,8 @@ class RunPlan:
                 elif lacking:
                     first = lacking[0]
                     tasks.append(Shared(RunTask(dict(first.entry.config), run, first.store.folder, first.key,
-                                                first.entry.make_tracker, self.experiment), lacking))
+                                                first.entry.make_tracker, self.experiment,
+                                                alone=run.name in self.one_pass_twins), lacking))
         return tasks, copies
 
     def run(self, command: str, jobs: int = 1, executor: str = "local", scheduler: str | None = None,
@@ -204,9 +207,9 @@ class RunPlan:
     def execute(self, jobs: int = 1, executor: str = "local", scheduler: str | None = None,
                 progress: Progress | None = None) -> None:
         """Copy the runs done in another experiment of their entry (:meth:`made_elsewhere`) or
-        in another entry of their key, then track the others, each once (in order in this
-        process, else longest first: the workers end together), with ``progress``; each run's
-        outcome goes to every entry that gets it."""
+        in another entry of their key, then track the others, each once (the runs sharing their
+        frames together, :mod:`dcfkit.running.lockstep`; the largest first), with ``progress``;
+        each run's outcome goes to every entry that gets it."""
         for p in self.entries:
             runs = {run.name: run for run in p.todo}
             for name, (source, source_name) in self.made_elsewhere(p).items():

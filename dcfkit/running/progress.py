@@ -57,7 +57,7 @@ class FrameBar(Progress):
             log.warning("%s: %s", self.desc, result["error"])
         self.frames += len(shared.task.seq)
         self.bar.set_postfix_str(shared.task.seq.name, refresh=False)
-        self.bar.update(self.frames - self.bar.n)  # a failed run skips its rest
+        self.bar.update(max(0, self.frames - self.bar.n))  # a failed run skips its rest; runs in lockstep end together
 
 
 class RunBar(Progress):

@@ -57,7 +57,9 @@ _THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS",
 @dataclasses.dataclass(frozen=True)
 class RunTask:
     """One run to do: ``config`` on ``seq`` into the store at ``folder`` under ``key``, tracked as
-    ``experiment`` tracks its runs (bound to its rule, if it has one).
+    ``experiment`` tracks its runs (bound to its rule, if it has one); ``alone``: timed alone,
+    not in lockstep (:mod:`dcfkit.running.lockstep`), since its twin in another experiment
+    (OPE's run, TRE's first) is copied with its timing.
     ``make_tracker(config)`` builds the tracker (None: :func:`dcfkit.load_tracker`)."""
 
     config: dict
@@ -66,7 +68,7 @@ class RunTask:
     key: str
     make_tracker: Callable | None = None
     experiment: Experiment = EXPERIMENTS["ope"]
-
+    alone: bool = False  # tracked by itself, never in lockstep: it is also another experiment's run
 
 # --------------------------------------------------------------------------- one run
 

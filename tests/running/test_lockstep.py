@@ -139,3 +139,53 @@ def test_execute_in_a_pool_stores_what_runs_alone_store(seq, tmp_path):
         run_sequence(task, VERSION)
     assert done == ["done"] * len(tasks_of(config, seq, tmp_path)) and stored(tmp_path / "pool") == stored(
         tmp_path / "alone")
+
+
+def test_the_run_that_is_also_the_one_pass_run_is_timed_alone_and_copied_so(seq, tmp_path):
+    """TRE's first run is OPE's run (copied between the two experiments): it is tracked alone,
+    so that its timing stands for OPE's; TRE's other runs in lockstep. Nothing is decoded for
+    runs that all failed to start."""
+    from dcfkit.running.evaluation import run_one_pass
+
+    config = load_config("kcf")
+    run_one_pass(config, [seq], tmp_path / "out", experiment="tre", progress=False)
+    tre = {p.stem: json.loads(p.read_text())["timing"] for p in (tmp_path / "out" / "kcf" / "tre").glob("*.json")}
+    assert tre.pop("seqA_001") == {"executor": "local", "workers": 1, "alone": True}
+    assert {t["lockstep"] for t in tre.values()} == {len(tre)} and not any(t["alone"] for t in tre.values())
+    run_one_pass(config, [seq], tmp_path / "out", progress=False)
+    ope = json.loads((tmp_path / "out" / "kcf" / "seqA.json").read_text())
+    assert ope["timing"]["alone"] and ope["sequence"] == "seqA"  # copied from TRE's first, timed alone
+
+
+def test_no_frame_is_decoded_once_every_run_has_failed(seq, tmp_path, monkeypatch):
+    reads = []
+    read = dcfkit.datasets.base.read_frame
+    monkeypatch.setattr(dcfkit.datasets.base, "read_frame", lambda path, what="frame": reads.append(path) or
+                        read(path, what))
+
+    def refuse(config):
+        raise RuntimeError("no tracker today")
+
+    results = lockstep.run_group(tasks_of({"name": "none"}, seq, tmp_path / "out", "sre", refuse), VERSION)
+    assert {r["status"] for r in results} == {"failed"} and reads == []
+    assert all("creating the tracker raised RuntimeError: no tracker today" in r["error"] for r in results)
+
+
+def test_a_unit_whose_worker_dies_after_storing_keeps_the_runs_it_stored(seq, tmp_path, monkeypatch):
+    """A pool's unit stores its runs one after another at its end: a worker dying among them
+    (the pool failing every unit not yet delivered) leaves those stored done, not overwritten
+    with the crash."""
+    from dcfkit.running import runner
+
+    def dying_pool(calls, jobs, on_result, on_crash):
+        for key, (fn, *args) in calls.items():
+            fn(*args)
+            on_result(key, on_crash(key, RuntimeError("the worker died")))
+
+    monkeypatch.setattr(runner, "run_pool", dying_pool)
+    monkeypatch.setattr(runner, "worker_init", lambda *args: None)
+    config = load_config("kcf")
+    done = []
+    execute(tasks_of(config, seq, tmp_path / "out"), lambda task, result: done.append(result["status"]), jobs=2)
+    assert done == ["done"] * len(tasks_of(config, seq, tmp_path))
+    assert not list((tmp_path / "out").glob("*.error"))
