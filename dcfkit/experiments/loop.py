@@ -35,6 +35,12 @@ class Track:
         if self.confidence is None:
             self.confidence = np.full((len(self.boxes), 3), np.nan)
 
+    @classmethod
+    def collected(cls, boxes: list, times: list, confidence: list) -> "Track":
+        """A run's per-frame boxes, seconds and confidences, gathered as it went, as a Track."""
+        return cls(np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(times, dtype=np.float64),
+                   np.array(confidence, dtype=np.float64).reshape(-1, 3))
+
     @property
     def fps(self) -> float | None:
         total = float(self.times.sum())
@@ -109,5 +115,4 @@ def track(tracker, frames: Iterable[np.ndarray], init_box, on_frame: OnFrame | N
         confidence.append(step.confidence)
         if on_frame is not None:
             on_frame(step.index, step.image, step.box, tracker)
-    return Track(np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(times, dtype=np.float64),
-                 np.array(confidence, dtype=np.float64).reshape(-1, 3))
+    return Track.collected(boxes, times, confidence)

@@ -74,8 +74,7 @@ class _Run:
     confidence: list = dataclasses.field(default_factory=list)
 
     def track(self) -> Track:
-        return Track(np.array(self.boxes, dtype=np.float64).reshape(-1, 4), np.array(self.times, dtype=np.float64),
-                     np.array(self.confidence, dtype=np.float64).reshape(-1, 3))
+        return Track.collected(self.boxes, self.times, self.confidence)
 
 
 def run_group(tasks: list[RunTask], version: str, on_frame: Callable[[], None] | None = None,
