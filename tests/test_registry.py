@@ -311,7 +311,7 @@ def test_result_hashes_change_with_the_version_of_a_plugin_the_config_uses(monke
     from dcfkit.config import load_config
     from dcfkit.errors import DcfkitError
     from dcfkit.store.provenance import dcfkit_version, run_key
-    from dcfkit.running.runner import RunTask, run_in_worker
+    from dcfkit.running.runner import RunTask, check_worker
 
     def registry_with(version):
         ep = install_plugin(monkeypatch, "dcfkit_test_versioned", PLUGIN)
@@ -331,7 +331,7 @@ def test_result_hashes_change_with_the_version_of_a_plugin_the_config_uses(monke
     monkeypatch.setattr("dcfkit.running.runner._worker_ready", True)  # no worker set-up in the test process
     with pytest.raises(DcfkitError, match=r"worker's dcfkit code \(\w+\) or plugins \(dcfkit-test-versioned 0.2.0\) "
                        r"are not the client's"):
-        run_in_worker(RunTask(flat, None, "unused", old_key), dcfkit_version())
+        check_worker(RunTask(flat, None, "unused", old_key), dcfkit_version())
     monkeypatch.setattr(reg, "_REGISTRY", None)
 
 

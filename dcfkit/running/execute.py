@@ -4,6 +4,7 @@ together (:mod:`dcfkit.running.lockstep`). ``dcfkit eval`` and ``dcfkit ablate``
 search`` go through :func:`execute` (:mod:`dcfkit.running.plan` says which runs)."""
 from __future__ import annotations
 
+import uuid
 from typing import Callable, Iterable, Mapping
 
 from dcfkit.errors import DcfkitError, shown
@@ -18,8 +19,8 @@ from dcfkit.store.timing import timing_record
 
 def run_unit_in_worker(unit: list[RunTask], version: str, origin: Mapping | None = None,
                        timing: Mapping | None = None) -> list[dict]:
-    """:func:`dcfkit.running.lockstep.run_group` in a pool worker, as
-    :func:`~dcfkit.running.runner.run_in_worker` runs one run."""
+    """:func:`dcfkit.running.lockstep.run_group` in a pool or dask worker, which must run the
+    client's dcfkit and plugins (:func:`~dcfkit.running.runner.check_worker`)."""
     runner.check_worker(unit[0], version)
     return run_group(unit, version, origin=origin, timing=timing)
 
@@ -33,9 +34,9 @@ def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None]
     sharing their frames tracked together), in this process when ``jobs == 1`` or there is one
     unit (then ``on_frame()`` is called after every frame of every run), else in ``jobs``
     spawned worker processes, at most one a usable core (tasks and their ``make_tracker`` must
-    be picklable). ``"dask"``: the scheduler at
-    ``scheduler`` (:func:`dcfkit.running.scheduler.connect`: a bad address, or one that is not a
-    Dask scheduler, is one line in bounded time), or a ``LocalCluster`` of ``jobs``
+    be picklable). ``"dask"``: the units as tasks of the scheduler at ``scheduler``
+    (:func:`dcfkit.running.scheduler.connect`: a bad address, or one that is not a Dask
+    scheduler, is one line in bounded time), or of a ``LocalCluster`` of ``jobs``
     single-threaded workers when ``scheduler`` is None."""
     tasks = list(tasks)
     version = version if version is not None else dcfkit_version()
@@ -52,8 +53,25 @@ def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None]
 
     if not tasks:
         return
+    calls: dict[str, tuple] = {}  # a unit's dask or pool task name: its call of run_unit_in_worker
+
+    def calls_for(units: list[list[RunTask]], timing: Mapping) -> dict[str, tuple]:
+        token = uuid.uuid4().hex[:12]  # two clients' runs of one sequence are two tasks to a shared scheduler
+        calls.update({f"dcfkit-{u[0].seq.name}-{i}-{token}": (run_unit_in_worker, u, version, origin, timing)
+                      for i, u in enumerate(units)})
+        return calls
+
+    def finished(name: str, results: list[dict]) -> None:
+        for task, result in zip(calls[name][1], results):
+            on_result(task, result)
+
+    def died(name: str, exc: BaseException) -> list[dict]:
+        return [_stored(task) or crashed(task, exc) for task in calls[name][1]]
+
     if executor == "dask":
-        runner.run_dask(tasks, jobs, scheduler, version, origin, on_result, crashed)
+        runner.run_dask(lambda workers: calls_for(groups(tasks, workers),
+                                                  timing_record("dask", None if scheduler else workers)),
+                        jobs, len(tasks), scheduler, finished, died)
         return
     units = groups(tasks, 1 if jobs == 1 else runner.pool_size(jobs, len(tasks)))
     if jobs == 1 or len(units) == 1:
@@ -61,10 +79,8 @@ def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None]
             for task, result in zip(unit, run_group(unit, version, on_frame, origin, timing_record("local", 1))):
                 on_result(task, result)
         return
-    timing = timing_record("local", runner.pool_size(jobs, len(units)))
-    runner.run_pool({i: (run_unit_in_worker, unit, version, origin, timing) for i, unit in enumerate(units)}, jobs,
-                    lambda i, results: [on_result(t, r) for t, r in zip(units[i], results)],
-                    lambda i, exc: [_stored(t) or crashed(t, exc) for t in units[i]])
+    runner.run_pool(calls_for(units, timing_record("local", runner.pool_size(jobs, len(units)))), jobs, finished,
+                    died)
 
 
 def _stored(task: RunTask) -> dict | None:

@@ -227,12 +227,6 @@ def _die_with_parent(parent_pid: int) -> None:
 _worker_ready = False
 
 
-def run_in_worker(task: RunTask, version: str, origin: Mapping | None = None, timing: Mapping | None = None) -> dict:
-    """:func:`run_sequence` in a pool or dask worker, which must run the client's dcfkit and plugins."""
-    check_worker(task, version)
-    return run_sequence(task, version, origin=origin, timing=timing)
-
-
 def check_worker(task: RunTask, version: str) -> None:
     """Set a worker up once, and refuse to run where its dcfkit or plugins are not the client's."""
     global _worker_ready
@@ -293,24 +287,27 @@ def _deliver(finished: Iterable, key_of: Callable, on_result: Callable, on_crash
         on_result(key, result)
 
 
-def run_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: str, origin: Mapping, on_result,
-              on_crash) -> None:
+def run_dask(calls_for: Callable[[int], Mapping[str, tuple]], jobs: int, tasks: int, scheduler: str | None,
+             on_result: Callable[[str, Any], None], on_crash: Callable[[str, BaseException], Any]) -> None:
+    """Run ``fn(*args)`` for every ``key: (fn, *args)`` of ``calls_for(workers)`` on
+    dask.distributed, ``key`` being dask's name for the task: on the scheduler at ``scheduler``
+    (``workers``: the threads of the workers it has when connected, at least 1), or else on a
+    ``LocalCluster`` of ``workers`` single-threaded processes (:func:`worker_count` of ``jobs``
+    and ``tasks``). ``on_result`` and ``on_crash`` as for :func:`run_pool`."""
     distributed = import_distributed()
-    timing = timing_record("dask", None if scheduler else pool_size(jobs, len(tasks)))
     with contextlib.ExitStack() as stack:
         if scheduler:
             client = stack.enter_context(connect_scheduler(scheduler))
+            workers = max(1, sum(client.nthreads().values()))
         else:
+            workers = worker_count(jobs, tasks)
             with single_threaded_env():  # inherited by the worker processes
                 cluster = stack.enter_context(distributed.LocalCluster(
-                    n_workers=worker_count(jobs, len(tasks)), threads_per_worker=1, processes=True,
-                    dashboard_address=None))
+                    n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None))
             client = stack.enter_context(distributed.Client(cluster))
-        futures = [client.submit(run_in_worker, t, version, origin, timing, pure=False,
-                                 key=f"dcfkit-{t.key}-{t.seq.dataset}-{t.seq.name}") for t in tasks]
-        by_key = {f.key: t for f, t in zip(futures, tasks)}
+        futures = [client.submit(*call, pure=False, key=key) for key, call in calls_for(workers).items()]
         try:
-            _deliver(distributed.as_completed(futures), lambda future: by_key[future.key], on_result, on_crash)
+            _deliver(distributed.as_completed(futures), lambda future: future.key, on_result, on_crash)
         except BaseException:
             client.cancel(futures)
             raise

@@ -35,5 +35,5 @@ def test_a_local_dask_cluster_is_capped_too(monkeypatch):
     monkeypatch.setattr(runner, "import_distributed", lambda: types.SimpleNamespace(LocalCluster=local_cluster))
     monkeypatch.setattr(runner, "usable_cores", lambda: 2)
     with pytest.raises(StopIteration):
-        runner.run_dask([object()] * 5, 8, None, "0", {}, None, None)
+        runner.run_dask(lambda workers: {}, 8, 5, None, None, None)
     assert made["n_workers"] == 2
