@@ -23,8 +23,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", required=True, type=Path,
                         help="results folder (OUT/<variant>/..., OUT/summary.md, ...); reruns resume")
     parser.add_argument("--jobs", type=int, default=None,
-                        help="worker processes (default: the usable cores); with dask and no "
-                             "--scheduler, the LocalCluster's workers")
+                        help="worker processes (default: the usable cores); with dask, the LocalCluster's "
+                             "workers, or with --scheduler the fewest worker threads to plan the runs for")
     parser.add_argument("--executor", choices=("local", "dask"), default=None,
                         help="local process pool (default) or dask.distributed (default with --scheduler)")
     parser.add_argument("--scheduler", default=None, metavar="ADDR",

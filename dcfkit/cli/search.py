@@ -29,7 +29,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="the objective's experiments, comma-separated, e.g. ope (default: the spec's "
                              "'experiments'); recorded, so a rerun must give the same")
     parser.add_argument("--jobs", type=int, default=None,
-                        help="worker processes for each trial's runs (default: the usable cores)")
+                        help="worker processes for each trial's runs (default: the usable cores); with "
+                             "--scheduler, the fewest worker threads to plan them for")
     parser.add_argument("--executor", choices=("local", "dask"), default=None,
                         help="local process pool (default) or dask.distributed (default with --scheduler)")
     parser.add_argument("--scheduler", default=None, metavar="ADDR",

@@ -4,7 +4,6 @@ together (:mod:`dcfkit.running.lockstep`). ``dcfkit eval`` and ``dcfkit ablate``
 search`` go through :func:`execute` (:mod:`dcfkit.running.plan` says which runs)."""
 from __future__ import annotations
 
-import uuid
 from typing import Callable, Iterable, Mapping
 
 from dcfkit.errors import DcfkitError, shown
@@ -53,25 +52,8 @@ def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None]
 
     if not tasks:
         return
-    calls: dict[str, tuple] = {}  # a unit's dask or pool task name: its call of run_unit_in_worker
-
-    def calls_for(units: list[list[RunTask]], timing: Mapping) -> dict[str, tuple]:
-        token = uuid.uuid4().hex[:12]  # two clients' runs of one sequence are two tasks to a shared scheduler
-        calls.update({f"dcfkit-{u[0].seq.name}-{i}-{token}": (run_unit_in_worker, u, version, origin, timing)
-                      for i, u in enumerate(units)})
-        return calls
-
-    def finished(name: str, results: list[dict]) -> None:
-        for task, result in zip(calls[name][1], results):
-            on_result(task, result)
-
-    def died(name: str, exc: BaseException) -> list[dict]:
-        return [_stored(task) or crashed(task, exc) for task in calls[name][1]]
-
     if executor == "dask":
-        runner.run_dask(lambda workers: calls_for(groups(tasks, workers),
-                                                  timing_record("dask", None if scheduler else workers)),
-                        jobs, len(tasks), scheduler, finished, died)
+        _run_on_dask(tasks, jobs, scheduler, version, origin, on_result, crashed)
         return
     units = groups(tasks, 1 if jobs == 1 else runner.pool_size(jobs, len(tasks)))
     if jobs == 1 or len(units) == 1:
@@ -79,8 +61,39 @@ def execute(tasks: Iterable[RunTask], on_result: Callable[[RunTask, dict], None]
             for task, result in zip(unit, run_group(unit, version, on_frame, origin, timing_record("local", 1))):
                 on_result(task, result)
         return
-    runner.run_pool(calls_for(units, timing_record("local", runner.pool_size(jobs, len(units)))), jobs, finished,
-                    died)
+    timing = timing_record("local", runner.pool_size(jobs, len(units)))
+    runner.run_pool(_calls(units, version, origin, timing), jobs, *_deliveries(units, on_result, crashed))
+
+
+def _run_on_dask(tasks: list[RunTask], jobs: int, scheduler: str | None, version: str, origin: Mapping,
+                 on_result: Callable, crashed: Callable) -> None:
+    """The units as dask tasks: split for the scheduler's worker threads
+    (:func:`~dcfkit.running.runner.dask_threads`), or, without a scheduler, as for the local pool
+    and run on a ``LocalCluster`` of as many workers."""
+    local = None if scheduler else groups(tasks, runner.pool_size(jobs, len(tasks)))
+    workers = None if local is None else runner.worker_count(jobs, len(local))
+    with runner.dask_client(scheduler, workers) as client:
+        units = local if local is not None else groups(tasks, runner.dask_threads(client, jobs))
+        runner.run_dask(client, _calls(units, version, origin, timing_record("dask", workers)),
+                        *_deliveries(units, on_result, crashed))
+
+
+def _calls(units: list[list[RunTask]], version: str, origin: Mapping, timing: Mapping) -> dict[int, tuple]:
+    """Each unit's call of :func:`run_unit_in_worker`, keyed by the unit's index."""
+    return {i: (run_unit_in_worker, unit, version, origin, timing) for i, unit in enumerate(units)}
+
+
+def _deliveries(units: list[list[RunTask]], on_result: Callable, crashed: Callable) -> tuple[Callable, Callable]:
+    """``on_result`` and ``on_crash`` for :func:`_calls`' keys: a unit's results each to its run,
+    and a unit whose worker failed failing each run it had not stored."""
+    def finished(i: int, results: list[dict]) -> None:
+        for task, result in zip(units[i], results):
+            on_result(task, result)
+
+    def died(i: int, exc: BaseException) -> list[dict]:
+        return [_stored(task) or crashed(task, exc) for task in units[i]]
+
+    return finished, died
 
 
 def _stored(task: RunTask) -> dict | None:

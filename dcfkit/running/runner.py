@@ -18,6 +18,7 @@ import multiprocessing
 import os
 import signal
 import sys
+import uuid
 import warnings
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
@@ -287,30 +288,45 @@ def _deliver(finished: Iterable, key_of: Callable, on_result: Callable, on_crash
         on_result(key, result)
 
 
-def run_dask(calls_for: Callable[[int], Mapping[str, tuple]], jobs: int, tasks: int, scheduler: str | None,
-             on_result: Callable[[str, Any], None], on_crash: Callable[[str, BaseException], Any]) -> None:
-    """Run ``fn(*args)`` for every ``key: (fn, *args)`` of ``calls_for(workers)`` on
-    dask.distributed, ``key`` being dask's name for the task: on the scheduler at ``scheduler``
-    (``workers``: the threads of the workers it has when connected, at least 1), or else on a
-    ``LocalCluster`` of ``workers`` single-threaded processes (:func:`worker_count` of ``jobs``
-    and ``tasks``). ``on_result`` and ``on_crash`` as for :func:`run_pool`."""
+@contextlib.contextmanager
+def dask_client(scheduler: str | None, workers: int | None):
+    """A dask.distributed client of the scheduler at ``scheduler``, or else of a ``LocalCluster``
+    of ``workers`` single-threaded worker processes (:func:`worker_count` says how many)."""
     distributed = import_distributed()
     with contextlib.ExitStack() as stack:
         if scheduler:
-            client = stack.enter_context(connect_scheduler(scheduler))
-            workers = max(1, sum(client.nthreads().values()))
-        else:
-            workers = worker_count(jobs, tasks)
-            with single_threaded_env():  # inherited by the worker processes
-                cluster = stack.enter_context(distributed.LocalCluster(
-                    n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None))
-            client = stack.enter_context(distributed.Client(cluster))
-        futures = [client.submit(*call, pure=False, key=key) for key, call in calls_for(workers).items()]
-        try:
-            _deliver(distributed.as_completed(futures), lambda future: future.key, on_result, on_crash)
-        except BaseException:
-            client.cancel(futures)
-            raise
+            yield stack.enter_context(connect_scheduler(scheduler))
+            return
+        with single_threaded_env():  # inherited by the worker processes
+            cluster = stack.enter_context(distributed.LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None))
+        yield stack.enter_context(distributed.Client(cluster))
+
+
+def dask_threads(client, jobs: int) -> int:
+    """The worker threads to plan a scheduler's work for: those of the workers it has, or
+    ``jobs`` if more (workers may still be joining), with a warning when none has joined."""
+    threads = sum(client.nthreads().values())
+    if threads == 0:
+        log.warning("no worker has joined the dask scheduler yet: the runs are planned for %d worker thread%s "
+                    "(--jobs)", jobs, "" if jobs == 1 else "s")
+    return max(jobs, threads)
+
+
+def run_dask(client, calls: Mapping[Any, tuple], on_result: Callable[[Any, Any], None],
+             on_crash: Callable[[Any, BaseException], Any]) -> None:
+    """Run ``fn(*args)`` for every ``key: (fn, *args)`` of ``calls`` on ``client``'s cluster;
+    ``on_result`` and ``on_crash`` as for :func:`run_pool`. Each task is named for its key and
+    this command (dask's name for it), so two clients' calls are never one task to a shared
+    scheduler."""
+    distributed = import_distributed()
+    command = uuid.uuid4().hex[:12]
+    futures = {client.submit(*call, pure=False, key=f"dcfkit-{key}-{command}"): key for key, call in calls.items()}
+    try:
+        _deliver(distributed.as_completed(futures), futures.__getitem__, on_result, on_crash)
+    except BaseException:
+        client.cancel(list(futures))
+        raise
 
 
 def usable_cores() -> int:

@@ -191,26 +191,45 @@ def test_a_unit_whose_worker_dies_after_storing_keeps_the_runs_it_stored(seq, tm
     assert not list((tmp_path / "out").glob("*.error"))
 
 
-@pytest.mark.slow
-def test_dask_tracks_a_sequences_runs_together_as_the_pool_does(seq, tmp_path, monkeypatch):
-    """On dask a unit of runs is one task: the same stored boxes as alone, the runs timed as in
-    lockstep, and a unit's runs delivered each to its own task."""
+@pytest.fixture
+def in_process_scheduler(monkeypatch):
+    """The address of a scheduler whose two workers are threads of this process."""
     distributed = pytest.importorskip("distributed", reason="dask.distributed not installed (pip install "
                                       "'dcfkit[dask]')")
     from dcfkit.running import runner
 
     monkeypatch.setattr(runner, "_worker_ready", True)  # the workers are threads of this process: no set-up
-    config = load_config("kcf")
-    delivered = {}
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster:
-        execute(tasks_of(config, seq, tmp_path / "dask"), lambda task, result: delivered.update(
-            {task.seq.name: result["sequence"]}), executor="dask", scheduler=cluster.scheduler_address)
+        yield cluster.scheduler_address
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("where", ["scheduler", "local cluster"])
+def test_dask_tracks_a_sequences_runs_together_as_the_pool_does(where, seq, tmp_path, request):
+    """On dask a unit of runs is one task: the same stored boxes as alone, the runs timed as in
+    lockstep, and a unit's runs delivered each to its own task."""
+    pytest.importorskip("distributed", reason="dask.distributed not installed (pip install 'dcfkit[dask]')")
+    scheduler = request.getfixturevalue("in_process_scheduler") if where == "scheduler" else None
+    config = load_config("kcf")
+    delivered = {}
+    execute(tasks_of(config, seq, tmp_path / "dask"), lambda task, result: delivered.update(
+        {task.seq.name: result["sequence"]}), jobs=2, executor="dask", scheduler=scheduler)
     for task in tasks_of(config, seq, tmp_path / "alone"):
         run_sequence(task, VERSION)
     names = [t.seq.name for t in tasks_of(config, seq, tmp_path)]
     assert delivered == dict(zip(names, names)) and stored(tmp_path / "dask") == stored(tmp_path / "alone")
     timing = [json.loads((tmp_path / "dask" / f"{name}.json").read_text())["timing"] for name in names]
-    assert {t["executor"] for t in timing} == {"dask"} and all(t["workers"] is None for t in timing)
-    sizes = [t.get("lockstep") for t in timing]
+    assert {(t["executor"], t["workers"]) for t in timing} == {("dask", None if scheduler else 2)}
+    sizes = [t.get("lockstep", 1) for t in timing]
     assert 1 < max(sizes) < len(names)  # split in units for the two workers, each tracked together
+
+
+@pytest.mark.slow
+def test_a_unit_failing_on_dask_fails_each_of_its_runs(seq, tmp_path, in_process_scheduler):
+    config = load_config("kcf")
+    results = []
+    execute(tasks_of(config, seq, tmp_path / "out"), lambda task, result: results.append(result),
+            executor="dask", scheduler=in_process_scheduler, version="0.0.0-other")
+    assert len(results) == len(tasks_of(config, seq, tmp_path)) and {r["status"] for r in results} == {"failed"}
+    assert all("the worker failed: DcfkitError: this worker runs dcfkit" in r["error"] for r in results)
