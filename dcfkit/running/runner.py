@@ -69,7 +69,8 @@ class RunTask:
     key: str
     make_tracker: Callable | None = None
     experiment: Experiment = EXPERIMENTS["ope"]
-    alone: bool = False  # tracked by itself, never in lockstep: it is also another experiment's run
+    alone: bool = False
+
 
 # --------------------------------------------------------------------------- one run
 
