@@ -108,10 +108,11 @@ def array(shape: Callable[[tuple, Any], tuple] | tuple | None = None, *, kinds: 
 
 
 def _values_problem(value: np.ndarray, finite: bool, nonnegative: bool) -> str | None:
-    if value.dtype.kind in "fc":
-        if finite and not np.isfinite(value).all():
-            return "NaN or infinite values"
-        if np.isnan(value).any():
+    if value.dtype.kind in "fc":  # one pass over the values: finite ones hold no NaN
+        if finite:
+            if not np.isfinite(value).all():
+                return "NaN or infinite values"
+        elif np.isnan(value).any():
             return "NaN values"
     if nonnegative and value.size and value.min() < 0:
         return f"negative values (min {value.min():g}), expected >= 0"
