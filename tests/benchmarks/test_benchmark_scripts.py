@@ -206,3 +206,45 @@ def test_decide_pairs_each_option_with_its_base(tmp_path, capsys):
         assert rows["mixed"]["difference"].ci_low >= -0.05 and rows["mixed"]["passes"] is kept and rows["up"]["passes"]
     assert decide.main([str(path), "--margin", "0.06"]) == 0
     assert "- T + mixed: adopt (non-inferiority, δ 0.06)" in capsys.readouterr().out
+
+
+def test_search_cost_counts_each_run_once_and_splits_by_choice(tmp_path):
+    """A hand-built search folder: config A (two trials, two studies) tracked 3 + 2 frames, its
+    TRE run from frame 1 a copy of the one-pass run; config B 4 frames; a folder no trial names."""
+    out = tmp_path / "search"
+
+    def record(study, n, key, params):
+        path = out / "trials" / study / f"{n:04d}.json"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps({"number": n, "key": key, "params": params}))
+
+    def times(path, values):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text("".join(f"{v:.8f}\n" for v in values))
+
+    record("fold1", 0, "aaaa", {"scale": "dsst", "mu": 0.5, "iterations": 4})
+    record("all", 0, "aaaa", {"scale": "dsst", "mu": 0.5, "iterations": 4})
+    record("fold1", 1, "bbbb", {"scale": "pyramid", "mu": 0.25, "iterations": 2, "redetect": "grid"})
+    times(out / "runs" / "aaaa" / "s1.time", [0.5, 0.25, 0.25])
+    times(out / "runs" / "aaaa" / "tre" / "s1_001.time", [0.5, 0.25, 0.25])  # the copy
+    times(out / "runs" / "aaaa" / "tre" / "s1_002.time", [0.5, 0.5])
+    times(out / "runs" / "bbbb" / "s1.time", [1.0, 1.0, 1.0, 1.0])
+    times(out / "runs" / "cccc" / "s1.time", [9.0])
+    printed = run("search_cost.py", str(out), tmp_path=tmp_path)
+    # A: 5 frames in 2 s; B: 4 frames in 4 s; together 9 frames in 6 s
+    assert "2 configs' runs: 9 frames tracked in 0.00 core-hours of tracking, 1.5 fps" in printed
+    assert "left out: 1 folder(s) under runs/ that no trial record names (cccc)" in printed
+    rows = {tuple(line.strip("| ").split(" | ")[:2]): line.strip("| ").split(" | ")[2:]
+            for line in printed.splitlines() if line.startswith("| ") and not line.startswith("| dimension")}
+    assert rows[("scale", "pyramid")] == ["1", "4", "0.00", "67%", "1.0"]
+    assert rows[("scale", "dsst")] == ["1", "5", "0.00", "33%", "2.5"]
+    assert rows[("iterations", "4")][:2] == ["1", "5"]
+    assert rows[("redetect", "(inactive)")][:2] == ["1", "5"] and rows[("redetect", "grid")][:2] == ["1", "4"]
+    assert not any(name == "mu" for name, _ in rows)  # real numbers are not split
+
+
+def test_search_cost_refuses_a_folder_that_is_not_a_search(tmp_path):
+    env = {**os.environ}
+    done = subprocess.run([sys.executable, str(BENCHMARKS / "search_cost.py"), str(tmp_path)], env=env,
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2 and "not a search's --out (no trials/ and runs/ in it)" in done.stderr
