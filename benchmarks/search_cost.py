@@ -32,7 +32,10 @@ def tally(folder: Path) -> tuple[int, float]:
         if digest in seen:
             continue
         seen.add(digest)
-        times = np.loadtxt(path, ndmin=1) if data.strip() else np.zeros(0)
+        try:
+            times = np.array(data.split(), dtype=float)
+        except ValueError:
+            sys.exit(f"{path}: not a run's per-frame times (one number a line)")
         frames, seconds = frames + times.size, seconds + float(times.sum())
     return frames, seconds
 
@@ -41,7 +44,10 @@ def trial_params(out: Path) -> dict[str, dict]:
     """Run key -> the params its trials sampled (every study's records)."""
     params = {}
     for path in sorted((out / "trials").glob("*/*.json")):
-        record = json.loads(path.read_text(encoding="utf-8"))
+        try:
+            record = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            sys.exit(f"{path}: not a trial record ({exc})")
         if isinstance(record, dict) and isinstance(record.get("key"), str):
             params[record["key"]] = record.get("params") or {}
     return params

@@ -244,7 +244,20 @@ def test_search_cost_counts_each_run_once_and_splits_by_choice(tmp_path):
 
 
 def test_search_cost_refuses_a_folder_that_is_not_a_search(tmp_path):
-    env = {**os.environ}
-    done = subprocess.run([sys.executable, str(BENCHMARKS / "search_cost.py"), str(tmp_path)], env=env,
+    done = subprocess.run([sys.executable, str(BENCHMARKS / "search_cost.py"), str(tmp_path)],
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 2 and "not a search's --out (no trials/ and runs/ in it)" in done.stderr
+
+
+@pytest.mark.parametrize("where, text, said", [
+    ("trials/fold1/0000.json", "{not json", "fold1/0000.json: not a trial record"),
+    ("runs/aaaa/s1.time", "0.5\nabc\n", "aaaa/s1.time: not a run's per-frame times (one number a line)")])
+def test_search_cost_names_the_file_it_cannot_read(tmp_path, where, text, said):
+    out = tmp_path / "search"
+    for path, content in (("trials/fold1/0000.json", json.dumps({"key": "aaaa", "params": {}})),
+                          ("runs/aaaa/s1.time", "0.5\n"), (where, text)):
+        (out / path).parent.mkdir(parents=True, exist_ok=True)
+        (out / path).write_text(content)
+    done = subprocess.run([sys.executable, str(BENCHMARKS / "search_cost.py"), str(out)],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 1 and said in done.stderr and "Traceback" not in done.stderr
