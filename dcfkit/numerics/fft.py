@@ -15,7 +15,24 @@ from dcfkit.errors import shown
 BACKENDS = ("scipy", "pyfftw")
 
 
-class ScipyFFT:
+class Backend:
+    """The transforms of maps that are zero outside a band of rows (a filter constrained to a
+    mask), computed whole here; a backend may spare the rows' work."""
+
+    def rfft2_rows(self, x: np.ndarray, rows: slice) -> np.ndarray:
+        """``rfft2(x)`` for an ``x`` that is zero outside ``rows`` of its second-last axis."""
+        return self.rfft2(x)
+
+    def irfft2_rows(self, xf: np.ndarray, shape: tuple[int, int], rows: slice) -> np.ndarray:
+        """``irfft2(xf, shape)`` on ``rows`` of its second-last axis, zero outside them."""
+        out = self.irfft2(xf, shape)
+        band = np.zeros(out.shape[-2], bool)
+        band[rows] = True
+        out[..., ~band, :] = 0
+        return out
+
+
+class ScipyFFT(Backend):
     name = "scipy"
     full = False  # half spectra (W//2 + 1 columns) of real maps
 
@@ -30,8 +47,33 @@ class ScipyFFT:
     def irfft2(self, xf: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
         return self._fft.irfft2(xf, s=shape, axes=(-2, -1), workers=1)
 
+    def rfft2_rows(self, x: np.ndarray, rows: slice) -> np.ndarray:
+        """Only ``rows`` transformed along the last axis (the others' transforms are zero), then
+        every column: pocketfft's rfft2 takes the axes in this order, so the bits are its own."""
+        if _whole(rows, x.shape[-2]):
+            return self.rfft2(x)
+        out = np.zeros((*x.shape[:-1], x.shape[-1] // 2 + 1), np.result_type(x.dtype, np.complex64))
+        out[..., rows, :] = self._fft.rfft(x[..., rows, :], axis=-1, workers=1)
+        return self._fft.fft(out, axis=-2, workers=1, overwrite_x=True)
 
-class PyFFTW:
+    def irfft2_rows(self, xf: np.ndarray, shape: tuple[int, int], rows: slice) -> np.ndarray:
+        """Every column inverted, then only ``rows`` along the last axis, unscaled, and 1/(H W)
+        applied last in the output's precision: pocketfft's irfft2 in the same order, its bits."""
+        h, w = shape
+        if _whole(rows, h):
+            return self.irfft2(xf, shape)
+        columns = self._fft.ifft(xf, n=h, axis=-2, norm="forward", workers=1)
+        band = self._fft.irfft(columns[..., rows, :], n=w, axis=-1, norm="forward", workers=1)
+        out = np.zeros((*xf.shape[:-2], h, w), band.dtype)
+        out[..., rows, :] = band * band.dtype.type(1.0 / (h * w))
+        return out
+
+
+def _whole(rows: slice, n: int) -> bool:
+    return rows.indices(n) == (0, n, 1)
+
+
+class PyFFTW(Backend):
     """pyfftw with plans cached per (shape, dtype). Inputs are copied into the plan's own
     buffer (FFTW's multi-dimensional c2r transform overwrites its input) and outputs copied
     out of it, so callers' arrays are never touched or aliased."""
@@ -76,6 +118,7 @@ class FullSpectra(ScipyFFT):
 
     name = "full"
     full = True
+    rfft2_rows, irfft2_rows = Backend.rfft2_rows, Backend.irfft2_rows  # whole complex transforms
 
     def rfft2(self, x: np.ndarray) -> np.ndarray:
         return self._fft.fft2(x, axes=(-2, -1), workers=1)

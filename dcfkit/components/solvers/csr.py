@@ -45,21 +45,29 @@ def csr_filter(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, p: CSRParams, fft
     mu = p.mu0
     with np.errstate(divide="ignore"):  # w² = inf: the constraint's zero
         start = np.float32(p.lam + mu) / (np.float32(p.lam + mu) + w2)
-    h = fft.irfft2(sxy / (sxx + np.float32(p.lam)), shape) * start
-    hf = np.asarray(fft.rfft2(h.astype(np.float32)), np.complex64)
+    rows = constrained_rows(w2)  # h is zero outside them: their transforms are spared
+    h = fft.irfft2_rows(sxy / (sxx + np.float32(p.lam)), shape, rows) * start
+    hf = np.asarray(fft.rfft2_rows(h.astype(np.float32), rows), np.complex64)
     lf = np.zeros_like(hf)
     for e in range(p.iterations):
         m = np.float32(mu)
         gf = (sxy + m * hf - lf) / (sxx + m)
         with np.errstate(divide="ignore"):
             shrink = np.float32(1.0) / (np.float32(p.lam + mu) + w2)
-        h = fft.irfft2(m * gf + lf, shape) * shrink
-        hf = np.asarray(fft.rfft2(h.astype(np.float32)), np.complex64)
+        h = fft.irfft2_rows(m * gf + lf, shape, rows) * shrink
+        hf = np.asarray(fft.rfft2_rows(h.astype(np.float32), rows), np.complex64)
         if e == p.iterations - 1:
             break
         lf = lf + m * (gf - hf)
         mu = min(p.mu_max, p.beta * mu)
     return hf
+
+
+def constrained_rows(w2: np.ndarray) -> slice:
+    """The band of rows of w² (H, W) holding a finite value: the constraint h = m ⊙ h_c keeps
+    h zero in every other row."""
+    finite = np.flatnonzero(np.isfinite(w2).any(axis=1))
+    return slice(int(finite[0]), int(finite[-1]) + 1) if finite.size else slice(0, 0)
 
 
 class ADMMCsr(Solver):
