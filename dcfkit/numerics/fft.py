@@ -5,6 +5,8 @@ once per (shape, dtype) and reuses them, one thread. Both keep float32/complex64
 single precision. Forward transforms are unnormalised, inverse ones scaled by 1/K (numpy
 convention), which is the convention the solver's equations assume (Eq. 10's K).
 :func:`multiply` is the elementwise product of spectra, rounded the same way on every machine.
+``rfft2_rows``/``irfft2_rows`` transform maps that are zero outside a band of rows (CSR-DCF's
+constrained filter); scipy's spare the other rows' work and keep the whole transforms' bits.
 """
 from __future__ import annotations
 
