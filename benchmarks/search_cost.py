@@ -27,7 +27,12 @@ def tally(folder: Path) -> tuple[int, float]:
     """(frames, seconds) of the runs under ``folder``, a run whose times equal another's once."""
     frames, seconds, seen = 0, 0.0, set()
     for path in sorted(folder.rglob("*.time")):
-        data = path.read_bytes()
+        try:
+            data = path.read_bytes()
+        except FileNotFoundError:  # a running search replaced it (a failure, a copy) since the listing
+            continue
+        except OSError as exc:
+            sys.exit(f"{path}: cannot be read ({exc})")
         digest = hashlib.sha256(data).digest()
         if digest in seen:
             continue
@@ -74,9 +79,9 @@ def main() -> int:
     if not (args.out / "trials").is_dir() or not runs.is_dir():
         parser.error(f"{args.out}: not a search's --out (no trials/ and runs/ in it)")
     params = trial_params(args.out)
-    costs = {folder.name: tally(folder) for folder in sorted(runs.iterdir()) if folder.is_dir()}
-    others = sorted(set(costs) - set(params))
-    counted = {key: cost for key, cost in costs.items() if key in params}
+    folders = [folder for folder in sorted(runs.iterdir()) if folder.is_dir()]
+    others = [folder.name for folder in folders if folder.name not in params]  # a trial still running, say
+    counted = {folder.name: tally(folder) for folder in folders if folder.name in params}
     frames, seconds = (sum(c[i] for c in counted.values()) for i in (0, 1))
     print(f"{args.out}: {len(counted)} configs' runs: {frames:,} frames tracked in {seconds / 3600:.2f} core-hours "
           f"of tracking, {fps(frames, seconds)} fps")

@@ -18,8 +18,15 @@ BACKENDS = ("scipy", "pyfftw")
 
 
 class Backend:
-    """The transforms of maps that are zero outside a band of rows (a filter constrained to a
-    mask), computed whole here; a backend may spare the rows' work."""
+    """An FFT backend: ``rfft2`` and ``irfft2`` over the last two axes, and the transforms of maps
+    that are zero outside a band of rows (a filter constrained to a mask), computed whole here;
+    a backend may spare the rows' work."""
+
+    def rfft2(self, x: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def irfft2(self, xf: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+        raise NotImplementedError
 
     def rfft2_rows(self, x: np.ndarray, rows: slice) -> np.ndarray:
         """``rfft2(x)`` for an ``x`` that is zero outside ``rows`` of its second-last axis."""
@@ -51,28 +58,40 @@ class ScipyFFT(Backend):
 
     def rfft2_rows(self, x: np.ndarray, rows: slice) -> np.ndarray:
         """Only ``rows`` transformed along the last axis (the others' transforms are zero), then
-        every column: pocketfft's rfft2 takes the axes in this order, so the bits are its own."""
-        if _whole(rows, x.shape[-2]):
-            return self.rfft2(x)
+        every column: pocketfft's rfft2 takes the axes in this order, so for an ``x`` that is +0
+        outside ``rows`` the bits are its own. An empty band is transformed whole, whose zeros
+        may be signed."""
+        if not _worth_sparing(rows, x.shape[-2]) or _empty(rows, x.shape[-2]):
+            return super().rfft2_rows(x, rows)
         out = np.zeros((*x.shape[:-1], x.shape[-1] // 2 + 1), np.result_type(x.dtype, np.complex64))
         out[..., rows, :] = self._fft.rfft(x[..., rows, :], axis=-1, workers=1)
         return self._fft.fft(out, axis=-2, workers=1, overwrite_x=True)
 
     def irfft2_rows(self, xf: np.ndarray, shape: tuple[int, int], rows: slice) -> np.ndarray:
         """Every column inverted, then only ``rows`` along the last axis, unscaled, and 1/(H W)
-        applied last in the output's precision: pocketfft's irfft2 in the same order, its bits."""
+        applied last: pocketfft's irfft2 in the same order, its bits (it takes 1/N in long double,
+        rounded to the output's precision, which 1/N in double is not for every N)."""
         h, w = shape
-        if _whole(rows, h):
-            return self.irfft2(xf, shape)
+        if not _worth_sparing(rows, h):
+            return super().irfft2_rows(xf, shape, rows)
         columns = self._fft.ifft(xf, n=h, axis=-2, norm="forward", workers=1)
         band = self._fft.irfft(columns[..., rows, :], n=w, axis=-1, norm="forward", workers=1)
         out = np.zeros((*xf.shape[:-2], h, w), band.dtype)
-        out[..., rows, :] = band * band.dtype.type(1.0 / (h * w))
+        out[..., rows, :] = band * band.dtype.type(np.longdouble(1) / (h * w))
         return out
 
 
-def _whole(rows: slice, n: int) -> bool:
-    return rows.indices(n) == (0, n, 1)
+SPARED_BAND = 2 / 3  # a band of more rows is transformed whole: its separate passes cost more than they spare
+
+
+def _worth_sparing(rows: slice, n: int) -> bool:
+    start, stop, _ = rows.indices(n)
+    return stop - start <= SPARED_BAND * n
+
+
+def _empty(rows: slice, n: int) -> bool:
+    start, stop, _ = rows.indices(n)
+    return stop <= start
 
 
 class PyFFTW(Backend):
@@ -112,7 +131,7 @@ class PyFFTW(Backend):
         return plan().copy()
 
 
-class FullSpectra(ScipyFFT):
+class FullSpectra(Backend):
     """Whole complex spectra (..., H, W) in place of half ones, with scipy.fft: ``rfft2`` is fft2
     and ``irfft2`` the complex ifft2 (callers needing a real map take its real part). As DR²Track's
     code computes: shift_sample's Nyquist frequency (+N/2) makes the shifted sample complex, and
@@ -120,7 +139,11 @@ class FullSpectra(ScipyFFT):
 
     name = "full"
     full = True
-    rfft2_rows, irfft2_rows = Backend.rfft2_rows, Backend.irfft2_rows  # whole complex transforms
+
+    def __init__(self):
+        import scipy.fft  # lazy: only the chosen backend is imported
+
+        self._fft = scipy.fft
 
     def rfft2(self, x: np.ndarray) -> np.ndarray:
         return self._fft.fft2(x, axes=(-2, -1), workers=1)

@@ -53,23 +53,36 @@ def bits(a: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(a).view(np.uint8)
 
 
-@pytest.mark.parametrize("backend, full", [("scipy", False), ("pyfftw", False), ("scipy", True)])
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
-@pytest.mark.parametrize("shape, rows", [((3, 50, 50), slice(17, 34)), ((2, 37, 53), slice(0, 5)),
-                                         ((4, 31, 48), slice(30, 31)), ((1, 8, 9), slice(0, 8)),
-                                         ((2, 12, 10), slice(5, 5))])
-def test_the_transforms_of_a_band_of_rows_are_the_whole_transforms_bit_for_bit(backend, full, dtype, shape, rows):
-    """rfft2_rows of a map zero outside ``rows`` is its rfft2, and irfft2_rows is irfft2 on those
-    rows and zero elsewhere, to the bit (scipy's transforms only the band; the others, whole)."""
-    fft = make_fft(backend, full=full)
+@pytest.mark.parametrize("shape, rows, spectrum_rows", [
+    ((3, 50, 50), slice(17, 34), 50), ((2, 37, 53), slice(0, 5), 37), ((4, 31, 48), slice(30, 31), 31),
+    ((1, 8, 9), slice(0, 8), 8), ((2, 12, 10), slice(5, 5), 12), ((2, 89, 67), slice(10, 50), 89),
+    ((2, 63, 89), slice(1, 40), 63), ((2, 30, 20), slice(0, 29), 30), ((2, 20, 16), slice(3, 11), 14),
+    ((2, 20, 16), slice(3, 11), 26)])
+def test_scipys_transforms_of_a_band_of_rows_are_the_whole_transforms_bit_for_bit(dtype, shape, rows, spectrum_rows):
+    """rfft2_rows of a map +0 outside ``rows`` is its rfft2, and irfft2_rows is irfft2 on those
+    rows and +0 elsewhere, to the bit: strided inputs, odd sizes, an empty band, a spectrum of
+    other height (cropped or padded), and sizes whose 1/(H W) in double is not pocketfft's (89 x 67)."""
+    fft = make_fft("scipy")
     rng = np.random.default_rng(shape[1])
-    x = np.zeros(shape, dtype)
+    x = np.zeros((shape[0], shape[1], 2 * shape[2]), dtype)[..., ::2]  # strided
     x[:, rows] = rng.standard_normal(x[:, rows].shape)
-    xf = fft.rfft2(x)
-    assert np.array_equal(bits(fft.rfft2_rows(x, rows)), bits(xf))
-    spectrum = fft.rfft2(rng.standard_normal(shape).astype(dtype))
+    start, stop, _ = rows.indices(shape[1])
+    band_rfft = fft.rfft2_rows(x, rows)
+    assert np.array_equal(bits(band_rfft), bits(fft.rfft2(x))) or start >= stop  # empty: whole, signed zeros
+    spectrum = fft.rfft2(rng.standard_normal((shape[0], spectrum_rows, shape[2])).astype(dtype))[:, ::1]
     whole = fft.irfft2(spectrum, shape[1:])
     band = fft.irfft2_rows(spectrum, shape[1:], rows)
     expected = np.zeros_like(whole)
     expected[:, rows] = whole[:, rows]
     assert band.dtype == whole.dtype and np.array_equal(bits(band), bits(expected))
+
+
+@pytest.mark.parametrize("backend, full", [("pyfftw", False), ("scipy", True)])
+def test_other_backends_transform_a_band_whole_and_zero_the_rows_outside_it(backend, full):
+    fft = make_fft(backend, full=full)
+    spectrum = fft.rfft2(np.random.default_rng(1).standard_normal((2, 12, 10)).astype(np.float32))
+    band = fft.irfft2_rows(spectrum, (12, 10), slice(3, 7))
+    whole = fft.irfft2(spectrum, (12, 10))
+    assert np.array_equal(band[:, 3:7], whole[:, 3:7]) and not band[:, :3].any() and not band[:, 7:].any()
+    assert np.array_equal(fft.rfft2_rows(band, slice(3, 7)), fft.rfft2(band))

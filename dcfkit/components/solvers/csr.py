@@ -64,10 +64,11 @@ def csr_filter(xf: np.ndarray, yf: np.ndarray, w2: np.ndarray, p: CSRParams, fft
 
 
 def constrained_rows(w2: np.ndarray) -> slice:
-    """The band of rows of w² (H, W) holding a finite value: the constraint h = m ⊙ h_c keeps
-    h zero in every other row."""
-    finite = np.flatnonzero(np.isfinite(w2).any(axis=1))
-    return slice(int(finite[0]), int(finite[-1]) + 1) if finite.size else slice(0, 0)
+    """The band of rows of w² (H, W) from the first to the last holding a value below +inf:
+    the constraint h = m ⊙ h_c keeps h zero in every other row (a NaN, which the regularizer's
+    contract refuses, is inside, so that it reaches the filter as before)."""
+    inside = np.flatnonzero((~np.isposinf(w2)).any(axis=1))
+    return slice(int(inside[0]), int(inside[-1]) + 1) if inside.size else slice(0, 0)
 
 
 class ADMMCsr(Solver):

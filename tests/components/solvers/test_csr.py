@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from dcfkit.components.solvers import ADMMCsr, CSRParams, csr_filter
-from dcfkit.numerics.fft import make_fft
+from dcfkit.components.solvers.csr import constrained_rows
+from dcfkit.numerics.fft import Backend, make_fft
 
 FFT = make_fft("scipy")
 
@@ -61,3 +62,34 @@ def test_the_filter_is_averaged_over_frames_and_the_frame_filter_kept():
     np.testing.assert_allclose(second, 0.75 * first + 0.25 * solver.frame_filter, rtol=1e-6)
     solver.reset()
     assert solver.model is None and solver.frame_filter is None
+
+
+def test_the_constrained_band_runs_from_the_first_to_the_last_row_the_mask_opens():
+    w2 = np.full((9, 5), np.inf, np.float32)
+    assert constrained_rows(w2) == slice(0, 0)
+    w2[2, 1] = w2[6, 4] = 0.5  # two separated rows: the band holds both and the rows between
+    assert constrained_rows(w2) == slice(2, 7)
+    w2[8, 0] = np.nan  # refused by the regularizer's contract; inside, so that it reaches the filter
+    assert constrained_rows(w2) == slice(2, 9)
+
+
+class WholeTransforms(type(FFT)):
+    """scipy's transforms with the band ones computed whole (the Backend's)."""
+
+    rfft2_rows, irfft2_rows = Backend.rfft2_rows, Backend.irfft2_rows
+
+
+@pytest.mark.parametrize("mask_rows", [(3, 9), (0, 16), (5, 6), (0, 0), (2, 4, 11, 13)])
+def test_the_filter_is_the_one_computed_with_whole_transforms(mask_rows):
+    """Sparing the rows outside the mask changes no value of the filter: masks of a band, every
+    row, one row, none, and two separated groups."""
+    rng = np.random.default_rng(len(mask_rows))
+    shape = (16, 14)
+    mask = np.zeros(shape, bool)
+    for top, bottom in zip(mask_rows[::2], mask_rows[1::2]):
+        mask[top:bottom, 2:11] = True
+    w2 = np.where(mask, rng.uniform(0, 1, shape), np.inf).astype(np.float32)
+    xf = FFT.rfft2(rng.standard_normal((3, *shape)).astype(np.float32)).astype(np.complex64)
+    yf = FFT.rfft2(rng.standard_normal(shape).astype(np.float32)).astype(np.complex64)
+    p = CSRParams()
+    assert np.array_equal(csr_filter(xf, yf, w2, p, FFT), csr_filter(xf, yf, w2, p, WholeTransforms()))
