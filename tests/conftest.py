@@ -43,12 +43,17 @@ def pytest_addoption(parser, pluginmanager):
 def pytest_collection_modifyitems(config, items):
     """Tiers: ``realdata`` (needs ../shared/data), ``install`` (pip-installs a copy), ``slow``
     (marked by hand: spawns worker processes or a cluster). The fast tier is
-    ``python -m pytest -m "not realdata and not install and not slow"``."""
+    ``python -m pytest -m "not realdata and not install and not slow"``.
+
+    The files holding real-data tests run first: they take minutes each, and pytest-xdist hands
+    out whole files in this order, so one of them collected last kept one worker busy alone."""
     for item in items:
         if "shared_data" in item.fixturenames:
             item.add_marker(pytest.mark.realdata)
         if "pip_install_copy" in item.fixturenames or item.path.name == "test_install.py":
             item.add_marker(pytest.mark.install)
+    real = {item.path for item in items if item.get_closest_marker("realdata")}
+    items.sort(key=lambda item: item.path not in real)  # stable: each file's order kept
 
 
 @pytest.fixture(autouse=True)
