@@ -20,13 +20,15 @@ from pathlib import Path
 
 import numpy as np
 
+from dcfkit.store.results import TIME_END
+
 INACTIVE = "(inactive)"  # a conditional dimension its trial did not sample
 
 
 def tally(folder: Path) -> tuple[int, float]:
     """(frames, seconds) of the runs under ``folder``, a run whose times equal another's once."""
     frames, seconds, seen = 0, 0.0, set()
-    for path in sorted(folder.rglob("*.time")):
+    for path in sorted(folder.rglob(f"*{TIME_END}")):
         try:
             data = path.read_bytes()
         except FileNotFoundError:  # a running search replaced it (a failure, a copy) since the listing

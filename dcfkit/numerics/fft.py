@@ -61,7 +61,7 @@ class ScipyFFT(Backend):
         every column: pocketfft's rfft2 takes the axes in this order, so for an ``x`` that is +0
         outside ``rows`` the bits are its own. An empty band is transformed whole, whose zeros
         may be signed."""
-        if not _worth_sparing(rows, x.shape[-2]) or _empty(rows, x.shape[-2]):
+        if not _spares(rows, x.shape[-2]):
             return super().rfft2_rows(x, rows)
         out = np.zeros((*x.shape[:-1], x.shape[-1] // 2 + 1), np.result_type(x.dtype, np.complex64))
         out[..., rows, :] = self._fft.rfft(x[..., rows, :], axis=-1, workers=1)
@@ -72,7 +72,7 @@ class ScipyFFT(Backend):
         applied last: pocketfft's irfft2 in the same order, its bits (it takes 1/N in long double,
         rounded to the output's precision, which 1/N in double is not for every N)."""
         h, w = shape
-        if not _worth_sparing(rows, h):
+        if not _spares(rows, h):
             return super().irfft2_rows(xf, shape, rows)
         columns = self._fft.ifft(xf, n=h, axis=-2, norm="forward", workers=1)
         band = self._fft.irfft(columns[..., rows, :], n=w, axis=-1, norm="forward", workers=1)
@@ -84,14 +84,10 @@ class ScipyFFT(Backend):
 SPARED_BAND = 2 / 3  # a band of more rows is transformed whole: its separate passes cost more than they spare
 
 
-def _worth_sparing(rows: slice, n: int) -> bool:
+def _spares(rows: slice, n: int) -> bool:
+    """Whether transforming only ``rows`` of ``n`` is worth it: a band, at most SPARED_BAND of them."""
     start, stop, _ = rows.indices(n)
-    return stop - start <= SPARED_BAND * n
-
-
-def _empty(rows: slice, n: int) -> bool:
-    start, stop, _ = rows.indices(n)
-    return stop <= start
+    return 0 < stop - start <= SPARED_BAND * n
 
 
 class PyFFTW(Backend):
